@@ -1,0 +1,46 @@
+#include "apps/cli/cli.h"
+
+#include "apps/cli/commands.h"
+#include "core/error.h"
+
+#include <iostream>
+
+namespace pathlab::cli {
+
+int run(int argc, const char* const* argv) { return run(argc, argv, std::cout, std::cerr); }
+
+int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
+  CLI::App app("pathlab: get path tracing right, then fast", "pathlab");
+  app.set_version_flag("--version", PATHLAB_VERSION);
+  app.require_subcommand(1);
+  RenderCommand render;
+  TracePixelCommand trace_pixel;
+  render.add_to(app);
+  trace_pixel.add_to(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {  // --help, --version
+    return app.exit(e, out, err);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e, out, err);
+    return 2;
+  }
+
+  try {
+    if (render.selected) return render.run(out, err);
+    if (trace_pixel.selected) return trace_pixel.run(out, err);
+  } catch (const InputError& e) {
+    err << "pathlab: error: " << e.what() << "\n";
+    return 2;
+  } catch (const SystemError& e) {
+    err << "pathlab: error: " << e.what() << "\n";
+    return 3;
+  } catch (const std::bad_alloc&) {
+    err << "pathlab: error: out of memory\n";
+    return 3;
+  }
+  return 2;
+}
+
+}  // namespace pathlab::cli

@@ -1,0 +1,87 @@
+// pathlab render [SCENE] [-o out.exr] [--tracer T] [--strategy S] [--spp N]
+//                [--max-depth D] [--rr-depth R] [--seed S] [--threads T]
+//                [--resolution WxH] [--quiet]
+#include "apps/cli/commands.h"
+
+#include "apps/cli/progress.h"
+#include "core/compiled_scene.h"
+#include "core/error.h"
+#include "core/image_io.h"
+#include "core/parallel.h"
+#include "core/render.h"
+
+#include <cstdio>
+#include <ostream>
+
+namespace pathlab::cli {
+
+void RenderCommand::add_to(CLI::App& app) {
+  CLI::App* cmd = app.add_subcommand("render", "Render a scene to EXR and PNG");
+  scene.add_to(*cmd, true);
+  cmd->add_option("-o,--output", output, "Output EXR (a tone-mapped PNG is written beside it); default out/<scene>.exr");
+  cmd->add_option("--threads", threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
+  cmd->add_option("--exposure", exposure, "Exposure of the PNG, in stops");
+  cmd->add_flag("-q,--quiet", quiet, "Print nothing but errors");
+  cmd->callback([this] { selected = true; });
+}
+
+int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
+  Scene s = scene.load();
+  for (const std::string& w : s.warnings) err << "pathlab: warning: " << w << "\n";
+
+  std::filesystem::path exr = output.empty() ? std::filesystem::path("out") / (s.name + ".exr") : std::filesystem::path(output);
+  if (exr.extension() != ".exr") throw InputError(exr.string() + ": the output must be an .exr file (a .png is written beside it)");
+  std::filesystem::path png = exr;
+  png.replace_extension(".png");
+  ensure_writable(exr);
+  ensure_writable(png);
+
+  const ThreadLimit limit(threads);
+  const RenderSettings settings = s.render;
+  const CompiledScene compiled(std::move(s));
+  const auto tracer = make_tracer(scene.tracer, compiled, settings);
+  const Scene& sc = compiled.scene();
+  Film film(sc.film.width, sc.film.height, sc.film.filter);
+
+  ProgressBar bar(err, "rendering", !quiet && stderr_is_terminal());
+  const RenderStats stats = render(*tracer, film, [&](double f) { bar.update(f); });
+  bar.finish();
+
+  const Image image = film.image();
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, "%.3f", stats.seconds);
+  const ImageMetadata meta = {
+      {"scene", sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string()},
+      {"tracer", std::string(tracer->name())},
+      {"strategy", strategy_name(settings.strategy)},
+      {"spp", std::to_string(settings.spp)},
+      {"seed", std::to_string(settings.seed)},
+      {"max_depth", std::to_string(settings.max_depth)},
+      {"rr_depth", std::to_string(settings.rr_depth)},
+      {"filter", sc.film.filter == FilterKind::Box ? "box" : "bilinear"},
+      {"render_time_seconds", seconds},
+      {"bad_samples", std::to_string(stats.bad_samples)},
+      {"version", PATHLAB_VERSION},
+  };
+  write_exr(exr, image, meta);
+  write_png(png, image, exposure);
+
+  if (stats.bad_samples > 0) {
+    err << "pathlab: warning: " << stats.bad_samples
+        << " sample(s) had NaN or infinite radiance and were left out of the image. Replay them with:\n";
+    for (const BadSample& b : film.bad_samples())
+      err << "  " << scene.trace_pixel_command(sc, b.x, b.y, b.sample) << "\n";
+  }
+  if (!quiet) {
+    char line[256];
+    std::snprintf(line, sizeof line, "%.2f s, %.3g samples/s, %.3g rays/s", stats.seconds,
+                  static_cast<double>(stats.samples) / std::max(stats.seconds, 1e-9),
+                  static_cast<double>(stats.rays) / std::max(stats.seconds, 1e-9));
+    err << "pathlab: wrote " << exr.string() << " and " << png.string() << " (" << sc.film.width << "x"
+        << sc.film.height << ", " << settings.spp << " spp, " << tracer->name() << ", "
+        << strategy_name(settings.strategy) << "): " << line << "\n";
+  }
+  return 0;
+}
+
+}  // namespace pathlab::cli

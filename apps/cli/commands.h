@@ -1,0 +1,35 @@
+// The subcommands of `pathlab`, each an options struct that registers itself
+// on the CLI11 app and runs. run() may throw InputError (exit 2).
+#pragma once
+
+#include "apps/cli/scene_options.h"
+
+#include <CLI/CLI.hpp>
+
+#include <iosfwd>
+#include <string>
+
+namespace pathlab::cli {
+
+struct RenderCommand {
+  SceneOptions scene;
+  std::string output;
+  int threads = 0;
+  float exposure = 0.0f;
+  bool quiet = false;
+  bool selected = false;
+  void add_to(CLI::App& app);
+  int run(std::ostream& out, std::ostream& err) const;
+};
+
+struct TracePixelCommand {
+  SceneOptions scene;
+  std::string pixel;  // "X,Y"
+  std::uint32_t sample = 0;
+  bool json = false;
+  bool selected = false;
+  void add_to(CLI::App& app);
+  int run(std::ostream& out, std::ostream& err) const;
+};
+
+}  // namespace pathlab::cli

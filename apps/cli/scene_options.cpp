@@ -1,0 +1,62 @@
+#include "apps/cli/scene_options.h"
+
+#include "core/compiled_scene.h"
+#include "core/error.h"
+#include "core/scene_loader.h"
+#include "reference/reference_tracer.h"
+
+#include <sstream>
+
+namespace pathlab::cli {
+
+void SceneOptions::add_to(CLI::App& cmd, bool with_spp) {
+  cmd.add_option("scene", scene_file, "Scene file (JSON); omit for the built-in Cornell box");
+  cmd.add_option("--tracer", tracer, "Tracer: reference")->check(CLI::IsMember({"reference"}));
+  cmd.add_option("--strategy", strategy, "Sampling strategy: cosine, bsdf, light, light+bsdf, mis")
+      ->check(CLI::IsMember({"cosine", "bsdf", "light", "light+bsdf", "mis"}));
+  if (with_spp) cmd.add_option("--spp", spp, "Samples per pixel")->check(CLI::Range(1, 1 << 24));
+  cmd.add_option("--max-depth", max_depth, "Maximum bounces; -1 = until Russian roulette")
+      ->check(CLI::Range(-1, kMaxVerticesUncapped));
+  cmd.add_option("--rr-depth", rr_depth, "Bounces before Russian roulette starts")
+      ->check(CLI::Range(0, kMaxVerticesUncapped));
+  cmd.add_option("--seed", seed, "Random seed");
+  cmd.add_option("--resolution", resolution, "Image size WxH, e.g. 640x480");
+}
+
+Scene SceneOptions::load() const {
+  Scene scene = scene_file.empty() ? builtin_cornell_box() : load_scene(scene_file);
+  RenderSettings& r = scene.render;
+  if (strategy) r.strategy = *parse_strategy(*strategy);
+  if (spp) r.spp = *spp;
+  if (max_depth) r.max_depth = *max_depth;
+  if (rr_depth) r.rr_depth = *rr_depth;
+  if (seed) r.seed = *seed;
+  if (resolution) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    std::istringstream in(*resolution);
+    if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || (in >> extra) || w < 1 || h < 1 || w > 65536 || h > 65536)
+      throw InputError("--resolution " + *resolution + ": expected WIDTHxHEIGHT with each in [1, 65536], e.g. 640x480");
+    scene.film.width = w;
+    scene.film.height = h;
+  }
+  return scene;
+}
+
+std::string SceneOptions::trace_pixel_command(const Scene& scene, std::uint32_t x, std::uint32_t y,
+                                              std::uint32_t sample) const {
+  std::ostringstream cmd;
+  cmd << "pathlab trace-pixel";
+  if (!scene_file.empty()) cmd << " " << scene_file;
+  cmd << " --pixel " << x << "," << y << " --sample " << sample << " --seed " << scene.render.seed << " --tracer "
+      << tracer << " --strategy " << strategy_name(scene.render.strategy) << " --max-depth " << scene.render.max_depth
+      << " --rr-depth " << scene.render.rr_depth << " --resolution " << scene.film.width << "x" << scene.film.height;
+  return cmd.str();
+}
+
+std::unique_ptr<Tracer> make_tracer(const std::string& name, const CompiledScene& scene, const RenderSettings& settings) {
+  if (name == "reference") return std::make_unique<ReferenceTracer>(scene, settings);
+  throw InputError("unknown tracer '" + name + "' (expected reference)");
+}
+
+}  // namespace pathlab::cli

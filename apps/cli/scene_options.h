@@ -1,0 +1,40 @@
+// Options shared by every subcommand that renders or replays a scene: the
+// scene file and the overrides of its render settings.
+#pragma once
+
+#include "core/scene.h"
+
+#include <CLI/CLI.hpp>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace pathlab {
+class Tracer;
+class CompiledScene;
+}
+
+namespace pathlab::cli {
+
+struct SceneOptions {
+  std::string scene_file;  // empty: the built-in Cornell box
+  std::string tracer = "reference";
+  std::optional<std::string> strategy;
+  std::optional<int> spp, max_depth, rr_depth;
+  std::optional<std::uint64_t> seed;
+  std::optional<std::string> resolution;  // "WxH"
+
+  // Registers the options on `cmd`; `with_spp` for commands that render.
+  void add_to(CLI::App& cmd, bool with_spp);
+  // Loads the scene and applies the overrides. Throws InputError.
+  Scene load() const;
+  // "pathlab trace-pixel <scene> --pixel x,y --sample s ..." for one sample
+  // of a render with `scene`'s final settings.
+  std::string trace_pixel_command(const Scene& scene, std::uint32_t x, std::uint32_t y, std::uint32_t sample) const;
+};
+
+// Builds the named tracer. Throws InputError for an unknown name.
+std::unique_ptr<Tracer> make_tracer(const std::string& name, const CompiledScene& scene, const RenderSettings& settings);
+
+}  // namespace pathlab::cli

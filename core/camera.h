@@ -1,0 +1,46 @@
+// Pinhole and thin-lens perspective cameras.
+//
+// Scene-file parameters (object "camera"; see docs/scene-format.md):
+//   position        [x,y,z]  eye point                          required
+//   look_at         [x,y,z]  point the view is centred on         required
+//   up              [x,y,z]  approximate up vector               default [0,1,0]
+//   fov_y           degrees  vertical field of view, (0, 180)     default 40
+//   aperture_radius world    thin-lens radius; 0 = pinhole        default 0
+//   focus_distance  world    distance of the plane in focus > 0   default |look_at - position|
+#pragma once
+
+#include "core/math.h"
+#include "core/ray.h"
+
+namespace pathlab {
+
+struct CameraDesc {
+  vec3 position{0.0f, 0.0f, 5.0f};
+  vec3 look_at{0.0f};
+  vec3 up{0.0f, 1.0f, 0.0f};
+  float fov_y_degrees = 40.0f;
+  float aperture_radius = 0.0f;
+  float focus_distance = 5.0f;
+};
+
+class Camera {
+ public:
+  Camera(const CameraDesc& desc, int width, int height);
+
+  // The primary ray through film position `film` (in pixels: x to the right,
+  // y down, (0,0) the top-left corner of the image) and aperture sample
+  // `u_lens` in [0,1)^2 (ignored by a pinhole).
+  Ray generate_ray(vec2 film, vec2 u_lens) const;
+
+  const CameraDesc& desc() const { return desc_; }
+  vec3 forward() const { return forward_; }
+
+ private:
+  CameraDesc desc_;
+  vec3 forward_, right_, up_;
+  float tan_half_fov_ = 0.0f;
+  float aspect_ = 1.0f;
+  float inv_width_ = 1.0f, inv_height_ = 1.0f;
+};
+
+}  // namespace pathlab

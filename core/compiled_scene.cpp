@@ -1,0 +1,47 @@
+#include "core/compiled_scene.h"
+
+#include "core/geometry.h"
+
+namespace pathlab {
+
+CompiledScene::CompiledScene(Scene scene)
+    : scene_(std::move(scene)), camera_(scene_.camera, scene_.film.width, scene_.film.height) {
+  vec3 lo(kInfinity), hi(-kInfinity);
+  for (const Shape& shape : scene_.shapes) {
+    if (shape.kind == Shape::Kind::Sphere) {
+      lo = glm::min(lo, shape.center - shape.radius);
+      hi = glm::max(hi, shape.center + shape.radius);
+    } else {
+      for (const vec3& p : shape.mesh.positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+      }
+    }
+    lobes_ |= scene_.materials[shape.material].lobes();
+  }
+  if (lo.x <= hi.x) {
+    bounds_center_ = 0.5f * (lo + hi);
+    bounds_radius_ = std::max(0.5f * glm::length(hi - lo), 1e-3f);
+  }
+  accel_ = std::make_unique<EmbreeAccel>(scene_.shapes);
+  lights_ = std::make_unique<LightSampler>(scene_, bounds_radius_);
+}
+
+bool CompiledScene::intersect(const Ray& ray, Surfel* s) const {
+  RayHit hit;
+  if (!accel_->intersect(ray, &hit)) return false;
+  const Shape& shape = scene_.shapes[hit.shape];
+  const SurfacePoint sp = shape.kind == Shape::Kind::Sphere
+                              ? sphere_point(shape, ray.origin + hit.t * ray.dir)
+                              : triangle_point(shape, hit.prim, hit.uv);
+  s->p = sp.p;
+  s->p_error = sp.p_error;
+  s->n = sp.n;
+  s->frame = Frame(sp.n);
+  s->material = &scene_.materials[shape.material];
+  s->shape = hit.shape;
+  s->prim = hit.prim;
+  return true;
+}
+
+}  // namespace pathlab

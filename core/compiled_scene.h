@@ -1,0 +1,46 @@
+// A scene made ready to trace: the BVH, the light sampler, the camera and the
+// set of lobes its materials use. Built once, then shared read-only by every
+// thread of every tracer.
+#pragma once
+
+#include "core/camera.h"
+#include "core/embree_accel.h"
+#include "core/light_sampler.h"
+#include "core/scene.h"
+#include "core/surfel.h"
+
+#include <memory>
+
+namespace pathlab {
+
+class CompiledScene {
+ public:
+  // Throws SystemError if Embree fails.
+  explicit CompiledScene(Scene scene);
+
+  const Scene& scene() const { return scene_; }
+  const Camera& camera() const { return camera_; }
+  const LightSampler& lights() const { return *lights_; }
+  // Every lobe any material of the scene uses ("model only what a scene
+  // requires": shading may skip the rest).
+  LobeMask lobes() const { return lobes_; }
+  // Centre and radius of a sphere bounding all finite geometry.
+  vec3 bounds_center() const { return bounds_center_; }
+  float bounds_radius() const { return bounds_radius_; }
+
+  // The first surface along `ray`, resolved into a Surfel. False if the ray
+  // escapes.
+  bool intersect(const Ray& ray, Surfel* surfel) const;
+  bool occluded(const Ray& ray) const { return accel_->occluded(ray); }
+
+ private:
+  Scene scene_;
+  Camera camera_;
+  std::unique_ptr<EmbreeAccel> accel_;
+  std::unique_ptr<LightSampler> lights_;
+  LobeMask lobes_ = 0;
+  vec3 bounds_center_{0.0f};
+  float bounds_radius_ = 1.0f;
+};
+
+}  // namespace pathlab

@@ -1,0 +1,140 @@
+#include "core/embree_accel.h"
+
+#include "core/error.h"
+
+#include <embree3/rtcore.h>
+
+#include <cstring>
+#include <mutex>
+
+namespace pathlab {
+namespace {
+
+// Embree reports errors through a callback registered when the device is
+// created; we keep the first one and turn it into an exception after the
+// call that caused it (library code never exits).
+struct ErrorSink {
+  std::mutex mutex;
+  std::string first;
+  static void callback(void* user, RTCError code, const char* message) {
+    if (code == RTC_ERROR_NONE) return;
+    auto* sink = static_cast<ErrorSink*>(user);
+    std::lock_guard<std::mutex> lock(sink->mutex);
+    if (sink->first.empty()) sink->first = message ? message : "unknown Embree error";
+  }
+  void check(const char* what) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!first.empty()) throw SystemError(std::string("Embree: ") + what + ": " + first);
+  }
+};
+
+}  // namespace
+
+struct EmbreeAccel::Impl {
+  ErrorSink errors;
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  ~Impl() {
+    if (scene) rtcReleaseScene(scene);
+    if (device) rtcReleaseDevice(device);
+  }
+};
+
+EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes) : impl_(std::make_unique<Impl>()) {
+  impl_->device = rtcNewDevice(nullptr);
+  if (!impl_->device)
+    throw SystemError(std::string("Embree: cannot create device: error ") +
+                      std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))));
+  rtcSetDeviceErrorFunction(impl_->device, &ErrorSink::callback, &impl_->errors);
+
+  impl_->scene = rtcNewScene(impl_->device);
+  // ROBUST: no arithmetic shortcuts that could let a ray slip through an
+  // edge shared by two triangles.
+  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+
+  for (std::uint32_t id = 0; id < shapes.size(); ++id) {
+    const Shape& shape = shapes[id];
+    RTCGeometry geom = nullptr;
+    if (shape.kind == Shape::Kind::Triangles) {
+      geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      const auto& m = shape.mesh;
+      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                            3 * sizeof(float), m.positions.size()));
+      auto* t = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                               3 * sizeof(unsigned), m.triangles.size()));
+      if (v && t) {
+        std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(vec3));
+        std::memcpy(t, m.triangles.data(), m.triangles.size() * sizeof(glm::uvec3));
+      }
+    } else {
+      geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+      auto* v = static_cast<float*>(
+          rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
+      if (v) {
+        v[0] = shape.center.x;
+        v[1] = shape.center.y;
+        v[2] = shape.center.z;
+        v[3] = shape.radius;
+      }
+    }
+    impl_->errors.check(shape.description.c_str());
+    rtcCommitGeometry(geom);
+    rtcAttachGeometryByID(impl_->scene, geom, id);
+    rtcReleaseGeometry(geom);
+    impl_->errors.check(shape.description.c_str());
+  }
+  rtcCommitScene(impl_->scene);
+  impl_->errors.check("building the BVH");
+}
+
+EmbreeAccel::~EmbreeAccel() = default;
+
+bool EmbreeAccel::intersect(const Ray& ray, RayHit* hit) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  rh.ray.org_x = ray.origin.x;
+  rh.ray.org_y = ray.origin.y;
+  rh.ray.org_z = ray.origin.z;
+  rh.ray.dir_x = ray.dir.x;
+  rh.ray.dir_y = ray.dir.y;
+  rh.ray.dir_z = ray.dir.z;
+  rh.ray.tnear = 0.0f;
+  rh.ray.tfar = ray.tmax;
+  rh.ray.time = 0.0f;
+  rh.ray.mask = 0xffffffffu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  hit->t = rh.ray.tfar;
+  hit->shape = rh.hit.geomID;
+  hit->prim = rh.hit.primID;
+  hit->uv = vec2(rh.hit.u, rh.hit.v);
+  return true;
+}
+
+bool EmbreeAccel::occluded(const Ray& ray) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRay r;
+  r.org_x = ray.origin.x;
+  r.org_y = ray.origin.y;
+  r.org_z = ray.origin.z;
+  r.dir_x = ray.dir.x;
+  r.dir_y = ray.dir.y;
+  r.dir_z = ray.dir.z;
+  r.tnear = 0.0f;
+  r.tfar = ray.tmax;
+  r.time = 0.0f;
+  r.mask = 0xffffffffu;
+  r.id = 0;
+  r.flags = 0;
+  rtcOccluded1(impl_->scene, &context, &r);
+  return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
+}
+
+}  // namespace pathlab

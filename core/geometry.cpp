@@ -1,0 +1,51 @@
+#include "core/geometry.h"
+
+#include "core/sampling.h"
+
+namespace pathlab {
+
+float triangle_area(const TriangleMesh& mesh, std::uint32_t tri) {
+  const glm::uvec3 t = mesh.triangles[tri];
+  const dvec3 p0(mesh.positions[t.x]), p1(mesh.positions[t.y]), p2(mesh.positions[t.z]);
+  return static_cast<float>(0.5 * glm::length(glm::cross(p1 - p0, p2 - p0)));
+}
+
+vec3 triangle_normal(const Shape& shape, std::uint32_t tri) {
+  const glm::uvec3 t = shape.mesh.triangles[tri];
+  const dvec3 p0(shape.mesh.positions[t.x]), p1(shape.mesh.positions[t.y]), p2(shape.mesh.positions[t.z]);
+  const vec3 n(glm::normalize(glm::cross(p1 - p0, p2 - p0)));
+  return shape.flip_normals ? -n : n;
+}
+
+SurfacePoint triangle_point(const Shape& shape, std::uint32_t tri, vec2 b) {
+  const glm::uvec3 t = shape.mesh.triangles[tri];
+  const vec3 &p0 = shape.mesh.positions[t.x], &p1 = shape.mesh.positions[t.y], &p2 = shape.mesh.positions[t.z];
+  const float b0 = 1.0f - b.x - b.y;
+  SurfacePoint sp;
+  sp.p = b0 * p0 + b.x * p1 + b.y * p2;
+  // PBR 4th ed. 6.8.3: interpolation error of barycentric evaluation.
+  sp.p_error = gamma_bound(7) * (glm::abs(b0 * p0) + glm::abs(b.x * p1) + glm::abs(b.y * p2));
+  sp.n = triangle_normal(shape, tri);
+  return sp;
+}
+
+SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx) {
+  const vec3 dir = glm::normalize(p_approx - shape.center);
+  SurfacePoint sp;
+  sp.p = shape.center + shape.radius * dir;
+  // Reprojection leaves a few ulps of the offset from the centre (PBR 6.8.4),
+  // plus the rounding of adding the centre back.
+  sp.p_error = gamma_bound(5) * glm::abs(shape.radius * dir) + gamma_bound(2) * glm::abs(sp.p);
+  sp.n = shape.flip_normals ? -dir : dir;
+  return sp;
+}
+
+SurfacePoint sample_triangle(const Shape& shape, std::uint32_t tri, vec2 u) {
+  return triangle_point(shape, tri, square_to_uniform_triangle(u));
+}
+
+SurfacePoint sample_sphere(const Shape& shape, vec2 u) {
+  return sphere_point(shape, shape.center + shape.radius * square_to_uniform_sphere(u));
+}
+
+}  // namespace pathlab

@@ -1,0 +1,37 @@
+// Points on shapes: positions with rounding-error bounds and front-facing
+// normals, for ray hits and for light samples alike.
+#pragma once
+
+#include "core/scene.h"
+
+#include <cstdint>
+
+namespace pathlab {
+
+struct SurfacePoint {
+  vec3 p;
+  vec3 p_error;  // per-axis bound on |p - true point|
+  vec3 n;        // unit normal of the front side
+};
+
+// gamma(n) of Higham / PBR: a bound on the relative error of n float
+// operations, n * eps / (1 - n * eps) with eps = 2^-24.
+constexpr float gamma_bound(int n) {
+  constexpr float eps = 0x1p-24f;
+  return (static_cast<float>(n) * eps) / (1.0f - static_cast<float>(n) * eps);
+}
+
+float triangle_area(const TriangleMesh& mesh, std::uint32_t tri);
+// Front normal of a triangle: counter-clockwise winding, unless flipped.
+vec3 triangle_normal(const Shape& shape, std::uint32_t tri);
+
+// The point with barycentrics (b1, b2) of a triangle, recomputed from the
+// vertices (more accurate than origin + t * dir far from the origin).
+SurfacePoint triangle_point(const Shape& shape, std::uint32_t tri, vec2 b);
+// A point near `p_approx` projected back onto the sphere.
+SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx);
+
+SurfacePoint sample_triangle(const Shape& shape, std::uint32_t tri, vec2 u);
+SurfacePoint sample_sphere(const Shape& shape, vec2 u);
+
+}  // namespace pathlab

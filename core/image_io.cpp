@@ -1,0 +1,213 @@
+// Image files through OpenImageIO 2.4. See image_io.h for the contract.
+#include "core/image_io.h"
+
+#include "core/error.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string_view>
+#include <system_error>
+
+namespace pathlab {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::string_view kMetadataPrefix = "pathlab:";
+
+// Process-wide counter so that concurrent writes (and probes) from several
+// threads of one process never pick the same temporary name.
+std::atomic<unsigned> g_temp_counter{0};
+
+std::string unique_suffix() {
+  return std::to_string(::getpid()) + "-" + std::to_string(g_temp_counter.fetch_add(1));
+}
+
+// The folder a file lives in; "." for a bare file name.
+fs::path folder_of(const fs::path& file) {
+  return file.parent_path().empty() ? fs::path(".") : file.parent_path();
+}
+
+// OIIO error texts may span lines or end with a newline; the user gets one line.
+std::string one_line(std::string text) {
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text.empty() ? std::string("unknown OpenImageIO error") : text;
+}
+
+// Removes the temporary file on scope exit unless the write was committed.
+// Declared before the ImageOutput so that the output is closed first.
+struct TempFileGuard {
+  fs::path path;
+  bool committed = false;
+  ~TempFileGuard() {
+    if (!committed) {
+      std::error_code ec;
+      fs::remove(path, ec);
+    }
+  }
+};
+
+// Writes `spec`-shaped `pixels` of type `type` with the OIIO writer `format`
+// to a hidden sibling of `file`, then renames it into place.
+void write_atomically(const fs::path& file, const char* format, const OIIO::ImageSpec& spec,
+                      OIIO::TypeDesc type, const void* pixels) {
+  ensure_writable(file);
+  const auto fail = [&](const std::string& reason) {
+    throw SystemError(file.string() + ": cannot write image: " + one_line(reason));
+  };
+
+  // Keep the real extension: whatever later inspects the temporary name
+  // (OIIO, a file manager) sees the right type.
+  const fs::path temp = folder_of(file) / ("." + file.stem().string() + ".tmp-" + unique_suffix() +
+                                          file.extension().string());
+  TempFileGuard guard{temp};
+  {
+    // Created by format name, so write_exr always writes EXR whatever the
+    // extension of `file`.
+    std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(format);
+    if (!out) fail(OIIO::geterror());
+    if (!out->open(temp.string(), spec)) fail(out->geterror());
+    if (!out->write_image(type, pixels)) fail(out->geterror());
+    if (!out->close()) fail(out->geterror());
+  }
+  std::error_code ec;
+  fs::rename(temp, file, ec);
+  if (ec) fail("cannot move " + temp.string() + " into place: " + ec.message());
+  guard.committed = true;
+}
+
+void check_shape(const fs::path& file, const Image& image) {
+  if (image.width <= 0 || image.height <= 0 ||
+      image.pixels.size() != static_cast<std::size_t>(image.width) * image.height) {
+    throw SystemError(file.string() + ": cannot write image: invalid image size " +
+                      std::to_string(image.width) + "x" + std::to_string(image.height));
+  }
+}
+
+}  // namespace
+
+void ensure_writable(const fs::path& file) {
+  const auto fail = [&](const std::string& reason) {
+    throw InputError(file.string() + ": cannot write output: " + reason);
+  };
+  if (!file.has_filename()) fail("not a file name");
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) fail("is a folder");
+
+  const fs::path folder = folder_of(file);
+  fs::create_directories(folder, ec);
+  if (ec) fail("cannot create folder " + folder.string() + ": " + ec.message());
+  if (!fs::is_directory(folder, ec)) fail(folder.string() + " is not a folder");
+
+  // Probe by creating a file: access(2) says yes to root even on read-only
+  // mounts and pseudo file systems such as /proc.
+  const fs::path probe = folder / (".pathlab-probe-" + unique_suffix());
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    fail("folder " + folder.string() + " is not writable: " +
+         std::generic_category().message(errno));
+  }
+  ::close(fd);
+  fs::remove(probe, ec);
+}
+
+void write_exr(const fs::path& file, const Image& image, const ImageMetadata& metadata) {
+  check_shape(file, image);
+  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeFloat);
+  spec.channelnames = {"R", "G", "B"};
+  spec.attribute("compression", "zip");
+  for (const auto& [key, value] : metadata) {
+    spec.attribute(std::string(kMetadataPrefix) + key, value);
+  }
+  // vec3 is three packed floats (checked below), so the pixel vector is
+  // already the interleaved RGB buffer OIIO wants.
+  static_assert(sizeof(vec3) == 3 * sizeof(float));
+  write_atomically(file, "openexr", spec, OIIO::TypeFloat, image.pixels.data());
+}
+
+void write_png(const fs::path& file, const Image& image, float exposure) {
+  check_shape(file, image);
+  const float scale = std::exp2(exposure);
+  std::vector<std::uint8_t> bytes(image.pixels.size() * 3);
+  for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+    const vec3& p = image.pixels[i];
+    std::uint8_t* out = &bytes[3 * i];
+    if (std::isnan(p.x) || std::isnan(p.y) || std::isnan(p.z)) {
+      out[0] = 255, out[1] = 0, out[2] = 255;  // magenta: impossible to miss
+      continue;
+    }
+    for (int c = 0; c < 3; ++c) {
+      const float v = linear_to_srgb(std::clamp(p[c] * scale, 0.0f, 1.0f));
+      out[c] = static_cast<std::uint8_t>(v * 255.0f + 0.5f);
+    }
+  }
+  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeUInt8);
+  spec.channelnames = {"R", "G", "B"};
+  spec.attribute("oiio:ColorSpace", "sRGB");  // tags the PNG with an sRGB chunk
+  write_atomically(file, "png", spec, OIIO::TypeUInt8, bytes.data());
+}
+
+Image read_image(const fs::path& file, ImageMetadata* metadata) {
+  const auto fail = [&](const std::string& reason) {
+    throw InputError(file.string() + ": cannot read image: " + one_line(reason));
+  };
+  std::error_code ec;
+  const fs::file_status status = fs::status(file, ec);
+  if (!fs::exists(status)) fail("no such file");
+  if (fs::is_directory(status)) fail("is a folder");
+
+  std::unique_ptr<OIIO::ImageInput> in = OIIO::ImageInput::open(file.string());
+  if (!in) fail(OIIO::geterror());
+  const OIIO::ImageSpec spec = in->spec();  // subimage 0 after open
+  if (spec.nchannels == 2) fail("has 2 channels (expected 1, 3 or more)");
+  if (spec.nchannels < 1 || spec.width <= 0 || spec.height <= 0 || spec.depth != 1) {
+    fail("unsupported image shape");
+  }
+
+  const int channels = spec.nchannels == 1 ? 1 : 3;
+  Image image(spec.width, spec.height);
+  std::vector<float> buffer(image.pixels.size() * channels);
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeFloat, buffer.data())) fail(in->geterror());
+  in->close();
+  for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+    image.pixels[i] = channels == 1 ? vec3(buffer[i])
+                                    : vec3(buffer[3 * i], buffer[3 * i + 1], buffer[3 * i + 2]);
+  }
+
+  // Note: OIIO 2.4's EXR reader skips string attributes whose value is
+  // empty, so a ("key", "") pair written by write_exr does not come back.
+  if (metadata != nullptr) {
+    metadata->clear();
+    for (const OIIO::ParamValue& attr : spec.extra_attribs) {
+      const std::string& name = attr.name().string();
+      if (attr.type() == OIIO::TypeString && attr.nvalues() == 1 &&
+          name.compare(0, kMetadataPrefix.size(), kMetadataPrefix) == 0) {
+        metadata->emplace_back(name.substr(kMetadataPrefix.size()),
+                               attr.get<OIIO::ustring>().string());
+      }
+    }
+  }
+  return image;
+}
+
+float linear_to_srgb(float v) {
+  // IEC 61966-2-1: linear segment below 0.0031308, offset power curve above.
+  // Evaluated in double so that 1 maps to exactly 1.
+  const double x = std::clamp(static_cast<double>(v), 0.0, 1.0);
+  if (x <= 0.0031308) return static_cast<float>(12.92 * x);
+  return static_cast<float>(1.055 * std::pow(x, 1.0 / 2.4) - 0.055);
+}
+
+}  // namespace pathlab

@@ -1,0 +1,52 @@
+// Image files: float32 OpenEXR with render metadata, and tone-mapped sRGB
+// PNG, both through OpenImageIO. Every write goes to a temporary file in the
+// destination folder and is renamed into place, so a crash or a failure never
+// leaves a half-written image under the requested name.
+#pragma once
+
+#include "core/math.h"
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace pathlab {
+
+// An RGB float image, row-major, top row first.
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<vec3> pixels;
+
+  Image() = default;
+  Image(int w, int h) : width(w), height(h), pixels(static_cast<std::size_t>(w) * h, vec3(0.0f)) {}
+  vec3& at(int x, int y) { return pixels[static_cast<std::size_t>(y) * width + x]; }
+  const vec3& at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * width + x]; }
+};
+
+// String metadata written into the EXR header as "pathlab:<key>".
+using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
+
+// Throws InputError if `file`'s folder does not exist and cannot be created,
+// or is not writable. Called before a render so that a bad `-o` fails in a
+// second, not after an hour.
+void ensure_writable(const std::filesystem::path& file);
+
+// Writes float32 RGB OpenEXR. Throws InputError / SystemError on failure,
+// leaving no file behind.
+void write_exr(const std::filesystem::path& file, const Image& image, const ImageMetadata& metadata);
+
+// Writes an 8-bit sRGB PNG: radiance scaled by 2^exposure, clamped to [0,1],
+// encoded with the sRGB transfer curve. NaN pixels become magenta so that
+// they cannot hide (the renderer never produces them; diff inputs might).
+void write_png(const std::filesystem::path& file, const Image& image, float exposure = 0.0f);
+
+// Reads the first three channels of any image OpenImageIO understands as
+// linear float RGB (a one-channel image is replicated). Throws InputError.
+Image read_image(const std::filesystem::path& file, ImageMetadata* metadata = nullptr);
+
+// The sRGB opto-electronic transfer function (IEC 61966-2-1) on [0,1].
+float linear_to_srgb(float v);
+
+}  // namespace pathlab

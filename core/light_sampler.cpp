@@ -1,0 +1,128 @@
+#include "core/light_sampler.h"
+
+#include "core/geometry.h"
+#include "core/sampling.h"
+
+#include <algorithm>
+#include <numeric>
+
+namespace pathlab {
+namespace {
+
+// Normalised pmf and cdf (cdf.back() == 1 exactly) of non-negative weights.
+void build_distribution(const std::vector<double>& weights, std::vector<float>* pmf, std::vector<float>* cdf) {
+  const double total = std::accumulate(weights.begin(), weights.end(), 0.0);
+  pmf->resize(weights.size());
+  cdf->resize(weights.size());
+  double running = 0.0;
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    (*pmf)[i] = static_cast<float>(weights[i] / total);
+    running += weights[i];
+    (*cdf)[i] = static_cast<float>(running / total);
+  }
+  if (!cdf->empty()) cdf->back() = 1.0f;
+}
+
+}  // namespace
+
+LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&scene) {
+  std::vector<double> power;
+  first_entry_.assign(scene.shapes.size(), -1);
+  for (std::uint32_t s = 0; s < scene.shapes.size(); ++s) {
+    const Shape& shape = scene.shapes[s];
+    const Material& m = scene.materials[shape.material];
+    if (!m.emits()) continue;
+    // Flux of a Lambertian emitter: pi * L * area per emitting side.
+    const double per_area = kPi * luminance(m.emission) * (m.two_sided_emission ? 2.0 : 1.0);
+    first_entry_[s] = static_cast<std::int64_t>(entries_.size());
+    if (shape.kind == Shape::Kind::Sphere) {
+      const float area = 4.0f * kPi * shape.radius * shape.radius;
+      entries_.push_back({s, 0, area});
+      power.push_back(per_area * area);
+    } else {
+      for (std::uint32_t t = 0; t < shape.mesh.triangles.size(); ++t) {
+        const float area = triangle_area(shape.mesh, t);
+        entries_.push_back({s, t, area});
+        power.push_back(per_area * area);
+      }
+    }
+  }
+  if (scene.environment && !is_black(*scene.environment)) {
+    env_index_ = static_cast<std::int64_t>(entries_.size());
+    entries_.push_back({0, 0, 0.0f});
+    power.push_back(4.0 * kPi * kPi * double(scene_radius) * scene_radius * luminance(*scene.environment));
+  }
+  build_distribution(power, &pmf_, &cdf_);
+
+  std::vector<double> intensity;
+  for (const PointLight& pl : scene.point_lights) {
+    if (is_black(pl.intensity)) continue;
+    points_.push_back(pl);
+    intensity.push_back(luminance(pl.intensity));
+  }
+  build_distribution(intensity, &point_pmf_, &point_cdf_);
+}
+
+std::size_t LightSampler::pick(const std::vector<float>& cdf, float u) {
+  const auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
+  return std::min<std::size_t>(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
+}
+
+std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice, vec2 u) const {
+  if (entries_.empty()) return std::nullopt;
+  const std::size_t i = pick(cdf_, u_choice);
+  LightSample ls;
+  ls.light = static_cast<std::uint32_t>(i);
+  if (static_cast<std::int64_t>(i) == env_index_) {
+    ls.wi = square_to_uniform_sphere(u);
+    ls.dist = kInfinity;
+    ls.infinite = true;
+    ls.Le = *scene_->environment;
+    ls.pdf = pmf_[i] * kInv4Pi;
+    return ls;
+  }
+  const Entry& e = entries_[i];
+  const Shape& shape = scene_->shapes[e.shape];
+  const SurfacePoint sp = shape.kind == Shape::Kind::Sphere ? sample_sphere(shape, u) : sample_triangle(shape, e.prim, u);
+  ls.p = sp.p;
+  ls.p_error = sp.p_error;
+  ls.n = sp.n;
+  const vec3 d = ls.p - ref;
+  ls.dist = glm::length(d);
+  if (!(ls.dist > 0.0f)) return std::nullopt;
+  ls.wi = d / ls.dist;
+  const Material& m = scene_->materials[shape.material];
+  const float cos_light = glm::dot(ls.n, -ls.wi);
+  if (!m.two_sided_emission && cos_light <= 0.0f) return std::nullopt;  // back of a one-sided emitter
+  ls.pdf = pmf_[i] * area_to_solid_angle(1.0f / e.area, ls.dist, cos_light);
+  if (!(ls.pdf > 0.0f) || std::isinf(ls.pdf)) return std::nullopt;  // seen edge-on
+  ls.Le = m.emission;
+  return ls;
+}
+
+float LightSampler::pdf(const vec3& ref, const Surfel& hit) const {
+  const std::int64_t first = first_entry_[hit.shape];
+  if (first < 0) return 0.0f;
+  const std::size_t i = static_cast<std::size_t>(first) + hit.prim;
+  const vec3 d = hit.p - ref;
+  const float dist = glm::length(d);
+  return pmf_[i] * area_to_solid_angle(1.0f / entries_[i].area, dist, glm::dot(hit.n, d) / dist);
+}
+
+std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_choice) const {
+  if (points_.empty()) return std::nullopt;
+  const std::size_t i = pick(point_cdf_, u_choice);
+  LightSample ls;
+  ls.light = static_cast<std::uint32_t>(i);
+  ls.p = points_[i].position;
+  const vec3 d = ls.p - ref;
+  const float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.0f)) return std::nullopt;
+  ls.dist = std::sqrt(dist2);
+  ls.wi = d / ls.dist;
+  ls.Le = points_[i].intensity / dist2;
+  ls.pdf = point_pmf_[i];
+  return ls;
+}
+
+}  // namespace pathlab

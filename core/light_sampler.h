@@ -1,0 +1,78 @@
+// Light sampling for next-event estimation.
+//
+// Area lights are every emitting triangle and sphere, plus the uniform
+// environment; one is picked in proportion to its power, then a point on it
+// uniformly by area (a direction uniformly on the sphere, for the
+// environment). Densities are returned in solid angle as seen from the
+// shading point and include the probability of picking that light, so
+// `pdf()` of an emitter that a BSDF-sampled ray hits is directly comparable
+// with the BSDF's pdf (MIS).
+//
+// Point lights are delta lights: no ray can hit them, so they live in a
+// separate list that every strategy samples explicitly (DESIGN: the
+// strategies differ only on lights a ray can find).
+#pragma once
+
+#include "core/scene.h"
+#include "core/surfel.h"
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace pathlab {
+
+struct LightSample {
+  vec3 p{0.0f};        // point on the light (unused for the environment)
+  vec3 p_error{0.0f};  // bound on its rounding error
+  vec3 n{0.0f};        // the light's normal at p (unused for points / environment)
+  vec3 wi{0.0f};       // unit direction from the shading point towards the light
+  float dist = 0.0f;   // distance to p; infinity for the environment
+  Spectrum Le{0.0f};   // radiance (or intensity / dist^2 for a point light) arriving
+  float pdf = 0.0f;    // solid angle, times the probability of choosing this light;
+                       // for a point light just that probability
+  std::uint32_t light = 0;
+  bool infinite = false;
+};
+
+class LightSampler {
+ public:
+  // `scene_radius`: radius of a sphere bounding the scene, for the power of
+  // the environment (pi * L * 4 pi r^2: the flux it sends through the scene).
+  LightSampler(const Scene& scene, float scene_radius);
+
+  std::size_t area_light_count() const { return entries_.size(); }
+  bool has_area_lights() const { return !entries_.empty(); }
+  bool has_delta_lights() const { return !points_.empty(); }
+
+  // An area or environment light sample as seen from `ref`. Nothing if the
+  // sample cannot contribute (back of a one-sided emitter, seen edge-on).
+  std::optional<LightSample> sample(const vec3& ref, float u_choice, vec2 u) const;
+  // Density with which sample() would produce the emitter point `hit`
+  // (reached from `ref`), in solid angle; 0 if `hit` is not on a light.
+  float pdf(const vec3& ref, const Surfel& hit) const;
+  // Density with which sample() would produce direction `wi` towards the
+  // environment (0 without one).
+  float pdf_environment() const { return env_index_ < 0 ? 0.0f : pmf_[env_index_] * kInv4Pi; }
+
+  // A point light picked in proportion to its intensity.
+  std::optional<LightSample> sample_delta(const vec3& ref, float u_choice) const;
+
+ private:
+  struct Entry {
+    std::uint32_t shape;
+    std::uint32_t prim;
+    float area;
+  };
+  static std::size_t pick(const std::vector<float>& cdf, float u);
+
+  const Scene* scene_;
+  std::vector<Entry> entries_;           // area lights, then the environment
+  std::vector<float> pmf_, cdf_;         // over entries_
+  std::vector<std::int64_t> first_entry_;  // per shape: index of its prim 0, or -1
+  std::int64_t env_index_ = -1;
+  std::vector<PointLight> points_;
+  std::vector<float> point_pmf_, point_cdf_;
+};
+
+}  // namespace pathlab

@@ -1,0 +1,56 @@
+// Small math vocabulary shared by every pathlab module: GLM vectors, RGB
+// radiance, orthonormal frames and the constants the estimators need.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace pathlab {
+
+using vec2 = glm::vec2;
+using vec3 = glm::vec3;
+using vec4 = glm::vec4;
+using dvec3 = glm::dvec3;
+using mat3 = glm::mat3;
+using mat4 = glm::mat4;
+
+// Linear RGB radiance, irradiance or throughput. One type keeps every
+// estimator's arithmetic explicit; spectral rendering is out of scope.
+using Spectrum = glm::vec3;
+
+inline constexpr float kPi = 3.14159265358979323846f;
+inline constexpr float kInvPi = 1.0f / kPi;
+inline constexpr float kInv2Pi = 1.0f / (2.0f * kPi);
+inline constexpr float kInv4Pi = 1.0f / (4.0f * kPi);
+inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+inline float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+inline float average(const vec3& v) { return (v.x + v.y + v.z) * (1.0f / 3.0f); }
+// Rec. 709 luminance: the scalar "power" of a colour used to pick lights.
+inline float luminance(const Spectrum& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+inline bool is_black(const Spectrum& c) { return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f; }
+inline bool is_finite(const vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+inline float sqr(float x) { return x * x; }
+
+// Orthonormal basis with `n` as its z axis (Duff et al. 2017, "Building an
+// Orthonormal Basis, Revisited": branchless and continuous except at n.z = -1).
+struct Frame {
+  vec3 s, t, n;
+
+  Frame() : s(1, 0, 0), t(0, 1, 0), n(0, 0, 1) {}
+  explicit Frame(const vec3& normal) : n(normal) {
+    const float sign = std::copysign(1.0f, n.z);
+    const float a = -1.0f / (sign + n.z);
+    const float b = n.x * n.y * a;
+    s = vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    t = vec3(b, sign + n.y * n.y * a, -n.y);
+  }
+  vec3 to_local(const vec3& v) const { return vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)); }
+  vec3 to_world(const vec3& v) const { return s * v.x + t * v.y + n * v.z; }
+};
+
+}  // namespace pathlab

@@ -1,0 +1,426 @@
+// Mesh loading: OBJ through tinyobjloader, PLY through the small parser
+// below, either one optionally gzip-compressed. Both formats are first read
+// into a RawMesh (polygons exactly as stored), which one shared function then
+// validates, triangulates and cleans, so every format reports problems alike.
+#include "core/mesh.h"
+
+#include "core/error.h"
+
+#include <tiny_obj_loader.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <initializer_list>
+#include <iterator>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace pathlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Throws "<file>: <problem>", or "<file>:<line>: <problem>" given a line number.
+[[noreturn]] void fail(const fs::path& file, const std::string& problem, int line = 0) {
+  throw InputError(file.string() + (line > 0 ? ":" + std::to_string(line) : "") + ": " + problem);
+}
+
+// Polygons as stored in the file, before validation and triangulation.
+struct RawMesh {
+  std::vector<vec3> positions;
+  std::vector<std::int64_t> indices;       // every face's vertex indices, concatenated
+  std::vector<std::size_t> face_start{0};  // face f is indices[face_start[f], face_start[f + 1])
+  int number_base = 0;  // messages number faces and vertices as the format does: PLY 0, OBJ 1
+
+  std::size_t face_count() const { return face_start.size() - 1; }
+};
+
+void check_indices(const fs::path& file, const RawMesh& raw) {
+  const auto vertex_count = static_cast<std::int64_t>(raw.positions.size());
+  for (std::size_t f = 0; f < raw.face_count(); ++f) {
+    for (std::size_t k = raw.face_start[f]; k < raw.face_start[f + 1]; ++k) {
+      const std::int64_t i = raw.indices[k];
+      if (i < 0 || i >= vertex_count)
+        fail(file, "face " + std::to_string(f + raw.number_base) + " refers to vertex " +
+                       std::to_string(i + raw.number_base) + " but the mesh has " +
+                       std::to_string(vertex_count) + " vertices");
+    }
+  }
+}
+
+// Validates `raw`, fan-triangulates its polygons and drops degenerate triangles.
+TriangleMesh finish(const fs::path& file, const RawMesh& raw, MeshLoadReport* report) {
+  for (std::size_t v = 0; v < raw.positions.size(); ++v) {
+    const vec3& p = raw.positions[v];
+    if (!is_finite(p)) {
+      std::ostringstream problem;
+      problem << "vertex " << v + raw.number_base << " has a non-finite coordinate (" << p.x
+              << ", " << p.y << ", " << p.z << ")";
+      fail(file, problem.str());
+    }
+  }
+  if (raw.positions.size() > std::numeric_limits<std::uint32_t>::max())
+    fail(file, "too many vertices (" + std::to_string(raw.positions.size()) + ")");
+  check_indices(file, raw);
+
+  TriangleMesh mesh;
+  mesh.positions = raw.positions;
+  std::size_t dropped = 0;
+  for (std::size_t f = 0; f < raw.face_count(); ++f) {
+    // A fan around the polygon's first vertex: correct for convex polygons
+    // (all that OBJ/PLY writers normally emit); concave ones may fold over.
+    const std::size_t first = raw.face_start[f];
+    for (std::size_t k = first + 1; k + 1 < raw.face_start[f + 1]; ++k) {
+      const glm::uvec3 tri(raw.indices[first], raw.indices[k], raw.indices[k + 1]);
+      const dvec3 a(mesh.positions[tri.x]), b(mesh.positions[tri.y]), c(mesh.positions[tri.z]);
+      const bool repeated = tri.x == tri.y || tri.y == tri.z || tri.x == tri.z;
+      if (repeated || glm::length(glm::cross(b - a, c - a)) == 0.0) {
+        ++dropped;
+        continue;
+      }
+      mesh.triangles.push_back(tri);
+    }
+  }
+  if (mesh.triangles.empty())
+    fail(file, "no usable triangles (" + std::to_string(dropped) + " degenerate dropped)");
+  if (report) {
+    report->faces_in_file = raw.face_count();
+    report->triangles_loaded = mesh.triangles.size();
+    report->degenerate_dropped = dropped;
+  }
+  return mesh;
+}
+
+// ---------------------------------------------------------------- OBJ
+
+RawMesh parse_obj(const fs::path& file, std::string_view text) {
+  tinyobj::ObjReaderConfig config;
+  config.triangulate = true;
+  config.vertex_color = false;
+  tinyobj::ObjReader reader;
+  if (!reader.ParseFromString(std::string(text), "", config)) {
+    std::string error = reader.Error();
+    while (!error.empty() && std::isspace(static_cast<unsigned char>(error.back()))) error.pop_back();
+    fail(file, "cannot parse OBJ: " + error);
+  }
+
+  RawMesh raw;
+  raw.number_base = 1;
+  const std::vector<tinyobj::real_t>& v = reader.GetAttrib().vertices;
+  for (std::size_t i = 0; i + 2 < v.size(); i += 3) raw.positions.emplace_back(v[i], v[i + 1], v[i + 2]);
+  // All shapes index the same vertex array, so concatenating them is trivial.
+  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+    std::size_t k = 0;
+    for (const unsigned char n : shape.mesh.num_face_vertices) {
+      for (unsigned j = 0; j < n; ++j) raw.indices.push_back(shape.mesh.indices[k++].vertex_index);
+      raw.face_start.push_back(raw.indices.size());
+    }
+  }
+
+  // tinyobj does not fail on these; it warns and silently drops the face.
+  const std::string& warning = reader.Warning();
+  if (warning.find("Degenerated face") != std::string::npos)
+    fail(file, "a face has fewer than 3 vertices");
+  if (warning.find("invalid vertex index") != std::string::npos ||
+      warning.find("Vertex indices out of bounds") != std::string::npos) {
+    check_indices(file, raw);  // names the face if tinyobj kept it
+    fail(file, "a face refers to a vertex beyond the " + std::to_string(raw.positions.size()) +
+                   " vertices of the mesh");
+  }
+  return raw;
+}
+
+// ---------------------------------------------------------------- PLY
+
+enum class Scalar { I8, U8, I16, U16, I32, U32, F32, F64 };
+constexpr std::size_t kScalarSize[] = {1, 1, 2, 2, 4, 4, 4, 8};
+
+std::optional<Scalar> scalar_type(std::string_view name) {
+  // Each type's classic and sized name, in the order of Scalar.
+  static constexpr std::string_view kNames[][2] = {
+      {"char", "int8"}, {"uchar", "uint8"}, {"short", "int16"},   {"ushort", "uint16"},
+      {"int", "int32"}, {"uint", "uint32"}, {"float", "float32"}, {"double", "float64"}};
+  for (int i = 0; i < 8; ++i)
+    if (name == kNames[i][0] || name == kNames[i][1]) return static_cast<Scalar>(i);
+  return std::nullopt;
+}
+
+struct PlyProperty {
+  std::string name;
+  bool is_list = false;
+  Scalar count_type = Scalar::U8;  // lists only
+  Scalar type = Scalar::F32;       // the value, or each list item
+};
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+enum class Encoding { Ascii, LittleEndian, BigEndian };
+
+struct PlyHeader {
+  Encoding encoding = Encoding::Ascii;
+  std::vector<PlyElement> elements;
+  std::size_t body_offset = 0;  // first byte after the end_header line
+  int line_count = 0;
+};
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
+
+PlyHeader parse_ply_header(const fs::path& file, std::string_view text) {
+  if (!text.starts_with("ply\n") && !text.starts_with("ply\r\n"))
+    fail(file, "not a PLY file (it does not start with 'ply')");
+  PlyHeader header;
+  bool have_format = false;
+  std::size_t pos = 0;
+  for (int line_no = 1;; ++line_no) {
+    const std::size_t eol = text.find('\n', pos);
+    if (eol == std::string_view::npos) fail(file, "truncated PLY header (no end_header line)");
+    const std::string_view line = text.substr(pos, eol - pos);
+    pos = eol + 1;
+    std::istringstream words{std::string(line)};
+    const std::vector<std::string> tok{std::istream_iterator<std::string>(words), {}};
+    const auto bad_line = [&](const char* what) {
+      fail(file, std::string(what) + " '" + std::string(line.substr(0, 80)) + "'", line_no);
+    };
+    if (line_no == 1 || tok.empty() || tok[0] == "comment" || tok[0] == "obj_info") continue;
+
+    if (tok[0] == "end_header") {
+      header.body_offset = pos;
+      header.line_count = line_no;
+      break;
+    } else if (tok[0] == "format") {
+      if (tok.size() != 3 || tok[2] != "1.0") bad_line("unsupported PLY format line");
+      if (tok[1] == "ascii") header.encoding = Encoding::Ascii;
+      else if (tok[1] == "binary_little_endian") header.encoding = Encoding::LittleEndian;
+      else if (tok[1] == "binary_big_endian") header.encoding = Encoding::BigEndian;
+      else bad_line("unsupported PLY format line");
+      have_format = true;
+    } else if (tok[0] == "element") {
+      std::uint64_t count = 0;
+      if (tok.size() != 3) bad_line("malformed PLY element line");
+      const auto [end, ec] = std::from_chars(tok[2].data(), tok[2].data() + tok[2].size(), count);
+      if (ec != std::errc() || end != tok[2].data() + tok[2].size()) bad_line("malformed PLY element line");
+      header.elements.push_back({tok[1], count, {}});
+    } else if (tok[0] == "property") {
+      if (header.elements.empty()) bad_line("PLY property before any element");
+      PlyProperty prop;
+      prop.is_list = tok.size() == 5 && tok[1] == "list";
+      if (!prop.is_list && tok.size() != 3) bad_line("malformed PLY property line");
+      // The type names sit between "property" (and "list") and the property name.
+      std::vector<Scalar> types;
+      for (std::size_t i = prop.is_list ? 2 : 1; i + 1 < tok.size(); ++i) {
+        const std::optional<Scalar> type = scalar_type(tok[i]);
+        if (!type) fail(file, "unknown PLY property type '" + tok[i] + "'", line_no);
+        types.push_back(*type);
+      }
+      prop.count_type = types.front();
+      prop.type = types.back();
+      prop.name = tok.back();
+      header.elements.back().properties.push_back(std::move(prop));
+    } else {
+      fail(file, "unknown PLY header keyword '" + tok[0] + "'", line_no);
+    }
+  }
+  if (!have_format) fail(file, "PLY header has no format line");
+  return header;
+}
+
+template <typename T>
+double decode(const unsigned char* bytes) {
+  T value;
+  std::memcpy(&value, bytes, sizeof value);
+  return static_cast<double>(value);
+}
+// In the order of Scalar.
+constexpr double (*kDecode[])(const unsigned char*) = {
+    decode<std::int8_t>,  decode<std::uint8_t>,  decode<std::int16_t>, decode<std::uint16_t>,
+    decode<std::int32_t>, decode<std::uint32_t>, decode<float>,        decode<double>};
+
+// Reads the values of a PLY body one at a time, as doubles (exact for
+// every PLY type). ASCII values are whitespace-separated tokens; line
+// breaks are not significant, which also tolerates "\r\n" and extra spaces.
+class PlyBody {
+ public:
+  PlyBody(const fs::path& file, std::string_view body, Encoding encoding, int first_line)
+      : file_(file), body_(body), encoding_(encoding), line_(first_line) {}
+
+  // False when the data ran out before the value.
+  bool next(Scalar type, double& out) {
+    if (encoding_ == Encoding::Ascii) return next_ascii(out);
+    const std::size_t size = kScalarSize[static_cast<int>(type)];
+    if (body_.size() - pos_ < size) return false;
+    unsigned char bytes[8];
+    std::memcpy(bytes, body_.data() + pos_, size);
+    pos_ += size;
+    if ((encoding_ == Encoding::LittleEndian) != (std::endian::native == std::endian::little))
+      std::reverse(bytes, bytes + size);
+    out = kDecode[static_cast<int>(type)](bytes);
+    return true;
+  }
+
+ private:
+  bool next_ascii(double& out) {
+    for (; pos_ < body_.size() && is_space(body_[pos_]); ++pos_)
+      if (body_[pos_] == '\n') ++line_;
+    if (pos_ == body_.size()) return false;
+    const std::size_t start = pos_;
+    while (pos_ < body_.size() && !is_space(body_[pos_])) ++pos_;
+    std::string_view token = body_.substr(start, pos_ - start);
+    if (token.size() > 1 && token[0] == '+') token.remove_prefix(1);  // from_chars rejects '+'
+    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), out);
+    if (ec != std::errc() || end != token.data() + token.size())
+      fail(file_, "malformed number '" + std::string(token.substr(0, 40)) + "'", line_);
+    return true;
+  }
+
+  const fs::path& file_;
+  std::string_view body_;
+  Encoding encoding_;
+  std::size_t pos_ = 0;
+  int line_;  // ASCII only, for messages
+};
+
+std::string plural(const std::string& element) {
+  if (element == "vertex") return "vertices";
+  if (element == "face") return "faces";
+  return "'" + element + "' elements";
+}
+
+RawMesh parse_ply(const fs::path& file, std::string_view text) {
+  const PlyHeader header = parse_ply_header(file, text);
+
+  // What each property of each element is for; everything else is skipped.
+  enum Role { kSkip = -1, kX = 0, kY = 1, kZ = 2, kFaceIndices = 3 };
+  std::vector<std::vector<int>> roles;
+  bool have_vertex = false, have_face = false;
+  for (const PlyElement& element : header.elements) {
+    std::vector<int>& role = roles.emplace_back(element.properties.size(), kSkip);
+    const auto find = [&](std::initializer_list<std::string_view> names) -> int {
+      for (std::size_t i = 0; i < element.properties.size(); ++i)
+        for (const std::string_view name : names)
+          if (element.properties[i].name == name) return static_cast<int>(i);
+      return -1;
+    };
+    if (element.name == "vertex" && !have_vertex) {
+      have_vertex = true;
+      for (int axis : {kX, kY, kZ}) {
+        const std::string name(1, "xyz"[axis]);
+        const int i = find({name});
+        if (i < 0 || element.properties[i].is_list)
+          fail(file, "PLY vertex element has no scalar '" + name + "' property");
+        role[i] = axis;
+      }
+    } else if (element.name == "face" && !have_face) {
+      have_face = true;
+      const int i = find({"vertex_indices", "vertex_index"});
+      if (i < 0 || !element.properties[i].is_list)
+        fail(file, "PLY face element has no 'vertex_indices' list property");
+      role[i] = kFaceIndices;
+    }
+  }
+  if (!have_vertex) fail(file, "PLY file has no 'vertex' element");
+  if (!have_face) fail(file, "PLY file has no 'face' element");
+
+  RawMesh raw;
+  PlyBody body(file, text.substr(header.body_offset), header.encoding, header.line_count + 1);
+  for (std::size_t e = 0; e < header.elements.size(); ++e) {
+    const PlyElement& element = header.elements[e];
+    const std::vector<int>& role = roles[e];
+    const bool is_vertex = std::count(role.begin(), role.end(), kX) > 0;
+    const bool is_face = std::count(role.begin(), role.end(), kFaceIndices) > 0;
+    if (element.properties.empty()) continue;  // nothing stored, however large the count
+    for (std::uint64_t i = 0; i < element.count; ++i) {
+      const auto read = [&](Scalar type) {
+        double value = 0.0;
+        if (!body.next(type, value))
+          fail(file, "truncated: expected " + std::to_string(element.count) + " " + plural(element.name) +
+                         ", found " + std::to_string(i));
+        return value;
+      };
+      vec3 position(0.0f);
+      for (std::size_t p = 0; p < element.properties.size(); ++p) {
+        const PlyProperty& prop = element.properties[p];
+        if (!prop.is_list) {
+          const double value = read(prop.type);
+          if (role[p] >= kX && role[p] <= kZ) position[role[p]] = static_cast<float>(value);
+          continue;
+        }
+        const double length = read(prop.count_type);
+        if (!(length >= 0.0 && length <= 1e9 && std::floor(length) == length))
+          fail(file, "PLY " + element.name + " " + std::to_string(i) + " has an invalid list length");
+        if (role[p] == kFaceIndices && length < 3)
+          fail(file, "face " + std::to_string(i) + " has " + std::to_string(static_cast<int>(length)) +
+                         " vertices (at least 3 needed)");
+        for (std::size_t k = 0; k < static_cast<std::size_t>(length); ++k) {
+          const double value = read(prop.type);
+          if (role[p] != kFaceIndices) continue;
+          if (!(std::floor(value) == value && std::abs(value) < 1e18))
+            fail(file, "face " + std::to_string(i) + " has an invalid vertex index");
+          raw.indices.push_back(static_cast<std::int64_t>(value));
+        }
+      }
+      if (is_vertex) raw.positions.push_back(position);
+      if (is_face) raw.face_start.push_back(raw.indices.size());
+    }
+  }
+  return raw;
+}
+
+}  // namespace
+
+std::vector<char> read_file_maybe_gz(const std::filesystem::path& file) {
+  errno = 0;
+  const std::unique_ptr<gzFile_s, int (*)(gzFile)> gz(gzopen(file.string().c_str(), "rb"), gzclose);
+  if (!gz) fail(file, std::string("cannot open file: ") + (errno ? std::strerror(errno) : "out of memory"));
+  gzbuffer(gz.get(), 1 << 17);
+
+  std::vector<char> data;
+  std::size_t size = 0;
+  while (true) {
+    data.resize(size + (1 << 18));
+    const int n = gzread(gz.get(), data.data() + size, static_cast<unsigned>(data.size() - size));
+    int code = Z_OK;
+    std::string_view message = gzerror(gz.get(), &code);  // mostly "<path>: <problem>"
+    if (message.starts_with(file.string() + ": ")) message.remove_prefix(file.string().size() + 2);
+    // At the end of the input, Z_BUF_ERROR means it stopped inside a gzip stream.
+    if (n < 0 || (code != Z_OK && (code != Z_BUF_ERROR || n == 0))) {
+      if (code == Z_ERRNO) fail(file, std::string("cannot read file: ") + std::strerror(errno));
+      fail(file, "corrupt gzip data: " + std::string(message));
+    }
+    if (n == 0) break;
+    size += static_cast<std::size_t>(n);
+  }
+  data.resize(size);
+  return data;
+}
+
+TriangleMesh load_mesh(const std::filesystem::path& file, MeshLoadReport* report) {
+  std::string name = file.filename().string();
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (name.ends_with(".gz")) name.resize(name.size() - 3);
+  const std::size_t dot = name.rfind('.');
+  const std::string extension = dot == std::string::npos ? "" : name.substr(dot);
+  if (extension != ".obj" && extension != ".ply")
+    fail(file, "unknown mesh format '" + extension + "' (expected .obj, .ply, optionally .gz)");
+
+  const std::vector<char> data = read_file_maybe_gz(file);
+  const std::string_view text(data.data(), data.size());
+  const RawMesh raw = extension == ".obj" ? parse_obj(file, text) : parse_ply(file, text);
+  return finish(file, raw, report);
+}
+
+}  // namespace pathlab

@@ -1,0 +1,16 @@
+#include "core/path_observer.h"
+
+namespace pathlab {
+
+const char* path_end_name(PathEnd end) {
+  switch (end) {
+    case PathEnd::Escaped: return "escaped";
+    case PathEnd::MaxDepth: return "max_depth";
+    case PathEnd::Absorbed: return "absorbed";
+    case PathEnd::Roulette: return "roulette";
+    case PathEnd::NoSample: return "no_sample";
+  }
+  return "?";
+}
+
+}  // namespace pathlab

@@ -1,0 +1,35 @@
+// Every random number pathlab draws is u(seed, pixel, sample, bounce, dim):
+// this header names every dimension, in one place, so that both tracers draw
+// the same number for the same event. Adding a decision to a tracer means
+// adding its name here first.
+//
+// `bounce` is 0 for the camera ray and k >= 1 for the k-th surface vertex of
+// the path (the first surface the camera ray hits is vertex 1).
+#pragma once
+
+#include <cstdint>
+
+namespace pathlab {
+
+enum class Dim : std::uint32_t {
+  // --- bounce 0: the camera -------------------------------------------------
+  FilmX = 0,  // position of the sample inside its pixel
+  FilmY,
+  LensX,      // point on the thin-lens aperture
+  LensY,
+
+  // --- bounce k >= 1: one vertex of the path ----------------------------------
+  DeltaLightChoice,  // which point light next-event estimation connects to
+  LightChoice,       // which area / environment light to sample (by power)
+  LightX,            // point on that light (or direction, for the environment)
+  LightY,
+  Technique,         // strategy light+bsdf: light sampling or BSDF sampling
+  LobeChoice,        // which lobe or impulse of the material scatters
+  DirectionX,        // the direction that lobe samples
+  DirectionY,
+  Roulette,          // Russian roulette survival
+
+  Count
+};
+
+}  // namespace pathlab

@@ -1,0 +1,73 @@
+#include "core/sampling.h"
+
+namespace pathlab {
+
+vec2 square_to_concentric_disk(vec2 u) {
+  const vec2 o = 2.0f * u - vec2(1.0f);
+  if (o.x == 0.0f && o.y == 0.0f) return vec2(0.0f);
+  float r, theta;
+  if (std::abs(o.x) > std::abs(o.y)) {
+    r = o.x;
+    theta = (kPi / 4.0f) * (o.y / o.x);
+  } else {
+    r = o.y;
+    theta = (kPi / 2.0f) - (kPi / 4.0f) * (o.x / o.y);
+  }
+  return r * vec2(std::cos(theta), std::sin(theta));
+}
+
+vec2 concentric_disk_to_square(vec2 p) {
+  const float r = std::sqrt(p.x * p.x + p.y * p.y);
+  float phi = std::atan2(p.y, p.x);
+  if (phi < -kPi / 4.0f) phi += 2.0f * kPi;  // phi in [-pi/4, 7pi/4)
+  float a, b;
+  if (phi < kPi / 4.0f) {  // right wedge: r = a, theta = pi/4 * b/a
+    a = r;
+    b = phi * a / (kPi / 4.0f);
+  } else if (phi < 3.0f * kPi / 4.0f) {  // top wedge: r = b
+    b = r;
+    a = -(phi - kPi / 2.0f) * b / (kPi / 4.0f);
+  } else if (phi < 5.0f * kPi / 4.0f) {  // left wedge: r = a < 0
+    a = -r;
+    b = (phi - kPi) * a / (kPi / 4.0f);
+  } else {  // bottom wedge: r = b < 0
+    b = -r;
+    a = -(phi - 3.0f * kPi / 2.0f) * b / (kPi / 4.0f);
+  }
+  return (vec2(a, b) + vec2(1.0f)) * 0.5f;
+}
+
+vec3 square_to_cosine_hemisphere(vec2 u) {
+  const vec2 d = square_to_concentric_disk(u);
+  const float z = std::sqrt(std::max(0.0f, 1.0f - d.x * d.x - d.y * d.y));
+  return vec3(d.x, d.y, z);
+}
+
+float cosine_hemisphere_pdf(const vec3& w) { return w.z > 0.0f ? w.z * kInvPi : 0.0f; }
+
+vec2 cosine_hemisphere_to_square(const vec3& w) { return concentric_disk_to_square(vec2(w.x, w.y)); }
+
+vec3 square_to_uniform_sphere(vec2 u) {
+  const float z = 1.0f - 2.0f * u.x;
+  const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
+  const float phi = 2.0f * kPi * u.y;
+  return vec3(r * std::cos(phi), r * std::sin(phi), z);
+}
+
+vec2 uniform_sphere_to_square(const vec3& w) {
+  float phi = std::atan2(w.y, w.x);
+  if (phi < 0.0f) phi += 2.0f * kPi;
+  return vec2((1.0f - w.z) * 0.5f, phi * kInv2Pi);
+}
+
+vec2 square_to_uniform_triangle(vec2 u) {
+  const float s = std::sqrt(u.x);
+  return vec2(u.y * s, 1.0f - s);  // (b1, b2); b0 = s (1 - u.y)
+}
+
+vec2 uniform_triangle_to_square(vec2 b) {
+  const float s = 1.0f - b.y;
+  return vec2(s * s, s > 0.0f ? b.x / s : 0.0f);
+}
+
+}  // namespace pathlab

@@ -1,0 +1,22 @@
+#include "core/scene.h"
+
+namespace pathlab {
+
+const char* strategy_name(Strategy s) {
+  switch (s) {
+    case Strategy::Cosine: return "cosine";
+    case Strategy::Bsdf: return "bsdf";
+    case Strategy::Light: return "light";
+    case Strategy::LightBsdf: return "light+bsdf";
+    case Strategy::Mis: return "mis";
+  }
+  return "?";
+}
+
+std::optional<Strategy> parse_strategy(std::string_view name) {
+  for (Strategy s : {Strategy::Cosine, Strategy::Bsdf, Strategy::Light, Strategy::LightBsdf, Strategy::Mis})
+    if (name == strategy_name(s)) return s;
+  return std::nullopt;
+}
+
+}  // namespace pathlab

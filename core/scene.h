@@ -1,0 +1,84 @@
+// A scene as described by its file: camera, film, materials, shapes, lights
+// and render defaults, all in world space. `CompiledScene` (compiled_scene.h)
+// turns it into what tracers query. The file format is documented in
+// docs/scene-format.md and parsed by scene_loader.h.
+#pragma once
+
+#include "core/camera.h"
+#include "core/material.h"
+#include "core/mesh.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace pathlab {
+
+// How a sample's radiance reaches the pixels (the reconstruction filter).
+enum class FilterKind : std::uint8_t {
+  Box,       // a sample counts for the pixel it lies in, with weight 1
+  Bilinear,  // splatted to the 2x2 nearest pixel centres with tent weights
+};
+
+struct FilmDesc {
+  int width = 256;
+  int height = 256;
+  FilterKind filter = FilterKind::Box;
+};
+
+enum class Strategy : std::uint8_t {
+  Cosine,     // cosine-weighted directions, emission found by hitting it
+  Bsdf,       // the material's own sampling, emission found by hitting it
+  Light,      // next-event estimation; BSDF sampling continues the path
+  LightBsdf,  // one-sample 50/50 choice of light or BSDF sampling (balance)
+  Mis,        // next-event estimation and BSDF sampling, power heuristic
+};
+const char* strategy_name(Strategy s);
+std::optional<Strategy> parse_strategy(std::string_view name);
+
+struct RenderSettings {
+  int spp = 16;
+  // Maximum number of scattering events on a path: 0 shows only emission
+  // seen directly, 1 adds direct lighting, ... -1 means no cap (Russian
+  // roulette ends paths, with a safety cap of kMaxVerticesUncapped).
+  int max_depth = 8;
+  // Russian roulette starts at the vertex after this many bounces.
+  int rr_depth = 5;
+  Strategy strategy = Strategy::Mis;
+  std::uint64_t seed = 0;
+};
+inline constexpr int kMaxVerticesUncapped = 1000;
+
+struct Shape {
+  enum class Kind : std::uint8_t { Triangles, Sphere };
+  Kind kind = Kind::Triangles;
+  std::string description;     // for messages, e.g. "shapes[2] (mesh bunny.ply)"
+  std::uint32_t material = 0;  // index into Scene::materials
+  TriangleMesh mesh;           // Kind::Triangles, world space, counter-clockwise = front
+  vec3 center{0.0f};           // Kind::Sphere
+  float radius = 0.0f;
+  bool flip_normals = false;   // front side faces the other way
+};
+
+struct PointLight {
+  vec3 position{0.0f};
+  Spectrum intensity{0.0f};  // radiant intensity, W/sr per channel
+};
+
+struct Scene {
+  std::filesystem::path file;  // empty for a built-in scene
+  std::string name;            // file stem, or the built-in scene's name
+  CameraDesc camera;
+  FilmDesc film;
+  RenderSettings render;
+  std::vector<Material> materials;
+  std::vector<Shape> shapes;
+  std::vector<PointLight> point_lights;
+  std::optional<Spectrum> environment;  // uniform radiance from every direction
+  std::vector<std::string> warnings;    // non-fatal problems found while loading
+};
+
+}  // namespace pathlab

@@ -1,0 +1,421 @@
+#include "core/scene_loader.h"
+
+#include "core/error.h"
+#include "core/geometry.h"
+#include "core/json_document.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include <array>
+#include <sstream>
+
+namespace pathlab {
+namespace {
+
+using json = nlohmann::json;
+using Pointer = json::json_pointer;
+
+// A cursor on one JSON object of the scene: typed accessors that report
+// their own location, and a check that no key is misspelt.
+class Node {
+ public:
+  Node(const JsonDocument& doc, Pointer ptr) : doc_(doc), ptr_(std::move(ptr)), value_(doc.root()[ptr_]) {}
+
+  const json& value() const { return value_; }
+  const Pointer& pointer() const { return ptr_; }
+  bool has(const std::string& key) const { return value_.is_object() && value_.contains(key); }
+  Node child(const std::string& key) const { return Node(doc_, ptr_ / key); }
+  Node child(std::size_t index) const { return Node(doc_, ptr_ / index); }
+
+  [[noreturn]] void fail(const std::string& problem) const {
+    const std::string path = ptr_.empty() ? std::string("(top level)") : ptr_.to_string();
+    throw InputError(doc_.where(ptr_) + ": " + path + ": " + problem);
+  }
+
+  void expect_object() const {
+    if (!value_.is_object()) fail("expected an object, found " + std::string(value_.type_name()));
+  }
+
+  void allow_only(std::initializer_list<std::string_view> keys) const {
+    expect_object();
+    const std::vector<std::string_view> allowed(keys);
+    for (const auto& [key, unused] : value_.items()) {
+      if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+      const std::string near = nearest_name(key, allowed);
+      child(key).fail("unknown key '" + key + "'" + (near.empty() ? std::string() : " (did you mean '" + near + "'?)"));
+    }
+  }
+
+  double number() const {
+    if (!value_.is_number()) fail("expected a number, found " + std::string(value_.type_name()));
+    const double v = value_.get<double>();
+    if (!std::isfinite(v)) fail("number is not finite");
+    return v;
+  }
+  std::int64_t integer() const {
+    if (!value_.is_number_integer()) fail("expected an integer, found " + std::string(value_.type_name()));
+    return value_.get<std::int64_t>();
+  }
+  std::string string() const {
+    if (!value_.is_string()) fail("expected a string, found " + std::string(value_.type_name()));
+    return value_.get<std::string>();
+  }
+  bool boolean() const {
+    if (!value_.is_boolean()) fail("expected true or false, found " + std::string(value_.type_name()));
+    return value_.get<bool>();
+  }
+  vec3 vector3() const {
+    if (!value_.is_array() || value_.size() != 3) fail("expected an array of 3 numbers");
+    return vec3(static_cast<float>(child(0).number()), static_cast<float>(child(1).number()),
+                static_cast<float>(child(2).number()));
+  }
+  // A colour: [r,g,b] or one number for grey; each component >= 0 (and <= 1
+  // if `max_one`).
+  Spectrum color(bool max_one) const {
+    const Spectrum c = value_.is_number() ? Spectrum(static_cast<float>(number())) : vector3();
+    for (int i = 0; i < 3; ++i) {
+      if (c[i] < 0.0f) fail("components must not be negative");
+      if (max_one && c[i] > 1.0f) fail("components must lie in [0, 1] (a reflectance above 1 creates energy)");
+    }
+    return c;
+  }
+
+  double number_or(const std::string& key, double fallback) const { return has(key) ? child(key).number() : fallback; }
+  bool boolean_or(const std::string& key, bool fallback) const { return has(key) ? child(key).boolean() : fallback; }
+  Node required(const std::string& key) const {
+    if (!has(key)) fail("missing required key '" + key + "'");
+    return child(key);
+  }
+
+ private:
+  const JsonDocument& doc_;
+  Pointer ptr_;
+  const json& value_;
+};
+
+CameraDesc read_camera(const Node& node) {
+  node.allow_only({"position", "look_at", "up", "fov_y", "aperture_radius", "focus_distance"});
+  CameraDesc c;
+  c.position = node.required("position").vector3();
+  c.look_at = node.required("look_at").vector3();
+  if (node.has("up")) c.up = node.child("up").vector3();
+  if (glm::length(c.look_at - c.position) <= 0.0f) node.child("look_at").fail("look_at must differ from position");
+  if (glm::length(glm::cross(c.look_at - c.position, c.up)) <= 0.0f)
+    node.child("up").fail("up must not be parallel to the viewing direction");
+  c.fov_y_degrees = static_cast<float>(node.number_or("fov_y", 40.0));
+  if (!(c.fov_y_degrees > 0.0f && c.fov_y_degrees < 180.0f)) node.child("fov_y").fail("fov_y must lie in (0, 180) degrees");
+  c.aperture_radius = static_cast<float>(node.number_or("aperture_radius", 0.0));
+  if (c.aperture_radius < 0.0f) node.child("aperture_radius").fail("aperture_radius must not be negative");
+  c.focus_distance = static_cast<float>(node.number_or("focus_distance", glm::length(c.look_at - c.position)));
+  if (!(c.focus_distance > 0.0f)) node.child("focus_distance").fail("focus_distance must be positive");
+  return c;
+}
+
+FilmDesc read_film(const Node& node) {
+  node.allow_only({"resolution", "filter"});
+  FilmDesc f;
+  if (node.has("resolution")) {
+    const Node r = node.child("resolution");
+    if (!r.value().is_array() || r.value().size() != 2) r.fail("expected [width, height]");
+    const std::int64_t w = r.child(0).integer(), h = r.child(1).integer();
+    if (w < 1 || h < 1 || w > 65536 || h > 65536) r.fail("width and height must lie in [1, 65536]");
+    f.width = static_cast<int>(w);
+    f.height = static_cast<int>(h);
+  }
+  if (node.has("filter")) {
+    const std::string name = node.child("filter").string();
+    if (name == "box") f.filter = FilterKind::Box;
+    else if (name == "bilinear") f.filter = FilterKind::Bilinear;
+    else node.child("filter").fail("unknown filter '" + name + "' (expected box or bilinear)");
+  }
+  return f;
+}
+
+RenderSettings read_render(const Node& node) {
+  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed"});
+  RenderSettings r;
+  if (node.has("spp")) {
+    const std::int64_t spp = node.child("spp").integer();
+    if (spp < 1 || spp > (1 << 24)) node.child("spp").fail("spp must lie in [1, 16777216]");
+    r.spp = static_cast<int>(spp);
+  }
+  if (node.has("max_depth")) {
+    const std::int64_t d = node.child("max_depth").integer();
+    if (d < -1 || d > kMaxVerticesUncapped) node.child("max_depth").fail("max_depth must be -1 (no cap) or lie in [0, 1000]");
+    r.max_depth = static_cast<int>(d);
+  }
+  if (node.has("rr_depth")) {
+    const std::int64_t d = node.child("rr_depth").integer();
+    if (d < 0 || d > kMaxVerticesUncapped) node.child("rr_depth").fail("rr_depth must lie in [0, 1000]");
+    r.rr_depth = static_cast<int>(d);
+  }
+  if (node.has("strategy")) {
+    const std::string name = node.child("strategy").string();
+    const auto s = parse_strategy(name);
+    if (!s) node.child("strategy").fail("unknown strategy '" + name + "' (expected cosine, bsdf, light, light+bsdf or mis)");
+    r.strategy = *s;
+  }
+  if (node.has("seed")) {
+    const std::int64_t seed = node.child("seed").integer();
+    if (seed < 0) node.child("seed").fail("seed must not be negative");
+    r.seed = static_cast<std::uint64_t>(seed);
+  }
+  return r;
+}
+
+Material read_material(const Node& node, const std::string& name) {
+  node.expect_object();
+  const std::string type = node.required("type").string();
+  Material m;
+  m.name = name;
+  if (type == "diffuse" || type == "mirror") {
+    const char* refl = type == "diffuse" ? "albedo" : "reflectance";
+    node.allow_only({"type", refl, "emission", "two_sided"});
+    m.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
+    m.albedo = node.has(refl) ? node.child(refl).color(true) : Spectrum(type == "diffuse" ? 0.5f : 1.0f);
+    if (node.has("emission")) m.emission = node.child("emission").color(false);
+  } else if (type == "emissive") {
+    node.allow_only({"type", "radiance", "two_sided"});
+    m.type = MaterialType::Emissive;
+    m.albedo = Spectrum(0.0f);
+    m.emission = node.required("radiance").color(false);
+  } else {
+    const std::array<std::string_view, 3> types{"diffuse", "mirror", "emissive"};
+    const std::string near = nearest_name(type, types);
+    node.child("type").fail("unknown material type '" + type + "'" +
+                            (near.empty() ? " (expected diffuse, mirror or emissive)" : " (did you mean '" + near + "'?)"));
+  }
+  m.two_sided_emission = node.boolean_or("two_sided", false);
+  return m;
+}
+
+// One transform step, or a list applied in order (the first listed is
+// applied to the shape first).
+mat4 read_transform(const Node& node) {
+  if (node.value().is_array()) {
+    mat4 m(1.0f);
+    for (std::size_t i = 0; i < node.value().size(); ++i) m = read_transform(node.child(i)) * m;
+    return m;
+  }
+  node.expect_object();
+  if (node.value().size() != 1) node.fail("a transform step has exactly one of translate, scale, rotate, matrix");
+  if (node.has("translate")) return glm::translate(mat4(1.0f), node.child("translate").vector3());
+  if (node.has("scale")) {
+    const Node s = node.child("scale");
+    const vec3 v = s.value().is_number() ? vec3(static_cast<float>(s.number())) : s.vector3();
+    if (v.x == 0.0f || v.y == 0.0f || v.z == 0.0f) s.fail("scale must not be zero");
+    return glm::scale(mat4(1.0f), v);
+  }
+  if (node.has("rotate")) {
+    const Node r = node.child("rotate");
+    r.allow_only({"axis", "angle"});
+    const vec3 axis = r.required("axis").vector3();
+    if (glm::length(axis) <= 0.0f) r.child("axis").fail("axis must not be zero");
+    return glm::rotate(mat4(1.0f), glm::radians(static_cast<float>(r.required("angle").number())), glm::normalize(axis));
+  }
+  if (node.has("matrix")) {
+    const Node mn = node.child("matrix");
+    if (!mn.value().is_array() || mn.value().size() != 16) mn.fail("expected 16 numbers, row by row");
+    mat4 m;
+    for (int row = 0; row < 4; ++row)
+      for (int col = 0; col < 4; ++col) m[col][row] = static_cast<float>(mn.child(row * 4 + col).number());
+    if (m[0][3] != 0.0f || m[1][3] != 0.0f || m[2][3] != 0.0f || m[3][3] != 1.0f)
+      mn.fail("the last row must be [0, 0, 0, 1] (no projective transforms)");
+    if (glm::determinant(mat3(m)) == 0.0f) mn.fail("matrix is singular");
+    return m;
+  }
+  const auto key = node.value().begin().key();
+  const std::array<std::string_view, 4> steps{"translate", "scale", "rotate", "matrix"};
+  const std::string near = nearest_name(key, steps);
+  node.child(key).fail("unknown transform step '" + key + "'" + (near.empty() ? std::string() : " (did you mean '" + near + "'?)"));
+}
+
+TriangleMesh unit_rectangle() {
+  return {{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, {{0, 1, 2}, {0, 2, 3}}};
+}
+
+TriangleMesh unit_box() {
+  TriangleMesh m;
+  // Six faces, each with its own four corners, wound counter-clockwise seen
+  // from outside.
+  const vec3 n[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const vec3& normal : n) {
+    const Frame f(normal);
+    const auto base = static_cast<unsigned>(m.positions.size());
+    for (const vec2 c : {vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, 1)})
+      m.positions.push_back(normal + c.x * f.s + c.y * f.t);
+    // (s, t, n) is right-handed, so s -> t is counter-clockwise about n.
+    m.triangles.push_back({base, base + 1, base + 2});
+    m.triangles.push_back({base, base + 2, base + 3});
+  }
+  return m;
+}
+
+// Applies `xf` to a mesh and drops triangles that it made degenerate.
+std::size_t transform_mesh(TriangleMesh* mesh, const mat4& xf) {
+  for (vec3& p : mesh->positions) p = vec3(xf * vec4(p, 1.0f));
+  // A mirroring transform turns counter-clockwise into clockwise: swap two
+  // indices so the front side stays the side the normal was on.
+  if (glm::determinant(mat3(xf)) < 0.0f)
+    for (glm::uvec3& t : mesh->triangles) std::swap(t.y, t.z);
+  std::vector<glm::uvec3> kept;
+  kept.reserve(mesh->triangles.size());
+  for (std::uint32_t i = 0; i < mesh->triangles.size(); ++i)
+    if (triangle_area(*mesh, i) > 0.0f) kept.push_back(mesh->triangles[i]);
+  const std::size_t dropped = mesh->triangles.size() - kept.size();
+  mesh->triangles = std::move(kept);
+  return dropped;
+}
+
+Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
+                 const std::map<std::string, std::uint32_t>& materials, std::size_t index) {
+  node.expect_object();
+  const std::string type = node.required("type").string();
+  Shape shape;
+  shape.description = "shapes[" + std::to_string(index) + "] (" + type + ")";
+  if (type == "mesh") {
+    node.allow_only({"type", "file", "material", "transform", "flip_normals"});
+  } else if (type == "sphere") {
+    node.allow_only({"type", "center", "radius", "material", "transform", "flip_normals"});
+  } else if (type == "rectangle" || type == "box") {
+    node.allow_only({"type", "material", "transform", "flip_normals"});
+  } else {
+    const std::array<std::string_view, 4> types{"mesh", "sphere", "rectangle", "box"};
+    const std::string near = nearest_name(type, types);
+    node.child("type").fail("unknown shape type '" + type + "'" +
+                            (near.empty() ? " (expected mesh, sphere, rectangle or box)" : " (did you mean '" + near + "'?)"));
+  }
+
+  const Node mat = node.required("material");
+  const std::string mat_name = mat.string();
+  const auto found = materials.find(mat_name);
+  if (found == materials.end()) {
+    std::vector<std::string_view> names;
+    for (const auto& [name, unused] : materials) names.push_back(name);
+    const std::string near = nearest_name(mat_name, names);
+    mat.fail("no material named '" + mat_name + "'" + (near.empty() ? std::string() : " (did you mean '" + near + "'?)"));
+  }
+  shape.material = found->second;
+  shape.flip_normals = node.boolean_or("flip_normals", false);
+  const mat4 xf = node.has("transform") ? read_transform(node.child("transform")) : mat4(1.0f);
+
+  if (type == "sphere") {
+    shape.kind = Shape::Kind::Sphere;
+    shape.center = node.has("center") ? node.child("center").vector3() : vec3(0.0f);
+    shape.radius = static_cast<float>(node.number_or("radius", 1.0));
+    if (!(shape.radius > 0.0f)) node.child("radius").fail("radius must be positive");
+    // A sphere stays a sphere only under rotation, uniform scale, translation.
+    const mat3 l(xf);
+    const float sx = glm::length(l[0]), sy = glm::length(l[1]), sz = glm::length(l[2]);
+    const float tol = 1e-5f * std::max(sx, std::max(sy, sz));
+    if (std::abs(sx - sy) > tol || std::abs(sx - sz) > tol || std::abs(glm::dot(l[0], l[1])) > tol * sx ||
+        std::abs(glm::dot(l[0], l[2])) > tol * sx || std::abs(glm::dot(l[1], l[2])) > tol * sx)
+      node.child("transform").fail("a sphere's transform may only rotate, translate and scale uniformly");
+    shape.center = vec3(xf * vec4(shape.center, 1.0f));
+    shape.radius *= sx;
+    return shape;
+  }
+
+  shape.kind = Shape::Kind::Triangles;
+  if (type == "mesh") {
+    const Node file = node.required("file");
+    const std::filesystem::path path = folder / file.string();
+    shape.description = "shapes[" + std::to_string(index) + "] (mesh " + file.string() + ")";
+    MeshLoadReport report;
+    try {
+      shape.mesh = load_mesh(path, &report);
+    } catch (const InputError& e) {
+      file.fail(e.what());
+    }
+    if (report.degenerate_dropped > 0)
+      scene.warnings.push_back(path.string() + ": dropped " + std::to_string(report.degenerate_dropped) +
+                                                   " degenerate triangle(s)");
+  } else {
+    shape.mesh = type == "rectangle" ? unit_rectangle() : unit_box();
+  }
+  const std::size_t dropped = transform_mesh(&shape.mesh, xf);
+  if (dropped > 0 && !shape.mesh.triangles.empty())
+    scene.warnings.push_back(shape.description + ": the transform made " + std::to_string(dropped) +
+                                                 " triangle(s) degenerate; dropped");
+  if (shape.mesh.triangles.empty()) {
+    const bool emits = scene.materials[shape.material].emits();
+    (node.has("transform") ? node.child("transform") : node)
+        .fail(emits ? "zero-area light: the shape has no area left after its transform"
+                    : "the shape has no area left after its transform");
+  }
+  return shape;
+}
+
+void read_lights(const Node& node, Scene* scene) {
+  if (!node.value().is_array()) node.fail("expected an array of lights");
+  for (std::size_t i = 0; i < node.value().size(); ++i) {
+    const Node l = node.child(i);
+    l.expect_object();
+    const std::string type = l.required("type").string();
+    if (type == "point") {
+      l.allow_only({"type", "position", "intensity"});
+      scene->point_lights.push_back({l.required("position").vector3(), l.required("intensity").color(false)});
+    } else if (type == "environment") {
+      l.allow_only({"type", "radiance"});
+      if (scene->environment) l.fail("only one environment light is allowed");
+      scene->environment = l.required("radiance").color(false);
+    } else {
+      l.child("type").fail("unknown light type '" + type + "' (expected point or environment)");
+    }
+  }
+}
+
+Scene read_scene(const JsonDocument& doc) {
+  const Node root(doc, Pointer());
+  root.allow_only({"pathlab_scene", "camera", "film", "render", "materials", "shapes", "lights"});
+  if (!root.has("pathlab_scene"))
+    root.fail("missing 'pathlab_scene' (the format version; this pathlab reads version " +
+              std::to_string(kSceneFormatVersion) + ")");
+  if (root.child("pathlab_scene").integer() != kSceneFormatVersion)
+    root.child("pathlab_scene").fail("unsupported scene format version (this pathlab reads version " +
+                                     std::to_string(kSceneFormatVersion) + ")");
+  Scene scene;
+  scene.file = doc.file();
+  scene.name = doc.file().stem().string();
+  scene.camera = read_camera(root.required("camera"));
+  if (root.has("film")) scene.film = read_film(root.child("film"));
+  if (root.has("render")) scene.render = read_render(root.child("render"));
+
+  std::map<std::string, std::uint32_t> materials;
+  const Node mats = root.required("materials");
+  mats.expect_object();
+  for (const auto& [name, unused] : mats.value().items()) {
+    materials[name] = static_cast<std::uint32_t>(scene.materials.size());
+    scene.materials.push_back(read_material(mats.child(name), name));
+  }
+
+  const Node shapes = root.required("shapes");
+  if (!shapes.value().is_array()) shapes.fail("expected an array of shapes");
+  const std::filesystem::path folder = doc.file().parent_path();
+  for (std::size_t i = 0; i < shapes.value().size(); ++i)
+    scene.shapes.push_back(read_shape(shapes.child(i), scene, folder, materials, i));
+
+  if (root.has("lights")) read_lights(root.child("lights"), &scene);
+
+  bool any_light = !scene.point_lights.empty() || (scene.environment && !is_black(*scene.environment));
+  for (const Shape& s : scene.shapes) any_light = any_light || scene.materials[s.material].emits();
+  if (!any_light) scene.warnings.push_back(doc.file().string() + ": the scene has no light; it will render black");
+  return scene;
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
+  return read_scene(JsonDocument::parse(text, file));
+}
+
+Scene load_scene(const std::filesystem::path& file) { return read_scene(JsonDocument::load(file)); }
+
+Scene builtin_cornell_box() {
+  Scene scene = parse_scene(builtin_cornell_box_text(), "<built-in cornell-box>");
+  scene.file.clear();
+  scene.name = "cornell";
+  return scene;
+}
+
+}  // namespace pathlab

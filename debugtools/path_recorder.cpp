@@ -1,0 +1,130 @@
+#include "debugtools/path_recorder.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace pathlab {
+namespace {
+
+using json = nlohmann::json;
+
+json j3(const vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+std::string fmt3(const vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%.6g, %.6g, %.6g)", static_cast<double>(v.x), static_cast<double>(v.y),
+                static_cast<double>(v.z));
+  return buf;
+}
+
+std::string fmt(float v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", static_cast<double>(v));
+  return buf;
+}
+
+const std::string& material_name(const Scene& scene, std::uint32_t m) {
+  static const std::string unknown = "?";
+  return m < scene.materials.size() ? scene.materials[m].name : unknown;
+}
+
+struct JsonVisitor {
+  const Scene& scene;
+  json operator()(const CameraEvent& e) const {
+    return {{"type", "camera"}, {"film", {e.film.x, e.film.y}}, {"origin", j3(e.origin)}, {"dir", j3(e.dir)}};
+  }
+  json operator()(const HitEvent& e) const {
+    return {{"type", "hit"},          {"vertex", e.vertex},        {"p", j3(e.p)},
+            {"n", j3(e.n)},           {"front", e.front},          {"material", material_name(scene, e.material)},
+            {"shape", e.shape},       {"prim", e.prim},            {"emitted", j3(e.emitted)},
+            {"emission_weight", e.emission_weight}, {"added", j3(e.added)}, {"throughput", j3(e.throughput)}};
+  }
+  json operator()(const EscapeEvent& e) const {
+    return {{"type", "escape"}, {"vertex", e.vertex}, {"emitted", j3(e.emitted)},
+            {"emission_weight", e.emission_weight}, {"added", j3(e.added)}};
+  }
+  json operator()(const LightEvent& e) const {
+    json j = {{"type", "light"}, {"vertex", e.vertex}, {"kind", e.delta ? "point" : "area"},
+              {"light", e.light}, {"point", j3(e.point)}, {"wi", j3(e.wi)},
+              {"pdf", e.pdf},     {"Le", j3(e.Le)},       {"visible", e.visible},
+              {"mis_weight", e.mis_weight}, {"added", j3(e.added)}};
+    j["dist"] = std::isinf(e.dist) ? json(nullptr) : json(e.dist);  // null: the environment
+    return j;
+  }
+  json operator()(const ScatterEvent& e) const {
+    return {{"type", "scatter"}, {"vertex", e.vertex}, {"lobe", e.cosine ? "cosine" : lobe_name(e.lobe)},
+            {"impulse", e.impulse}, {"wi", j3(e.wi)}, {"pdf", e.pdf},
+            {"weight", j3(e.weight)}, {"survival", e.survival}, {"throughput", j3(e.throughput)}};
+  }
+  json operator()(const EndEvent& e) const {
+    return {{"type", "end"}, {"vertex", e.vertex}, {"reason", path_end_name(e.reason)}};
+  }
+};
+
+struct TextVisitor {
+  const Scene& scene;
+  std::ostream& out;
+  void operator()(const CameraEvent& e) const {
+    out << "camera      film (" << fmt(e.film.x) << ", " << fmt(e.film.y) << ")  origin " << fmt3(e.origin)
+        << "  dir " << fmt3(e.dir) << "\n";
+  }
+  void operator()(const HitEvent& e) const {
+    out << "#" << e.vertex << " hit      p " << fmt3(e.p) << "  n " << fmt3(e.n) << (e.front ? "  front" : "  back")
+        << "  material '" << material_name(scene, e.material) << "'  shape " << e.shape << " prim " << e.prim << "\n";
+    if (!is_black(e.emitted))
+      out << "   emission  Le " << fmt3(e.emitted) << "  weight " << fmt(e.emission_weight) << "  added "
+          << fmt3(e.added) << "\n";
+  }
+  void operator()(const EscapeEvent& e) const {
+    out << "#" << e.vertex << " escape   environment " << fmt3(e.emitted) << "  weight " << fmt(e.emission_weight)
+        << "  added " << fmt3(e.added) << "\n";
+  }
+  void operator()(const LightEvent& e) const {
+    out << "#" << e.vertex << " light    " << (e.delta ? "point " : "area ") << e.light;
+    if (std::isinf(e.dist)) out << "  environment";
+    else out << "  point " << fmt3(e.point) << "  dist " << fmt(e.dist);
+    out << "  wi " << fmt3(e.wi) << "  pdf " << fmt(e.pdf) << "  Le " << fmt3(e.Le)
+        << (e.visible ? "  visible" : "  occluded") << "  mis " << fmt(e.mis_weight) << "  added " << fmt3(e.added)
+        << "\n";
+  }
+  void operator()(const ScatterEvent& e) const {
+    out << "#" << e.vertex << " scatter  " << (e.cosine ? "cosine" : lobe_name(e.lobe)) << (e.impulse ? " (impulse)" : "")
+        << "  wi " << fmt3(e.wi) << "  pdf " << fmt(e.pdf) << "  weight " << fmt3(e.weight);
+    if (e.survival < 1.0f) out << "  roulette p " << fmt(e.survival);
+    out << "  throughput " << fmt3(e.throughput) << "\n";
+  }
+  void operator()(const EndEvent& e) const {
+    out << "#" << e.vertex << " end      " << path_end_name(e.reason) << "\n";
+  }
+};
+
+}  // namespace
+
+json path_to_json(const TraceHeader& h, const PathRecorder& path, const Scene& scene) {
+  json events = json::array();
+  for (const PathEvent& e : path.events()) events.push_back(std::visit(JsonVisitor{scene}, e));
+  return {{"format", "pathlab-trace"},
+          {"version", 1},
+          {"scene", h.scene},
+          {"tracer", h.tracer},
+          {"pixel", {h.x, h.y}},
+          {"sample", h.sample},
+          {"seed", h.settings.seed},
+          {"strategy", strategy_name(h.settings.strategy)},
+          {"max_depth", h.settings.max_depth},
+          {"rr_depth", h.settings.rr_depth},
+          {"events", events},
+          {"radiance", j3(path.result())}};
+}
+
+std::string path_to_text(const TraceHeader& h, const PathRecorder& path, const Scene& scene) {
+  std::ostringstream out;
+  out << h.scene << "  pixel (" << h.x << ", " << h.y << ")  sample " << h.sample << "  seed " << h.settings.seed
+      << "  tracer " << h.tracer << "  strategy " << strategy_name(h.settings.strategy) << "  max depth "
+      << h.settings.max_depth << "  rr depth " << h.settings.rr_depth << "\n";
+  for (const PathEvent& e : path.events()) std::visit(TextVisitor{scene, out}, e);
+  out << "radiance    " << fmt3(path.result()) << "\n";
+  return out.str();
+}
+
+}  // namespace pathlab

@@ -1,0 +1,49 @@
+// Records the events of one path (a PathObserver) and writes them out as a
+// readable trace or as stable JSON (docs/trace-pixel-json.md).
+#pragma once
+
+#include "core/path_observer.h"
+#include "core/scene.h"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace pathlab {
+
+using PathEvent = std::variant<CameraEvent, HitEvent, EscapeEvent, LightEvent, ScatterEvent, EndEvent>;
+
+class PathRecorder final : public PathObserver {
+ public:
+  void on_camera(const CameraEvent& e) override { events_.emplace_back(e); }
+  void on_hit(const HitEvent& e) override { events_.emplace_back(e); }
+  void on_escape(const EscapeEvent& e) override { events_.emplace_back(e); }
+  void on_light(const LightEvent& e) override { events_.emplace_back(e); }
+  void on_scatter(const ScatterEvent& e) override { events_.emplace_back(e); }
+  void on_end(const EndEvent& e) override { events_.emplace_back(e); }
+  void on_result(const Spectrum& L) override { result_ = L; }
+
+  const std::vector<PathEvent>& events() const { return events_; }
+  const Spectrum& result() const { return result_; }
+
+ private:
+  std::vector<PathEvent> events_;
+  Spectrum result_{0.0f};
+};
+
+// Identifies the replayed sample in the output.
+struct TraceHeader {
+  std::string scene;      // file, or "<built-in cornell>"
+  std::string tracer;
+  std::uint32_t x = 0, y = 0, sample = 0;
+  RenderSettings settings;
+};
+
+// The JSON document of a recorded path (format version 1).
+nlohmann::json path_to_json(const TraceHeader& header, const PathRecorder& path, const Scene& scene);
+// A human-readable listing, one event per line or two.
+std::string path_to_text(const TraceHeader& header, const PathRecorder& path, const Scene& scene);
+
+}  // namespace pathlab

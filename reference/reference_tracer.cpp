@@ -1,0 +1,185 @@
+#include "reference/reference_tracer.h"
+
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+
+namespace pathlab {
+
+// What one pixel sample carries down the recursion.
+struct ReferenceTracer::Path {
+  SampleStream rng;
+  PathObserver* observer;
+  std::uint32_t rays = 0;
+  float u(int vertex, Dim dim) const { return rng.get(static_cast<std::uint32_t>(vertex), dim); }
+};
+
+// How the ray being traced was chosen at the vertex before it: decides how
+// much of the emission it finds counts (not at all where next-event
+// estimation already counted it, partly under MIS).
+struct ReferenceTracer::Previous {
+  vec3 p{0.0f};
+  float pdf = 0.0f;            // solid-angle density of the direction
+  bool impulse = true;         // camera ray or impulse: no other way to find the emitter
+  bool bsdf_technique = true;  // light+bsdf: this vertex chose BSDF sampling
+};
+
+float ReferenceTracer::emission_weight(const Previous& prev, float light_pdf) const {
+  if (prev.impulse) return 1.0f;
+  switch (settings_.strategy) {
+    case Strategy::Cosine:
+    case Strategy::Bsdf: return 1.0f;
+    case Strategy::Light: return 0.0f;
+    case Strategy::Mis: return power_heuristic(prev.pdf, light_pdf);
+    case Strategy::LightBsdf:
+      // One-sample balance heuristic with c = 1/2: f / (p_b / 2 + p_l / 2)
+      // = (f / p_b) * 2 p_b / (p_b + p_l).
+      return prev.bsdf_technique ? 2.0f * prev.pdf / (prev.pdf + light_pdf) : 0.0f;
+  }
+  return 0.0f;
+}
+
+Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const Previous& prev, const Spectrum& beta,
+                             Path& path) const {
+  const CompiledScene& scene = scene_;
+  Surfel s;
+  ++path.rays;
+  if (!scene.intersect(ray, &s)) {
+    const Spectrum Le = scene.scene().environment.value_or(Spectrum(0.0f));
+    const float w = is_black(Le) ? 0.0f : emission_weight(prev, scene.lights().pdf_environment());
+    if (path.observer) {
+      path.observer->on_escape({vertex, Le, w, beta * w * Le});
+      path.observer->on_end({vertex, PathEnd::Escaped});
+    }
+    return w * Le;
+  }
+
+  const vec3 wo = -ray.dir;
+  const Spectrum Le = s.emitted(wo);
+  const float w_e = is_black(Le) ? 0.0f : emission_weight(prev, scene.lights().pdf(prev.p, s));
+  Spectrum L = w_e * Le;
+  if (path.observer)
+    path.observer->on_hit({vertex, s.p, s.n, glm::dot(s.n, wo) > 0.0f,
+                           static_cast<std::uint32_t>(s.material - scene.scene().materials.data()), s.shape, s.prim,
+                           Le, w_e, beta * L, beta});
+
+  const int cap = settings_.max_depth >= 0 ? settings_.max_depth : kMaxVerticesUncapped;
+  if (vertex > cap) {
+    if (path.observer) path.observer->on_end({vertex, PathEnd::MaxDepth});
+    return L;
+  }
+  if (!s.material->scatters()) {
+    if (path.observer) path.observer->on_end({vertex, PathEnd::Absorbed});
+    return L;
+  }
+
+  // Light a ray cannot find: point lights, in every strategy.
+  L += direct_delta(s, wo, vertex, beta, path);
+
+  // Light a ray can find, as the strategy says.
+  const Strategy strategy = settings_.strategy;
+  const bool light_technique =
+      strategy == Strategy::LightBsdf && path.u(vertex, Dim::Technique) < 0.5f;
+  if (strategy == Strategy::Light || strategy == Strategy::Mis || light_technique)
+    L += direct_area(s, wo, vertex, beta, path);
+
+  // Continue the path.
+  const vec2 u_dir(path.u(vertex, Dim::DirectionX), path.u(vertex, Dim::DirectionY));
+  const bool cosine = strategy == Strategy::Cosine && !s.material->is_pure_impulse();
+  const std::optional<BsdfSample> bs =
+      cosine ? s.scatter_cosine(wo, u_dir) : s.scatter(wo, path.u(vertex, Dim::LobeChoice), u_dir);
+  if (!bs || is_black(bs->weight)) {
+    if (path.observer) path.observer->on_end({vertex, bs ? PathEnd::NoSample : PathEnd::Absorbed});
+    return L;
+  }
+  Spectrum weight = bs->weight;
+  float survival = 1.0f;
+  if (vertex > settings_.rr_depth) {
+    // Survive in proportion to the throughput, so that paths which carry
+    // little end early; dividing by the probability keeps the estimate unbiased.
+    survival = std::min(1.0f, max_component(beta * weight));
+    if (!(path.u(vertex, Dim::Roulette) < survival)) {
+      if (path.observer) {
+        path.observer->on_scatter({vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, Spectrum(0.0f)});
+        path.observer->on_end({vertex, PathEnd::Roulette});
+      }
+      return L;
+    }
+    weight /= survival;
+  }
+  const Spectrum beta_next = beta * weight;
+  if (path.observer)
+    path.observer->on_scatter({vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, beta_next});
+
+  const Previous next{s.p, bs->pdf, bs->impulse, !light_technique};
+  return L + weight * Li(s.spawn(bs->wi), vertex + 1, next, beta_next, path);
+}
+
+Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vertex, const Spectrum& beta,
+                                       Path& path) const {
+  const LightSampler& lights = scene_.lights();
+  if (!lights.has_delta_lights()) return Spectrum(0.0f);
+  const std::optional<LightSample> ls = lights.sample_delta(s.p, path.u(vertex, Dim::DeltaLightChoice));
+  if (!ls) return Spectrum(0.0f);
+  const Spectrum f = s.eval(ls->wi, wo);
+  if (is_black(f)) return Spectrum(0.0f);
+  ++path.rays;
+  const bool visible = !scene_.occluded(s.spawn_to(ls->p, vec3(0.0f), -ls->wi));
+  const Spectrum L = visible ? f * ls->Le / ls->pdf : Spectrum(0.0f);
+  if (path.observer)
+    path.observer->on_light({vertex, true, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, 1.0f, beta * L});
+  return L;
+}
+
+Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int vertex, const Spectrum& beta,
+                                      Path& path) const {
+  const std::optional<LightSample> ls = scene_.lights().sample(
+      s.p, path.u(vertex, Dim::LightChoice), vec2(path.u(vertex, Dim::LightX), path.u(vertex, Dim::LightY)));
+  if (!ls) return Spectrum(0.0f);
+  const Spectrum f = s.eval(ls->wi, wo);
+  if (is_black(f)) return Spectrum(0.0f);
+  float w = 1.0f;
+  if (settings_.strategy == Strategy::Mis) {
+    w = power_heuristic(ls->pdf, s.pdf(ls->wi, wo));
+  } else if (settings_.strategy == Strategy::LightBsdf) {
+    const float pb = s.pdf(ls->wi, wo);
+    w = 2.0f * ls->pdf / (ls->pdf + pb);
+  }
+  ++path.rays;
+  const Ray shadow = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, ls->p_error, ls->n);
+  const bool visible = !scene_.occluded(shadow);
+  const Spectrum L = visible ? f * ls->Le * (w / ls->pdf) : Spectrum(0.0f);
+  if (path.observer)
+    path.observer->on_light({vertex, false, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, w, beta * L});
+  return L;
+}
+
+FilmSample ReferenceTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::uint32_t sample,
+                                         PathObserver* observer) const {
+  const std::uint32_t pixel = y * static_cast<std::uint32_t>(scene_.scene().film.width) + x;
+  Path path{SampleStream(settings_.seed, pixel, sample), observer};
+  FilmSample fs;
+  fs.film = vec2(static_cast<float>(x) + path.u(0, Dim::FilmX), static_cast<float>(y) + path.u(0, Dim::FilmY));
+  const Ray ray = scene_.camera().generate_ray(fs.film, vec2(path.u(0, Dim::LensX), path.u(0, Dim::LensY)));
+  if (observer) observer->on_camera({x, y, sample, fs.film, ray.origin, ray.dir});
+  fs.L = Li(ray, 1, Previous{}, Spectrum(1.0f), path);
+  fs.rays = path.rays;
+  if (observer) observer->on_result(fs.L);
+  return fs;
+}
+
+void ReferenceTracer::render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const {
+  const int width = scene_.scene().film.width;
+  const int height = scene_.scene().film.height;
+  parallel_for(0, static_cast<std::size_t>(height), 1, [&](std::size_t y0, std::size_t y1) {
+    for (std::size_t y = y0; y < y1; ++y)
+      for (int x = 0; x < width; ++x) {
+        const std::size_t pixel = y * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+        for (std::uint32_t j = 0; j < count; ++j)
+          out[pixel * count + j] =
+              trace_sample(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), first + j, nullptr);
+      }
+  });
+}
+
+}  // namespace pathlab
