@@ -6,8 +6,12 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <limits>
 #include <sstream>
+#include <utility>
 
 namespace pathlab {
 namespace {
@@ -15,11 +19,48 @@ namespace {
 using json = nlohmann::json;
 using Pointer = json::json_pointer;
 
+// A name from the file, quoted for a one-line message: control characters
+// become '?' and very long names are cut.
+std::string in_quotes(std::string_view name) {
+  std::string out(name.substr(0, 60));
+  std::replace_if(out.begin(), out.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }, '?');
+  return "'" + out + (name.size() > 60 ? "...'" : "'");
+}
+
+// " (did you mean 'x'?)" if one of `candidates` is close to `name`, else "".
+std::string suggestion(std::string_view name, std::span<const std::string_view> candidates) {
+  const std::string near = nearest_name(name, candidates);
+  return near.empty() ? std::string() : " (did you mean " + in_quotes(near) + "?)";
+}
+
+// What a value is, for "expected X, found Y": the value itself when short.
+std::string describe(const json& v) {
+  switch (v.type()) {
+    case json::value_t::object: return "an object";
+    case json::value_t::array: return "an array of " + std::to_string(v.size());
+    case json::value_t::string: {
+      const std::string& s = v.get_ref<const std::string&>();
+      return "the string " + (s.size() <= 40 ? v.dump() : "\"" + s.substr(0, 40) + "...\"");
+    }
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return v.get<bool>() ? "true" : "false";
+    case json::value_t::discarded: return "nothing";
+    default: return "the number " + v.dump();
+  }
+}
+
+// The value at `ptr`, or null if there is none (a const json's operator[]
+// on a missing key is undefined behaviour).
+const json& resolve(const JsonDocument& doc, const Pointer& ptr) {
+  static const json missing;
+  return doc.root().contains(ptr) ? doc.root()[ptr] : missing;
+}
+
 // A cursor on one JSON object of the scene: typed accessors that report
 // their own location, and a check that no key is misspelt.
 class Node {
  public:
-  Node(const JsonDocument& doc, Pointer ptr) : doc_(doc), ptr_(std::move(ptr)), value_(doc.root()[ptr_]) {}
+  Node(const JsonDocument& doc, Pointer ptr) : doc_(doc), ptr_(std::move(ptr)), value_(resolve(doc, ptr_)) {}
 
   const json& value() const { return value_; }
   const Pointer& pointer() const { return ptr_; }
@@ -27,13 +68,18 @@ class Node {
   Node child(const std::string& key) const { return Node(doc_, ptr_ / key); }
   Node child(std::size_t index) const { return Node(doc_, ptr_ / index); }
 
-  [[noreturn]] void fail(const std::string& problem) const {
+  // "<file>:<line>:<col>: <pointer>: <problem>". A value that is not in the
+  // file (a default) is placed at its nearest enclosing value that is.
+  std::string message(const std::string& problem) const {
+    Pointer located = ptr_;
+    while (!located.empty() && doc_.position(located).line == 0) located = located.parent_pointer();
     const std::string path = ptr_.empty() ? std::string("(top level)") : ptr_.to_string();
-    throw InputError(doc_.where(ptr_) + ": " + path + ": " + problem);
+    return doc_.where(located) + ": " + path + ": " + problem;
   }
+  [[noreturn]] void fail(const std::string& problem) const { throw InputError(message(problem)); }
 
   void expect_object() const {
-    if (!value_.is_object()) fail("expected an object, found " + std::string(value_.type_name()));
+    if (!value_.is_object()) fail("expected an object, found " + describe(value_));
   }
 
   void allow_only(std::initializer_list<std::string_view> keys) const {
@@ -41,37 +87,42 @@ class Node {
     const std::vector<std::string_view> allowed(keys);
     for (const auto& [key, unused] : value_.items()) {
       if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
-      const std::string near = nearest_name(key, allowed);
-      child(key).fail("unknown key '" + key + "'" + (near.empty() ? std::string() : " (did you mean '" + near + "'?)"));
+      child(key).fail("unknown key " + in_quotes(key) + suggestion(key, allowed));
     }
   }
 
+  // Every number ends up a float: reject what a float cannot hold.
   double number() const {
-    if (!value_.is_number()) fail("expected a number, found " + std::string(value_.type_name()));
+    if (!value_.is_number()) fail("expected a number, found " + describe(value_));
     const double v = value_.get<double>();
     if (!std::isfinite(v)) fail("number is not finite");
+    if (std::abs(v) > std::numeric_limits<float>::max()) fail("number " + value_.dump() + " is too large (the limit is 3.4e38)");
     return v;
   }
   std::int64_t integer() const {
-    if (!value_.is_number_integer()) fail("expected an integer, found " + std::string(value_.type_name()));
+    if (!value_.is_number_integer()) fail("expected an integer, found " + describe(value_));
+    if (value_.is_number_unsigned() && value_.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX))
+      fail("integer " + value_.dump() + " is too large");
     return value_.get<std::int64_t>();
   }
   std::string string() const {
-    if (!value_.is_string()) fail("expected a string, found " + std::string(value_.type_name()));
+    if (!value_.is_string()) fail("expected a string, found " + describe(value_));
     return value_.get<std::string>();
   }
   bool boolean() const {
-    if (!value_.is_boolean()) fail("expected true or false, found " + std::string(value_.type_name()));
+    if (!value_.is_boolean()) fail("expected true or false, found " + describe(value_));
     return value_.get<bool>();
   }
   vec3 vector3() const {
-    if (!value_.is_array() || value_.size() != 3) fail("expected an array of 3 numbers");
+    if (!value_.is_array() || value_.size() != 3) fail("expected an array of 3 numbers, found " + describe(value_));
     return vec3(static_cast<float>(child(0).number()), static_cast<float>(child(1).number()),
                 static_cast<float>(child(2).number()));
   }
   // A colour: [r,g,b] or one number for grey; each component >= 0 (and <= 1
   // if `max_one`).
   Spectrum color(bool max_one) const {
+    if (!value_.is_number() && !(value_.is_array() && value_.size() == 3))
+      fail("expected a colour: one number or an array of 3 numbers, found " + describe(value_));
     const Spectrum c = value_.is_number() ? Spectrum(static_cast<float>(number())) : vector3();
     for (int i = 0; i < 3; ++i) {
       if (c[i] < 0.0f) fail("components must not be negative");
@@ -82,8 +133,18 @@ class Node {
 
   double number_or(const std::string& key, double fallback) const { return has(key) ? child(key).number() : fallback; }
   bool boolean_or(const std::string& key, bool fallback) const { return has(key) ? child(key).boolean() : fallback; }
+  // The member `key`, which must be there. If it is missing but a key close
+  // to it is present, the message says which (a misspelt required key would
+  // otherwise only be reported as missing).
   Node required(const std::string& key) const {
-    if (!has(key)) fail("missing required key '" + key + "'");
+    expect_object();
+    if (!has(key)) {
+      std::string hint;
+      const std::array<std::string_view, 1> wanted{key};
+      for (const auto& [present, unused] : value_.items())
+        if (!nearest_name(present, wanted).empty()) hint = " (is " + in_quotes(present) + " a misspelling of it?)";
+      fail("missing required key " + in_quotes(key) + hint);
+    }
     return child(key);
   }
 
@@ -99,9 +160,15 @@ CameraDesc read_camera(const Node& node) {
   c.position = node.required("position").vector3();
   c.look_at = node.required("look_at").vector3();
   if (node.has("up")) c.up = node.child("up").vector3();
-  if (glm::length(c.look_at - c.position) <= 0.0f) node.child("look_at").fail("look_at must differ from position");
-  if (glm::length(glm::cross(c.look_at - c.position, c.up)) <= 0.0f)
-    node.child("up").fail("up must not be parallel to the viewing direction");
+  const vec3 view = c.look_at - c.position;
+  if (!is_finite(view) || !std::isfinite(glm::length(view)))
+    node.child("look_at").fail("look_at is too far from position (beyond the float range)");
+  if (glm::length(view) <= 0.0f) node.child("look_at").fail("look_at must differ from position");
+  if (!(glm::length(glm::cross(view, c.up)) > 0.0f)) {
+    if (!node.has("up"))
+      node.fail("the view is straight up or down, so the default up [0, 1, 0] is parallel to it; give 'up'");
+    node.child("up").fail("up must not be zero or parallel to the viewing direction");
+  }
   c.fov_y_degrees = static_cast<float>(node.number_or("fov_y", 40.0));
   if (!(c.fov_y_degrees > 0.0f && c.fov_y_degrees < 180.0f)) node.child("fov_y").fail("fov_y must lie in (0, 180) degrees");
   c.aperture_radius = static_cast<float>(node.number_or("aperture_radius", 0.0));
@@ -156,11 +223,20 @@ RenderSettings read_render(const Node& node) {
     r.strategy = *s;
   }
   if (node.has("seed")) {
-    const std::int64_t seed = node.child("seed").integer();
-    if (seed < 0) node.child("seed").fail("seed must not be negative");
-    r.seed = static_cast<std::uint64_t>(seed);
+    // Any 64-bit unsigned value, as --seed takes.
+    const Node s = node.child("seed");
+    if (s.value().is_number_unsigned()) r.seed = s.value().get<std::uint64_t>();
+    else if (s.integer() < 0) s.fail("seed must not be negative");
   }
   return r;
+}
+
+// A key that belongs to another material type gets a pointed message, not
+// only "unknown key": {key used, what to say}.
+void reject_misplaced(const Node& node, const std::string& type,
+                      std::initializer_list<std::pair<const char*, const char*>> keys) {
+  for (const auto& [key, advice] : keys)
+    if (node.has(key)) node.child(key).fail("a " + type + " material has no '" + key + "'; " + advice);
 }
 
 Material read_material(const Node& node, const std::string& name) {
@@ -170,20 +246,28 @@ Material read_material(const Node& node, const std::string& name) {
   m.name = name;
   if (type == "diffuse" || type == "mirror") {
     const char* refl = type == "diffuse" ? "albedo" : "reflectance";
+    reject_misplaced(node, type,
+                     {{type == "diffuse" ? "reflectance" : "albedo",
+                       type == "diffuse" ? "its colour is 'albedo'" : "its colour is 'reflectance'"},
+                      {"radiance", "emitted light is 'emission'"}});
     node.allow_only({"type", refl, "emission", "two_sided"});
     m.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
     m.albedo = node.has(refl) ? node.child(refl).color(true) : Spectrum(type == "diffuse" ? 0.5f : 1.0f);
     if (node.has("emission")) m.emission = node.child("emission").color(false);
   } else if (type == "emissive") {
+    reject_misplaced(node, type,
+                     {{"emission", "its emitted light is 'radiance'"},
+                      {"albedo", "it reflects nothing (use type diffuse with 'emission' for a surface that does both)"},
+                      {"reflectance", "it reflects nothing"}});
     node.allow_only({"type", "radiance", "two_sided"});
     m.type = MaterialType::Emissive;
     m.albedo = Spectrum(0.0f);
     m.emission = node.required("radiance").color(false);
   } else {
     const std::array<std::string_view, 3> types{"diffuse", "mirror", "emissive"};
-    const std::string near = nearest_name(type, types);
-    node.child("type").fail("unknown material type '" + type + "'" +
-                            (near.empty() ? " (expected diffuse, mirror or emissive)" : " (did you mean '" + near + "'?)"));
+    const std::string near = suggestion(type, types);
+    node.child("type").fail("unknown material type " + in_quotes(type) +
+                            (near.empty() ? " (expected diffuse, mirror or emissive)" : near));
   }
   m.two_sided_emission = node.boolean_or("two_sided", false);
   return m;
@@ -197,7 +281,9 @@ mat4 read_transform(const Node& node) {
     for (std::size_t i = 0; i < node.value().size(); ++i) m = read_transform(node.child(i)) * m;
     return m;
   }
-  node.expect_object();
+  if (!node.value().is_object())
+    node.fail("expected a transform step such as {\"translate\": [x, y, z]}, or a list of them; found " +
+              describe(node.value()));
   if (node.value().size() != 1) node.fail("a transform step has exactly one of translate, scale, rotate, matrix");
   if (node.has("translate")) return glm::translate(mat4(1.0f), node.child("translate").vector3());
   if (node.has("scale")) {
@@ -226,8 +312,9 @@ mat4 read_transform(const Node& node) {
   }
   const auto key = node.value().begin().key();
   const std::array<std::string_view, 4> steps{"translate", "scale", "rotate", "matrix"};
-  const std::string near = nearest_name(key, steps);
-  node.child(key).fail("unknown transform step '" + key + "'" + (near.empty() ? std::string() : " (did you mean '" + near + "'?)"));
+  const std::string near = suggestion(key, steps);
+  node.child(key).fail("unknown transform step " + in_quotes(key) +
+                       (near.empty() ? " (expected translate, scale, rotate or matrix)" : near));
 }
 
 TriangleMesh unit_rectangle() {
@@ -281,9 +368,9 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
     node.allow_only({"type", "material", "transform", "flip_normals"});
   } else {
     const std::array<std::string_view, 4> types{"mesh", "sphere", "rectangle", "box"};
-    const std::string near = nearest_name(type, types);
-    node.child("type").fail("unknown shape type '" + type + "'" +
-                            (near.empty() ? " (expected mesh, sphere, rectangle or box)" : " (did you mean '" + near + "'?)"));
+    const std::string near = suggestion(type, types);
+    node.child("type").fail("unknown shape type " + in_quotes(type) +
+                            (near.empty() ? " (expected mesh, sphere, rectangle or box)" : near));
   }
 
   const Node mat = node.required("material");
@@ -292,8 +379,7 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
   if (found == materials.end()) {
     std::vector<std::string_view> names;
     for (const auto& [name, unused] : materials) names.push_back(name);
-    const std::string near = nearest_name(mat_name, names);
-    mat.fail("no material named '" + mat_name + "'" + (near.empty() ? std::string() : " (did you mean '" + near + "'?)"));
+    mat.fail("no material named " + in_quotes(mat_name) + suggestion(mat_name, names));
   }
   shape.material = found->second;
   shape.flip_normals = node.boolean_or("flip_normals", false);
@@ -313,12 +399,19 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
       node.child("transform").fail("a sphere's transform may only rotate, translate and scale uniformly");
     shape.center = vec3(xf * vec4(shape.center, 1.0f));
     shape.radius *= sx;
+    const Node where = node.has("transform") ? node.child("transform") : node.child("radius");
+    if (!is_finite(shape.center) || !std::isfinite(shape.radius))
+      where.fail("the sphere lies beyond the float range after its transform");
+    if (!(shape.radius > 0.0f))
+      where.fail(std::string(scene.materials[shape.material].emits() ? "zero-area light: " : "") +
+                 "the sphere's radius is zero after its transform");
     return shape;
   }
 
   shape.kind = Shape::Kind::Triangles;
   if (type == "mesh") {
     const Node file = node.required("file");
+    if (file.string().empty()) file.fail("the mesh file name is empty");
     const std::filesystem::path path = folder / file.string();
     shape.description = "shapes[" + std::to_string(index) + "] (mesh " + file.string() + ")";
     MeshLoadReport report;
@@ -328,20 +421,24 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
       file.fail(e.what());
     }
     if (report.degenerate_dropped > 0)
-      scene.warnings.push_back(path.string() + ": dropped " + std::to_string(report.degenerate_dropped) +
-                                                   " degenerate triangle(s)");
+      scene.warnings.push_back(file.message(
+          path.string() + ": dropped " + std::to_string(report.degenerate_dropped) + " degenerate triangle(s) of " +
+          std::to_string(report.degenerate_dropped + report.triangles_loaded) +
+          " (zero area or a repeated vertex)"));
   } else {
     shape.mesh = type == "rectangle" ? unit_rectangle() : unit_box();
   }
+  const Node where = node.has("transform") ? node.child("transform") : node;
   const std::size_t dropped = transform_mesh(&shape.mesh, xf);
+  for (const vec3& p : shape.mesh.positions)
+    if (!is_finite(p)) where.fail("the transform moves vertices beyond the float range (about 3.4e38)");
   if (dropped > 0 && !shape.mesh.triangles.empty())
-    scene.warnings.push_back(shape.description + ": the transform made " + std::to_string(dropped) +
-                                                 " triangle(s) degenerate; dropped");
+    scene.warnings.push_back(where.message(shape.description + ": the transform made " + std::to_string(dropped) +
+                                           " triangle(s) degenerate; dropped"));
   if (shape.mesh.triangles.empty()) {
     const bool emits = scene.materials[shape.material].emits();
-    (node.has("transform") ? node.child("transform") : node)
-        .fail(emits ? "zero-area light: the shape has no area left after its transform"
-                    : "the shape has no area left after its transform");
+    where.fail(emits ? "zero-area light: the shape has no area left after its transform"
+                     : "the shape has no area left after its transform");
   }
   return shape;
 }
@@ -360,20 +457,25 @@ void read_lights(const Node& node, Scene* scene) {
       if (scene->environment) l.fail("only one environment light is allowed");
       scene->environment = l.required("radiance").color(false);
     } else {
-      l.child("type").fail("unknown light type '" + type + "' (expected point or environment)");
+      const std::array<std::string_view, 2> types{"point", "environment"};
+      const std::string near = suggestion(type, types);
+      l.child("type").fail("unknown light type " + in_quotes(type) + (near.empty() ? " (expected point or environment)" : near));
     }
   }
 }
 
 Scene read_scene(const JsonDocument& doc) {
   const Node root(doc, Pointer());
-  root.allow_only({"pathlab_scene", "camera", "film", "render", "materials", "shapes", "lights"});
+  root.expect_object();
+  // The version first: a file of another version may well have other keys.
   if (!root.has("pathlab_scene"))
     root.fail("missing 'pathlab_scene' (the format version; this pathlab reads version " +
               std::to_string(kSceneFormatVersion) + ")");
-  if (root.child("pathlab_scene").integer() != kSceneFormatVersion)
-    root.child("pathlab_scene").fail("unsupported scene format version (this pathlab reads version " +
-                                     std::to_string(kSceneFormatVersion) + ")");
+  const Node version = root.child("pathlab_scene");
+  if (!version.value().is_number_integer() || version.value().get<std::int64_t>() != kSceneFormatVersion)
+    version.fail("unsupported scene format version " + version.value().dump().substr(0, 40) +
+                 " (this pathlab reads version " + std::to_string(kSceneFormatVersion) + ")");
+  root.allow_only({"pathlab_scene", "camera", "film", "render", "materials", "shapes", "lights"});
   Scene scene;
   scene.file = doc.file();
   scene.name = doc.file().stem().string();
@@ -397,7 +499,8 @@ Scene read_scene(const JsonDocument& doc) {
 
   if (root.has("lights")) read_lights(root.child("lights"), &scene);
 
-  bool any_light = !scene.point_lights.empty() || (scene.environment && !is_black(*scene.environment));
+  bool any_light = scene.environment && !is_black(*scene.environment);
+  for (const PointLight& p : scene.point_lights) any_light = any_light || !is_black(p.intensity);
   for (const Shape& s : scene.shapes) any_light = any_light || scene.materials[s.material].emits();
   if (!any_light) scene.warnings.push_back(doc.file().string() + ": the scene has no light; it will render black");
   return scene;

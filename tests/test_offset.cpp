@@ -1,0 +1,112 @@
+// Rays leaving a surface must not hit it again, however far from the world
+// origin the surface lies (floats there are 0.0078 apart at 1e5).
+#include "core/compiled_scene.h"
+#include "core/film.h"
+#include "core/geometry.h"
+#include "core/render.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "reference/reference_tracer.h"
+
+#include <gtest/gtest.h>
+
+namespace pathlab {
+namespace {
+
+Scene box_and_sphere_at(const vec3& offset) {
+  Scene scene;
+  scene.name = "offset";
+  scene.materials.push_back(Material{"white", MaterialType::Diffuse, Spectrum(0.5f), Spectrum(0.0f), false});
+  scene.camera.position = offset + vec3(0, 0, 50);
+  scene.camera.look_at = offset;
+  Shape box;
+  box.description = "box";
+  box.mesh = {{{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}},
+              {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+               {3, 6, 2}, {3, 7, 6}, {0, 4, 7}, {0, 7, 3}, {1, 2, 6}, {1, 6, 5}}};
+  for (vec3& p : box.mesh.positions) p = offset + 3.0f * p + vec3(-8, 0, 0);
+  scene.shapes.push_back(box);
+  Shape sphere;
+  sphere.kind = Shape::Kind::Sphere;
+  sphere.description = "sphere";
+  sphere.center = offset + vec3(8, 0, 0);
+  sphere.radius = 3.0f;
+  scene.shapes.push_back(sphere);
+  return scene;
+}
+
+// Both shapes are convex: a ray leaving either surface outwards can hit
+// neither itself nor (the two being far apart and the directions drawn in
+// the outward hemisphere) anything nearby on the same shape.
+void expect_no_self_hits(const vec3& offset) {
+  const CompiledScene scene(box_and_sphere_at(offset));
+  int self_hits = 0, rays = 0;
+  for (std::uint32_t shape = 0; shape < 2; ++shape) {
+    const Shape& s = scene.scene().shapes[shape];
+    const std::uint32_t prims = s.kind == Shape::Kind::Sphere ? 1 : static_cast<std::uint32_t>(s.mesh.triangles.size());
+    for (std::uint32_t i = 0; i < 20000; ++i) {
+      const std::uint32_t prim = i % prims;
+      const vec2 u(sample_u(1, shape, i, 0, Dim::LightX), sample_u(1, shape, i, 0, Dim::LightY));
+      const SurfacePoint sp = s.kind == Shape::Kind::Sphere ? sample_sphere(s, u) : sample_triangle(s, prim, u);
+      Surfel surfel;
+      surfel.p = sp.p;
+      surfel.p_error = sp.p_error;
+      surfel.n = sp.n;
+      // Outward directions, down to grazing ones (cos theta ~ 1e-3).
+      vec3 w = square_to_cosine_hemisphere(vec2(sample_u(2, shape, i, 0, Dim::DirectionX),
+                                                sample_u(2, shape, i, 0, Dim::DirectionY)));
+      if (i % 4 == 0) w = glm::normalize(vec3(w.x, w.y, 1e-3f));
+      const vec3 dir = Frame(sp.n).to_world(w);
+      Surfel hit;
+      ++rays;
+      if (scene.intersect(surfel.spawn(dir), &hit) && hit.shape == shape) ++self_hits;
+    }
+  }
+  EXPECT_EQ(self_hits, 0) << "of " << rays << " rays at offset (" << offset.x << ", " << offset.y << ", " << offset.z << ")";
+}
+
+TEST(RayOffset, NoSelfIntersectionAtTheOrigin) { expect_no_self_hits(vec3(0.0f)); }
+TEST(RayOffset, NoSelfIntersectionAt1e5) { expect_no_self_hits(vec3(1e5f, -1e5f, 1e5f)); }
+TEST(RayOffset, NoSelfIntersectionAt1e6) { expect_no_self_hits(vec3(-1e6f, 3e5f, 1e6f)); }
+
+// The same check through a whole render: a Lambert plane far from the origin
+// lit by a point light. Self-shadowing would show as black speckle; every
+// pixel must instead get the direct light rho/pi * I cos(theta) / d^2 of
+// its visible point (within the variation over the pixel's footprint).
+TEST(RayOffset, NoShadowSpeckleOnAPlaneAt1e5) {
+  const vec3 o(1e5f, 1e5f, -1e5f);
+  Scene scene;
+  scene.name = "far-plane";
+  scene.materials.push_back(Material{"white", MaterialType::Diffuse, Spectrum(0.8f), Spectrum(0.0f), false});
+  Shape plane;
+  plane.description = "plane";
+  plane.mesh = {{o + vec3(-40, 0, -40), o + vec3(40, 0, -40), o + vec3(40, 0, 40), o + vec3(-40, 0, 40)},
+                {{0, 2, 1}, {0, 3, 2}}};
+  scene.shapes.push_back(plane);
+  scene.point_lights.push_back({o + vec3(0, 20, 0), Spectrum(400.0f)});
+  scene.camera.position = o + vec3(0, 30, 10);
+  scene.camera.look_at = o;
+  scene.film = {32, 32, FilterKind::Box};
+  scene.render.spp = 4;
+  scene.render.max_depth = 1;
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const ReferenceTracer tracer(compiled, settings);
+  Film film(32, 32, FilterKind::Box);
+  render(tracer, film);
+  int dark = 0;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const Ray r = compiled.camera().generate_ray(vec2(x + 0.5f, y + 0.5f), vec2(0.5f));
+      Surfel s;
+      ASSERT_TRUE(compiled.intersect(r, &s));
+      const vec3 to_light = compiled.scene().point_lights[0].position - s.p;
+      const float d2 = glm::dot(to_light, to_light);
+      const float expected = 0.8f * kInvPi * 400.0f * glm::dot(s.n, to_light) / std::sqrt(d2) / d2;
+      if (film.mean(x, y).x < 0.5f * expected) ++dark;
+    }
+  EXPECT_EQ(dark, 0);
+}
+
+}  // namespace
+}  // namespace pathlab

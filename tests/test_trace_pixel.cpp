@@ -1,0 +1,132 @@
+// Replaying one pixel sample: deterministic, identical to the render, and
+// reachable from the command a NaN report prints.
+#include "apps/cli/cli.h"
+#include "apps/cli/scene_options.h"
+#include "core/compiled_scene.h"
+#include "core/render.h"
+#include "debugtools/path_recorder.h"
+#include "reference/reference_tracer.h"
+#include "tests/test_scenes.h"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <sstream>
+
+namespace pathlab {
+namespace {
+
+TEST(TracePixel, ReplayIsDeterministicAndMatchesTheRender) {
+  Scene scene = test::small_cornell(16, 3, FilterKind::Box);
+  scene.render.strategy = Strategy::Mis;
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const ReferenceTracer tracer(compiled, settings);
+  std::vector<FilmSample> batch(16 * 16 * 3);
+  tracer.render_batch(0, 3, batch);
+
+  for (std::uint32_t sample = 0; sample < 3; ++sample) {
+    PathRecorder a, b;
+    const FilmSample fa = tracer.trace_sample(7, 9, sample, &a);
+    tracer.trace_sample(7, 9, sample, &b);
+    const TraceHeader h{"cornell", "reference", 7, 9, sample, settings};
+    EXPECT_EQ(path_to_json(h, a, compiled.scene()).dump(), path_to_json(h, b, compiled.scene()).dump());
+    // The observer changes nothing: same bits as the production render.
+    const FilmSample& fr = batch[(9 * 16 + 7) * 3 + sample];
+    EXPECT_EQ(std::memcmp(&fa.L, &fr.L, sizeof(Spectrum)), 0);
+    EXPECT_EQ(fa.film, fr.film);
+    EXPECT_EQ(a.result(), fa.L);
+  }
+}
+
+TEST(TracePixel, EventsAddUpToTheRadiance) {
+  Scene scene = test::small_cornell(16, 1, FilterKind::Box);
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const ReferenceTracer tracer(compiled, settings);
+  int paths_with_light = 0;
+  for (std::uint32_t sample = 0; sample < 64; ++sample) {
+    PathRecorder rec;
+    const FilmSample fs = tracer.trace_sample(8, 12, sample, &rec);
+    Spectrum sum(0.0f);
+    for (const PathEvent& e : rec.events()) {
+      if (const auto* h = std::get_if<HitEvent>(&e)) sum += h->added;
+      if (const auto* l = std::get_if<LightEvent>(&e)) sum += l->added;
+      if (const auto* x = std::get_if<EscapeEvent>(&e)) sum += x->added;
+    }
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], fs.L[c], 1e-4f * (1.0f + fs.L[c]));
+    ASSERT_FALSE(rec.events().empty());
+    EXPECT_TRUE(std::holds_alternative<CameraEvent>(rec.events().front()));
+    EXPECT_TRUE(std::holds_alternative<EndEvent>(rec.events().back()));
+    paths_with_light += max_component(fs.L) > 0.0f;
+  }
+  EXPECT_GT(paths_with_light, 0);
+}
+
+TEST(TracePixel, CliJsonIsStable) {
+  const char* argv[] = {"pathlab", "trace-pixel", "--pixel", "20,30", "--sample", "2", "--resolution", "64x64", "--json"};
+  std::ostringstream out1, err1, out2, err2;
+  ASSERT_EQ(cli::run(static_cast<int>(std::size(argv)), argv, out1, err1), 0) << err1.str();
+  ASSERT_EQ(cli::run(static_cast<int>(std::size(argv)), argv, out2, err2), 0) << err2.str();
+  EXPECT_EQ(out1.str(), out2.str());
+  const auto j = nlohmann::json::parse(out1.str());
+  EXPECT_EQ(j["format"], "pathlab-trace");
+  EXPECT_EQ(j["version"], 1);
+  EXPECT_EQ(j["pixel"], nlohmann::json::array({20, 30}));
+  EXPECT_EQ(j["sample"], 2);
+  EXPECT_EQ(j["events"].front()["type"], "camera");
+  EXPECT_EQ(j["events"].back()["type"], "end");
+  EXPECT_EQ(j["radiance"].size(), 3u);
+}
+
+// A tracer that fails on one sample, to exercise the NaN report.
+class NanAtOneSample final : public Tracer {
+ public:
+  using Tracer::Tracer;
+  std::string_view name() const override { return "nan-test"; }
+  FilmSample trace_sample(std::uint32_t x, std::uint32_t y, std::uint32_t sample, PathObserver*) const override {
+    FilmSample fs{vec2(float(x) + 0.5f, float(y) + 0.5f), Spectrum(1.0f), 1};
+    if (x == 3 && y == 2 && sample == 5) fs.L.y = std::nanf("");
+    return fs;
+  }
+  void render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const override {
+    const int w = scene_.scene().film.width;
+    for (std::size_t i = 0; i < out.size(); ++i)
+      out[i] = trace_sample(static_cast<std::uint32_t>((i / count) % w), static_cast<std::uint32_t>((i / count) / w),
+                            first + static_cast<std::uint32_t>(i % count), nullptr);
+  }
+};
+
+TEST(TracePixel, NanIsKeptOutOfTheImageAndReportedWithItsReplayCommand) {
+  Scene scene = test::small_cornell(8, 8, FilterKind::Bilinear);
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const NanAtOneSample tracer(compiled, settings);
+  Film film(8, 8, FilterKind::Bilinear);
+  const RenderStats stats = render(tracer, film);
+  EXPECT_EQ(stats.bad_samples, 1u);
+  for (const vec3& p : film.image().pixels) EXPECT_EQ(p, vec3(1.0f));
+  ASSERT_EQ(film.bad_samples().size(), 1u);
+  const BadSample& b = film.bad_samples()[0];
+  EXPECT_EQ(b.x, 3u);
+  EXPECT_EQ(b.y, 2u);
+  EXPECT_EQ(b.sample, 5u);
+
+  // The printed command replays exactly that sample.
+  cli::SceneOptions options;
+  const std::string cmd = options.trace_pixel_command(compiled.scene(), b.x, b.y, b.sample);
+  EXPECT_NE(cmd.find("--pixel 3,2 --sample 5"), std::string::npos) << cmd;
+  std::istringstream words(cmd);
+  std::vector<std::string> args((std::istream_iterator<std::string>(words)), std::istream_iterator<std::string>());
+  args.push_back("--json");
+  std::vector<const char*> argv;
+  for (const std::string& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  ASSERT_EQ(cli::run(static_cast<int>(argv.size()), argv.data(), out, err), 0) << err.str();
+  const auto j = nlohmann::json::parse(out.str());
+  EXPECT_EQ(j["pixel"], nlohmann::json::array({3, 2}));
+  EXPECT_EQ(j["sample"], 5);
+}
+
+}  // namespace
+}  // namespace pathlab

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages pathlab builds and tests with. Used by the
+# README's first command and by CI, so the two cannot drift apart.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config ccache
+  libembree-dev           # Embree 3.13: BVH and ray queries
+  libopenimageio-dev      # OpenImageIO 2.4: EXR and PNG output
+  libopenexr-dev          # OpenEXR 3.1
+  libtbb-dev              # oneTBB: the parallel-for
+  libglm-dev              # vector math
+  nlohmann-json3-dev      # scene files, JSON output
+  libtinyobjloader-dev    # OBJ meshes
+  zlib1g-dev              # .gz meshes
+  libcli11-dev            # the command line
+  libgtest-dev libgmock-dev  # tests
+)
+
+as_root=()
+if [ "$(id -u)" -ne 0 ]; then as_root=(sudo); fi
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" apt-get update -qq
+"${as_root[@]}" apt-get install -y -qq --no-install-recommends "${packages[@]}" >/dev/null
+echo "pathlab: Debian packages installed"
