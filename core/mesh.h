@@ -15,7 +15,7 @@ struct TriangleMesh {
 };
 
 struct MeshLoadReport {
-  std::size_t faces_in_file = 0;         // faces as stored (polygons count once)
+  std::size_t faces_in_file = 0;         // PLY: faces as stored; OBJ: triangles after tinyobjloader
   std::size_t triangles_loaded = 0;      // after fan triangulation and dropping
   std::size_t degenerate_dropped = 0;    // zero-area or repeated-index triangles
 };
@@ -23,7 +23,8 @@ struct MeshLoadReport {
 // Loads a triangle mesh from Wavefront OBJ (via tinyobjloader) or PLY
 // (ASCII, binary little- or big-endian). Either may be gzip-compressed
 // (`.obj.gz`, `.ply.gz`); the format is chosen by the extension before `.gz`.
-// Polygons are fan-triangulated. Degenerate triangles (repeated indices or
+// PLY polygons are fan-triangulated (convex polygons assumed); OBJ polygons
+// are triangulated by tinyobjloader. Degenerate triangles (repeated indices or
 // zero area) are dropped and counted in `report`.
 //
 // Throws InputError naming the file and the problem for: a missing or

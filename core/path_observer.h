@@ -16,9 +16,10 @@ namespace pathlab {
 enum class PathEnd : std::uint8_t {
   Escaped,    // the ray left the scene
   MaxDepth,   // the vertex was past the depth cap
-  Absorbed,   // the material sampled no continuation (black, or an impulse's absorption)
+  Absorbed,   // the material sampled no continuation (black, an impulse's absorption,
+              // or a direction with zero density such as an exactly grazing one)
   Roulette,   // Russian roulette ended it
-  NoSample,   // the sampled direction carried no energy (below the surface, grazing)
+  NoSample,   // the sampled direction carried no energy (a zero weight)
 };
 const char* path_end_name(PathEnd end);
 
@@ -49,6 +50,7 @@ struct EscapeEvent {
 struct LightEvent {
   int vertex = 0;
   bool delta = false;       // a point light
+  bool infinite = false;    // the environment
   std::uint32_t light = 0;
   vec3 point{0.0f};         // point on the light (undefined for the environment)
   vec3 wi{0.0f};
@@ -66,7 +68,7 @@ struct ScatterEvent {
   bool cosine = false;      // strategy "cosine" replaced the material's sampling
   vec3 wi{0.0f};
   float pdf = 0.0f;
-  Spectrum weight{0.0f};    // f |cos| / pdf, after Russian roulette
+  Spectrum weight{0.0f};    // f |cos| / pdf, divided by `survival` if the path survived roulette
   float survival = 1.0f;    // Russian roulette probability (1 = not applied)
   Spectrum throughput{0.0f};  // after this scattering
 };

@@ -472,9 +472,9 @@ Scene read_scene(const JsonDocument& doc) {
     root.fail("missing 'pathlab_scene' (the format version; this pathlab reads version " +
               std::to_string(kSceneFormatVersion) + ")");
   const Node version = root.child("pathlab_scene");
-  if (!version.value().is_number_integer() || version.value().get<std::int64_t>() != kSceneFormatVersion)
-    version.fail("unsupported scene format version " + version.value().dump().substr(0, 40) +
-                 " (this pathlab reads version " + std::to_string(kSceneFormatVersion) + ")");
+  if (const std::int64_t v = version.integer(); v != kSceneFormatVersion)
+    version.fail("unsupported scene format version " + std::to_string(v) + " (this pathlab reads version " +
+                 std::to_string(kSceneFormatVersion) + ")");
   root.allow_only({"pathlab_scene", "camera", "film", "render", "materials", "shapes", "lights"});
   Scene scene;
   scene.file = doc.file();

@@ -44,7 +44,7 @@ struct JsonVisitor {
             {"emission_weight", e.emission_weight}, {"added", j3(e.added)}};
   }
   json operator()(const LightEvent& e) const {
-    json j = {{"type", "light"}, {"vertex", e.vertex}, {"kind", e.delta ? "point" : "area"},
+    json j = {{"type", "light"}, {"vertex", e.vertex}, {"kind", e.delta ? "point" : e.infinite ? "environment" : "area"},
               {"light", e.light}, {"point", j3(e.point)}, {"wi", j3(e.wi)},
               {"pdf", e.pdf},     {"Le", j3(e.Le)},       {"visible", e.visible},
               {"mis_weight", e.mis_weight}, {"added", j3(e.added)}};
@@ -80,9 +80,8 @@ struct TextVisitor {
         << "  added " << fmt3(e.added) << "\n";
   }
   void operator()(const LightEvent& e) const {
-    out << "#" << e.vertex << " light    " << (e.delta ? "point " : "area ") << e.light;
-    if (std::isinf(e.dist)) out << "  environment";
-    else out << "  point " << fmt3(e.point) << "  dist " << fmt(e.dist);
+    out << "#" << e.vertex << " light    " << (e.delta ? "point " : e.infinite ? "environment " : "area ") << e.light;
+    if (!e.infinite) out << "  point " << fmt3(e.point) << "  dist " << fmt(e.dist);
     out << "  wi " << fmt3(e.wi) << "  pdf " << fmt(e.pdf) << "  Le " << fmt3(e.Le)
         << (e.visible ? "  visible" : "  occluded") << "  mis " << fmt(e.mis_weight) << "  added " << fmt3(e.added)
         << "\n";
@@ -107,6 +106,7 @@ json path_to_json(const TraceHeader& h, const PathRecorder& path, const Scene& s
           {"version", 1},
           {"scene", h.scene},
           {"tracer", h.tracer},
+          {"resolution", {h.width, h.height}},
           {"pixel", {h.x, h.y}},
           {"sample", h.sample},
           {"seed", h.settings.seed},
@@ -119,7 +119,7 @@ json path_to_json(const TraceHeader& h, const PathRecorder& path, const Scene& s
 
 std::string path_to_text(const TraceHeader& h, const PathRecorder& path, const Scene& scene) {
   std::ostringstream out;
-  out << h.scene << "  pixel (" << h.x << ", " << h.y << ")  sample " << h.sample << "  seed " << h.settings.seed
+  out << h.scene << "  " << h.width << "x" << h.height << "  pixel (" << h.x << ", " << h.y << ")  sample " << h.sample << "  seed " << h.settings.seed
       << "  tracer " << h.tracer << "  strategy " << strategy_name(h.settings.strategy) << "  max depth "
       << h.settings.max_depth << "  rr depth " << h.settings.rr_depth << "\n";
   for (const PathEvent& e : path.events()) std::visit(TextVisitor{scene, out}, e);

@@ -39,6 +39,7 @@ struct TraceHeader {
   std::string tracer;
   std::uint32_t x = 0, y = 0, sample = 0;
   RenderSettings settings;
+  int width = 0, height = 0;  // the film: pixel numbering and camera rays depend on it
 };
 
 // The JSON document of a recorded path (format version 1).

@@ -127,7 +127,7 @@ Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vert
   const bool visible = !scene_.occluded(s.spawn_to(ls->p, vec3(0.0f), -ls->wi));
   const Spectrum L = visible ? f * ls->Le / ls->pdf : Spectrum(0.0f);
   if (path.observer)
-    path.observer->on_light({vertex, true, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, 1.0f, beta * L});
+    path.observer->on_light({vertex, true, false, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, 1.0f, beta * L});
   return L;
 }
 
@@ -150,7 +150,7 @@ Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int verte
   const bool visible = !scene_.occluded(shadow);
   const Spectrum L = visible ? f * ls->Le * (w / ls->pdf) : Spectrum(0.0f);
   if (path.observer)
-    path.observer->on_light({vertex, false, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, w, beta * L});
+    path.observer->on_light({vertex, false, ls->infinite, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, w, beta * L});
   return L;
 }
 

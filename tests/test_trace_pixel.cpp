@@ -29,7 +29,7 @@ TEST(TracePixel, ReplayIsDeterministicAndMatchesTheRender) {
     PathRecorder a, b;
     const FilmSample fa = tracer.trace_sample(7, 9, sample, &a);
     tracer.trace_sample(7, 9, sample, &b);
-    const TraceHeader h{"cornell", "reference", 7, 9, sample, settings};
+    const TraceHeader h{"cornell", "reference", 7, 9, sample, settings, 16, 16};
     EXPECT_EQ(path_to_json(h, a, compiled.scene()).dump(), path_to_json(h, b, compiled.scene()).dump());
     // The observer changes nothing: same bits as the production render.
     const FilmSample& fr = batch[(9 * 16 + 7) * 3 + sample];

@@ -1,6 +1,6 @@
 // The `pathlab` command line. Each subcommand lives in its own file; main()
 // only calls run(). Exit codes: 0 success, 1 a check failed, 2 bad input or
-// usage. Human output goes to stderr, machine output (--json) to stdout.
+// usage, 3 a system failure (Embree, out of memory). Human output goes to stderr, machine output (--json) to stdout.
 #pragma once
 
 #include <iosfwd>

@@ -43,7 +43,8 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
 
   const Scene& sc = compiled.scene();
   TraceHeader header{sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string(), std::string(tracer->name()),
-                     static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), sample, settings};
+                     static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), sample, settings,
+                     sc.film.width, sc.film.height};
   if (json) out << path_to_json(header, recorder, sc).dump(2) << "\n";
   else err << path_to_text(header, recorder, sc);
   return 0;
