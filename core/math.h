@@ -27,6 +27,7 @@ inline constexpr float kInvPi = 1.0f / kPi;
 inline constexpr float kInv2Pi = 1.0f / (2.0f * kPi);
 inline constexpr float kInv4Pi = 1.0f / (4.0f * kPi);
 inline constexpr float kInfinity = std::numeric_limits<float>::infinity();
+inline constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;  // the largest float below 1
 
 inline float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
 inline float average(const vec3& v) { return (v.x + v.y + v.z) * (1.0f / 3.0f); }

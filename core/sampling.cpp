@@ -34,7 +34,9 @@ vec2 concentric_disk_to_square(vec2 p) {
     b = -r;
     a = -(phi - 3.0f * kPi / 2.0f) * b / (kPi / 4.0f);
   }
-  return (vec2(a, b) + vec2(1.0f)) * 0.5f;
+  // (x + 1) / 2 can round up to exactly 1 for the last float below 1; keep
+  // the result in [0, 1) like the square it inverts.
+  return glm::clamp((vec2(a, b) + vec2(1.0f)) * 0.5f, vec2(0.0f), vec2(kOneMinusEpsilon));
 }
 
 vec3 square_to_cosine_hemisphere(vec2 u) {
@@ -66,8 +68,10 @@ vec2 square_to_uniform_triangle(vec2 u) {
 }
 
 vec2 uniform_triangle_to_square(vec2 b) {
+  // s = 1 - b2 cancels when s is tiny, so b1 / s can come out a little
+  // above 1: clamp to the square the forward warp reads.
   const float s = 1.0f - b.y;
-  return vec2(s * s, s > 0.0f ? b.x / s : 0.0f);
+  return glm::clamp(vec2(s * s, s > 0.0f ? b.x / s : 0.0f), vec2(0.0f), vec2(kOneMinusEpsilon));
 }
 
 }  // namespace pathlab

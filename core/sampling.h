@@ -29,11 +29,12 @@ vec2 uniform_triangle_to_square(vec2 b);
 
 // Veach's power heuristic (beta = 2) for two one-sample techniques.
 inline float power_heuristic(float pdf_a, float pdf_b) {
-  const float a = pdf_a * pdf_a;
-  const float b = pdf_b * pdf_b;
-  // pdf_a = inf (a delta the other cannot sample) must give 1, not NaN.
-  if (std::isinf(a)) return 1.0f;
-  return a + b > 0.0f ? a / (a + b) : 0.0f;
+  if (std::isinf(pdf_a)) return 1.0f;  // a delta the other technique cannot sample
+  if (!(pdf_a > 0.0f)) return 0.0f;
+  // a^2 / (a^2 + b^2) through the ratio: squaring the pdfs themselves would
+  // overflow above ~1.8e19 and underflow below ~1e-23.
+  const float r = pdf_b / pdf_a;
+  return 1.0f / (1.0f + r * r);
 }
 
 // Solid-angle density of a point sampled on a surface with area density

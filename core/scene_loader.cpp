@@ -8,10 +8,17 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
+#include <span>
 #include <sstream>
+#include <string>
+#include <string_view>
 #include <utility>
+#include <vector>
 
 namespace pathlab {
 namespace {
@@ -96,7 +103,8 @@ class Node {
     if (!value_.is_number()) fail("expected a number, found " + describe(value_));
     const double v = value_.get<double>();
     if (!std::isfinite(v)) fail("number is not finite");
-    if (std::abs(v) > std::numeric_limits<float>::max()) fail("number " + value_.dump() + " is too large (the limit is 3.4e38)");
+    if (std::abs(v) > std::numeric_limits<float>::max())
+      fail("number " + value_.dump() + " is too large (the limit is 3.4e38)");
     return v;
   }
   std::int64_t integer() const {
@@ -193,7 +201,7 @@ FilmDesc read_film(const Node& node) {
     const std::string name = node.child("filter").string();
     if (name == "box") f.filter = FilterKind::Box;
     else if (name == "bilinear") f.filter = FilterKind::Bilinear;
-    else node.child("filter").fail("unknown filter '" + name + "' (expected box or bilinear)");
+    else node.child("filter").fail("unknown filter " + in_quotes(name) + " (expected box or bilinear)");
   }
   return f;
 }
@@ -219,14 +227,24 @@ RenderSettings read_render(const Node& node) {
   if (node.has("strategy")) {
     const std::string name = node.child("strategy").string();
     const auto s = parse_strategy(name);
-    if (!s) node.child("strategy").fail("unknown strategy '" + name + "' (expected cosine, bsdf, light, light+bsdf or mis)");
+    if (!s) {
+      const std::array<std::string_view, 5> names{"cosine", "bsdf", "light", "light+bsdf", "mis"};
+      const std::string near = suggestion(name, names);
+      node.child("strategy").fail("unknown strategy " + in_quotes(name) +
+                                  (near.empty() ? " (expected cosine, bsdf, light, light+bsdf or mis)" : near));
+    }
     r.strategy = *s;
   }
   if (node.has("seed")) {
     // Any 64-bit unsigned value, as --seed takes.
     const Node s = node.child("seed");
-    if (s.value().is_number_unsigned()) r.seed = s.value().get<std::uint64_t>();
-    else if (s.integer() < 0) s.fail("seed must not be negative");
+    if (s.value().is_number_unsigned()) {
+      r.seed = s.value().get<std::uint64_t>();
+    } else {
+      const std::int64_t seed = s.integer();
+      if (seed < 0) s.fail("seed must not be negative");
+      r.seed = static_cast<std::uint64_t>(seed);
+    }
   }
   return r;
 }
@@ -236,7 +254,8 @@ RenderSettings read_render(const Node& node) {
 void reject_misplaced(const Node& node, const std::string& type,
                       std::initializer_list<std::pair<const char*, const char*>> keys) {
   for (const auto& [key, advice] : keys)
-    if (node.has(key)) node.child(key).fail("a " + type + " material has no '" + key + "'; " + advice);
+    if (node.has(key))
+      node.child(key).fail((type == "emissive" ? "an " : "a ") + type + " material has no '" + key + "'; " + advice);
 }
 
 Material read_material(const Node& node, const std::string& name) {
@@ -459,9 +478,40 @@ void read_lights(const Node& node, Scene* scene) {
     } else {
       const std::array<std::string_view, 2> types{"point", "environment"};
       const std::string near = suggestion(type, types);
-      l.child("type").fail("unknown light type " + in_quotes(type) + (near.empty() ? " (expected point or environment)" : near));
+      l.child("type").fail("unknown light type " + in_quotes(type) +
+                           (near.empty() ? " (expected point or environment)" : near));
     }
   }
+}
+
+// nlohmann 3.11 reports a number literal beyond the double range (1e999, the
+// only way to write an infinity in JSON) as out_of_range 406, not as a
+// parse_error, and JsonDocument lets it through. Give it the same
+// "<file>:<line>:<column>: malformed JSON: ..." form as any other syntax error.
+[[noreturn]] void number_overflow(std::string_view text, const std::filesystem::path& file,
+                                  const nlohmann::json::out_of_range& e) {
+  // e.what(): "[json.exception.out_of_range.406] number overflow parsing '1e999'"
+  const std::string what = e.what();
+  const auto open = what.find("parsing '");
+  const auto close = open == std::string::npos ? std::string::npos : what.find('\'', open + 9);
+  if (close == std::string::npos) throw InputError(file.string() + ": malformed JSON: " + what);
+  const std::string literal = what.substr(open + 9, close - open - 9);
+  // The first occurrence of the literal as a whole token.
+  const auto is_token_char = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+';
+  };
+  std::string where = file.string();
+  for (std::size_t at = text.find(literal); at != std::string_view::npos; at = text.find(literal, at + 1)) {
+    const std::size_t end = at + literal.size();
+    if ((at > 0 && is_token_char(text[at - 1])) || (end < text.size() && is_token_char(text[end]))) continue;
+    const std::string_view before = text.substr(0, at);
+    const std::size_t line_start = before.rfind('\n') == std::string_view::npos ? 0 : before.rfind('\n') + 1;
+    where += ":" + std::to_string(std::count(before.begin(), before.end(), '\n') + 1) + ":" +
+             std::to_string(at - line_start + 1);
+    break;
+  }
+  throw InputError(where + ": malformed JSON: number " + in_quotes(literal) +
+                   " is out of range (numbers must be finite)");
 }
 
 Scene read_scene(const JsonDocument& doc) {
@@ -509,10 +559,29 @@ Scene read_scene(const JsonDocument& doc) {
 }  // namespace
 
 Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
-  return read_scene(JsonDocument::parse(text, file));
+  const auto parse = [&] {
+    try {
+      return JsonDocument::parse(text, file);
+    } catch (const nlohmann::json::out_of_range& e) {
+      number_overflow(text, file, e);
+    }
+  };
+  return read_scene(parse());
 }
 
-Scene load_scene(const std::filesystem::path& file) { return read_scene(JsonDocument::load(file)); }
+Scene load_scene(const std::filesystem::path& file) {
+  const auto load = [&] {
+    try {
+      return JsonDocument::load(file);
+    } catch (const nlohmann::json::out_of_range& e) {
+      // The file was read once already; read it again to place the number.
+      std::ifstream in(file, std::ios::binary);
+      const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+      number_overflow(text, file, e);
+    }
+  };
+  return read_scene(load());
+}
 
 Scene builtin_cornell_box() {
   Scene scene = parse_scene(builtin_cornell_box_text(), "<built-in cornell-box>");

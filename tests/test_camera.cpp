@@ -397,6 +397,14 @@ TEST(CameraThinLens, ZeroApertureIsThePinhole) {
 RayFn y_up(const Shot& s) {
   return [ray = real_camera(s), h = float(s.height)](vec2 f, vec2 l) { return ray(vec2(f.x, h - f.y), l); };
 }
+// Looking away from look_at (forward = position - look_at).
+RayFn backwards(const Shot& s) {
+  return [ray = real_camera(s)](vec2 f, vec2 l) {
+    Ray r = ray(f, l);
+    r.dir = -r.dir;
+    return r;
+  };
+}
 // Mirror image (right = up x forward).
 RayFn mirrored(const Shot& s) {
   return [ray = real_camera(s), w = float(s.width)](vec2 f, vec2 l) { return ray(vec2(w - f.x, f.y), l); };
@@ -452,6 +460,7 @@ RayFn sphere_of_focus(const Shot& s) {
 }
 
 TEST(CameraPlantedBugs, FramingBugsAreCaught) {
+  EXPECT_FALSE(centre_ray_points_at_look_at(kTilted, backwards(kTilted)));
   EXPECT_FALSE(film_y_grows_downward(kTilted, y_up(kTilted)));
   EXPECT_FALSE(corner_rays_make_half_angles(kTilted, y_up(kTilted)));
   EXPECT_FALSE(film_x_grows_rightward(kPortrait, mirrored(kPortrait)));
@@ -470,12 +479,14 @@ TEST(CameraPlantedBugs, ThinLensBugsAreCaught) {
   // Focus on a sphere instead of a plane: misses off-axis.
   EXPECT_FALSE(thin_lens_rays_meet_on_focus_plane(s, sphere_of_focus(s)));
   // Aperture radius used as a diameter.
-  EXPECT_FALSE(thin_lens_rays_meet_on_focus_plane(s, rewritten_lens(s, [](vec3 o) { return 2.0f * o; }, true_focus(s))));
+  EXPECT_FALSE(
+      thin_lens_rays_meet_on_focus_plane(s, rewritten_lens(s, [](vec3 o) { return 2.0f * o; }, true_focus(s))));
   // Lens tilted out of the plane perpendicular to forward (same radius).
   EXPECT_FALSE(thin_lens_rays_meet_on_focus_plane(
       s, rewritten_lens(s, [fwd](vec3 o) { return 0.8f * o + 0.6f * glm::length(o) * fwd; }, true_focus(s))));
   // Lens sample ignored: all rays from the centre of the lens.
-  EXPECT_FALSE(thin_lens_fills_aperture_uniformly(s, rewritten_lens(s, [](vec3) { return vec3(0.0f); }, true_focus(s))));
+  EXPECT_FALSE(
+      thin_lens_fills_aperture_uniformly(s, rewritten_lens(s, [](vec3) { return vec3(0.0f); }, true_focus(s))));
   // Radius r / R taken to (r / R)^2: not uniform over the disk.
   EXPECT_FALSE(thin_lens_fills_aperture_uniformly(
       s, rewritten_lens(s, [radius](vec3 o) { return o * (glm::length(o) / radius); }, true_focus(s))));

@@ -13,7 +13,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -222,7 +221,11 @@ testing::AssertionResult uncorrelated(const std::vector<PairCase>& cases) {
     double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0;
     for (std::uint32_t i = 0; i < kN; ++i) {
       const auto [a, b] = c.draw(i);
-      sa += a, sb += b, saa += double(a) * a, sbb += double(b) * b, sab += double(a) * b;
+      sa += a;
+      sb += b;
+      saa += double(a) * a;
+      sbb += double(b) * b;
+      sab += double(a) * b;
     }
     const double n = kN;
     const double cov = sab - sa * sb / n, va = saa - sa * sa / n, vb = sbb - sb * sb / n;
@@ -295,10 +298,11 @@ testing::AssertionResult no_structured_collisions(UFn u) {
         for (std::uint32_t d = 0; d < kDims; ++d) values.push_back(u(kBase.seed, p, s, b, dim(d)));
   std::sort(values.begin(), values.end());
   long equal_pairs = 0;
-  for (std::size_t i = 0, j; i < values.size(); i = j) {
-    for (j = i; j < values.size() && values[j] == values[i]; ++j) {
-    }
+  for (std::size_t i = 0; i < values.size();) {
+    std::size_t j = i + 1;
+    while (j < values.size() && values[j] == values[i]) ++j;
     equal_pairs += static_cast<long>((j - i) * (j - i - 1) / 2);
+    i = j;
   }
   const double n = static_cast<double>(values.size());
   const double lambda = n * (n - 1.0) / 2.0 * 0x1p-24;

@@ -213,7 +213,9 @@ TEST(SceneLoader, MaterialsOfEachTypeAndTheirDefaults) {
   expect_vec(get("lamp").albedo, vec3(0.0f));
   EXPECT_FALSE(get("lamp").scatters());
   EXPECT_FALSE(get("lamp").two_sided_emission);
-  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];  // "glow" and "lamp" are lights even if unused
+  // Emitting materials that no shape uses light nothing.
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("no light"), std::string::npos) << s.warnings[0];
 }
 
 TEST(SceneLoader, ShapesReferToTheirMaterialByName) {
@@ -551,9 +553,9 @@ TEST(SceneLoaderErrors, ErrorInANestedValueReportsItsPosition) {
     {"type": "rectangle", "material": "white",
      "transform": [{"translate": [0, 1, 0]}, {"rotate": {"axis": [0, 1, 0], "angle": "90"}}]}
   ])");
-  // Line 7 is the transform; the key "angle" starts at column 75.
-  EXPECT_EQ(where_in(text, "\"angle\""), "7:75");
-  expect_error(text, "7:75", "/shapes/1/transform/1/rotate/angle", "expected a number, found the string \"90\"");
+  // Line 8 is the transform; the key "angle" starts at column 77.
+  EXPECT_EQ(where_in(text, "\"angle\""), "8:77");
+  expect_error(text, "8:77", "/shapes/1/transform/1/rotate/angle", "expected a number, found the string \"90\"");
 
   // An array element is placed where its value starts.
   const std::string element = scene_text(kMaterials, R"([{"type": "sphere", "material": "lamp",
@@ -577,7 +579,9 @@ TEST(SceneLoaderErrors, UnknownKeysSuggestTheNearestValidOne) {
   EXPECT_NE(error_of(mirror).find("a mirror material has no 'albedo'; its colour is 'reflectance'"), std::string::npos)
       << error_of(mirror);
   const std::string emissive = scene_text(R"({"m": {"type": "emissive", "emission": 1}})", "[]");
-  EXPECT_NE(error_of(emissive).find("'radiance'"), std::string::npos) << error_of(emissive);
+  EXPECT_NE(error_of(emissive).find("an emissive material has no 'emission'; its emitted light is 'radiance'"),
+            std::string::npos)
+      << error_of(emissive);
 }
 
 TEST(SceneLoaderErrors, UnknownNamesSuggestTheNearest) {
@@ -597,7 +601,11 @@ TEST(SceneLoaderErrors, UnknownNamesSuggestTheNearest) {
   const std::string filter = scene_text("{}", "[]", R"("film": {"filter": "gauss"})");
   EXPECT_NE(error_of(filter).find("unknown filter 'gauss' (expected box or bilinear)"), std::string::npos);
   const std::string strategy = scene_text("{}", "[]", R"("render": {"strategy": "path"})");
-  EXPECT_NE(error_of(strategy).find("unknown strategy 'path'"), std::string::npos);
+  EXPECT_NE(error_of(strategy).find("unknown strategy 'path' (expected cosine, bsdf, light, light+bsdf or mis)"),
+            std::string::npos)
+      << error_of(strategy);
+  const std::string light_bsdf = scene_text("{}", "[]", R"("render": {"strategy": "light-bsdf"})");
+  EXPECT_NE(error_of(light_bsdf).find("(did you mean 'light+bsdf'?)"), std::string::npos) << error_of(light_bsdf);
 }
 
 TEST(SceneLoaderErrors, VersionAndStructure) {
@@ -614,14 +622,28 @@ TEST(SceneLoaderErrors, VersionAndStructure) {
                 "/camera: missing required key 'look_at'"),
             std::string::npos);
   // A misspelt required key is pointed out.
-  const std::string misspelt = scene_text(R"({"m": {"tpye": "diffuse"}})", "[]");
-  EXPECT_NE(error_of(misspelt).find("missing required key 'type' (is 'tpye' a misspelling of it?)"), std::string::npos)
+  const std::string misspelt = scene_text(R"({"m": {"typ": "diffuse"}})", "[]");
+  EXPECT_NE(error_of(misspelt).find("missing required key 'type' (is 'typ' a misspelling of it?)"), std::string::npos)
       << error_of(misspelt);
   EXPECT_NE(error_of(scene_text("{}", "{}")).find("/shapes: expected an array of shapes"), std::string::npos);
   // Malformed JSON names file, line and column.
   EXPECT_EQ(error_of("{\n  \"pathlab_scene\": 1,\n  \"camera\": {\"position\": [0, 0] \"look_at\": 1}\n}").rfind(
                 "scene.json:3:", 0),
             0u);
+}
+
+TEST(SceneLoaderErrors, OverflowingNumberIsMalformedJson) {
+  // 1e999 is the only way to write an infinity; nlohmann rejects it with an
+  // out_of_range exception that must not escape as anything but InputError.
+  const std::string text = scene_text(R"({"m": {"type": "diffuse",
+    "emission": [1, 1e999, 1]}})", "[]");
+  EXPECT_EQ(error_of(text), "scene.json:5:21: malformed JSON: number '1e999' is out of range (numbers must be finite)");
+  EXPECT_EQ(where_in(text, "1e999"), "5:21");
+  // A larger literal that contains it is not mistaken for it.
+  const std::string negative = scene_text("{}", "[]", R"("render": {"spp": 11e999, "seed": -1e999})");
+  EXPECT_NE(error_of(negative).find("number '11e999'"), std::string::npos) << error_of(negative);
+  EXPECT_NE(error_of(negative).find("scene.json:" + where_in(negative, "11e999") + ":"), std::string::npos)
+      << error_of(negative);
 }
 
 TEST(SceneLoaderErrors, WrongTypes) {
