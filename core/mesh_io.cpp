@@ -16,6 +16,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <initializer_list>
 #include <iterator>
@@ -34,6 +35,22 @@ namespace fs = std::filesystem;
 // Throws "<file>: <problem>", or "<file>:<line>: <problem>" given a line number.
 [[noreturn]] void fail(const fs::path& file, const std::string& problem, int line = 0) {
   throw InputError(file.string() + (line > 0 ? ":" + std::to_string(line) : "") + ": " + problem);
+}
+
+enum class Number { kOk, kMalformed, kOverflow };
+
+// Parses all of `token` as a decimal number into `out` (a leading '+' is
+// allowed; hex is not). An overflow such as 1e999 sets `out` to +-infinity
+// and returns kOverflow; an underflow such as 1e-999 is a valid (tiny or zero) number.
+Number parse_number(std::string_view token, double& out) {
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);  // from_chars rejects '+'
+  const char* const last = token.data() + token.size();
+  const auto [end, ec] = std::from_chars(token.data(), last, out);
+  if (end != last || (ec != std::errc() && ec != std::errc::result_out_of_range)) return Number::kMalformed;
+  if (ec == std::errc()) return Number::kOk;
+  // from_chars leaves `out` alone when out of range; strtod tells over- from underflow.
+  out = std::strtod(std::string(token).c_str(), nullptr);
+  return std::isinf(out) ? Number::kOverflow : Number::kOk;
 }
 
 // Polygons as stored in the file, before validation and triangulation.
@@ -70,6 +87,7 @@ TriangleMesh finish(const fs::path& file, const RawMesh& raw, MeshLoadReport* re
       fail(file, problem.str());
     }
   }
+  if (raw.face_count() == 0) fail(file, "no faces");
   if (raw.positions.size() > std::numeric_limits<std::uint32_t>::max())
     fail(file, "too many vertices (" + std::to_string(raw.positions.size()) + ")");
   check_indices(file, raw);
@@ -104,7 +122,44 @@ TriangleMesh finish(const fs::path& file, const RawMesh& raw, MeshLoadReport* re
 
 // ---------------------------------------------------------------- OBJ
 
+// tinyobj turns a coordinate it cannot parse ("nan", "inf", "1,5", "abc")
+// into 0 without a warning, so a broken vertex would load silently at the
+// origin. Check the first three coordinates of every vertex line ("v" as
+// tinyobj recognises it) before handing the text over.
+void check_obj_vertices(const fs::path& file, std::string_view text) {
+  const auto is_blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  int vertex = 0;
+  for (int line_no = 1; !text.empty(); ++line_no) {
+    const std::size_t eol = std::min(text.find('\n'), text.size());
+    std::string_view line = text.substr(0, eol);
+    text.remove_prefix(std::min(eol + 1, text.size()));
+    line.remove_prefix(std::min(line.find_first_not_of(" \t"), line.size()));
+    if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
+    ++vertex;
+    const auto bad = [&](const std::string& problem) { fail(file, "vertex " + std::to_string(vertex) + problem, line_no); };
+    std::string_view coords[3];
+    int n = 0;
+    for (std::size_t i = 1; n < 3;) {
+      while (i < line.size() && is_blank(line[i])) ++i;
+      if (i == line.size()) break;
+      const std::size_t start = i;
+      while (i < line.size() && !is_blank(line[i])) ++i;
+      coords[n++] = line.substr(start, i - start);
+    }
+    if (n < 3) bad(" has " + std::to_string(n) + " coordinates (3 needed)");
+    const auto quoted = [](std::string_view c) { return std::string(c.substr(0, 40)); };
+    for (const std::string_view c : coords) {
+      double value = 0.0;
+      if (parse_number(c, value) == Number::kMalformed) bad(": malformed number '" + quoted(c) + "'");
+      if (!std::isfinite(value))
+        bad(" has a non-finite coordinate (" + quoted(coords[0]) + ", " + quoted(coords[1]) + ", " +
+            quoted(coords[2]) + ")");
+    }
+  }
+}
+
 RawMesh parse_obj(const fs::path& file, std::string_view text) {
+  check_obj_vertices(file, text);
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;
   config.vertex_color = false;
@@ -279,11 +334,12 @@ class PlyBody {
     if (pos_ == body_.size()) return false;
     const std::size_t start = pos_;
     while (pos_ < body_.size() && !is_space(body_[pos_])) ++pos_;
-    std::string_view token = body_.substr(start, pos_ - start);
-    if (token.size() > 1 && token[0] == '+') token.remove_prefix(1);  // from_chars rejects '+'
-    const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), out);
-    if (ec != std::errc() || end != token.data() + token.size())
+    const std::string_view token = body_.substr(start, pos_ - start);
+    const Number parsed = parse_number(token, out);
+    if (parsed == Number::kMalformed)
       fail(file_, "malformed number '" + std::string(token.substr(0, 40)) + "'", line_);
+    if (parsed == Number::kOverflow)
+      fail(file_, "number '" + std::string(token.substr(0, 40)) + "' is out of range", line_);
     return true;
   }
 

@@ -251,7 +251,8 @@ TEST_F(BadInput, NegativeMaterialParameter) {
 TEST_F(BadInput, NanMaterialParameter) {
   // JSON has no NaN: the file is malformed where the NaN stands.
   const std::string text = scene("    \"white\": {\"type\": \"diffuse\", \"albedo\": NaN}", kSphere);
-  expect_rejected(render(write("nan.json", text)), {"nan.json:" + where_in(text, "NaN"), "malformed JSON"});
+  expect_rejected(render(write("nan.json", text)),
+                  {"nan.json:" + where_in(text, "NaN"), "malformed JSON", "(JSON has no NaN or infinity)"});
   const std::string huge = scene("    \"white\": {\"type\": \"diffuse\", \"emission\": 1e999}", kSphere);
   // An infinity can only be written as an overflowing number.
   expect_rejected(render(write("huge.json", huge)),
@@ -333,12 +334,15 @@ TEST_F(BadInput, InfiniteVertexInObj) {
                   {"inf-obj.json:", "inf.obj", "vertex 2 has a non-finite coordinate"});
 }
 
-// tinyobjloader reads "nan" and "inf" (and any garbage) as 0, so these
-// vertices load silently; see the report on core/mesh_io.cpp.
-TEST_F(BadInput, DISABLED_NanVertexInObj) {
+// tinyobjloader reads "nan" and "inf" (and any garbage) as 0; mesh_io checks
+// the vertex lines itself so that these do not load silently.
+TEST_F(BadInput, NanVertexInObj) {
   write("nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n");
   expect_rejected(render(write("nan-obj.json", mesh_scene("nan.obj"))),
-                  {"nan-obj.json:", "nan.obj", "non-finite coordinate"});
+                  {"nan-obj.json:", "nan.obj:2: vertex 2 has a non-finite coordinate"});
+  write("abc.obj", "v 0 0 0\nv 1 abc 0\nv 0 1 0\nf 1 2 3\n");
+  expect_rejected(render(write("abc-obj.json", mesh_scene("abc.obj"))),
+                  {"abc-obj.json:", "abc.obj:2: vertex 2: malformed number 'abc'"});
 }
 
 TEST_F(BadInput, DegenerateTrianglesAreDroppedCountedAndWarned) {

@@ -14,6 +14,7 @@
 #include "core/camera.h"
 
 #include "core/sampling.h"
+#include "tests/stat_util.h"
 
 #include <gtest/gtest.h>
 
@@ -31,48 +32,8 @@ namespace {
 
 // --- statistics (for the one statistical test: the lens is filled uniformly) -
 
-// Regularized upper incomplete gamma function Q(a, x): the series for P when
-// x < a + 1, Lentz's continued fraction for Q otherwise (Numerical Recipes,
-// 3rd ed., section 6.2).
-double gamma_q(double a, double x) {
-  if (x <= 0.0) return 1.0;
-  const double log_prefactor = -x + a * std::log(x) - std::lgamma(a);
-  if (x < a + 1.0) {
-    double ap = a, term = 1.0 / a, sum = term;
-    for (int n = 0; n < 10000 && std::abs(term) > std::abs(sum) * 1e-16; ++n) {
-      ap += 1.0;
-      term *= x / ap;
-      sum += term;
-    }
-    return 1.0 - sum * std::exp(log_prefactor);
-  }
-  constexpr double kTiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / kTiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < 10000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < kTiny) d = kTiny;
-    c = b + an / c;
-    if (std::abs(c) < kTiny) c = kTiny;
-    d = 1.0 / d;
-    const double delta = d * c;
-    h *= delta;
-    if (std::abs(delta - 1.0) < 1e-16) break;
-  }
-  return std::exp(log_prefactor) * h;
-}
-
-// The upper critical value c with P(X > c) = alpha for X ~ chi2(dof).
-double chi2_critical(double dof, double alpha) {
-  double lo = 0.0, hi = dof + 10.0;
-  while (gamma_q(0.5 * dof, 0.5 * hi) > alpha) hi *= 2.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (gamma_q(0.5 * dof, 0.5 * mid) > alpha ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
+using test::chi2_critical;
+using test::chi2_equal;
 
 constexpr double kAlpha = 1e-3;
 
@@ -351,9 +312,7 @@ testing::AssertionResult thin_lens_fills_aperture_uniformly(const Shot& s, const
     const int sector = std::min(static_cast<int>(phi / (2.0 * std::numbers::pi) * kSectors), kSectors - 1);
     counts[ring * kSectors + sector] += 1.0;
   }
-  const double expected = double(kN) / counts.size();
-  double stat = 0.0;
-  for (const double c : counts) stat += (c - expected) * (c - expected) / expected;
+  const double stat = chi2_equal(counts, kN);
   const double crit = chi2_critical(static_cast<double>(counts.size()) - 1.0, kAlpha);
   if (stat > crit) return testing::AssertionFailure() << "chi2(127) = " << stat << " > " << crit;
   return testing::AssertionSuccess();

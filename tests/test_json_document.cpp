@@ -164,6 +164,42 @@ TEST(JsonDocumentErrors, CommentsAreRejected) {
   EXPECT_EQ(error_of("// camera\n{}"), "scene.json:1:1: malformed JSON: invalid literal");
 }
 
+// nlohmann reports a number beyond the double range as out_of_range, not as
+// a parse error; it is still malformed JSON at the number's position.
+TEST(JsonDocumentErrors, OverflowingNumber) {
+  EXPECT_EQ(error_of("{\"a\": [1,\n  1e999]}"),
+            "scene.json:2:3: malformed JSON: number '1e999' is out of range (numbers must be finite)");
+  // The same characters inside a string do not count.
+  EXPECT_EQ(error_of("{\"1e999\": \"x 1e999 \\\" -2e400\",\n\"b\": [0, -2e400]}"),
+            "scene.json:2:10: malformed JSON: number '-2e400' is out of range (numbers must be finite)");
+  // An underflow is 0, not an error.
+  EXPECT_EQ(error_of("[1e-999]"), "(no error)");
+  // A very long number is cut short in the message.
+  const std::string digits(400, '9');
+  EXPECT_EQ(error_of("[" + digits + "]"), "scene.json:1:2: malformed JSON: number '" + digits.substr(0, 40) +
+                                               "...' is out of range (numbers must be finite)");
+}
+
+// JSON has no NaN or infinity; writers that emit them get a hint.
+TEST(JsonDocumentErrors, NanAndInfinityLiterals) {
+  for (const std::string token : {"NaN", "nan", "NAN", "Infinity", "inf", "INF", "-Infinity", "-inf", "+inf"}) {
+    SCOPED_TRACE(token);
+    const std::string message = error_of("{\"a\": [1, " + token + "]}");
+    EXPECT_EQ(message.rfind("scene.json:1:", 0), 0u) << message;
+    EXPECT_NE(message.find(": malformed JSON: "), std::string::npos) << message;
+    EXPECT_TRUE(message.ends_with(" (JSON has no NaN or infinity)")) << message;
+  }
+  EXPECT_EQ(error_of("[1, NaN]"), "scene.json:1:5: malformed JSON: invalid literal (JSON has no NaN or infinity)");
+  EXPECT_EQ(error_of("[1,\n  nan]"), "scene.json:2:3: malformed JSON: invalid literal (JSON has no NaN or infinity)");
+  // Other bad literals get no hint.
+  for (const std::string token : {"nope", "Nano", "infinite", "none", "tru"}) {
+    SCOPED_TRACE(token);
+    const std::string message = error_of("[" + token + "]");
+    EXPECT_NE(message.find("malformed JSON"), std::string::npos) << message;
+    EXPECT_EQ(message.find("NaN or infinity"), std::string::npos) << message;
+  }
+}
+
 TEST(JsonDocumentErrors, DuplicateKeyNamesBothLines) {
   const std::string text = R"({
   "materials": {
@@ -250,9 +286,22 @@ constexpr std::array<std::string_view, 5> kMaterialKeys = {"albedo", "roughness"
 TEST(NearestName, TypicalTypos) {
   EXPECT_EQ(nearest_name("albedoo", kMaterialKeys), "albedo");
   EXPECT_EQ(nearest_name("albdo", kMaterialKeys), "albedo");
-  EXPECT_EQ(nearest_name("raduis", kMaterialKeys), "radius");     // a swap costs 2; 6/3 = 2
+  EXPECT_EQ(nearest_name("raduis", kMaterialKeys), "radius");     // a swap of neighbours costs 1
   EXPECT_EQ(nearest_name("roughnes", kMaterialKeys), "roughness");
   EXPECT_EQ(nearest_name("Albedo", kMaterialKeys), "albedo");     // case counts, but 1 edit is close
+}
+
+// Optimal string alignment: swapping two adjacent letters is one edit, so
+// even short keys allow it.
+TEST(NearestName, AdjacentTranspositionIsOneEdit) {
+  constexpr std::array<std::string_view, 3> kKeys = {"material", "type", "file"};
+  EXPECT_EQ(nearest_name("tpye", kKeys), "type");
+  EXPECT_EQ(nearest_name("ytpe", kKeys), "type");
+  EXPECT_EQ(nearest_name("fiel", kKeys), "file");
+  EXPECT_EQ(nearest_name("matreial", kKeys), "material");
+  EXPECT_EQ(nearest_name("mtaeiral", kKeys), "material");  // two swaps: 2 <= 8/3
+  // Only neighbours: "epyt" is no swap away from "type".
+  EXPECT_EQ(nearest_name("epyt", kKeys), "");
 }
 
 TEST(NearestName, ExactMatchIsItsOwnNearest) {

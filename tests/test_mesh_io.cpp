@@ -410,6 +410,12 @@ TEST_F(MeshIoErrors, PlyBadBodyValues) {
   expect_error("two.ply", head + verts + "3 0 1 2\n2 0 1\n", {"face 1 has 2 vertices"});
   // Line 12 is the third body line.
   expect_error("number.ply", head + "0 0 0\n1 0 0\n0 1x 0\n0 0 1\n" + faces, {":12: ", "malformed number '1x'"});
+  expect_error("overflow.ply", head + "0 0 0\n1 0 0\n0 1e999 0\n0 0 1\n" + faces,
+               {":12: ", "number '1e999' is out of range"});
+  // An underflow is just 0.
+  MeshLoadReport report;
+  EXPECT_EQ(load_mesh(write("tiny.ply", head + "0 0 1e-999\n1 0 0\n0 1 0\n0 0 1\n" + faces), &report).positions[0],
+            vec3(0.0f));
   expect_error("fraction.ply", head + verts + "3 0 1 2.5\n3 0 1 3\n", {"face 0 has an invalid vertex index"});
   expect_error("length.ply", head + verts + "-3 0 1 2\n3 0 1 3\n", {"invalid list length"});
   expect_error("flat.ply", head + "0 0 0\n1 0 0\n2 0 0\n3 0 0\n3 0 1 2\n3 1 1 3\n",
@@ -436,8 +442,52 @@ TEST_F(MeshIoErrors, ObjProblems) {
   expect_error("quad.obj", verts + "f 1 2 3\nf 1 2 3 9\n", {"vertex", "4 vertices"});
   // 1e39 overflows float.
   expect_error("huge.obj", verts + "v 1e39 0 0\nf 1 2 3\n", {"vertex 5 has a non-finite coordinate (inf, 0, 0)"});
-  expect_error("empty.obj", "# nothing\n", {"no usable triangles (0 degenerate dropped)"});
   expect_error("line.obj", verts + "f 1 2\n", {"fewer than 3 vertices"});
+}
+
+// A file without faces says so, rather than "no usable triangles".
+TEST_F(MeshIoErrors, NoFaces) {
+  expect_error("empty.obj", "# nothing\n", {"empty.obj: no faces"});
+  expect_error("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n", {"points.obj: no faces"});
+  expect_error("none.ply",
+               "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+               "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n",
+               {"none.ply: no faces"});
+}
+
+// tinyobj reads "nan", "inf" and garbage coordinates as 0, so mesh_io checks
+// the vertex lines itself and names the line and the vertex (from 1).
+TEST_F(MeshIoErrors, ObjNonFiniteAndMalformedCoordinates) {
+  const std::string face = "f 1 2 3\n";
+  expect_error("nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\n" + face,
+               {"nan.obj:2: vertex 2 has a non-finite coordinate (1, nan, 0)"});
+  expect_error("inf.obj", "v inf 0 0\nv 1 0 0\nv 0 1 0\n" + face,
+               {"inf.obj:1: vertex 1 has a non-finite coordinate (inf, 0, 0)"});
+  expect_error("ninf.obj", "v 0 0 0\nv 1 0 0\nv 0 1 -Infinity\n" + face,
+               {"ninf.obj:3: vertex 3 has a non-finite coordinate (0, 1, -Infinity)"});
+  // 1e999 overflows even a double.
+  expect_error("huge.obj", "v 0 0 0\nv 1 1e999 0\nv 0 1 0\n" + face,
+               {"huge.obj:2: vertex 2 has a non-finite coordinate (1, 1e999, 0)"});
+  expect_error("abc.obj", "v 0 0 0\nv 1 abc 0\nv 0 1 0\n" + face, {"abc.obj:2: vertex 2: malformed number 'abc'"});
+  expect_error("suffix.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0.5x\n" + face,
+               {"suffix.obj:3: vertex 3: malformed number '0.5x'"});
+  expect_error("comma.obj", "v 0 0 0\nv 1,5 0 0\nv 0 1 0\n" + face, {"comma.obj:2: vertex 2: malformed number '1,5'"});
+  expect_error("short.obj", "v 0 0 0\nv 1 0\nv 0 1 0\n" + face, {"short.obj:2: vertex 2 has 2 coordinates (3 needed)"});
+  // Only 'v' lines count as vertices; lines count from 1, indented or not.
+  expect_error("mixed.obj", "# comment\nvn 0 0 1\nv 0 0 0\n  v 1 0 0\nvt nan 0\n\tv 0 1 NaN\r\n" + face,
+               {"mixed.obj:6: vertex 3 has a non-finite coordinate (0, 1, NaN)"});
+}
+
+TEST_F(MeshIoObj, VertexCheckAcceptsEveryNumberForm) {
+  // Signs, exponents, an underflow to 0, tabs, CRLF, a w and vertex colours.
+  const TriangleMesh mesh =
+      load_mesh(write("forms.obj", "v +0 -0.0 1e-999\r\nv\t1.\t0 0 1\nv .0 1E0 0 1 0.5 0.25\n"
+                                   "vt 0 0\nf 1 2 3\n"));
+  ASSERT_EQ(mesh.positions.size(), 3u);
+  EXPECT_EQ(mesh.positions[0], vec3(0.0f));
+  EXPECT_EQ(mesh.positions[1], vec3(1.0f, 0.0f, 0.0f));
+  EXPECT_EQ(mesh.positions[2], vec3(0.0f, 1.0f, 0.0f));
+  EXPECT_EQ(mesh.triangles.size(), 1u);
 }
 
 // ---------------------------------------------------------------- shared data

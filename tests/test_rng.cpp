@@ -9,6 +9,7 @@
 // deliberately broken generators and expects them to fail: it shows each
 // check has the power to catch the class of bug it is there for.
 #include "core/rng.h"
+#include "tests/stat_util.h"
 
 #include <gtest/gtest.h>
 
@@ -26,77 +27,11 @@ namespace {
 
 // --- statistics ----------------------------------------------------------------
 
-// Regularized upper incomplete gamma function Q(a, x): the series for P when
-// x < a + 1, Lentz's continued fraction for Q otherwise (Numerical Recipes,
-// 3rd ed., section 6.2).
-double gamma_q(double a, double x) {
-  if (x <= 0.0) return 1.0;
-  const double log_prefactor = -x + a * std::log(x) - std::lgamma(a);
-  if (x < a + 1.0) {
-    double ap = a, term = 1.0 / a, sum = term;
-    for (int n = 0; n < 10000 && std::abs(term) > std::abs(sum) * 1e-16; ++n) {
-      ap += 1.0;
-      term *= x / ap;
-      sum += term;
-    }
-    return 1.0 - sum * std::exp(log_prefactor);
-  }
-  constexpr double kTiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / kTiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < 10000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < kTiny) d = kTiny;
-    c = b + an / c;
-    if (std::abs(c) < kTiny) c = kTiny;
-    d = 1.0 / d;
-    const double delta = d * c;
-    h *= delta;
-    if (std::abs(delta - 1.0) < 1e-16) break;
-  }
-  return std::exp(log_prefactor) * h;
-}
-
-// P(X > x) for X ~ chi-square with `dof` degrees of freedom.
-double chi2_sf(double x, double dof) { return gamma_q(0.5 * dof, 0.5 * x); }
-
-// The upper critical value c with P(X > c) = alpha, by bisection.
-double chi2_critical(double dof, double alpha) {
-  double lo = 0.0, hi = dof + 10.0;
-  while (chi2_sf(hi, dof) > alpha) hi *= 2.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (chi2_sf(mid, dof) > alpha ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
-// Two-sided standard normal critical value z with P(|Z| > z) = alpha.
-double z_critical(double alpha) {
-  double lo = 0.0, hi = 40.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (std::erfc(mid / std::sqrt(2.0)) > alpha ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
-// Per-comparison level that keeps the family-wise level at alpha over m
-// independent comparisons (Sidak).
-double sidak(double alpha, std::size_t m) {
-  return -std::expm1(std::log1p(-alpha) / static_cast<double>(m));
-}
-
-// P(X >= k) for X ~ Poisson(lambda).
-double poisson_sf(long k, double lambda) {
-  double pmf = std::exp(-lambda), below = 0.0;
-  for (long i = 0; i < k; ++i) {
-    below += pmf;
-    pmf *= lambda / static_cast<double>(i + 1);
-  }
-  return std::max(0.0, 1.0 - below);
-}
+using test::chi2_critical;
+using test::chi2_equal;
+using test::poisson_sf;
+using test::sidak;
+using test::z_critical;
 
 // Family-wise false-alarm rate of each statistical test.
 constexpr double kAlpha = 1e-3;
@@ -141,14 +76,6 @@ Key step(Key k, Axis axis, std::uint32_t i) {
 }
 
 constexpr Key kBase{0x5eed1234ull, 1234, 5, 2};
-
-// Pearson chi-square of `counts` against equal expected counts.
-double chi2_equal(const std::vector<std::uint32_t>& counts, double n) {
-  const double expected = n / static_cast<double>(counts.size());
-  double stat = 0.0;
-  for (const std::uint32_t c : counts) stat += (c - expected) * (c - expected) / expected;
-  return stat;
-}
 
 // 64-bin chi-square of n draws, or a failure if a draw leaves [0, 1).
 testing::AssertionResult uniform_64(const std::function<float(std::uint32_t)>& draw, std::uint32_t n,

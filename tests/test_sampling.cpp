@@ -10,6 +10,7 @@
 // same checks on deliberately broken warps and expects them to fail: it shows
 // each check has the power to catch the class of bug it is there for.
 #include "core/sampling.h"
+#include "tests/stat_util.h"
 
 #include <gtest/gtest.h>
 
@@ -28,51 +29,8 @@ namespace {
 
 // --- statistics ----------------------------------------------------------------
 
-// Regularized upper incomplete gamma function Q(a, x): the series for P when
-// x < a + 1, Lentz's continued fraction for Q otherwise (Numerical Recipes,
-// 3rd ed., section 6.2).
-double gamma_q(double a, double x) {
-  if (x <= 0.0) return 1.0;
-  const double log_prefactor = -x + a * std::log(x) - std::lgamma(a);
-  if (x < a + 1.0) {
-    double ap = a, term = 1.0 / a, sum = term;
-    for (int n = 0; n < 10000 && std::abs(term) > std::abs(sum) * 1e-16; ++n) {
-      ap += 1.0;
-      term *= x / ap;
-      sum += term;
-    }
-    return 1.0 - sum * std::exp(log_prefactor);
-  }
-  constexpr double kTiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / kTiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < 10000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < kTiny) d = kTiny;
-    c = b + an / c;
-    if (std::abs(c) < kTiny) c = kTiny;
-    d = 1.0 / d;
-    const double delta = d * c;
-    h *= delta;
-    if (std::abs(delta - 1.0) < 1e-16) break;
-  }
-  return std::exp(log_prefactor) * h;
-}
-
-// P(X > x) for X ~ chi-square with `dof` degrees of freedom.
-double chi2_sf(double x, double dof) { return gamma_q(0.5 * dof, 0.5 * x); }
-
-// The upper critical value c with P(X > c) = alpha, by bisection.
-double chi2_critical(double dof, double alpha) {
-  double lo = 0.0, hi = dof + 10.0;
-  while (chi2_sf(hi, dof) > alpha) hi *= 2.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (chi2_sf(mid, dof) > alpha ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
+using test::chi2_critical;
+using test::chi2_fit;
 
 // False-alarm rate of each statistical test (each makes one comparison).
 constexpr double kAlpha = 1e-3;
@@ -83,45 +41,6 @@ TEST(WarpStats, CriticalValuesMatchTables) {
   EXPECT_NEAR(chi2_critical(10, 0.01), 23.209251, 1e-5);
   EXPECT_NEAR(chi2_critical(100, 0.05), 124.342113, 1e-5);
   EXPECT_NEAR(chi2_critical(2, 1e-3), -2.0 * std::log(1e-3), 1e-9);
-}
-
-// Pearson chi-square goodness of fit. Bins are taken in increasing order of
-// expected count and pooled until each pooled bin expects at least 5 (a
-// remainder below 5 joins the last pooled bin). A sample in a bin of zero
-// expected count fails outright.
-testing::AssertionResult chi2_fit(const std::vector<double>& observed, const std::vector<double>& expected,
-                                  double alpha) {
-  std::vector<std::size_t> order(observed.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return expected[a] < expected[b]; });
-  std::vector<std::pair<double, double>> pooled;  // (observed, expected)
-  double pool_obs = 0.0, pool_exp = 0.0;
-  for (const std::size_t i : order) {
-    if (expected[i] <= 0.0) {
-      if (observed[i] > 0.0)
-        return testing::AssertionFailure() << observed[i] << " samples in bin " << i << " of zero density";
-      continue;
-    }
-    pool_obs += observed[i];
-    pool_exp += expected[i];
-    if (pool_exp >= 5.0) {
-      pooled.emplace_back(pool_obs, pool_exp);
-      pool_obs = pool_exp = 0.0;
-    }
-  }
-  if (pool_exp > 0.0) {
-    if (pooled.empty()) return testing::AssertionFailure() << "fewer than 5 expected samples in all";
-    pooled.back().first += pool_obs;
-    pooled.back().second += pool_exp;
-  }
-  double stat = 0.0;
-  for (const auto& [o, e] : pooled) stat += (o - e) * (o - e) / e;
-  const double dof = static_cast<double>(pooled.size()) - 1.0;
-  const double crit = chi2_critical(dof, alpha);
-  if (stat > crit)
-    return testing::AssertionFailure() << "chi2(" << dof << ") = " << stat << " > " << crit << " ("
-                                       << observed.size() << " bins pooled into " << pooled.size() << ")";
-  return testing::AssertionSuccess();
 }
 
 // Fixed-seed uniform points of [0,1)^2 (24-bit floats, like the renderer's).

@@ -23,7 +23,9 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
   } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e, out, err);
   } catch (const CLI::ParseError& e) {
-    app.exit(e, out, err);
+    err << "pathlab: error: " << e.what() << "\n";
+    err << "Run 'pathlab " << (app.get_subcommands().empty() ? "" : app.get_subcommands().front()->get_name() + " ")
+        << "--help' for the options.\n";
     return 2;
   }
 
@@ -38,6 +40,10 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
     return 3;
   } catch (const std::bad_alloc&) {
     err << "pathlab: error: out of memory\n";
+    return 3;
+  } catch (const std::exception& e) {
+    // Nothing should get here; if it does, say what it was rather than abort.
+    err << "pathlab: error: internal error: " << e.what() << "\n";
     return 3;
   }
   return 2;

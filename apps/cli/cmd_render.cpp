@@ -10,6 +10,7 @@
 #include "core/parallel.h"
 #include "core/render.h"
 
+#include <cctype>
 #include <cstdio>
 #include <ostream>
 
@@ -21,7 +22,7 @@ void RenderCommand::add_to(CLI::App& app) {
   cmd->add_option("-o,--output", output, "Output EXR (a tone-mapped PNG is written beside it); default out/<scene>.exr");
   cmd->add_option("--threads", threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
   cmd->add_option("--exposure", exposure, "Exposure of the PNG, in stops");
-  cmd->add_flag("-q,--quiet", quiet, "Print nothing but errors");
+  cmd->add_flag("-q,--quiet", quiet, "Print only warnings and errors");
   cmd->callback([this] { selected = true; });
 }
 
@@ -30,7 +31,9 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   for (const std::string& w : s.warnings) err << "pathlab: warning: " << w << "\n";
 
   std::filesystem::path exr = output.empty() ? std::filesystem::path("out") / (s.name + ".exr") : std::filesystem::path(output);
-  if (exr.extension() != ".exr") throw InputError(exr.string() + ": the output must be an .exr file (a .png is written beside it)");
+  std::string ext = exr.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".exr") throw InputError(exr.string() + ": the output must be an .exr file (a .png is written beside it)");
   std::filesystem::path png = exr;
   png.replace_extension(".png");
   ensure_writable(exr);
@@ -64,7 +67,14 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
       {"version", PATHLAB_VERSION},
   };
   write_exr(exr, image, meta);
-  write_png(png, image, exposure);
+  try {
+    write_png(png, image, exposure);
+  } catch (...) {
+    // The two files are one result: do not leave the EXR without its PNG.
+    std::error_code ignored;
+    std::filesystem::remove(exr, ignored);
+    throw;
+  }
 
   if (stats.bad_samples > 0) {
     err << "pathlab: warning: " << stats.bad_samples
