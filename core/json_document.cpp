@@ -3,10 +3,12 @@
 #include "core/error.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace pathlab {
@@ -56,6 +58,54 @@ std::string printable(std::string_view key) {
   std::string out(key);
   std::replace_if(out.begin(), out.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }, '?');
   return out;
+}
+
+// If the token at or just before `offset` (where nlohmann gave up) is NaN or
+// an infinity as other languages write them (NaN, nan, Infinity, -inf, ...,
+// in any case), the offset where that token starts.
+std::optional<std::size_t> non_finite_literal(std::string_view text, std::size_t offset) {
+  const auto is_letter = [](char c) { return std::isalpha(static_cast<unsigned char>(c)) != 0; };
+  const auto is_sign = [](char c) { return c == '-' || c == '+'; };
+  std::size_t start = std::min(offset, text.size());
+  while (start > 0 && is_letter(text[start - 1])) --start;
+  if (start > 0 && is_sign(text[start - 1])) --start;
+  std::size_t end = start < text.size() && is_sign(text[start]) ? start + 1 : start;
+  std::string word;
+  for (; end < text.size() && is_letter(text[end]); ++end)
+    word += static_cast<char>(std::tolower(static_cast<unsigned char>(text[end])));
+  if (word == "nan" || word == "inf" || word == "infinity") return start;
+  return std::nullopt;
+}
+
+// nlohmann 3.11 reports a number beyond the double range (1e999, the only
+// way to write an infinity in JSON) as out_of_range 406, without a position:
+// "[json.exception.out_of_range.406] number overflow parsing '1e999'". Give
+// it the "<file>:<line>:<column>: malformed JSON: ..." form of any syntax error.
+std::string number_out_of_range(std::string_view text, const std::string& file, const std::string& what) {
+  const auto open = what.find("parsing '");
+  const auto close = open == std::string::npos ? std::string::npos : what.find('\'', open + 9);
+  if (close == std::string::npos) {  // not the message we know: keep it, without the "[json.exception...]"
+    return file + ": malformed JSON: " + what.substr(what.starts_with("[") ? what.find("] ") + 2 : 0);
+  }
+  const std::string literal = what.substr(open + 9, close - open - 9);
+  const std::string problem = "malformed JSON: number '" + printable(literal.substr(0, 40)) +
+                              (literal.size() > 40 ? "..." : "") + "' is out of range (numbers must be finite)";
+  // nlohmann stopped at this number, so the text before it is valid JSON:
+  // the first number token outside strings that equals the literal is it.
+  constexpr std::string_view kNumberChars = "+-.0123456789eE";
+  for (std::size_t i = 0; i < text.size();) {
+    if (text[i] == '"') {
+      for (++i; i < text.size() && text[i] != '"'; ++i) i += text[i] == '\\' ? 1 : 0;
+      ++i;
+    } else if (text[i] == '-' || (text[i] >= '0' && text[i] <= '9')) {
+      const std::size_t start = i;
+      while (i < text.size() && kNumberChars.find(text[i]) != std::string_view::npos) ++i;
+      if (text.substr(start, i - start) == literal) return located(file, position_at(text, start), problem);
+    } else {
+      ++i;
+    }
+  }
+  return file + ": " + problem;
 }
 
 // JSON pointer reference token: "~" -> "~0", "/" -> "~1" (RFC 6901).
@@ -238,9 +288,18 @@ JsonDocument JsonDocument::parse(std::string_view text, const std::filesystem::p
   } catch (const nlohmann::json::parse_error& e) {
     // e.byte is the 1-based index of the last byte read (text.size() + 1 at
     // the end of input); 0 would mean "no position", so use the start.
-    const std::size_t offset = e.byte == 0 ? 0 : e.byte - 1;
-    throw InputError(located(name, position_at(text, offset),
-                             "malformed JSON: " + parse_error_reason(e.what())));
+    std::size_t offset = e.byte == 0 ? 0 : e.byte - 1;
+    std::string problem = "malformed JSON: " + parse_error_reason(e.what());
+    // Writers that emit NaN or Infinity (JavaScript, Python) make this common.
+    if (const auto start = non_finite_literal(text, offset);
+        start && (problem.find("invalid literal") != std::string::npos ||
+                  problem.find("invalid number") != std::string::npos)) {
+      offset = *start;
+      problem += " (JSON has no NaN or infinity)";
+    }
+    throw InputError(located(name, position_at(text, offset), problem));
+  } catch (const nlohmann::json::out_of_range& e) {
+    throw InputError(number_out_of_range(text, name, e.what()));
   }
   PositionScanner(text, name, doc.positions_).run();
   return doc;
@@ -274,16 +333,21 @@ std::string JsonDocument::where(const nlohmann::json::json_pointer& pointer) con
 }
 
 std::string nearest_name(std::string_view key, std::span<const std::string_view> candidates) {
-  // Levenshtein distance with two rolling rows.
+  // Optimal string alignment distance: Levenshtein plus the swap of two
+  // adjacent characters as one edit ("tpye" -> "type"), with no substring
+  // edited twice. Three rolling rows: the swap looks two rows back.
   const auto distance = [key](std::string_view other) {
-    std::vector<std::size_t> prev(other.size() + 1), cur(other.size() + 1);
+    std::vector<std::size_t> before(other.size() + 1), prev(other.size() + 1), cur(other.size() + 1);
     for (std::size_t j = 0; j <= other.size(); ++j) prev[j] = j;
     for (std::size_t i = 1; i <= key.size(); ++i) {
       cur[0] = i;
       for (std::size_t j = 1; j <= other.size(); ++j) {
         const std::size_t substitute = prev[j - 1] + (key[i - 1] == other[j - 1] ? 0 : 1);
         cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, substitute});
+        if (i > 1 && j > 1 && key[i - 1] == other[j - 2] && key[i - 2] == other[j - 1])
+          cur[j] = std::min(cur[j], before[j - 2] + 1);
       }
+      std::swap(before, prev);
       std::swap(prev, cur);
     }
     return prev[other.size()];

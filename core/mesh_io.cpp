@@ -127,16 +127,19 @@ TriangleMesh finish(const fs::path& file, const RawMesh& raw, MeshLoadReport* re
 // origin. Check the first three coordinates of every vertex line ("v" as
 // tinyobj recognises it) before handing the text over.
 void check_obj_vertices(const fs::path& file, std::string_view text) {
-  const auto is_blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  const auto is_blank = [](char c) { return c == ' ' || c == '\t'; };
   int vertex = 0;
   for (int line_no = 1; !text.empty(); ++line_no) {
-    const std::size_t eol = std::min(text.find('\n'), text.size());
+    // Lines end like tinyobj's: at "\n", "\r\n" or a lone "\r".
+    const std::size_t eol = std::min(text.find_first_of("\r\n"), text.size());
     std::string_view line = text.substr(0, eol);
-    text.remove_prefix(std::min(eol + 1, text.size()));
+    text.remove_prefix(std::min(eol + (text.substr(eol).starts_with("\r\n") ? 2 : 1), text.size()));
     line.remove_prefix(std::min(line.find_first_not_of(" \t"), line.size()));
     if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
     ++vertex;
-    const auto bad = [&](const std::string& problem) { fail(file, "vertex " + std::to_string(vertex) + problem, line_no); };
+    const auto bad = [&](const std::string& problem) {
+      fail(file, "vertex " + std::to_string(vertex) + problem, line_no);
+    };
     std::string_view coords[3];
     int n = 0;
     for (std::size_t i = 1; n < 3;) {
@@ -147,13 +150,12 @@ void check_obj_vertices(const fs::path& file, std::string_view text) {
       coords[n++] = line.substr(start, i - start);
     }
     if (n < 3) bad(" has " + std::to_string(n) + " coordinates (3 needed)");
-    const auto quoted = [](std::string_view c) { return std::string(c.substr(0, 40)); };
+    const auto cut = [](std::string_view c) { return std::string(c.substr(0, 40)); };
     for (const std::string_view c : coords) {
       double value = 0.0;
-      if (parse_number(c, value) == Number::kMalformed) bad(": malformed number '" + quoted(c) + "'");
+      if (parse_number(c, value) == Number::kMalformed) bad(": malformed number '" + cut(c) + "'");
       if (!std::isfinite(value))
-        bad(" has a non-finite coordinate (" + quoted(coords[0]) + ", " + quoted(coords[1]) + ", " +
-            quoted(coords[2]) + ")");
+        bad(" has a non-finite coordinate (" + cut(coords[0]) + ", " + cut(coords[1]) + ", " + cut(coords[2]) + ")");
     }
   }
 }

@@ -8,10 +8,7 @@
 
 #include <algorithm>
 #include <array>
-#include <cctype>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <span>
 #include <sstream>
@@ -484,36 +481,6 @@ void read_lights(const Node& node, Scene* scene) {
   }
 }
 
-// nlohmann 3.11 reports a number literal beyond the double range (1e999, the
-// only way to write an infinity in JSON) as out_of_range 406, not as a
-// parse_error, and JsonDocument lets it through. Give it the same
-// "<file>:<line>:<column>: malformed JSON: ..." form as any other syntax error.
-[[noreturn]] void number_overflow(std::string_view text, const std::filesystem::path& file,
-                                  const nlohmann::json::out_of_range& e) {
-  // e.what(): "[json.exception.out_of_range.406] number overflow parsing '1e999'"
-  const std::string what = e.what();
-  const auto open = what.find("parsing '");
-  const auto close = open == std::string::npos ? std::string::npos : what.find('\'', open + 9);
-  if (close == std::string::npos) throw InputError(file.string() + ": malformed JSON: " + what);
-  const std::string literal = what.substr(open + 9, close - open - 9);
-  // The first occurrence of the literal as a whole token.
-  const auto is_token_char = [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+';
-  };
-  std::string where = file.string();
-  for (std::size_t at = text.find(literal); at != std::string_view::npos; at = text.find(literal, at + 1)) {
-    const std::size_t end = at + literal.size();
-    if ((at > 0 && is_token_char(text[at - 1])) || (end < text.size() && is_token_char(text[end]))) continue;
-    const std::string_view before = text.substr(0, at);
-    const std::size_t line_start = before.rfind('\n') == std::string_view::npos ? 0 : before.rfind('\n') + 1;
-    where += ":" + std::to_string(std::count(before.begin(), before.end(), '\n') + 1) + ":" +
-             std::to_string(at - line_start + 1);
-    break;
-  }
-  throw InputError(where + ": malformed JSON: number " + in_quotes(literal) +
-                   " is out of range (numbers must be finite)");
-}
-
 Scene read_scene(const JsonDocument& doc) {
   const Node root(doc, Pointer());
   root.expect_object();
@@ -559,29 +526,10 @@ Scene read_scene(const JsonDocument& doc) {
 }  // namespace
 
 Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
-  const auto parse = [&] {
-    try {
-      return JsonDocument::parse(text, file);
-    } catch (const nlohmann::json::out_of_range& e) {
-      number_overflow(text, file, e);
-    }
-  };
-  return read_scene(parse());
+  return read_scene(JsonDocument::parse(text, file));
 }
 
-Scene load_scene(const std::filesystem::path& file) {
-  const auto load = [&] {
-    try {
-      return JsonDocument::load(file);
-    } catch (const nlohmann::json::out_of_range& e) {
-      // The file was read once already; read it again to place the number.
-      std::ifstream in(file, std::ios::binary);
-      const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-      number_overflow(text, file, e);
-    }
-  };
-  return read_scene(load());
-}
+Scene load_scene(const std::filesystem::path& file) { return read_scene(JsonDocument::load(file)); }
 
 Scene builtin_cornell_box() {
   Scene scene = parse_scene(builtin_cornell_box_text(), "<built-in cornell-box>");

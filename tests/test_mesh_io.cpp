@@ -476,6 +476,8 @@ TEST_F(MeshIoErrors, ObjNonFiniteAndMalformedCoordinates) {
   // Only 'v' lines count as vertices; lines count from 1, indented or not.
   expect_error("mixed.obj", "# comment\nvn 0 0 1\nv 0 0 0\n  v 1 0 0\nvt nan 0\n\tv 0 1 NaN\r\n" + face,
                {"mixed.obj:6: vertex 3 has a non-finite coordinate (0, 1, NaN)"});
+  // A lone "\r" ends a line too (for tinyobj as well).
+  expect_error("cr.obj", "v 0 0 0\r\rv 1 0 0\rv 0 1 x\r" + face, {"cr.obj:4: vertex 3: malformed number 'x'"});
 }
 
 TEST_F(MeshIoObj, VertexCheckAcceptsEveryNumberForm) {

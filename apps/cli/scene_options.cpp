@@ -5,6 +5,7 @@
 #include "core/scene_loader.h"
 #include "reference/reference_tracer.h"
 
+#include <charconv>
 #include <sstream>
 
 namespace pathlab::cli {
@@ -30,7 +31,14 @@ Scene SceneOptions::load() const {
   if (spp) r.spp = *spp;
   if (max_depth) r.max_depth = *max_depth;
   if (rr_depth) r.rr_depth = *rr_depth;
-  if (seed) r.seed = *seed;
+  if (seed) {
+    std::uint64_t value = 0;
+    const char* end = seed->data() + seed->size();
+    const auto [ptr, ec] = std::from_chars(seed->data(), end, value);
+    if (ec != std::errc() || ptr != end)
+      throw InputError("--seed " + *seed + ": expected an integer in [0, 18446744073709551615]");
+    r.seed = value;
+  }
   if (resolution) {
     int w = 0, h = 0;
     char x = 0, extra = 0;

@@ -22,7 +22,7 @@ struct SceneOptions {
   std::string tracer = "reference";
   std::optional<std::string> strategy;
   std::optional<int> spp, max_depth, rr_depth;
-  std::optional<std::uint64_t> seed;
+  std::optional<std::string> seed;  // parsed by load(): CLI11 would wrap "-1" around
   std::optional<std::string> resolution;  // "WxH"
 
   // Registers the options on `cmd`; `with_spp` for commands that render.

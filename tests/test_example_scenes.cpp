@@ -1,0 +1,41 @@
+// Every scene shipped in scenes/ loads without a warning, compiles, and
+// traces a sample to a finite radiance.
+#include "core/compiled_scene.h"
+#include "core/scene_loader.h"
+#include "reference/reference_tracer.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace pathlab {
+namespace {
+
+TEST(ExampleScenes, LoadCompileAndTrace) {
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(PATHLAB_SOURCE_DIR) / "scenes")) {
+    if (entry.path().extension() != ".json") continue;
+    SCOPED_TRACE(entry.path().string());
+    Scene scene = load_scene(entry.path());
+    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
+    const RenderSettings settings = scene.render;
+    const CompiledScene compiled(std::move(scene));
+    const ReferenceTracer tracer(compiled, settings);
+    const auto w = static_cast<std::uint32_t>(compiled.scene().film.width);
+    const auto h = static_cast<std::uint32_t>(compiled.scene().film.height);
+    for (std::uint32_t s = 0; s < 16; ++s) EXPECT_TRUE(is_finite(tracer.trace_sample(w / 2, h / 2, s, nullptr).L));
+    ++count;
+  }
+  EXPECT_GE(count, 2);
+}
+
+// The built-in default is scenes/cornell-box.json, compiled in.
+TEST(ExampleScenes, BuiltinIsTheCornellBoxFile) {
+  const Scene a = builtin_cornell_box();
+  const Scene b = load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "scenes" / "cornell-box.json");
+  ASSERT_EQ(a.shapes.size(), b.shapes.size());
+  for (std::size_t i = 0; i < a.shapes.size(); ++i) EXPECT_EQ(a.shapes[i].mesh.positions, b.shapes[i].mesh.positions);
+}
+
+}  // namespace
+}  // namespace pathlab
