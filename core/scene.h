@@ -79,6 +79,9 @@ struct Scene {
   std::vector<PointLight> point_lights;
   std::optional<Spectrum> environment;  // uniform radiance from every direction
   std::vector<std::string> warnings;    // non-fatal problems found while loading
+  // The closed-form model whose answer this scene has ("furnace", ...; see
+  // analytic-scenes/), or empty. Only `pathlab check` reads it.
+  std::string analytic;
 };
 
 }  // namespace pathlab

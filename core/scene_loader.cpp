@@ -492,10 +492,14 @@ Scene read_scene(const JsonDocument& doc) {
   if (const std::int64_t v = version.integer(); v != kSceneFormatVersion)
     version.fail("unsupported scene format version " + std::to_string(v) + " (this pathlab reads version " +
                  std::to_string(kSceneFormatVersion) + ")");
-  root.allow_only({"pathlab_scene", "camera", "film", "render", "materials", "shapes", "lights"});
+  root.allow_only({"pathlab_scene", "camera", "film", "render", "materials", "shapes", "lights", "analytic"});
   Scene scene;
   scene.file = doc.file();
   scene.name = doc.file().stem().string();
+  if (root.has("analytic")) {
+    scene.analytic = root.child("analytic").string();
+    if (scene.analytic.empty()) root.child("analytic").fail("expected the name of an analytic model");
+  }
   scene.camera = read_camera(root.required("camera"));
   if (root.has("film")) scene.film = read_film(root.child("film"));
   if (root.has("render")) scene.render = read_render(root.child("render"));

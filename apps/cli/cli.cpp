@@ -15,7 +15,11 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
   app.require_subcommand(1);
   RenderCommand render;
   TracePixelCommand trace_pixel;
+  DiffCommand diff;
+  CheckCommand check;
   render.add_to(app);
+  check.add_to(app);
+  diff.add_to(app);
   trace_pixel.add_to(app);
 
   try {
@@ -32,6 +36,8 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
   try {
     if (render.selected) return render.run(out, err);
     if (trace_pixel.selected) return trace_pixel.run(out, err);
+    if (diff.selected) return diff.run(out, err);
+    if (check.selected) return check.run(out, err);
   } catch (const InputError& e) {
     err << "pathlab: error: " << e.what() << "\n";
     return 2;

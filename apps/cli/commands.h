@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include <iosfwd>
+#include <optional>
 #include <string>
 
 namespace pathlab::cli {
@@ -17,6 +18,29 @@ struct RenderCommand {
   int threads = 0;
   float exposure = 0.0f;
   bool quiet = false;
+  bool selected = false;
+  void add_to(CLI::App& app);
+  int run(std::ostream& out, std::ostream& err) const;
+};
+
+// pathlab check SCENE [--tracer T] [--strategy S] [--spp N] [--seed S] [--out DIR]
+struct CheckCommand {
+  SceneOptions scene;
+  std::string out_dir;
+  int threads = 0;
+  double alpha = 1e-4;
+  bool selected = false;
+  void add_to(CLI::App& app);
+  int run(std::ostream& out, std::ostream& err) const;
+};
+
+// pathlab diff A.exr B.exr [--heatmap out.png] [--json] [--tolerance X --metric M]
+struct DiffCommand {
+  std::string a, b;
+  std::string heatmap;
+  bool json = false;
+  std::optional<double> tolerance;
+  std::string metric = "rmse";
   bool selected = false;
   void add_to(CLI::App& app);
   int run(std::ostream& out, std::ostream& err) const;

@@ -1,0 +1,31 @@
+// The expected image of an analytic scene: the model's radiance integrated
+// over each pixel's footprint with the film's filter, exactly as the film
+// weighs samples (box: uniform over the pixel; bilinear: the tent of radius
+// one pixel, restricted to the image and renormalised, as the film only
+// receives samples from inside the image).
+#pragma once
+
+#include "analytic-scenes/analytic_model.h"
+#include "core/camera.h"
+#include "core/image_io.h"
+
+namespace pathlab {
+
+struct ExpectedImage {
+  Image mean;              // filter-weighted mean radiance per pixel
+  Image quadrature_error;  // estimated |error| of that integral, per channel
+  // Int w^2 (L - mean)^2 / (Int w)^2 over the footprint: the variance of the
+  // pixel estimate with one sample per pixel that comes from where the
+  // sample lands alone. A render with n samples per pixel has at least this
+  // over n (law of total variance), whatever its estimator; check.h uses it
+  // as a floor where the sample variance missed a rare part of the
+  // footprint (an edge pixel whose samples all fell on one side).
+  Image footprint_variance;
+};
+
+// Midpoint quadrature on an n x n grid per pixel unit, doubling n from 4
+// until two successive estimates agree to 1e-5 (relative) or n = 128; the
+// last difference is reported as the quadrature error. Parallel over rows.
+ExpectedImage expected_image(const AnalyticModel& model, const Camera& camera, const FilmDesc& film);
+
+}  // namespace pathlab
