@@ -1,5 +1,6 @@
 #include "core/light_sampler.h"
 
+#include "core/faults.h"
 #include "core/geometry.h"
 #include "core/sampling.h"
 
@@ -23,7 +24,12 @@ void build_distribution(const std::vector<double>& weights, std::vector<float>* 
   if (!cdf->empty()) cdf->back() = 1.0f;
 }
 
+// Test-only fault switches (core/faults.h); the identity in production.
+float faulty_distance(float dist) { return PATHLAB_FAULT(LightPdfWithoutDistance) ? 1.0f : dist; }
+
 }  // namespace
+
+float LightSampler::area_density(const Entry& e) { return PATHLAB_FAULT(LightPdfWithoutArea) ? 1.0f : 1.0f / e.area; }
 
 LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&scene) {
   std::vector<double> power;
@@ -94,7 +100,7 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
   const Material& m = scene_->materials[shape.material];
   const float cos_light = glm::dot(ls.n, -ls.wi);
   if (!m.two_sided_emission && cos_light <= 0.0f) return std::nullopt;  // back of a one-sided emitter
-  ls.pdf = pmf_[i] * area_to_solid_angle(1.0f / e.area, ls.dist, cos_light);
+  ls.pdf = pmf_[i] * area_to_solid_angle(area_density(e), faulty_distance(ls.dist), cos_light);
   if (!(ls.pdf > 0.0f) || std::isinf(ls.pdf)) return std::nullopt;  // seen edge-on
   ls.Le = m.emission;
   return ls;
@@ -106,7 +112,7 @@ float LightSampler::pdf(const vec3& ref, const Surfel& hit) const {
   const std::size_t i = static_cast<std::size_t>(first) + hit.prim;
   const vec3 d = hit.p - ref;
   const float dist = glm::length(d);
-  return pmf_[i] * area_to_solid_angle(1.0f / entries_[i].area, dist, glm::dot(hit.n, d) / dist);
+  return pmf_[i] * area_to_solid_angle(area_density(entries_[i]), faulty_distance(dist), glm::dot(hit.n, d) / dist);
 }
 
 std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_choice) const {

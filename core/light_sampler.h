@@ -65,6 +65,7 @@ class LightSampler {
     float area;
   };
   static std::size_t pick(const std::vector<float>& cdf, float u);
+  static float area_density(const Entry& e);  // 1 / area
 
   const Scene* scene_;
   std::vector<Entry> entries_;           // area lights, then the environment

@@ -2,6 +2,7 @@
 
 #include "core/bsdf/lambert.h"
 #include "core/bsdf/mirror.h"
+#include "core/faults.h"
 
 namespace pathlab {
 namespace {
@@ -30,12 +31,14 @@ Spectrum Surfel::emitted(const vec3& wo) const {
 Spectrum Surfel::eval(const vec3& wi, const vec3& wo) const {
   if (material->type != MaterialType::Diffuse) return Spectrum(0.0f);
   const LocalDirs d = to_local_upper(frame, wo, wi);
+  if (PATHLAB_FAULT(CosineDropped)) return d.wi.z > 0.0f ? material->albedo * kInvPi : Spectrum(0.0f);
   return lambert::eval(material->albedo, d.wi);
 }
 
 float Surfel::pdf(const vec3& wi, const vec3& wo) const {
   if (material->type != MaterialType::Diffuse) return 0.0f;
   const LocalDirs d = to_local_upper(frame, wo, wi);
+  if (PATHLAB_FAULT(BsdfPdfOff5Percent)) return 1.05f * lambert::pdf(d.wi);
   return lambert::pdf(d.wi);
 }
 
@@ -49,6 +52,11 @@ std::optional<BsdfSample> Surfel::scatter(const vec3& wo, float u_lobe, vec2 u) 
       const float pdf = lambert::pdf(wi);
       if (pdf <= 0.0f) return std::nullopt;  // u on the disk's rim: grazing, no energy
       wi.z *= side;
+      if (PATHLAB_FAULT(BsdfPdfOff5Percent) || PATHLAB_FAULT(CosineDropped)) {
+        const vec3 w = frame.to_world(wi);
+        const float faulty_pdf = this->pdf(w, wo);
+        return BsdfSample{w, eval(w, wo) / faulty_pdf, faulty_pdf, Lobe::Lambert, false};
+      }
       return BsdfSample{frame.to_world(wi), material->albedo, pdf, Lobe::Lambert, false};
     }
     case MaterialType::Mirror: {

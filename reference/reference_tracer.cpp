@@ -1,5 +1,6 @@
 #include "reference/reference_tracer.h"
 
+#include "core/faults.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -25,7 +26,7 @@ struct ReferenceTracer::Previous {
 };
 
 float ReferenceTracer::emission_weight(const Previous& prev, float light_pdf) const {
-  if (prev.impulse) return 1.0f;
+  if (prev.impulse || PATHLAB_FAULT(EmissionAfterNee)) return 1.0f;
   switch (settings_.strategy) {
     case Strategy::Cosine:
     case Strategy::Bsdf: return 1.0f;
@@ -105,7 +106,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const Previous& prev, c
       }
       return L;
     }
-    weight /= survival;
+    if (!PATHLAB_FAULT(RouletteNotReweighted)) weight /= survival;
   }
   const Spectrum beta_next = beta * weight;
   if (path.observer)

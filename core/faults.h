@@ -1,0 +1,32 @@
+// Test-only fault switches: the classic path-tracing mistakes, planted on
+// demand so that tests can prove the checker catches each one (a checker
+// that passes a planted bug is broken).
+//
+// They exist only in builds compiled with PATHLAB_FAULT_INJECTION, which
+// only tests/ does (pathlab_core_faults, pathlab_reference_faults). In every
+// other build PATHLAB_FAULT(name) is the constant false and the faulty
+// branches vanish.
+#pragma once
+
+namespace pathlab {
+
+enum class Fault {
+  None,
+  BsdfPdfOff5Percent,     // surfel.cpp: the Lambert lobe reports pdf * 1.05 (and weights by it)
+  CosineDropped,          // surfel.cpp: the Lambert lobe's f |cos| loses its cosine
+  EmissionAfterNee,       // reference: emission counted in full after next-event estimation
+  LightPdfWithoutArea,    // light_sampler.cpp: area density 1 instead of 1 / area
+  LightPdfWithoutDistance,// light_sampler.cpp: no distance^2 in the area -> solid-angle conversion
+  RouletteNotReweighted,  // reference: a roulette survivor is not divided by its probability
+};
+
+#ifdef PATHLAB_FAULT_INJECTION
+// The fault in force for the whole process (tests set it, single-threaded,
+// before rendering).
+inline Fault g_fault = Fault::None;
+#define PATHLAB_FAULT(name) (::pathlab::g_fault == ::pathlab::Fault::name)
+#else
+#define PATHLAB_FAULT(name) false
+#endif
+
+}  // namespace pathlab

@@ -1,0 +1,114 @@
+// Every analytic scene, with the reference tracer and every strategy, passes
+// its check at its own sample count (label "stat"); the models refuse scenes
+// that break their assumptions and follow edits of their parameters.
+#include "tests/check_util.h"
+#include "tests/test_scenes.h"
+
+#include "core/error.h"
+
+#include <gtest/gtest.h>
+
+namespace pathlab {
+namespace {
+
+struct Case {
+  std::string scene;
+  Strategy strategy;
+};
+
+class AnalyticScenes : public testing::TestWithParam<Case> {};
+
+TEST_P(AnalyticScenes, PassCheck) {
+  const CheckResult r = test::run_check(GetParam().scene, GetParam().strategy);
+  EXPECT_TRUE(r.pixels_pass) << r.failing << " pixel-channels beyond " << r.z_threshold << ", worst z "
+                             << r.worst.front().z << " at (" << r.worst.front().x << ", " << r.worst.front().y << ")";
+  EXPECT_TRUE(r.bias_pass) << "bias " << r.bias << " +- " << r.bias_se;
+}
+
+std::vector<Case> all_cases() {
+  std::vector<Case> cases;
+  for (const std::string& name : test::analytic_scene_names())
+    for (Strategy s : test::kAllStrategies) cases.push_back({name, s});
+  return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(Reference, AnalyticScenes, testing::ValuesIn(all_cases()),
+                         [](const testing::TestParamInfo<Case>& p) {
+                           std::string s = p.param.scene.substr(0, p.param.scene.size() - 5) + "_" +
+                                           strategy_name(p.param.strategy);
+                           for (char& c : s)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return s;
+                         });
+
+// Editing the parameters the models read keeps the check passing.
+TEST(AnalyticEdits, FurnaceFollowsAlbedoEmissionAndDepth) {
+  for (const auto& [albedo, Le, depth] : {std::tuple{0.3f, 2.0f, 0}, {0.9f, 0.5f, 7}, {0.5f, 1.0f, -1}}) {
+    Scene s = load_scene(test::analytic_scene("furnace-sphere.json"));
+    s.materials[0].albedo = Spectrum(albedo);
+    s.materials[0].emission = Spectrum(Le);
+    s.render.max_depth = depth;
+    EXPECT_TRUE(test::run_check(std::move(s)).pass) << albedo << " " << Le << " " << depth;
+  }
+}
+
+TEST(AnalyticEdits, SphereFollowsAlbedoRadiusAndRoom) {
+  Scene s = load_scene(test::analytic_scene("white-sphere-emissive-room.json"));
+  for (Material& m : s.materials) {
+    if (m.type == MaterialType::Diffuse) m.albedo = Spectrum(0.2f, 0.9f, 0.5f);
+    if (m.type == MaterialType::Emissive) m.emission = Spectrum(3.0f, 0.5f, 1.0f);
+  }
+  s.shapes[0].radius = 0.6f;
+  s.shapes[0].center = vec3(0.3f, -0.2f, 0.0f);
+  EXPECT_TRUE(test::run_check(std::move(s)).pass);
+}
+
+TEST(AnalyticEdits, AModelThatIgnoredAnEditWouldFail) {
+  // Render with albedo 0.2 but build the model from the file's albedo: the
+  // check must see the difference (guards against a model that reads
+  // nothing from the scene).
+  Scene s = load_scene(test::analytic_scene("furnace-sphere.json"));
+  const auto model = make_analytic_model(s);
+  s.materials[0].albedo = Spectrum(0.2f);
+  const RenderSettings settings = s.render;
+  const CompiledScene compiled(std::move(s));
+  const ReferenceTracer tracer(compiled, settings);
+  Film film(compiled.scene().film.width, compiled.scene().film.height, compiled.scene().film.filter);
+  render(tracer, film);
+  EXPECT_FALSE(check_against_expected(film, expected_image(*model, compiled.camera(), compiled.scene().film)).pass);
+}
+
+void expect_refused(const std::string& scene_name, const std::function<void(Scene&)>& edit, const std::string& words) {
+  Scene s = load_scene(test::analytic_scene(scene_name));
+  edit(s);
+  try {
+    make_analytic_model(s);
+    ADD_FAILURE() << "accepted a scene that breaks the model: " << words;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(scene_name), std::string::npos) << e.what();
+  }
+}
+
+TEST(AnalyticRefusals, FurnaceAssumptions) {
+  expect_refused("furnace-sphere.json", [](Scene& s) { s.shapes[0].flip_normals = false; }, "faces outwards");
+  expect_refused("furnace-sphere.json", [](Scene& s) { s.camera.position = vec3(0, 0, 3); }, "camera must be inside");
+  expect_refused("furnace-sphere.json", [](Scene& s) { s.materials[0].emission = Spectrum(0.0f); }, "must emit");
+  expect_refused("furnace-sphere.json", [](Scene& s) { s.materials[0].type = MaterialType::Mirror; }, "diffuse");
+  expect_refused("furnace-sphere.json", [](Scene& s) { s.point_lights.push_back({vec3(0.0f), Spectrum(1.0f)}); }, "point lights");
+  expect_refused("furnace-sphere.json", [](Scene& s) { s.render.max_depth = -1; s.materials[0].albedo = Spectrum(1.0f); }, "below 1");
+  expect_refused("furnace-box.json", [](Scene& s) { s.shapes[0].mesh.triangles.pop_back(); }, "closed");
+  expect_refused("furnace-box.json", [](Scene& s) { s.camera.aperture_radius = 0.1f; }, "pinhole");
+  expect_refused("furnace-box.json", [](Scene& s) { s.analytic = "furnac"; }, "did you mean 'furnace'");
+}
+
+TEST(AnalyticRefusals, SphereAssumptions) {
+  expect_refused("white-sphere-emissive-room.json", [](Scene& s) { s.shapes[1].flip_normals = false; }, "faces outwards");
+  expect_refused("white-sphere-emissive-room.json", [](Scene& s) { s.shapes[0].center = vec3(9, 0, 0); }, "sphere must be inside");
+  expect_refused("mirror-sphere-gray-room.json", [](Scene& s) { s.render.max_depth = 5; }, "perfect mirror");
+  expect_refused("mirror-sphere-gray-room.json", [](Scene& s) { s.materials[0].albedo = Spectrum(0.9f); }, "perfect mirror");
+  expect_refused("sphere-in-environment.json", [](Scene& s) { s.environment.reset(); }, "environment or a closed");
+}
+
+}  // namespace
+}  // namespace pathlab
