@@ -16,6 +16,14 @@ double normal_two_sided_quantile(double p) {
   return hi;
 }
 
+void write_check_images(const std::filesystem::path& dir, const Film& film, const ExpectedImage& expected,
+                        const CheckResult& result, const ImageMetadata& metadata) {
+  write_exr(dir / "rendered.exr", film.image(), metadata);
+  write_exr(dir / "expected.exr", expected.mean, metadata);
+  write_exr(dir / "error.exr", result.error, metadata);
+  write_exr(dir / "zscore.exr", result.z, metadata);
+}
+
 CheckResult check_against_expected(const Film& film, const ExpectedImage& expected, const CheckOptions& options,
                                    std::size_t keep_worst) {
   const int w = film.width(), h = film.height();
@@ -24,8 +32,9 @@ CheckResult check_against_expected(const Film& film, const ExpectedImage& expect
   r.error = Image(w, h);
   r.z = Image(w, h);
   r.z_threshold = normal_two_sided_quantile(-std::expm1(std::log1p(-options.alpha) / n));
-  r.bias_threshold = normal_two_sided_quantile(options.alpha);
-  double sum_d = 0.0, sum_var = 0.0, sum_d2 = 0.0, sum_rel = 0.0;
+  r.bias_threshold = normal_two_sided_quantile(-std::expm1(std::log1p(-options.alpha) / 3.0));
+  dvec3 sum_d(0.0), sum_var(0.0);
+  double sum_d2 = 0.0, sum_rel = 0.0;
   std::vector<PixelDeviation> all;
   all.reserve(static_cast<std::size_t>(n));
   for (int y = 0; y < h; ++y)
@@ -46,16 +55,24 @@ CheckResult check_against_expected(const Film& film, const ExpectedImage& expect
         r.error.at(x, y)[c] = static_cast<float>(d);
         r.z.at(x, y)[c] = static_cast<float>(z);
         all.push_back({x, y, c, z, double(m[c]), e, sigma});
-        sum_d += d;
+        sum_d[c] += d;
         sum_d2 += d * d;
         sum_rel += d * d / ((e + 0.01) * (e + 0.01));
-        sum_var += var + q * q + floor * floor;
+        sum_var[c] += var + q * q + floor * floor;
         if (std::abs(z) > r.z_threshold) ++r.failing;
       }
     }
-  r.bias = sum_d / n;
-  r.bias_se = std::sqrt(sum_var) / n * (film.filter() == FilterKind::Bilinear ? 3.0 : 1.0);
-  r.bias_z = r.bias / r.bias_se;
+  const double pixels = static_cast<double>(w) * h;
+  const double inflate = film.filter() == FilterKind::Bilinear ? 3.0 : 1.0;
+  for (int c = 0; c < 3; ++c) {
+    const double bias = sum_d[c] / pixels, se = std::sqrt(sum_var[c]) / pixels * inflate;
+    if (c == 0 || std::abs(bias / se) > std::abs(r.bias_z)) {
+      r.bias_channel = c;
+      r.bias = bias;
+      r.bias_se = se;
+      r.bias_z = bias / se;
+    }
+  }
   r.rmse = std::sqrt(sum_d2 / n);
   r.rel_mse = sum_rel / n;
   r.pixels_pass = r.failing == 0;

@@ -19,9 +19,9 @@
 // a sound stand-in; it costs some power next to a variance boundary (an
 // umbra pixel beside a lit one), never false alarms.
 //
-// Globally: the mean of (rendered - expected) over all pixels and channels,
-// with its standard error, tested against the single-test threshold for
-// alpha. With the bilinear filter neighbouring pixels share samples; each
+// Globally, per channel (the channels of one path are correlated, so they
+// are three tests, Šidák-corrected): the mean of (rendered - expected) over
+// all pixels, with its standard error. With the bilinear filter neighbouring pixels share samples; each
 // sample reaches at most 4 pixels, so the standard error of the mean is
 // inflated by 3 (covariances with the 8 neighbours bounded by the variances).
 #pragma once
@@ -29,6 +29,7 @@
 #include "analytic-scenes/expected_image.h"
 #include "core/film.h"
 
+#include <filesystem>
 #include <vector>
 
 namespace pathlab {
@@ -48,6 +49,8 @@ struct CheckResult {
   bool pass = false;
   bool pixels_pass = false, bias_pass = false;
   double z_threshold = 0.0;       // per pixel-channel, Šidák-corrected
+  // The channel whose mean deviation is the most significant.
+  int bias_channel = 0;
   double bias = 0.0, bias_se = 0.0, bias_z = 0.0, bias_threshold = 0.0;
   double rmse = 0.0, rel_mse = 0.0;  // rel_mse: (rendered - expected)^2 / (expected + 0.01)^2
   std::size_t failing = 0;        // pixel-channels beyond z_threshold
@@ -58,6 +61,11 @@ struct CheckResult {
 
 CheckResult check_against_expected(const Film& film, const ExpectedImage& expected, const CheckOptions& options = {},
                                    std::size_t keep_worst = 5);
+
+// Writes rendered.exr, expected.exr, error.exr (rendered - expected) and
+// zscore.exr into `dir` (created if needed). Throws InputError if it cannot.
+void write_check_images(const std::filesystem::path& dir, const Film& film, const ExpectedImage& expected,
+                        const CheckResult& result, const ImageMetadata& metadata);
 
 // |z| beyond which a two-sided test of a standard normal has tail
 // probability p.

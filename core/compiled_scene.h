@@ -17,6 +17,9 @@ class CompiledScene {
  public:
   // Throws SystemError if Embree fails.
   explicit CompiledScene(Scene scene);
+  // The light sampler points into scene_: neither copy nor move.
+  CompiledScene(const CompiledScene&) = delete;
+  CompiledScene& operator=(const CompiledScene&) = delete;
 
   const Scene& scene() const { return scene_; }
   const Camera& camera() const { return camera_; }

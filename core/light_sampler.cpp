@@ -5,23 +5,38 @@
 #include "core/sampling.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 namespace pathlab {
 namespace {
 
-// Normalised pmf and cdf (cdf.back() == 1 exactly) of non-negative weights.
+// The cdf (cdf.back() == 1 exactly) of non-negative weights, and the pmf
+// with which pick() really chooses each entry. The random number is a
+// multiple of 2^-24 (rng.h), so entry i is chosen for the grid points in
+// [cdf[i-1], cdf[i]): its probability is their count times 2^-24, which can
+// differ from w_i / total by a lot for a dim entry - and is 0 for one
+// dimmer than 2^-24 of the total. The estimators divide by this pmf, so
+// they stay unbiased; an entry with pmf 0 is never sampled, and the
+// tracers count its emission when a ray finds it (light pdf 0).
 void build_distribution(const std::vector<double>& weights, std::vector<float>* pmf, std::vector<float>* cdf) {
   const double total = std::accumulate(weights.begin(), weights.end(), 0.0);
   pmf->resize(weights.size());
   cdf->resize(weights.size());
   double running = 0.0;
   for (std::size_t i = 0; i < weights.size(); ++i) {
-    (*pmf)[i] = static_cast<float>(weights[i] / total);
     running += weights[i];
     (*cdf)[i] = static_cast<float>(running / total);
   }
   if (!cdf->empty()) cdf->back() = 1.0f;
+  // Grid points k * 2^-24 below c: ceil(c * 2^24) of them (c * 2^24 is exact).
+  auto below = [](float c) { return std::ceil(static_cast<double>(c) * 0x1p24); };
+  double previous = 0.0;
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    const double count = below((*cdf)[i]);
+    (*pmf)[i] = static_cast<float>((count - previous) * 0x1p-24);
+    previous = count;
+  }
 }
 
 // Test-only fault switches (core/faults.h); the identity in production.
@@ -67,6 +82,10 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&sce
     intensity.push_back(luminance(pl.intensity));
   }
   build_distribution(intensity, &point_pmf_, &point_cdf_);
+}
+
+std::size_t LightSampler::unsampled_light_count() const {
+  return static_cast<std::size_t>(std::count(pmf_.begin(), pmf_.end(), 0.0f));
 }
 
 std::size_t LightSampler::pick(const std::vector<float>& cdf, float u) {

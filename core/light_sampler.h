@@ -42,6 +42,10 @@ class LightSampler {
   LightSampler(const Scene& scene, float scene_radius);
 
   std::size_t area_light_count() const { return entries_.size(); }
+  // Area lights (or the environment) too dim, next to the others, ever to be
+  // picked: light sampling misses them and only rays that hit them count
+  // their emission.
+  std::size_t unsampled_light_count() const;
   bool has_area_lights() const { return !entries_.empty(); }
   bool has_delta_lights() const { return !points_.empty(); }
 

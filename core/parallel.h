@@ -10,7 +10,7 @@
 namespace pathlab {
 
 // While alive, limits every parallel_for to `threads` worker threads
-// (0 = all hardware threads). Nest them freely; the innermost one wins.
+// (0 = all hardware threads). Nested limits combine: the smallest wins.
 class ThreadLimit {
  public:
   explicit ThreadLimit(int threads);

@@ -97,9 +97,9 @@ Ray Surfel::spawn_to(const vec3& target, const vec3& target_error, const vec3& t
                                      glm::dot(origin - target, target_n) >= 0.0f ? target_n : -target_n);
   const vec3 d = end - origin;
   const float dist = glm::length(d);
-  // Both ends are now strictly off their surfaces; the small margin keeps the
-  // ray from touching the target surface in the rounding of dist.
-  return Ray{origin, d / dist, dist * (1.0f - 1e-4f)};
+  // Both ends are strictly off their surfaces, so the full length is safe;
+  // any shorter would let light through an occluder next to the target.
+  return Ray{origin, d / dist, dist};
 }
 
 }  // namespace pathlab

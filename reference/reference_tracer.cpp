@@ -30,7 +30,7 @@ float ReferenceTracer::emission_weight(const Previous& prev, float light_pdf) co
   switch (settings_.strategy) {
     case Strategy::Cosine:
     case Strategy::Bsdf: return 1.0f;
-    case Strategy::Light: return 0.0f;
+    case Strategy::Light: return light_pdf > 0.0f ? 0.0f : 1.0f;  // what NEE cannot pick, only a ray finds
     case Strategy::Mis: return power_heuristic(prev.pdf, light_pdf);
     case Strategy::LightBsdf:
       // One-sample balance heuristic with c = 1/2: f / (p_b / 2 + p_l / 2)

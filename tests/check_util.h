@@ -26,22 +26,30 @@ inline std::vector<std::string> analytic_scene_names() {
   return names;
 }
 
-// Renders `scene` with the reference tracer and checks it against its model.
-inline CheckResult run_check(Scene scene) {
+// Renders `scene` with the reference tracer and checks it against its model;
+// on failure, writes the check's images into `failure_dir` if given.
+inline CheckResult run_check(Scene scene, const std::filesystem::path& failure_dir = {}) {
   const auto model = make_analytic_model(scene);
   const RenderSettings settings = scene.render;
   const CompiledScene compiled(std::move(scene));
   const ReferenceTracer tracer(compiled, settings);
   Film film(compiled.scene().film.width, compiled.scene().film.height, compiled.scene().film.filter);
   render(tracer, film);
-  return check_against_expected(film, expected_image(*model, compiled.camera(), compiled.scene().film));
+  const ExpectedImage expected = expected_image(*model, compiled.camera(), compiled.scene().film);
+  CheckResult r = check_against_expected(film, expected);
+  if (!r.pass && !failure_dir.empty()) write_check_images(failure_dir, film, expected, r, {});
+  return r;
 }
 
-inline CheckResult run_check(const std::string& name, Strategy strategy, std::optional<int> spp = {}) {
+inline Scene load_with_strategy(const std::string& name, Strategy strategy) {
   Scene scene = load_scene(analytic_scene(name));
   scene.render.strategy = strategy;
-  if (spp) scene.render.spp = *spp;
-  return run_check(std::move(scene));
+  return scene;
+}
+
+inline CheckResult run_check(const std::string& name, Strategy strategy,
+                             const std::filesystem::path& failure_dir = {}) {
+  return run_check(load_with_strategy(name, strategy), failure_dir);
 }
 
 }  // namespace pathlab::test

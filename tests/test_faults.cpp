@@ -26,8 +26,14 @@ TEST_P(PlantedFault, IsCaughtByCheck) {
   g_fault = Fault::None;
   EXPECT_TRUE(test::run_check(c.scene, c.strategy).pass) << "the unfaulted control must pass";
   g_fault = c.fault;
-  const CheckResult r = test::run_check(c.scene, c.strategy);
+  const auto dir = std::filesystem::temp_directory_path() / ("pathlab-fault-" + std::string(c.name));
+  std::filesystem::remove_all(dir);
+  const CheckResult r = test::run_check(test::load_with_strategy(c.scene, c.strategy), dir);
   EXPECT_FALSE(r.pass) << c.name << " went unnoticed: worst z " << r.worst.front().z << ", bias z " << r.bias_z;
+  // A failed check leaves the four images a person needs to see why.
+  for (const char* f : {"rendered.exr", "expected.exr", "error.exr", "zscore.exr"})
+    EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+  std::filesystem::remove_all(dir);
 }
 
 // Each fault on a scene and strategy that exercise the broken code.

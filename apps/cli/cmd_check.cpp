@@ -66,7 +66,7 @@ int CheckCommand::run(std::ostream& /*out*/, std::ostream& err) const {
       << "  " << (r.pass ? "PASS" : "FAIL") << "  pixels: " << r.failing << " of " << 3 * sc.film.width * sc.film.height
       << " pixel-channels beyond |z| " << fmt("%.2f", r.z_threshold) << " (Sidak, alpha " << alpha << "), worst |z| "
       << fmt("%.2f", r.worst.empty() ? 0.0 : std::abs(r.worst.front().z)) << "\n"
-      << "        bias " << fmt("%.3g", r.bias) << " +- " << fmt("%.2g", r.bias_se) << " (z " << fmt("%.2f", r.bias_z)
+      << "        bias (" << channel[r.bias_channel] << ", the most significant channel) " << fmt("%.3g", r.bias) << " +- " << fmt("%.2g", r.bias_se) << " (z " << fmt("%.2f", r.bias_z)
       << ", threshold " << fmt("%.2f", r.bias_threshold) << ")" << (r.bias_pass ? "" : "  <- biased") << "\n"
       << "        RMSE " << fmt("%.3g", r.rmse) << ", relative MSE " << fmt("%.3g", r.rel_mse) << "\n";
   if (stats.bad_samples > 0) err << "  " << stats.bad_samples << " NaN/Inf sample(s) left out of the image\n";
@@ -80,10 +80,7 @@ int CheckCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     const ImageMetadata meta = {{"scene", sc.file.string()}, {"model", std::string(model->name())},
                                 {"tracer", std::string(tracer->name())}, {"strategy", strategy_name(settings.strategy)},
                                 {"spp", std::to_string(settings.spp)}, {"seed", std::to_string(settings.seed)}};
-    write_exr(dir / "rendered.exr", film.image(), meta);
-    write_exr(dir / "expected.exr", expected.mean, meta);
-    write_exr(dir / "error.exr", r.error, meta);
-    write_exr(dir / "zscore.exr", r.z, meta);
+    write_check_images(dir, film, expected, r, meta);
     err << "  wrote rendered.exr, expected.exr, error.exr and zscore.exr to " << dir.string() << "\n";
   }
   return r.pass ? 0 : 1;

@@ -44,6 +44,9 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   const CompiledScene compiled(std::move(s));
   const auto tracer = make_tracer(scene.tracer, compiled, settings);
   const Scene& sc = compiled.scene();
+  if (const std::size_t n = compiled.lights().unsampled_light_count())
+    err << "pathlab: warning: " << n << " light(s) are too dim next to the others ever to be picked for light "
+        << "sampling; only rays that hit them count their light\n";
   Film film(sc.film.width, sc.film.height, sc.film.filter);
 
   ProgressBar bar(err, "rendering", !quiet && stderr_is_terminal());

@@ -1,0 +1,47 @@
+// `pathlab check` from the command line: exit codes and what it writes.
+#include "apps/cli/cli.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <sstream>
+
+namespace pathlab {
+namespace {
+
+int run(std::vector<std::string> args, std::string* err_text = nullptr) {
+  args.insert(args.begin(), "pathlab");
+  std::vector<const char*> argv;
+  for (const std::string& a : args) argv.push_back(a.c_str());
+  std::ostringstream out, err;
+  const int code = cli::run(static_cast<int>(argv.size()), argv.data(), out, err);
+  if (err_text) *err_text = err.str();
+  return code;
+}
+
+const std::string kScenes = std::string(PATHLAB_SOURCE_DIR) + "/analytic-scenes/";
+
+TEST(CheckCli, PassesAnAnalyticSceneAndPrintsTheVerdict) {
+  const auto dir = std::filesystem::temp_directory_path() / ("pathlab-check-" + std::to_string(::getpid()));
+  std::string err;
+  EXPECT_EQ(run({"check", kScenes + "furnace-sphere.json", "--spp", "16", "--resolution", "8x8", "--out", dir.string()}, &err), 0)
+      << err;
+  EXPECT_NE(err.find("PASS"), std::string::npos) << err;
+  EXPECT_NE(err.find("pathlab trace-pixel"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir)) << "nothing is written when the check passes";
+}
+
+// Refusals exit 2. (The failing path, exit 1 with images written, needs a
+// planted fault: tests/test_faults.cpp.)
+TEST(CheckCli, RefusesScenesItCannotCheck) {
+  std::string err;
+  EXPECT_EQ(run({"check", std::string(PATHLAB_SOURCE_DIR) + "/scenes/cornell-box.json", "--spp", "1"}, &err), 2);
+  EXPECT_NE(err.find("names no analytic model"), std::string::npos) << err;
+  EXPECT_EQ(run({"check"}, &err), 2);
+  EXPECT_NE(err.find("needs a scene file"), std::string::npos) << err;
+  EXPECT_EQ(run({"check", kScenes + "mirror-sphere-gray-room.json", "--max-depth", "3", "--spp", "1"}, &err), 2);
+  EXPECT_NE(err.find("perfect mirror"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace pathlab
