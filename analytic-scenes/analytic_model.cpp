@@ -16,6 +16,7 @@ struct Entry {
 constexpr Entry kModels[] = {
     {"furnace", analytic::make_furnace},
     {"sphere-in-uniform-light", analytic::make_sphere_in_uniform_light},
+    {"penumbra", analytic::make_penumbra},
 };
 
 }  // namespace

@@ -7,6 +7,7 @@ namespace pathlab::analytic {
 
 std::unique_ptr<AnalyticModel> make_furnace(const Scene& scene);
 std::unique_ptr<AnalyticModel> make_sphere_in_uniform_light(const Scene& scene);
+std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene);
 
 // Radiance reaching the eye inside a closed Lambert room of albedo rho that
 // emits Le everywhere, counting paths of at most `max_depth` bounces

@@ -11,14 +11,16 @@
 //     albedo        [r,g,b] in [0,1]   reflectance                 default [0.5,0.5,0.5]
 //     emission      [r,g,b] >= 0       emitted radiance            default [0,0,0]
 //     two_sided     bool               emit from both sides        default false
+//     light         bool               register the emission as a  default true
+//                                      light for light sampling; false leaves it to rays that hit it
 //
 //   type "mirror"    perfect specular reflector (an impulse)
 //     reflectance   [r,g,b] in [0,1]                                default [1,1,1]
-//     emission, two_sided               as for "diffuse"
+//     emission, two_sided, light        as for "diffuse"
 //
 //   type "emissive"  emits, reflects nothing (a black body that glows)
 //     radiance      [r,g,b] >= 0       emitted radiance            required
-//     two_sided     bool                                           default false
+//     two_sided, light                  as for "diffuse"
 //
 // Emission leaves the front side of a surface: the side its geometric normal
 // points to (see each shape's "flip_normals"), or both sides if two_sided.
@@ -50,6 +52,7 @@ struct Material {
   Spectrum albedo{0.5f};       // diffuse albedo, or mirror reflectance
   Spectrum emission{0.0f};     // emitted radiance
   bool two_sided_emission = false;
+  bool sampled_as_light = true;  // false: only rays that hit it find its emission
 
   bool emits() const { return !is_black(emission); }
   // True if the material scatters light at all (an "emissive" does not).

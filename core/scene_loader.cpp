@@ -266,7 +266,7 @@ Material read_material(const Node& node, const std::string& name) {
                      {{type == "diffuse" ? "reflectance" : "albedo",
                        type == "diffuse" ? "its colour is 'albedo'" : "its colour is 'reflectance'"},
                       {"radiance", "emitted light is 'emission'"}});
-    node.allow_only({"type", refl, "emission", "two_sided"});
+    node.allow_only({"type", refl, "emission", "two_sided", "light"});
     m.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
     m.albedo = node.has(refl) ? node.child(refl).color(true) : Spectrum(type == "diffuse" ? 0.5f : 1.0f);
     if (node.has("emission")) m.emission = node.child("emission").color(false);
@@ -275,7 +275,7 @@ Material read_material(const Node& node, const std::string& name) {
                      {{"emission", "its emitted light is 'radiance'"},
                       {"albedo", "it reflects nothing (use type diffuse with 'emission' for a surface that does both)"},
                       {"reflectance", "it reflects nothing"}});
-    node.allow_only({"type", "radiance", "two_sided"});
+    node.allow_only({"type", "radiance", "two_sided", "light"});
     m.type = MaterialType::Emissive;
     m.albedo = Spectrum(0.0f);
     m.emission = node.required("radiance").color(false);
@@ -286,6 +286,7 @@ Material read_material(const Node& node, const std::string& name) {
                             (near.empty() ? " (expected diffuse, mirror or emissive)" : near));
   }
   m.two_sided_emission = node.boolean_or("two_sided", false);
+  m.sampled_as_light = node.boolean_or("light", true);
   return m;
 }
 

@@ -2,6 +2,7 @@
 // its check at its own sample count (label "stat"); the models refuse scenes
 // that break their assumptions and follow edits of their parameters.
 #include "tests/check_util.h"
+#include "tests/stat_util.h"
 #include "tests/test_scenes.h"
 
 #include "core/error.h"
@@ -78,6 +79,30 @@ TEST(AnalyticEdits, AModelThatIgnoredAnEditWouldFail) {
   EXPECT_FALSE(check_against_expected(film, expected_image(*model, compiled.camera(), compiled.scene().film)).pass);
 }
 
+// The same rectangle as a light (found by light sampling) and as a plain
+// emissive surface (found only by BSDF sampling): the latter's render passes
+// against the former scene's expected image, so the two agree with each other
+// through the one model. (Comparing the two renders directly would need the
+// checker's variance floors twice over.)
+TEST(AnalyticPenumbra, EmissivePolygonMatchesTheLightsExpectedImage) {
+  const Scene light_scene = load_scene(test::analytic_scene("penumbra-box.json"));
+  Scene polygon_scene = load_scene(test::analytic_scene("penumbra-emissive-polygon.json"));
+  ASSERT_TRUE(light_scene.materials[light_scene.shapes[1].material].sampled_as_light);
+  ASSERT_FALSE(polygon_scene.materials[polygon_scene.shapes[1].material].sampled_as_light);
+  const auto model = make_analytic_model(light_scene);
+  for (Strategy strategy : {Strategy::Mis, Strategy::Light}) {
+    polygon_scene.render.strategy = strategy;
+    const RenderSettings settings = polygon_scene.render;
+    const CompiledScene compiled{Scene(polygon_scene)};
+    EXPECT_EQ(compiled.lights().area_light_count(), 0u);
+    const ReferenceTracer tracer(compiled, settings);
+    Film film(compiled.scene().film.width, compiled.scene().film.height, compiled.scene().film.filter);
+    render(tracer, film);
+    EXPECT_TRUE(check_against_expected(film, expected_image(*model, compiled.camera(), compiled.scene().film)).pass)
+        << strategy_name(strategy);
+  }
+}
+
 void expect_refused(const std::string& scene_name, const std::function<void(Scene&)>& edit, const std::string& words) {
   Scene s = load_scene(test::analytic_scene(scene_name));
   edit(s);
@@ -100,6 +125,16 @@ TEST(AnalyticRefusals, FurnaceAssumptions) {
   expect_refused("furnace-box.json", [](Scene& s) { s.shapes[0].mesh.triangles.pop_back(); }, "closed");
   expect_refused("furnace-box.json", [](Scene& s) { s.camera.aperture_radius = 0.1f; }, "pinhole");
   expect_refused("furnace-box.json", [](Scene& s) { s.analytic = "furnac"; }, "did you mean 'furnace'");
+}
+
+TEST(AnalyticRefusals, PenumbraAssumptions) {
+  // shapes: 0 ground, 1 lamp, 2 box
+  expect_refused("penumbra-box.json", [](Scene& s) { s.shapes[2].mesh.positions[0].y += 5.0f; }, "");
+  expect_refused("penumbra-box.json", [](Scene& s) { for (vec3& p : s.shapes[2].mesh.positions) p.y += 1.5f; }, "strictly between");
+  expect_refused("penumbra-box.json", [](Scene& s) { s.shapes[1].mesh.positions[0].y -= 0.3f; }, "planar");
+  expect_refused("penumbra-box.json", [](Scene& s) { s.shapes.push_back(s.shapes[2]); }, "at most one black occluder");
+  expect_refused("penumbra-box.json", [](Scene& s) { s.environment = Spectrum(1.0f); }, "environment");
+  expect_refused("penumbra-box.json", [](Scene& s) { s.materials[s.shapes[0].material].type = MaterialType::Mirror; }, "diffuse");
 }
 
 TEST(AnalyticRefusals, SphereAssumptions) {

@@ -48,6 +48,9 @@ const FaultCase kCases[] = {
     {Fault::LightPdfWithoutArea, "light_pdf_without_area_mis", "white-sphere-emissive-room.json", Strategy::Mis},
     {Fault::LightPdfWithoutDistance, "light_pdf_without_distance_light", "white-sphere-emissive-room.json", Strategy::Light},
     {Fault::LightPdfWithoutDistance, "light_pdf_without_distance_mis", "furnace-box.json", Strategy::Mis},
+    {Fault::LightPdfWithoutDistance, "light_pdf_without_distance_penumbra", "penumbra-box.json", Strategy::Light},
+    {Fault::CosineDropped, "cosine_dropped_penumbra", "penumbra-box.json", Strategy::Mis},
+    {Fault::EmissionAfterNee, "emission_after_nee_penumbra", "penumbra-box.json", Strategy::LightBsdf},
     {Fault::RouletteNotReweighted, "roulette_not_reweighted_cosine", "furnace-box.json", Strategy::Cosine},
     {Fault::RouletteNotReweighted, "roulette_not_reweighted_mis", "mirror-sphere-gray-room.json", Strategy::Mis},
 };

@@ -76,6 +76,12 @@ int CheckCommand::run(std::ostream& /*out*/, std::ostream& err) const {
         << ", expected " << fmt("%.5g", p.expected) << " +- " << fmt("%.2g", p.sigma) << ", z " << fmt("%.2f", p.z)
         << "\n      " << scene.trace_pixel_command(sc, static_cast<std::uint32_t>(p.x), static_cast<std::uint32_t>(p.y), 0)
         << "\n";
+  if (!r.worst.empty()) {
+    const PixelDeviation& p = r.worst.front();
+    if (std::abs(p.z) > r.z_threshold && film.variance_of_mean(p.x, p.y)[p.channel] == 0.0f)
+      err << "  note: the worst pixel's samples were all equal, so its variance is unknown rather than zero (a light "
+             "found too rarely at this sample count?); try more --spp before suspecting the tracer\n";
+  }
   if (!r.pass) {
     const ImageMetadata meta = {{"scene", sc.file.string()}, {"model", std::string(model->name())},
                                 {"tracer", std::string(tracer->name())}, {"strategy", strategy_name(settings.strategy)},

@@ -1,0 +1,231 @@
+// Model "penumbra": a planar convex emitter of radiance Le (one-sided unless
+// two_sided), a planar Lambert ground of albedo rho, and at most one black,
+// closed, convex occluder (a box) strictly between the emitter's plane and
+// the ground. Nothing else reflects, so a ground point x receives direct
+// light only:
+//   L(x) = rho / pi * Le * FF(x),
+//   FF(x) = F(emitter) - F(emitter ∩ shadow(x)),
+// with F the cosine-weighted solid angle of a polygon seen from x (Lambert's
+// formula after clipping to x's horizon, polygon_irradiance.h), and
+// shadow(x) the occluder projected from x onto the emitter's plane: convex,
+// because the occluder is, and exactly the set of emitter points x cannot
+// see. Umbra (FF = 0), penumbra and fully lit points are all exact.
+//
+// A camera ray carries: Le where it meets the emitter's front, 0 on the
+// occluder or the emitter's back or when it escapes, and L(x) on the ground
+// (0 with a depth cap of 0). The same model serves the emitter registered
+// as a light and, with "light": false in its material, as a plain emissive
+// surface only BSDF sampling finds.
+#include "analytic-scenes/models.h"
+#include "analytic-scenes/polygon_irradiance.h"
+#include "analytic-scenes/room.h"
+#include "core/geometry.h"
+
+#include <sstream>
+
+namespace pathlab::analytic {
+namespace {
+
+struct Plane {
+  dvec3 point, normal;  // unit normal
+  double distance(const dvec3& p) const { return glm::dot(p - point, normal); }
+};
+
+// The plane of a triangle mesh's first triangle, if every vertex lies in it
+// (relative tolerance 1e-6 of the mesh's extent).
+std::optional<Plane> plane_of(const Shape& s) {
+  if (s.kind != Shape::Kind::Triangles || s.mesh.triangles.empty()) return std::nullopt;
+  const Plane p{dvec3(s.mesh.positions[s.mesh.triangles[0].x]), dvec3(triangle_normal(s, 0))};
+  double extent = 0.0;
+  for (const vec3& v : s.mesh.positions) extent = std::max(extent, glm::length(dvec3(v) - p.point));
+  for (const vec3& v : s.mesh.positions)
+    if (std::abs(p.distance(dvec3(v))) > 1e-6 * extent) return std::nullopt;
+  return p;
+}
+
+double mesh_area(const Shape& s) {
+  double a = 0.0;
+  for (std::uint32_t t = 0; t < s.mesh.triangles.size(); ++t) a += triangle_area(s.mesh, t);
+  return a;
+}
+
+double polygon_area(const std::vector<glm::dvec2>& p) {
+  double a = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const glm::dvec2 &u = p[i], &v = p[(i + 1) % p.size()];
+    a += u.x * v.y - u.y * v.x;
+  }
+  return 0.5 * std::abs(a);
+}
+
+// True if every vertex lies on the inner side of every face's plane.
+bool is_convex(const Shape& s) {
+  double extent = 0.0;
+  for (const vec3& v : s.mesh.positions) extent = std::max<double>(extent, glm::length(v - s.mesh.positions[0]));
+  const dvec3 centre = [&] {
+    dvec3 c(0.0);
+    for (const vec3& v : s.mesh.positions) c += dvec3(v);
+    return c / static_cast<double>(s.mesh.positions.size());
+  }();
+  for (std::uint32_t t = 0; t < s.mesh.triangles.size(); ++t) {
+    const dvec3 p(s.mesh.positions[s.mesh.triangles[t].x]);
+    dvec3 n(triangle_normal(s, t));
+    if (glm::dot(n, centre - p) > 0.0) n = -n;  // point n outwards
+    for (const vec3& v : s.mesh.positions)
+      if (glm::dot(dvec3(v) - p, n) > 1e-6 * extent) return false;
+  }
+  return true;
+}
+
+// Nearest triangle hit in double precision: the shape index and distance.
+std::optional<std::pair<std::size_t, double>> nearest_hit(const std::vector<const Shape*>& shapes, const Ray& ray) {
+  const dvec3 o(ray.origin), d = glm::normalize(dvec3(ray.dir));
+  std::optional<std::pair<std::size_t, double>> best;
+  for (std::size_t i = 0; i < shapes.size(); ++i)
+    for (const glm::uvec3& t : shapes[i]->mesh.triangles) {
+      const dvec3 p0(shapes[i]->mesh.positions[t.x]), e1 = dvec3(shapes[i]->mesh.positions[t.y]) - p0,
+          e2 = dvec3(shapes[i]->mesh.positions[t.z]) - p0, q = glm::cross(d, e2);
+      const double det = glm::dot(e1, q);
+      if (det == 0.0) continue;
+      const dvec3 s = o - p0;
+      const double u = glm::dot(s, q) / det;
+      if (u < 0.0 || u > 1.0) continue;
+      const dvec3 r = glm::cross(s, e1);
+      const double v = glm::dot(d, r) / det, dist = glm::dot(e2, r) / det;
+      if (v < 0.0 || u + v > 1.0 || dist <= 0.0) continue;
+      if (!best || dist < best->second) best = std::pair{i, dist};
+    }
+  return best;
+}
+
+class Penumbra final : public AnalyticModel {
+ public:
+  const Shape* emitter = nullptr;
+  const Shape* ground = nullptr;
+  const Shape* occluder = nullptr;  // may be null
+  Plane emitter_plane, ground_plane;
+  dvec3 eu, ev;                      // basis of the emitter's plane
+  std::vector<glm::dvec2> emitter_2d;  // convex, counter-clockwise
+  std::vector<dvec3> emitter_3d;
+  Spectrum Le{0.0f}, rho{0.0f};
+  bool two_sided = false;
+  int max_depth = 0;
+  std::string description;
+
+  std::string_view name() const override { return "penumbra"; }
+  std::string describe() const override { return description; }
+
+  glm::dvec2 to_2d(const dvec3& p) const { return {glm::dot(p - emitter_plane.point, eu), glm::dot(p - emitter_plane.point, ev)}; }
+  dvec3 to_3d(const glm::dvec2& p) const { return emitter_plane.point + p.x * eu + p.y * ev; }
+
+  // Cosine-weighted solid angle of the part of the emitter that x sees.
+  double visible_form_factor(const dvec3& x, const dvec3& n) const {
+    if (!two_sided && emitter_plane.distance(x) <= 0.0) return 0.0;  // behind a one-sided emitter
+    double ff = polygon_form_factor(emitter_3d, x, n);
+    if (occluder && ff > 0.0) {
+      std::vector<glm::dvec2> shadow;
+      const double hx = emitter_plane.distance(x);
+      for (const vec3& v : occluder->mesh.positions) {
+        // Central projection from x through v onto the emitter's plane.
+        const dvec3 dv = dvec3(v) - x;
+        const double t = -hx / glm::dot(dv, emitter_plane.normal);
+        shadow.push_back(to_2d(x + t * dv));
+      }
+      const std::vector<glm::dvec2> hidden = clip_convex(convex_hull(std::move(shadow)), emitter_2d);
+      if (!hidden.empty()) {
+        std::vector<dvec3> hidden_3d;
+        for (const glm::dvec2& p : hidden) hidden_3d.push_back(to_3d(p));
+        ff -= polygon_form_factor(hidden_3d, x, n);
+      }
+    }
+    return std::max(0.0, ff);
+  }
+
+  Spectrum radiance(const Ray& ray) const override {
+    std::vector<const Shape*> shapes{emitter, ground};
+    if (occluder) shapes.push_back(occluder);
+    const auto hit = nearest_hit(shapes, ray);
+    if (!hit) return Spectrum(0.0f);
+    const dvec3 d = glm::normalize(dvec3(ray.dir));
+    const dvec3 x = dvec3(ray.origin) + hit->second * d;
+    if (hit->first == 0) return (two_sided || glm::dot(d, emitter_plane.normal) < 0.0) ? Le : Spectrum(0.0f);
+    if (hit->first == 2 || max_depth == 0) return Spectrum(0.0f);
+    // The ground is two-sided Lambert: shade on the camera's side.
+    const dvec3 n = glm::dot(d, ground_plane.normal) < 0.0 ? ground_plane.normal : -ground_plane.normal;
+    return rho * Le * static_cast<float>(visible_form_factor(x, n) / kPi);
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
+  constexpr std::string_view kName = "penumbra";
+  auto model = std::make_unique<Penumbra>();
+  for (const Shape& s : scene.shapes) {
+    const Material& m = scene.materials[s.material];
+    if (m.emits()) {
+      if (model->emitter) refuse(scene, kName, "needs exactly one emitting shape; found two");
+      model->emitter = &s;
+    } else if (!is_black(m.albedo)) {
+      if (model->ground) refuse(scene, kName, "needs exactly one reflecting shape, the ground; found two");
+      model->ground = &s;
+    } else {
+      if (model->occluder) refuse(scene, kName, "allows at most one black occluder (their shadows would overlap)");
+      model->occluder = &s;
+    }
+  }
+  if (!model->emitter) refuse(scene, kName, "needs an emitting polygon");
+  if (!model->ground) refuse(scene, kName, "needs a reflecting ground");
+  if (scene.environment && !is_black(*scene.environment)) refuse(scene, kName, "an environment would light the ground too; remove it");
+  if (!scene.point_lights.empty()) refuse(scene, kName, "point lights would light the ground too; remove them");
+
+  const Material& em = scene.materials[model->emitter->material];
+  const Material& gm = scene.materials[model->ground->material];
+  if (em.scatters()) refuse(scene, kName, "the emitter must reflect nothing (material type \"emissive\")");
+  if (gm.type != MaterialType::Diffuse) refuse(scene, kName, "the ground must be diffuse (Lambert)");
+  const auto ep = plane_of(*model->emitter);
+  if (!ep) refuse(scene, kName, "the emitter must be planar (a rectangle or a planar mesh)");
+  const auto gp = plane_of(*model->ground);
+  if (!gp) refuse(scene, kName, "the ground must be planar");
+  model->emitter_plane = *ep;
+  model->ground_plane = *gp;
+
+  // The emitter as a convex polygon in its plane: the hull of its vertices,
+  // which must have the mesh's own area (else it is not convex).
+  const Frame f{vec3(ep->normal)};
+  model->eu = dvec3(f.s);
+  model->ev = dvec3(f.t);
+  std::vector<glm::dvec2> pts;
+  for (const vec3& v : model->emitter->mesh.positions) pts.push_back(model->to_2d(dvec3(v)));
+  model->emitter_2d = convex_hull(std::move(pts));
+  if (std::abs(polygon_area(model->emitter_2d) - mesh_area(*model->emitter)) > 1e-5 * mesh_area(*model->emitter))
+    refuse(scene, kName, "the emitter must be a convex polygon");
+  for (const glm::dvec2& p : model->emitter_2d) model->emitter_3d.push_back(model->to_3d(p));
+
+  if (const Shape* occ = model->occluder) {
+    if (occ->kind != Shape::Kind::Triangles || !is_closed(*occ) || !is_convex(*occ))
+      refuse(scene, kName, "the occluder must be a closed convex mesh (a box)");
+    // Strictly between the emitter's plane and the whole ground, so that from
+    // every ground point it projects onto the emitter's plane.
+    double ground_near = kInfinity;
+    for (const vec3& v : model->ground->mesh.positions) ground_near = std::min(ground_near, ep->distance(dvec3(v)));
+    for (const vec3& v : occ->mesh.positions) {
+      const double h = ep->distance(dvec3(v));
+      if (!(h > 0.0 && h < ground_near))
+        refuse(scene, kName, "the occluder must lie strictly between the emitter's front and the ground");
+    }
+  }
+  model->Le = em.emission;
+  model->rho = gm.albedo;
+  model->two_sided = em.two_sided_emission;
+  model->max_depth = scene.render.max_depth;
+  std::ostringstream d;
+  d << "emitter '" << em.name << "' Le (" << em.emission.x << ", " << em.emission.y << ", " << em.emission.z << ")"
+    << (em.sampled_as_light ? " as a light" : " not a light (BSDF sampling only)") << ", ground '" << gm.name
+    << "' albedo (" << gm.albedo.x << ", " << gm.albedo.y << ", " << gm.albedo.z << ")"
+    << (model->occluder ? ", one occluder" : ", no occluder") << ", depth cap " << model->max_depth;
+  model->description = d.str();
+  return model;
+}
+
+}  // namespace pathlab::analytic
