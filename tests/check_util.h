@@ -9,6 +9,7 @@
 #include "core/scene_loader.h"
 #include "reference/reference_tracer.h"
 
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 
@@ -41,9 +42,17 @@ inline CheckResult run_check(Scene scene, const std::filesystem::path& failure_d
   return r;
 }
 
+// PATHLAB_STAT_SCALE multiplies the scenes' sample counts (1 in CI; the
+// "long" tests run at 16).
+inline int stat_scale() {
+  const char* s = std::getenv("PATHLAB_STAT_SCALE");
+  return s ? std::max(1, std::atoi(s)) : 1;
+}
+
 inline Scene load_with_strategy(const std::string& name, Strategy strategy) {
   Scene scene = load_scene(analytic_scene(name));
   scene.render.strategy = strategy;
+  scene.render.spp *= stat_scale();
   return scene;
 }
 

@@ -20,7 +20,7 @@ struct Case {
 class AnalyticScenes : public testing::TestWithParam<Case> {};
 
 TEST_P(AnalyticScenes, PassCheck) {
-  const CheckResult r = test::run_check(GetParam().scene, GetParam().strategy);
+  const CheckResult r = test::run_check(test::load_with_strategy(GetParam().scene, GetParam().strategy));
   EXPECT_TRUE(r.pixels_pass) << r.failing << " pixel-channels beyond " << r.z_threshold << ", worst z "
                              << r.worst.front().z << " at (" << r.worst.front().x << ", " << r.worst.front().y << ")";
   EXPECT_TRUE(r.bias_pass) << "bias " << r.bias << " +- " << r.bias_se;
