@@ -4,6 +4,8 @@
 #include "core/scene.h"
 #include "core/scene_loader.h"
 
+#include <gtest/gtest.h>
+
 #include <string>
 
 namespace pathlab::test {
@@ -33,6 +35,14 @@ inline Scene small_cornell(int res, int spp, FilterKind filter) {
   scene.film.filter = filter;
   scene.render.spp = spp;
   return scene;
+}
+
+// A GoogleTest parameter name for a strategy ("light+bsdf" -> "light_bsdf").
+inline std::string strategy_test_name(const testing::TestParamInfo<Strategy>& p) {
+  std::string s = strategy_name(p.param);
+  for (char& c : s)
+    if (c == '+') c = '_';
+  return s;
 }
 
 inline constexpr Strategy kAllStrategies[] = {Strategy::Cosine, Strategy::Bsdf, Strategy::Light, Strategy::LightBsdf,

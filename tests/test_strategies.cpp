@@ -71,12 +71,7 @@ TEST_P(StrategiesAgree, WithMisOnTheCornellBox) {
 
 INSTANTIATE_TEST_SUITE_P(Reference, StrategiesAgree,
                          testing::Values(Strategy::Cosine, Strategy::Bsdf, Strategy::Light, Strategy::LightBsdf),
-                         [](const testing::TestParamInfo<Strategy>& p) {
-                           std::string s = strategy_name(p.param);
-                           for (char& ch : s)
-                             if (ch == '+') ch = '_';
-                           return s;
-                         });
+                         test::strategy_test_name);
 
 }  // namespace
 }  // namespace pathlab

@@ -149,19 +149,9 @@ TEST_P(MirrorSphere, ShowsReflectanceTimesRoom) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllStrategies, EnvironmentSphere, testing::ValuesIn(test::kAllStrategies),
-                         [](const testing::TestParamInfo<Strategy>& p) {
-                           std::string s = strategy_name(p.param);
-                           for (char& ch : s)
-                             if (ch == '+') ch = '_';
-                           return s;
-                         });
+                         test::strategy_test_name);
 INSTANTIATE_TEST_SUITE_P(AllStrategies, MirrorSphere, testing::ValuesIn(test::kAllStrategies),
-                         [](const testing::TestParamInfo<Strategy>& p) {
-                           std::string s = strategy_name(p.param);
-                           for (char& ch : s)
-                             if (ch == '+') ch = '_';
-                           return s;
-                         });
+                         test::strategy_test_name);
 
 }  // namespace
 }  // namespace pathlab
