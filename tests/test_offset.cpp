@@ -69,6 +69,62 @@ TEST(RayOffset, NoSelfIntersectionAtTheOrigin) { expect_no_self_hits(vec3(0.0f))
 TEST(RayOffset, NoSelfIntersectionAt1e5) { expect_no_self_hits(vec3(1e5f, -1e5f, 1e5f)); }
 TEST(RayOffset, NoSelfIntersectionAt1e6) { expect_no_self_hits(vec3(-1e6f, 3e5f, 1e6f)); }
 
+// Rays leaving a sphere inwards must cross it and hit its far side, never
+// the point they leave from: their first hit lies a chord away.
+TEST(RayOffset, InwardRaysCrossTheSphereAt1e5) {
+  const CompiledScene scene(box_and_sphere_at(vec3(1e5f, 1e5f, -1e5f)));
+  const Shape& sphere = scene.scene().shapes[1];
+  int short_hits = 0, misses = 0;
+  for (std::uint32_t i = 0; i < 20000; ++i) {
+    const SurfacePoint sp =
+        sample_sphere(sphere, vec2(sample_u(3, 0, i, 0, Dim::LightX), sample_u(3, 0, i, 0, Dim::LightY)));
+    Surfel surfel;
+    surfel.p = sp.p;
+    surfel.p_error = sp.p_error;
+    surfel.n = sp.n;
+    vec3 w = square_to_cosine_hemisphere(vec2(sample_u(4, 0, i, 0, Dim::DirectionX), sample_u(4, 0, i, 0, Dim::DirectionY)));
+    const vec3 dir = -Frame(sp.n).to_world(w);  // into the sphere
+    Surfel hit;
+    if (!scene.intersect(surfel.spawn(dir), &hit)) {
+      ++misses;
+      continue;
+    }
+    // The chord from p along dir has length 2 r cos(theta) = 2 r w.z.
+    if (glm::length(hit.p - sp.p) < 0.5f * 2.0f * sphere.radius * w.z) ++short_hits;
+  }
+  EXPECT_EQ(short_hits, 0);
+  EXPECT_EQ(misses, 0);
+}
+
+// Shadow rays between two surfaces far from the origin, with nothing in
+// between, must all be unoccluded: both ends are offset off their surfaces.
+TEST(RayOffset, ShadowRaysBetweenSurfacesAt1e5AreUnoccluded) {
+  const vec3 o(-1e5f, 1e5f, 1e5f);
+  Scene s;
+  s.name = "far-shadow";
+  s.materials.push_back(Material{"white", MaterialType::Diffuse, Spectrum(0.5f), Spectrum(0.0f), false});
+  Shape floor, lamp;
+  floor.description = "floor";
+  floor.mesh = {{o + vec3(-5, 0, -5), o + vec3(5, 0, -5), o + vec3(5, 0, 5), o + vec3(-5, 0, 5)}, {{0, 2, 1}, {0, 3, 2}}};
+  lamp.description = "lamp";
+  lamp.mesh = {{o + vec3(-1, 2, -1), o + vec3(1, 2, -1), o + vec3(1, 2, 1), o + vec3(-1, 2, 1)}, {{0, 1, 2}, {0, 2, 3}}};
+  s.shapes = {floor, lamp};
+  const CompiledScene scene(std::move(s));
+  int blocked = 0;
+  for (std::uint32_t i = 0; i < 20000; ++i) {
+    const vec2 u0(sample_u(5, 0, i, 0, Dim::LightX), sample_u(5, 0, i, 0, Dim::LightY));
+    const vec2 u1(sample_u(6, 0, i, 0, Dim::LightX), sample_u(6, 0, i, 0, Dim::LightY));
+    const SurfacePoint a = sample_triangle(scene.scene().shapes[0], i % 2, u0);
+    const SurfacePoint b = sample_triangle(scene.scene().shapes[1], i % 2, u1);
+    Surfel from;
+    from.p = a.p;
+    from.p_error = a.p_error;
+    from.n = a.n;
+    blocked += scene.occluded(from.spawn_to(b.p, b.p_error, b.n));
+  }
+  EXPECT_EQ(blocked, 0);
+}
+
 // The same check through a whole render: a Lambert plane far from the origin
 // lit by a point light. Self-shadowing would show as black speckle; every
 // pixel must instead get the direct light rho/pi * I cos(theta) / d^2 of
