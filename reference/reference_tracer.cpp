@@ -4,6 +4,7 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "core/strategy_weights.h"
 
 namespace pathlab {
 
@@ -15,39 +16,14 @@ struct ReferenceTracer::Path {
   float u(int vertex, Dim dim) const { return rng.get(static_cast<std::uint32_t>(vertex), dim); }
 };
 
-// How the ray being traced was chosen at the vertex before it: decides how
-// much of the emission it finds counts (not at all where next-event
-// estimation already counted it, partly under MIS).
-struct ReferenceTracer::Previous {
-  vec3 p{0.0f};
-  float pdf = 0.0f;            // solid-angle density of the direction
-  bool impulse = true;         // camera ray or impulse: no other way to find the emitter
-  bool bsdf_technique = true;  // light+bsdf: this vertex chose BSDF sampling
-};
-
-float ReferenceTracer::emission_weight(const Previous& prev, float light_pdf) const {
-  if (prev.impulse || PATHLAB_FAULT(EmissionAfterNee)) return 1.0f;
-  switch (settings_.strategy) {
-    case Strategy::Cosine:
-    case Strategy::Bsdf: return 1.0f;
-    case Strategy::Light: return light_pdf > 0.0f ? 0.0f : 1.0f;  // what NEE cannot pick, only a ray finds
-    case Strategy::Mis: return power_heuristic(prev.pdf, light_pdf);
-    case Strategy::LightBsdf:
-      // One-sample balance heuristic with c = 1/2: f / (p_b / 2 + p_l / 2)
-      // = (f / p_b) * 2 p_b / (p_b + p_l).
-      return prev.bsdf_technique ? 2.0f * prev.pdf / (prev.pdf + light_pdf) : 0.0f;
-  }
-  return 0.0f;
-}
-
-Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const Previous& prev, const Spectrum& beta,
+Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& prev, const Spectrum& beta,
                              Path& path) const {
   const CompiledScene& scene = scene_;
   Surfel s;
   ++path.rays;
   if (!scene.intersect(ray, &s)) {
     const Spectrum Le = scene.scene().environment.value_or(Spectrum(0.0f));
-    const float w = is_black(Le) ? 0.0f : emission_weight(prev, scene.lights().pdf_environment());
+    const float w = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, scene.lights().pdf_environment());
     if (path.observer) {
       path.observer->on_escape({vertex, Le, w, beta * w * Le});
       path.observer->on_end({vertex, PathEnd::Escaped});
@@ -57,7 +33,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const Previous& prev, c
 
   const vec3 wo = -ray.dir;
   const Spectrum Le = s.emitted(wo);
-  const float w_e = is_black(Le) ? 0.0f : emission_weight(prev, scene.lights().pdf(prev.p, s));
+  const float w_e = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, scene.lights().pdf(prev.p, s));
   Spectrum L = w_e * Le;
   if (path.observer)
     path.observer->on_hit({vertex, s.p, s.n, glm::dot(s.n, wo) > 0.0f,
@@ -79,10 +55,8 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const Previous& prev, c
 
   // Light a ray can find, as the strategy says.
   const Strategy strategy = settings_.strategy;
-  const bool light_technique =
-      strategy == Strategy::LightBsdf && path.u(vertex, Dim::Technique) < 0.5f;
-  if (strategy == Strategy::Light || strategy == Strategy::Mis || light_technique)
-    L += direct_area(s, wo, vertex, beta, path);
+  const float u_technique = path.u(vertex, Dim::Technique);
+  if (samples_area_lights(strategy, u_technique)) L += direct_area(s, wo, vertex, beta, path);
 
   // Continue the path.
   const vec2 u_dir(path.u(vertex, Dim::DirectionX), path.u(vertex, Dim::DirectionY));
@@ -112,7 +86,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const Previous& prev, c
   if (path.observer)
     path.observer->on_scatter({vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, beta_next});
 
-  const Previous next{s.p, bs->pdf, bs->impulse, !light_technique};
+  const PreviousVertex next{s.p, bs->pdf, bs->impulse, !(strategy == Strategy::LightBsdf && u_technique < 0.5f)};
   return L + weight * Li(s.spawn(bs->wi), vertex + 1, next, beta_next, path);
 }
 
@@ -139,13 +113,7 @@ Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int verte
   if (!ls) return Spectrum(0.0f);
   const Spectrum f = s.eval(ls->wi, wo);
   if (is_black(f)) return Spectrum(0.0f);
-  float w = 1.0f;
-  if (settings_.strategy == Strategy::Mis) {
-    w = power_heuristic(ls->pdf, s.pdf(ls->wi, wo));
-  } else if (settings_.strategy == Strategy::LightBsdf) {
-    const float pb = s.pdf(ls->wi, wo);
-    w = 2.0f * ls->pdf / (ls->pdf + pb);
-  }
+  const float w = light_sample_weight(settings_.strategy, ls->pdf, s.pdf(ls->wi, wo));
   ++path.rays;
   const Ray shadow = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, ls->p_error, ls->n);
   const bool visible = !scene_.occluded(shadow);
@@ -163,7 +131,7 @@ FilmSample ReferenceTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::
   fs.film = vec2(static_cast<float>(x) + path.u(0, Dim::FilmX), static_cast<float>(y) + path.u(0, Dim::FilmY));
   const Ray ray = scene_.camera().generate_ray(fs.film, vec2(path.u(0, Dim::LensX), path.u(0, Dim::LensY)));
   if (observer) observer->on_camera({x, y, sample, fs.film, ray.origin, ray.dir});
-  fs.L = Li(ray, 1, Previous{}, Spectrum(1.0f), path);
+  fs.L = Li(ray, 1, PreviousVertex{}, Spectrum(1.0f), path);
   fs.rays = path.rays;
   if (observer) observer->on_result(fs.L);
   return fs;

@@ -3,6 +3,7 @@
 // wavefront tracer must agree with it path by path.
 #pragma once
 
+#include "core/strategy_weights.h"
 #include "core/tracer.h"
 
 namespace pathlab {
@@ -18,11 +19,9 @@ class ReferenceTracer final : public Tracer {
 
  private:
   struct Path;
-  struct Previous;
-  Spectrum Li(const Ray& ray, int vertex, const Previous& prev, const Spectrum& beta, Path& path) const;
+  Spectrum Li(const Ray& ray, int vertex, const PreviousVertex& prev, const Spectrum& beta, Path& path) const;
   Spectrum direct_delta(const Surfel& s, const vec3& wo, int vertex, const Spectrum& beta, Path& path) const;
   Spectrum direct_area(const Surfel& s, const vec3& wo, int vertex, const Spectrum& beta, Path& path) const;
-  float emission_weight(const Previous& prev, float light_pdf) const;
 };
 
 }  // namespace pathlab

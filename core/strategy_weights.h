@@ -1,0 +1,54 @@
+// How much of each contribution a strategy keeps: the weights both tracers
+// apply, in one place so that they cannot drift apart.
+//
+//   emission found by a ray:  camera ray or impulse 1; cosine, bsdf 1;
+//     light 0 (NEE counted it) unless NEE could not pick it (light pdf 0);
+//     mis power heuristic; light+bsdf 2 p_b / (p_b + p_l) after BSDF
+//     sampling, 0 after light sampling (one-sample balance heuristic, c = 1/2).
+//   a light sample (NEE):     light 1; mis power heuristic;
+//     light+bsdf 2 p_l / (p_l + p_b).
+#pragma once
+
+#include "core/faults.h"
+#include "core/math.h"
+#include "core/sampling.h"
+#include "core/scene.h"
+
+namespace pathlab {
+
+// How the ray now being traced was chosen at the vertex before it.
+struct PreviousVertex {
+  vec3 p{0.0f};
+  float pdf = 0.0f;            // solid-angle density of the direction
+  bool impulse = true;         // camera ray or impulse: no other way to find the emitter
+  bool bsdf_technique = true;  // light+bsdf: that vertex chose BSDF sampling
+};
+
+inline float emission_weight(Strategy strategy, const PreviousVertex& prev, float light_pdf) {
+  if (prev.impulse || PATHLAB_FAULT(EmissionAfterNee)) return 1.0f;
+  switch (strategy) {
+    case Strategy::Cosine:
+    case Strategy::Bsdf: return 1.0f;
+    case Strategy::Light: return light_pdf > 0.0f ? 0.0f : 1.0f;  // what NEE cannot pick, only a ray finds
+    case Strategy::Mis: return power_heuristic(prev.pdf, light_pdf);
+    case Strategy::LightBsdf:
+      // f / (p_b / 2 + p_l / 2) = (f / p_b) * 2 p_b / (p_b + p_l).
+      return prev.bsdf_technique ? 2.0f * prev.pdf / (prev.pdf + light_pdf) : 0.0f;
+  }
+  return 0.0f;
+}
+
+inline float light_sample_weight(Strategy strategy, float light_pdf, float bsdf_pdf) {
+  if (strategy == Strategy::Mis) return power_heuristic(light_pdf, bsdf_pdf);
+  if (strategy == Strategy::LightBsdf) return 2.0f * light_pdf / (light_pdf + bsdf_pdf);
+  return 1.0f;
+}
+
+// Whether vertex `vertex` samples area lights (NEE) under `strategy`;
+// `u_technique` is its Dim::Technique number.
+inline bool samples_area_lights(Strategy strategy, float u_technique) {
+  return strategy == Strategy::Light || strategy == Strategy::Mis ||
+         (strategy == Strategy::LightBsdf && u_technique < 0.5f);
+}
+
+}  // namespace pathlab
