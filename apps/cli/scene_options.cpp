@@ -4,6 +4,7 @@
 #include "core/error.h"
 #include "core/scene_loader.h"
 #include "reference/reference_tracer.h"
+#include "wavefront/wavefront_tracer.h"
 
 #include <charconv>
 #include <sstream>
@@ -12,7 +13,7 @@ namespace pathlab::cli {
 
 void SceneOptions::add_to(CLI::App& cmd, bool with_spp) {
   cmd.add_option("scene", scene_file, "Scene file (JSON); omit for the built-in Cornell box");
-  cmd.add_option("--tracer", tracer, "Tracer: reference")->check(CLI::IsMember({"reference"}));
+  cmd.add_option("--tracer", tracer, "Tracer: reference or wavefront")->check(CLI::IsMember({"reference", "wavefront"}));
   cmd.add_option("--strategy", strategy, "Sampling strategy: cosine, bsdf, light, light+bsdf, mis")
       ->check(CLI::IsMember({"cosine", "bsdf", "light", "light+bsdf", "mis"}));
   if (with_spp) cmd.add_option("--spp", spp, "Samples per pixel")->check(CLI::Range(1, 1 << 24));
@@ -64,7 +65,8 @@ std::string SceneOptions::trace_pixel_command(const Scene& scene, std::uint32_t 
 
 std::unique_ptr<Tracer> make_tracer(const std::string& name, const CompiledScene& scene, const RenderSettings& settings) {
   if (name == "reference") return std::make_unique<ReferenceTracer>(scene, settings);
-  throw InputError("unknown tracer '" + name + "' (expected reference)");
+  if (name == "wavefront") return std::make_unique<WavefrontTracer>(scene, settings);
+  throw InputError("unknown tracer '" + name + "' (expected reference or wavefront)");
 }
 
 }  // namespace pathlab::cli

@@ -1,0 +1,29 @@
+// Comparing two recorded paths of the same pixel sample (the reference's and
+// the wavefront's), event by event, to find where they part.
+#pragma once
+
+#include "debugtools/path_recorder.h"
+
+#include <string>
+#include <vector>
+
+namespace pathlab {
+
+struct PathDivergence {
+  bool identical = true;  // every event agrees within the tolerance
+  // The paths are the same path up to their parting, which a floating-point
+  // difference explains: they part on a discrete outcome (a visibility, a
+  // roulette draw, the end of a path) or on values that still agree to 1e-2,
+  // never on an unrelated path (different camera ray, direction, surface).
+  bool rounding = true;
+  std::size_t event = 0;  // index of the first event that differs
+  int vertex = 0;         // its vertex
+  std::string reason;     // what differs, for people
+};
+
+// Events agree if they are of the same kind at the same vertex, their
+// discrete outcomes are equal, and their positions, directions, pdfs and
+// contributions agree within `tolerance` relative (absolute below 1).
+PathDivergence first_divergence(const std::vector<PathEvent>& a, const std::vector<PathEvent>& b, float tolerance);
+
+}  // namespace pathlab

@@ -1,0 +1,277 @@
+#include "wavefront/wavefront_tracer.h"
+
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "core/strategy_weights.h"
+
+#include <algorithm>
+
+namespace pathlab {
+
+// The state of every path of a wave, one array per field. Paths keep their
+// slot for the whole wave; `live` lists the slots still being traced, in
+// slot order, and is compacted after each bounce.
+struct WavefrontTracer::Wave {
+  // Identity and output.
+  std::vector<std::uint32_t> out_index, x, y, sample;
+  std::vector<SampleStream> rng;
+  std::vector<vec2> film;
+  // The path so far.
+  std::vector<Ray> ray;
+  std::vector<Spectrum> beta, L;
+  std::vector<PreviousVertex> prev;
+  std::vector<std::int32_t> vertex;  // the vertex the current ray will reach
+  std::vector<std::uint32_t> rays;
+  std::vector<std::uint8_t> alive;
+  // This bounce.
+  std::vector<Surfel> surfel;
+  // Two shadow rays per path: [0] a point light, [1] an area light.
+  std::vector<Ray> shadow;
+  std::vector<LightSample> light;
+  std::vector<Spectrum> unoccluded;  // f Le w / pdf, before visibility
+  std::vector<float> light_weight;
+  std::vector<std::uint8_t> shadow_state;  // 0 none, 1 to trace, 2 visible, 3 occluded
+  std::vector<std::uint32_t> live;
+
+  void resize(std::size_t n) {
+    out_index.resize(n), x.resize(n), y.resize(n), sample.resize(n), rng.resize(n, SampleStream(0, 0, 0));
+    film.resize(n), ray.resize(n), beta.resize(n), L.resize(n), prev.resize(n), vertex.resize(n), rays.resize(n);
+    alive.resize(n), surfel.resize(n);
+    shadow.resize(2 * n), light.resize(2 * n), unoccluded.resize(2 * n), light_weight.resize(2 * n);
+    shadow_state.resize(2 * n);
+    live.resize(n);
+  }
+  float u(std::uint32_t i, Dim dim) const { return rng[i].get(static_cast<std::uint32_t>(vertex[i]), dim); }
+};
+
+std::size_t WavefrontTracer::bytes_per_path() {
+  return 4 * sizeof(std::uint32_t) + sizeof(SampleStream) + sizeof(vec2) + sizeof(Ray) + 2 * sizeof(Spectrum) +
+         sizeof(PreviousVertex) + sizeof(std::int32_t) + sizeof(std::uint32_t) + 1 + sizeof(Surfel) +
+         2 * (sizeof(Ray) + sizeof(LightSample) + sizeof(Spectrum) + sizeof(float) + 1) + sizeof(std::uint32_t);
+}
+
+WavefrontTracer::WavefrontTracer(const CompiledScene& scene, const RenderSettings& settings, std::size_t wave_size)
+    : Tracer(scene, settings), wave_size_(std::max<std::size_t>(wave_size, 1)) {}
+
+namespace {
+constexpr std::size_t kGrain = 256;  // paths per parallel task
+
+template <typename Fn>
+void for_live(const std::vector<std::uint32_t>& live, Fn&& fn) {
+  parallel_for(0, live.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) fn(live[k]);
+  });
+}
+}  // namespace
+
+// Stage: the first surface along each ray, the emission found there (as the
+// strategy weighs it), and the end of paths that escape, pass the depth cap
+// or reach a surface that does not scatter.
+void WavefrontTracer::intersect_and_add_emission(Wave& w, PathObserver* obs) const {
+  const int cap = settings_.max_depth >= 0 ? settings_.max_depth : kMaxVerticesUncapped;
+  const Strategy strategy = settings_.strategy;
+  for_live(w.live, [&](std::uint32_t i) {
+    ++w.rays[i];
+    Surfel& s = w.surfel[i];
+    if (!scene_.intersect(w.ray[i], &s)) {
+      const Spectrum Le = scene_.scene().environment.value_or(Spectrum(0.0f));
+      const float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf_environment());
+      w.L[i] += w.beta[i] * (we * Le);
+      if (obs) {
+        obs->on_escape({w.vertex[i], Le, we, w.beta[i] * we * Le});
+        obs->on_end({w.vertex[i], PathEnd::Escaped});
+      }
+      w.alive[i] = 0;
+      return;
+    }
+    const vec3 wo = -w.ray[i].dir;
+    const Spectrum Le = s.emitted(wo);
+    const float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf(w.prev[i].p, s));
+    const Spectrum added = w.beta[i] * (we * Le);
+    w.L[i] += added;
+    if (obs)
+      obs->on_hit({w.vertex[i], s.p, s.n, glm::dot(s.n, wo) > 0.0f,
+                   static_cast<std::uint32_t>(s.material - scene_.scene().materials.data()), s.shape, s.prim, Le, we,
+                   added, w.beta[i]});
+    if (w.vertex[i] > cap || !s.material->scatters()) {
+      if (obs) obs->on_end({w.vertex[i], w.vertex[i] > cap ? PathEnd::MaxDepth : PathEnd::Absorbed});
+      w.alive[i] = 0;
+    }
+  });
+}
+
+// Stage: next-event estimation, up to two light samples per path (a point
+// light in every strategy; an area light as the strategy says), each with
+// the contribution it brings if nothing blocks its shadow ray.
+void WavefrontTracer::sample_lights(Wave& w) const {
+  const LightSampler& lights = scene_.lights();
+  const Strategy strategy = settings_.strategy;
+  for_live(w.live, [&](std::uint32_t i) {
+    w.shadow_state[2 * i] = w.shadow_state[2 * i + 1] = 0;
+    if (!w.alive[i]) return;
+    const Surfel& s = w.surfel[i];
+    const vec3 wo = -w.ray[i].dir;
+    if (lights.has_delta_lights()) {
+      if (const auto ls = lights.sample_delta(s.p, w.u(i, Dim::DeltaLightChoice))) {
+        const Spectrum f = s.eval(ls->wi, wo);
+        if (!is_black(f)) {
+          w.light[2 * i] = *ls;
+          w.unoccluded[2 * i] = f * ls->Le / ls->pdf;
+          w.light_weight[2 * i] = 1.0f;
+          w.shadow[2 * i] = s.spawn_to(ls->p, vec3(0.0f), -ls->wi);
+          w.shadow_state[2 * i] = 1;
+        }
+      }
+    }
+    if (samples_area_lights(strategy, w.u(i, Dim::Technique))) {
+      const auto ls = lights.sample(s.p, w.u(i, Dim::LightChoice), vec2(w.u(i, Dim::LightX), w.u(i, Dim::LightY)));
+      if (!ls) return;
+      const Spectrum f = s.eval(ls->wi, wo);
+      if (is_black(f)) return;
+      const float lw = light_sample_weight(strategy, ls->pdf, s.pdf(ls->wi, wo));
+      w.light[2 * i + 1] = *ls;
+      w.unoccluded[2 * i + 1] = f * ls->Le * (lw / ls->pdf);
+      w.light_weight[2 * i + 1] = lw;
+      w.shadow[2 * i + 1] = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, ls->p_error, ls->n);
+      w.shadow_state[2 * i + 1] = 1;
+    }
+  });
+}
+
+// Stage: occlusion queries for every pending shadow ray.
+void WavefrontTracer::trace_shadow_rays(Wave& w) const {
+  for_live(w.live, [&](std::uint32_t i) {
+    for (std::uint32_t k = 2 * i; k < 2 * i + 2; ++k) {
+      if (w.shadow_state[k] != 1) continue;
+      ++w.rays[i];
+      w.shadow_state[k] = scene_.occluded(w.shadow[k]) ? 3 : 2;
+    }
+  });
+}
+
+// Stage: the light of visible samples, point light first (the reference's order).
+void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
+  for_live(w.live, [&](std::uint32_t i) {
+    for (std::uint32_t k = 2 * i; k < 2 * i + 2; ++k) {
+      if (w.shadow_state[k] == 0) continue;
+      const bool visible = w.shadow_state[k] == 2;
+      const Spectrum added = visible ? w.beta[i] * w.unoccluded[k] : Spectrum(0.0f);
+      w.L[i] += added;
+      if (obs) {
+        const LightSample& ls = w.light[k];
+        obs->on_light({w.vertex[i], k == 2 * i, ls.infinite, ls.light, ls.p, ls.wi, ls.dist, ls.pdf, ls.Le, visible,
+                       w.light_weight[k], added});
+      }
+    }
+  });
+}
+
+// Stage: sample the continuation, apply Russian roulette, spawn the next ray.
+void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
+  const Strategy strategy = settings_.strategy;
+  for_live(w.live, [&](std::uint32_t i) {
+    if (!w.alive[i]) return;
+    const Surfel& s = w.surfel[i];
+    const vec3 wo = -w.ray[i].dir;
+    const int v = w.vertex[i];
+    const vec2 u_dir(w.u(i, Dim::DirectionX), w.u(i, Dim::DirectionY));
+    const bool cosine = strategy == Strategy::Cosine && !s.material->is_pure_impulse();
+    const std::optional<BsdfSample> bs = cosine ? s.scatter_cosine(wo, u_dir) : s.scatter(wo, w.u(i, Dim::LobeChoice), u_dir);
+    if (!bs || is_black(bs->weight)) {
+      if (obs) obs->on_end({v, bs ? PathEnd::NoSample : PathEnd::Absorbed});
+      w.alive[i] = 0;
+      return;
+    }
+    Spectrum weight = bs->weight;
+    float survival = 1.0f;
+    if (v > settings_.rr_depth) {
+      survival = std::min(1.0f, max_component(w.beta[i] * weight));
+      if (!(w.u(i, Dim::Roulette) < survival)) {
+        if (obs) {
+          obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, Spectrum(0.0f)});
+          obs->on_end({v, PathEnd::Roulette});
+        }
+        w.alive[i] = 0;
+        return;
+      }
+      weight /= survival;
+    }
+    w.beta[i] *= weight;
+    if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i]});
+    w.prev[i] = PreviousVertex{s.p, bs->pdf, bs->impulse,
+                               !(strategy == Strategy::LightBsdf && w.u(i, Dim::Technique) < 0.5f)};
+    w.ray[i] = s.spawn(bs->wi);
+    w.vertex[i] = v + 1;
+  });
+}
+
+// Stage: keep the slots still alive, in slot order (a stable compaction, so
+// the work order - and nothing else - changes from bounce to bounce).
+void WavefrontTracer::compact(Wave& w) {
+  const auto end = std::stable_partition(w.live.begin(), w.live.end(), [&](std::uint32_t i) { return w.alive[i] != 0; });
+  w.live.erase(end, w.live.end());
+}
+
+void WavefrontTracer::run_wave(Wave& w, PathObserver* obs) const {
+  // Generate camera rays.
+  const Camera& camera = scene_.camera();
+  for_live(w.live, [&](std::uint32_t i) {
+    w.vertex[i] = 0;
+    w.film[i] = vec2(static_cast<float>(w.x[i]) + w.u(i, Dim::FilmX), static_cast<float>(w.y[i]) + w.u(i, Dim::FilmY));
+    w.ray[i] = camera.generate_ray(w.film[i], vec2(w.u(i, Dim::LensX), w.u(i, Dim::LensY)));
+    w.beta[i] = Spectrum(1.0f);
+    w.L[i] = Spectrum(0.0f);
+    w.prev[i] = PreviousVertex{};
+    w.rays[i] = 0;
+    w.alive[i] = 1;
+    w.vertex[i] = 1;
+    if (obs) obs->on_camera({w.x[i], w.y[i], w.sample[i], w.film[i], w.ray[i].origin, w.ray[i].dir});
+  });
+  while (!w.live.empty()) {
+    intersect_and_add_emission(w, obs);
+    sample_lights(w);
+    trace_shadow_rays(w);
+    add_light(w, obs);
+    scatter(w, obs);
+    compact(w);
+  }
+}
+
+void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const {
+  const auto width = static_cast<std::uint32_t>(scene_.scene().film.width);
+  Wave w;
+  for (std::size_t begin = 0; begin < out.size(); begin += wave_size_) {
+    const std::size_t n = std::min(wave_size_, out.size() - begin);
+    w.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t id = begin + i;
+      const auto pixel = static_cast<std::uint32_t>(id / count);
+      w.out_index[i] = static_cast<std::uint32_t>(id);
+      w.x[i] = pixel % width;
+      w.y[i] = pixel / width;
+      w.sample[i] = first + static_cast<std::uint32_t>(id % count);
+      w.rng[i] = SampleStream(settings_.seed, pixel, w.sample[i]);
+      w.live[i] = static_cast<std::uint32_t>(i);
+    }
+    run_wave(w, nullptr);
+    for (std::size_t i = 0; i < n; ++i) out[w.out_index[i]] = FilmSample{w.film[i], w.L[i], w.rays[i]};
+  }
+}
+
+FilmSample WavefrontTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::uint32_t sample,
+                                         PathObserver* observer) const {
+  Wave w;
+  w.resize(1);
+  const std::uint32_t pixel = y * static_cast<std::uint32_t>(scene_.scene().film.width) + x;
+  w.out_index[0] = 0;
+  w.x[0] = x;
+  w.y[0] = y;
+  w.sample[0] = sample;
+  w.rng[0] = SampleStream(settings_.seed, pixel, sample);
+  w.live[0] = 0;
+  run_wave(w, observer);
+  if (observer) observer->on_result(w.L[0]);
+  return FilmSample{w.film[0], w.L[0], w.rays[0]};
+}
+
+}  // namespace pathlab
