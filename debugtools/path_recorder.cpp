@@ -117,12 +117,24 @@ json path_to_json(const TraceHeader& h, const PathRecorder& path, const Scene& s
           {"radiance", j3(path.result())}};
 }
 
-std::string path_to_text(const TraceHeader& h, const PathRecorder& path, const Scene& scene) {
+std::string event_to_text(const PathEvent& event, const Scene& scene) {
+  std::ostringstream out;
+  std::visit(TextVisitor{scene, out}, event);
+  return out.str();
+}
+
+std::string trace_header_text(const TraceHeader& h) {
   std::ostringstream out;
   out << h.scene << "  " << h.width << "x" << h.height << "  pixel (" << h.x << ", " << h.y << ")  sample " << h.sample << "  seed " << h.settings.seed
       << "  tracer " << h.tracer << "  strategy " << strategy_name(h.settings.strategy) << "  max depth "
       << h.settings.max_depth << "  rr depth " << h.settings.rr_depth << "\n";
-  for (const PathEvent& e : path.events()) std::visit(TextVisitor{scene, out}, e);
+  return out.str();
+}
+
+std::string path_to_text(const TraceHeader& h, const PathRecorder& path, const Scene& scene) {
+  std::ostringstream out;
+  out << trace_header_text(h);
+  for (const PathEvent& e : path.events()) out << event_to_text(e, scene);
   out << "radiance    " << fmt3(path.result()) << "\n";
   return out.str();
 }

@@ -44,6 +44,10 @@ struct TraceHeader {
 
 // The JSON document of a recorded path (format version 1).
 nlohmann::json path_to_json(const TraceHeader& header, const PathRecorder& path, const Scene& scene);
+// One event as text (one line, two for a hit with emission).
+std::string event_to_text(const PathEvent& event, const Scene& scene);
+// The header line of a listing.
+std::string trace_header_text(const TraceHeader& header);
 // A human-readable listing, one event per line or two.
 std::string path_to_text(const TraceHeader& header, const PathRecorder& path, const Scene& scene);
 

@@ -27,13 +27,15 @@ inline std::vector<std::string> analytic_scene_names() {
   return names;
 }
 
-// Renders `scene` with the reference tracer and checks it against its model;
-// on failure, writes the check's images into `failure_dir` if given.
-inline CheckResult run_check(Scene scene, const std::filesystem::path& failure_dir = {}) {
+// Renders `scene` with the reference tracer (or `TracerT`) and checks it
+// against its model; on failure, writes the check's images into
+// `failure_dir` if given.
+template <typename TracerT = ReferenceTracer>
+CheckResult run_check(Scene scene, const std::filesystem::path& failure_dir = {}) {
   const auto model = make_analytic_model(scene);
   const RenderSettings settings = scene.render;
   const CompiledScene compiled(std::move(scene));
-  const ReferenceTracer tracer(compiled, settings);
+  const TracerT tracer(compiled, settings);
   Film film(compiled.scene().film.width, compiled.scene().film.height, compiled.scene().film.filter);
   render(tracer, film);
   const ExpectedImage expected = expected_image(*model, compiled.camera(), compiled.scene().film);

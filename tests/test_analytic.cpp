@@ -6,6 +6,7 @@
 #include "tests/test_scenes.h"
 
 #include "core/error.h"
+#include "wavefront/wavefront_tracer.h"
 
 #include <gtest/gtest.h>
 
@@ -15,12 +16,15 @@ namespace {
 struct Case {
   std::string scene;
   Strategy strategy;
+  bool wavefront;
 };
 
 class AnalyticScenes : public testing::TestWithParam<Case> {};
 
 TEST_P(AnalyticScenes, PassCheck) {
-  const CheckResult r = test::run_check(test::load_with_strategy(GetParam().scene, GetParam().strategy));
+  Scene scene = test::load_with_strategy(GetParam().scene, GetParam().strategy);
+  const CheckResult r = GetParam().wavefront ? test::run_check<WavefrontTracer>(std::move(scene))
+                                             : test::run_check(std::move(scene));
   EXPECT_TRUE(r.pixels_pass) << r.failing << " pixel-channels beyond " << r.z_threshold << ", worst z "
                              << r.worst.front().z << " at (" << r.worst.front().x << ", " << r.worst.front().y << ")";
   EXPECT_TRUE(r.bias_pass) << "bias " << r.bias << " +- " << r.bias_se;
@@ -29,14 +33,16 @@ TEST_P(AnalyticScenes, PassCheck) {
 std::vector<Case> all_cases() {
   std::vector<Case> cases;
   for (const std::string& name : test::analytic_scene_names())
-    for (Strategy s : test::kAllStrategies) cases.push_back({name, s});
+    for (Strategy s : test::kAllStrategies)
+      for (bool wavefront : {false, true}) cases.push_back({name, s, wavefront});
   return cases;
 }
 
 INSTANTIATE_TEST_SUITE_P(Reference, AnalyticScenes, testing::ValuesIn(all_cases()),
                          [](const testing::TestParamInfo<Case>& p) {
                            std::string s = p.param.scene.substr(0, p.param.scene.size() - 5) + "_" +
-                                           strategy_name(p.param.strategy);
+                                           strategy_name(p.param.strategy) +
+                                           (p.param.wavefront ? "_wavefront" : "_reference");
                            for (char& c : s)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return s;

@@ -4,6 +4,7 @@
 #include "apps/cli/scene_options.h"
 #include "core/compiled_scene.h"
 #include "core/render.h"
+#include "debugtools/path_compare.h"
 #include "debugtools/path_recorder.h"
 #include "reference/reference_tracer.h"
 #include "tests/test_scenes.h"
@@ -77,6 +78,54 @@ TEST(TracePixel, CliJsonIsStable) {
   EXPECT_EQ(j["events"].front()["type"], "camera");
   EXPECT_EQ(j["events"].back()["type"], "end");
   EXPECT_EQ(j["radiance"].size(), 3u);
+}
+
+TEST(TracePixel, BothTracersSideBySideAgree) {
+  for (const char* sample : {"0", "1", "2", "3"}) {
+    const char* argv[] = {"pathlab", "trace-pixel", "--pixel", "20,30", "--sample", sample, "--resolution", "64x64",
+                          "--tracer", "both", "--json"};
+    std::ostringstream out, err;
+    ASSERT_EQ(cli::run(static_cast<int>(std::size(argv)), argv, out, err), 0) << err.str();
+    const auto j = nlohmann::json::parse(out.str());
+    EXPECT_EQ(j["format"], "pathlab-trace-pair");
+    EXPECT_EQ(j["reference"]["tracer"], "reference");
+    EXPECT_EQ(j["wavefront"]["tracer"], "wavefront");
+    EXPECT_TRUE(j["divergence"].is_null()) << j["divergence"].dump();
+    EXPECT_EQ(j["reference"]["events"].size(), j["wavefront"]["events"].size());
+  }
+  // The text form marks agreement (or the parting vertex) for a person.
+  const char* argv[] = {"pathlab", "trace-pixel", "--pixel", "20,30", "--resolution", "64x64", "--tracer", "both"};
+  std::ostringstream out, err;
+  ASSERT_EQ(cli::run(static_cast<int>(std::size(argv)), argv, out, err), 0);
+  EXPECT_NE(err.str().find("the paths agree at every event"), std::string::npos) << err.str();
+}
+
+TEST(TracePixel, FirstDivergenceTellsRoundingFromADifferentPath) {
+  Scene scene = test::small_cornell(16, 1, FilterKind::Box);
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const ReferenceTracer tracer(compiled, settings);
+  PathRecorder rec;
+  tracer.trace_sample(8, 10, 0, &rec);
+  const std::vector<PathEvent>& a = rec.events();
+  EXPECT_TRUE(first_divergence(a, a, 1e-4f).identical);
+
+  std::vector<PathEvent> b = a;  // a visibility flipped by rounding
+  for (PathEvent& e : b)
+    if (auto* l = std::get_if<LightEvent>(&e)) {
+      l->visible = !l->visible;
+      break;
+    }
+  PathDivergence d = first_divergence(a, b, 1e-4f);
+  EXPECT_FALSE(d.identical);
+  EXPECT_TRUE(d.rounding) << d.reason;
+  EXPECT_NE(d.reason.find("visibility"), std::string::npos) << d.reason;
+
+  b = a;  // a different camera ray: another path, not rounding
+  std::get<CameraEvent>(b[0]).dir = -std::get<CameraEvent>(b[0]).dir;
+  d = first_divergence(a, b, 1e-4f);
+  EXPECT_FALSE(d.rounding) << d.reason;
+  EXPECT_EQ(d.event, 0u);
 }
 
 // A tracer that fails on one sample, to exercise the NaN report.

@@ -6,6 +6,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/tracer.h"
+#include "debugtools/path_compare.h"
 #include "debugtools/path_recorder.h"
 
 #include <ostream>
@@ -15,7 +16,7 @@ namespace pathlab::cli {
 
 void TracePixelCommand::add_to(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("trace-pixel", "Replay one pixel sample and print its path");
-  scene.add_to(*cmd, false);
+  scene.add_to(*cmd, false, true);
   cmd->add_option("--pixel", pixel, "Pixel X,Y (0,0 = top left)")->required();
   cmd->add_option("--sample", sample, "Sample index within the pixel");
   cmd->add_flag("--json", json, "Print the path as JSON on stdout (docs/trace-pixel-json.md)");
@@ -37,16 +38,55 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
   const ThreadLimit one_thread(1);
   const RenderSettings settings = s.render;
   const CompiledScene compiled(std::move(s));
-  const auto tracer = make_tracer(scene.tracer, compiled, settings);
-  PathRecorder recorder;
-  tracer->trace_sample(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), sample, &recorder);
-
   const Scene& sc = compiled.scene();
-  TraceHeader header{sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string(), std::string(tracer->name()),
-                     static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), sample, settings,
-                     sc.film.width, sc.film.height};
-  if (json) out << path_to_json(header, recorder, sc).dump(2) << "\n";
-  else err << path_to_text(header, recorder, sc);
+  const auto ux = static_cast<std::uint32_t>(x), uy = static_cast<std::uint32_t>(y);
+  auto record = [&](const std::string& name, PathRecorder& recorder) {
+    make_tracer(name, compiled, settings)->trace_sample(ux, uy, sample, &recorder);
+    return TraceHeader{sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string(), name, ux, uy, sample, settings,
+                       sc.film.width, sc.film.height};
+  };
+  if (scene.tracer != "both") {
+    PathRecorder recorder;
+    const TraceHeader header = record(scene.tracer, recorder);
+    if (json) out << path_to_json(header, recorder, sc).dump(2) << "\n";
+    else err << path_to_text(header, recorder, sc);
+    return 0;
+  }
+
+  // Both tracers, event by event, marking where the paths part.
+  PathRecorder ref, wave;
+  const TraceHeader href = record("reference", ref), hwave = record("wavefront", wave);
+  const PathDivergence d = first_divergence(ref.events(), wave.events(), 1e-4f);
+  if (json) {
+    nlohmann::json j = {{"format", "pathlab-trace-pair"}, {"version", 1},
+                        {"reference", path_to_json(href, ref, sc)}, {"wavefront", path_to_json(hwave, wave, sc)}};
+    j["divergence"] = d.identical ? nlohmann::json(nullptr)
+                                  : nlohmann::json{{"event", d.event}, {"vertex", d.vertex}, {"reason", d.reason},
+                                                   {"rounding", d.rounding}};
+    out << j.dump(2) << "\n";
+    return 0;
+  }
+  err << trace_header_text(TraceHeader{href.scene, "reference | wavefront", ux, uy, sample, settings, sc.film.width,
+                                       sc.film.height});
+  const std::size_t n = std::max(ref.events().size(), wave.events().size());
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!d.identical && i == d.event)
+      err << ">>> the paths part here: " << d.reason << (d.rounding ? " (a floating-point difference)" : "") << "\n";
+    auto line = [&](const char* who, const PathRecorder& r) {
+      std::string text = i < r.events().size() ? event_to_text(r.events()[i], sc) : std::string("(no event)\n");
+      std::string indented;
+      for (std::size_t p = 0, q; p < text.size(); p = q + 1) {
+        q = text.find('\n', p);
+        indented += std::string(who) + text.substr(p, q - p + 1);
+      }
+      err << indented;
+    };
+    line("ref  ", ref);
+    line("wave ", wave);
+  }
+  err << "ref   radiance (" << ref.result().x << ", " << ref.result().y << ", " << ref.result().z << ")\n"
+      << "wave  radiance (" << wave.result().x << ", " << wave.result().y << ", " << wave.result().z << ")\n"
+      << (d.identical ? "the paths agree at every event (tolerance 1e-4)\n" : "");
   return 0;
 }
 

@@ -11,9 +11,13 @@
 
 namespace pathlab::cli {
 
-void SceneOptions::add_to(CLI::App& cmd, bool with_spp) {
+void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
   cmd.add_option("scene", scene_file, "Scene file (JSON); omit for the built-in Cornell box");
-  cmd.add_option("--tracer", tracer, "Tracer: reference or wavefront")->check(CLI::IsMember({"reference", "wavefront"}));
+  if (allow_both)
+    cmd.add_option("--tracer", tracer, "Tracer: reference, wavefront, or both (side by side, marking where they part)")
+        ->check(CLI::IsMember({"reference", "wavefront", "both"}));
+  else
+    cmd.add_option("--tracer", tracer, "Tracer: reference or wavefront")->check(CLI::IsMember({"reference", "wavefront"}));
   cmd.add_option("--strategy", strategy, "Sampling strategy: cosine, bsdf, light, light+bsdf, mis")
       ->check(CLI::IsMember({"cosine", "bsdf", "light", "light+bsdf", "mis"}));
   if (with_spp) cmd.add_option("--spp", spp, "Samples per pixel")->check(CLI::Range(1, 1 << 24));

@@ -25,8 +25,9 @@ struct SceneOptions {
   std::optional<std::string> seed;  // parsed by load(): CLI11 would wrap "-1" around
   std::optional<std::string> resolution;  // "WxH"
 
-  // Registers the options on `cmd`; `with_spp` for commands that render.
-  void add_to(CLI::App& cmd, bool with_spp);
+  // Registers the options on `cmd`; `with_spp` for commands that render,
+  // `allow_both` for trace-pixel's --tracer both.
+  void add_to(CLI::App& cmd, bool with_spp, bool allow_both = false);
   // Loads the scene and applies the overrides. Throws InputError.
   Scene load() const;
   // "pathlab trace-pixel <scene> --pixel x,y --sample s ..." for one sample
