@@ -9,6 +9,7 @@
 #include "core/image_io.h"
 #include "core/parallel.h"
 #include "core/render.h"
+#include "wavefront/wavefront_tracer.h"
 
 #include <cctype>
 #include <cstdio>
@@ -93,6 +94,9 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     err << "pathlab: wrote " << exr.string() << " and " << png.string() << " (" << sc.film.width << "x"
         << sc.film.height << ", " << settings.spp << " spp, " << tracer->name() << ", "
         << strategy_name(settings.strategy) << "): " << line << "\n";
+    if (const auto* wf = dynamic_cast<const WavefrontTracer*>(tracer.get()))
+      err << "pathlab: wavefront waves of up to " << wf->wave_size() << " paths, " << WavefrontTracer::bytes_per_path()
+          << " bytes of path state per path\n";
   }
   return 0;
 }
