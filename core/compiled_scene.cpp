@@ -30,6 +30,20 @@ CompiledScene::CompiledScene(Scene scene)
 bool CompiledScene::intersect(const Ray& ray, Surfel* s) const {
   RayHit hit;
   if (!accel_->intersect(ray, &hit)) return false;
+  resolve(ray, hit, s);
+  return true;
+}
+
+void CompiledScene::intersect_stream(std::span<const Ray> rays, std::span<Surfel> surfels,
+                                     std::span<std::uint8_t> found) const {
+  thread_local std::vector<RayHit> hits;
+  hits.resize(rays.size());
+  accel_->intersect_stream(rays, hits, found);
+  for (std::size_t i = 0; i < rays.size(); ++i)
+    if (found[i]) resolve(rays[i], hits[i], &surfels[i]);
+}
+
+void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const {
   const Shape& shape = scene_.shapes[hit.shape];
   const SurfacePoint sp = shape.kind == Shape::Kind::Sphere
                               ? sphere_point(shape, ray.origin + hit.t * ray.dir)
@@ -41,7 +55,6 @@ bool CompiledScene::intersect(const Ray& ray, Surfel* s) const {
   s->material = &scene_.materials[shape.material];
   s->shape = hit.shape;
   s->prim = hit.prim;
-  return true;
 }
 
 }  // namespace pathlab

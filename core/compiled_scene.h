@@ -10,6 +10,7 @@
 #include "core/surfel.h"
 
 #include <memory>
+#include <span>
 
 namespace pathlab {
 
@@ -36,7 +37,16 @@ class CompiledScene {
   bool intersect(const Ray& ray, Surfel* surfel) const;
   bool occluded(const Ray& ray) const { return accel_->occluded(ray); }
 
+  // Many rays at once through Embree's ray streams; the results equal those
+  // of intersect() / occluded() ray by ray.
+  void intersect_stream(std::span<const Ray> rays, std::span<Surfel> surfels, std::span<std::uint8_t> found) const;
+  void occluded_stream(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const {
+    accel_->occluded_stream(rays, occluded);
+  }
+
  private:
+  void resolve(const Ray& ray, const RayHit& hit, Surfel* surfel) const;
+
   Scene scene_;
   Camera camera_;
   std::unique_ptr<EmbreeAccel> accel_;

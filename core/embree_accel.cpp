@@ -6,6 +6,7 @@
 
 #include <cstring>
 #include <mutex>
+#include <vector>
 
 namespace pathlab {
 namespace {
@@ -115,6 +116,53 @@ bool EmbreeAccel::intersect(const Ray& ray, RayHit* hit) const {
   hit->prim = rh.hit.primID;
   hit->uv = vec2(rh.hit.u, rh.hit.v);
   return true;
+}
+
+namespace {
+
+void fill(RTCRay& r, const Ray& ray) {
+  r.org_x = ray.origin.x;
+  r.org_y = ray.origin.y;
+  r.org_z = ray.origin.z;
+  r.dir_x = ray.dir.x;
+  r.dir_y = ray.dir.y;
+  r.dir_z = ray.dir.z;
+  r.tnear = 0.0f;
+  r.tfar = ray.tmax;
+  r.time = 0.0f;
+  r.mask = 0xffffffffu;
+  r.id = 0;
+  r.flags = 0;
+}
+
+}  // namespace
+
+void EmbreeAccel::intersect_stream(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found) const {
+  thread_local std::vector<RTCRayHit> buffer;
+  buffer.resize(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    fill(buffer[i].ray, rays[i]);
+    buffer[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    buffer[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  rtcIntersect1M(impl_->scene, &context, buffer.data(), static_cast<unsigned>(buffer.size()), sizeof(RTCRayHit));
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const RTCRayHit& rh = buffer[i];
+    found[i] = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    if (found[i]) hits[i] = RayHit{rh.ray.tfar, rh.hit.geomID, rh.hit.primID, vec2(rh.hit.u, rh.hit.v)};
+  }
+}
+
+void EmbreeAccel::occluded_stream(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const {
+  thread_local std::vector<RTCRay> buffer;
+  buffer.resize(rays.size());
+  for (std::size_t i = 0; i < rays.size(); ++i) fill(buffer[i], rays[i]);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  rtcOccluded1M(impl_->scene, &context, buffer.data(), static_cast<unsigned>(buffer.size()), sizeof(RTCRay));
+  for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = buffer[i].tfar < 0.0f;
 }
 
 bool EmbreeAccel::occluded(const Ray& ray) const {

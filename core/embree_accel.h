@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 
 namespace pathlab {
@@ -32,6 +33,12 @@ class EmbreeAccel {
   bool intersect(const Ray& ray, RayHit* hit) const;
   // True if anything lies on the ray with t in (0, ray.tmax).
   bool occluded(const Ray& ray) const;
+
+  // The same queries for many rays at once, through Embree's ray streams
+  // (rtcIntersect1M / rtcOccluded1M): found[i] / occluded[i] is 0 or 1.
+  // This pair is the one place to change for Embree 4, which has no streams.
+  void intersect_stream(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found) const;
+  void occluded_stream(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const;
 
  private:
   struct Impl;

@@ -25,6 +25,7 @@ struct WavefrontTracer::Wave {
   std::vector<std::uint8_t> alive;
   // This bounce.
   std::vector<Surfel> surfel;
+  std::vector<std::uint8_t> found;
   // Two shadow rays per path: [0] a point light, [1] an area light.
   std::vector<Ray> shadow;
   std::vector<LightSample> light;
@@ -36,7 +37,7 @@ struct WavefrontTracer::Wave {
   void resize(std::size_t n) {
     out_index.resize(n), x.resize(n), y.resize(n), sample.resize(n), rng.resize(n, SampleStream(0, 0, 0));
     film.resize(n), ray.resize(n), beta.resize(n), L.resize(n), prev.resize(n), vertex.resize(n), rays.resize(n);
-    alive.resize(n), surfel.resize(n);
+    alive.resize(n), surfel.resize(n), found.resize(n);
     shadow.resize(2 * n), light.resize(2 * n), unoccluded.resize(2 * n), light_weight.resize(2 * n);
     shadow_state.resize(2 * n);
     live.resize(n);
@@ -46,12 +47,13 @@ struct WavefrontTracer::Wave {
 
 std::size_t WavefrontTracer::bytes_per_path() {
   return 4 * sizeof(std::uint32_t) + sizeof(SampleStream) + sizeof(vec2) + sizeof(Ray) + 2 * sizeof(Spectrum) +
-         sizeof(PreviousVertex) + sizeof(std::int32_t) + sizeof(std::uint32_t) + 1 + sizeof(Surfel) +
+         sizeof(PreviousVertex) + sizeof(std::int32_t) + sizeof(std::uint32_t) + 2 + sizeof(Surfel) +
          2 * (sizeof(Ray) + sizeof(LightSample) + sizeof(Spectrum) + sizeof(float) + 1) + sizeof(std::uint32_t);
 }
 
-WavefrontTracer::WavefrontTracer(const CompiledScene& scene, const RenderSettings& settings, std::size_t wave_size)
-    : Tracer(scene, settings), wave_size_(std::max<std::size_t>(wave_size, 1)) {}
+WavefrontTracer::WavefrontTracer(const CompiledScene& scene, const RenderSettings& settings, std::size_t wave_size,
+                                 RayQueries queries)
+    : Tracer(scene, settings), wave_size_(std::max<std::size_t>(wave_size, 1)), queries_(queries) {}
 
 namespace {
 constexpr std::size_t kGrain = 256;  // paths per parallel task
@@ -64,16 +66,38 @@ void for_live(const std::vector<std::uint32_t>& live, Fn&& fn) {
 }
 }  // namespace
 
-// Stage: the first surface along each ray, the emission found there (as the
-// strategy weighs it), and the end of paths that escape, pass the depth cap
-// or reach a surface that does not scatter.
-void WavefrontTracer::intersect_and_add_emission(Wave& w, PathObserver* obs) const {
+// Stage: the first surface along each live path's ray, one Embree ray
+// stream per task (or one query per ray).
+void WavefrontTracer::intersect(Wave& w) const {
+  if (queries_ == RayQueries::OneByOne) {
+    for_live(w.live, [&](std::uint32_t i) { w.found[i] = scene_.intersect(w.ray[i], &w.surfel[i]); });
+    return;
+  }
+  parallel_for(0, w.live.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    thread_local std::vector<Ray> rays;
+    thread_local std::vector<Surfel> surfels;
+    thread_local std::vector<std::uint8_t> found;
+    rays.resize(e - b), surfels.resize(e - b), found.resize(e - b);
+    for (std::size_t k = b; k < e; ++k) rays[k - b] = w.ray[w.live[k]];
+    scene_.intersect_stream(rays, surfels, found);
+    for (std::size_t k = b; k < e; ++k) {
+      const std::uint32_t i = w.live[k];
+      w.found[i] = found[k - b];
+      if (found[k - b]) w.surfel[i] = surfels[k - b];
+    }
+  });
+}
+
+// Stage: the emission found at each hit (as the strategy weighs it), and
+// the end of paths that escape, pass the depth cap or reach a surface that
+// does not scatter.
+void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
   const int cap = settings_.max_depth >= 0 ? settings_.max_depth : kMaxVerticesUncapped;
   const Strategy strategy = settings_.strategy;
   for_live(w.live, [&](std::uint32_t i) {
     ++w.rays[i];
     Surfel& s = w.surfel[i];
-    if (!scene_.intersect(w.ray[i], &s)) {
+    if (!w.found[i]) {
       const Spectrum Le = scene_.scene().environment.value_or(Spectrum(0.0f));
       const float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf_environment());
       w.L[i] += w.beta[i] * (we * Le);
@@ -138,14 +162,34 @@ void WavefrontTracer::sample_lights(Wave& w) const {
   });
 }
 
-// Stage: occlusion queries for every pending shadow ray.
+// Stage: occlusion queries for every pending shadow ray, one Embree ray
+// stream per task (or one query per ray).
 void WavefrontTracer::trace_shadow_rays(Wave& w) const {
-  for_live(w.live, [&](std::uint32_t i) {
-    for (std::uint32_t k = 2 * i; k < 2 * i + 2; ++k) {
-      if (w.shadow_state[k] != 1) continue;
-      ++w.rays[i];
-      w.shadow_state[k] = scene_.occluded(w.shadow[k]) ? 3 : 2;
-    }
+  if (queries_ == RayQueries::OneByOne) {
+    for_live(w.live, [&](std::uint32_t i) {
+      for (std::uint32_t k = 2 * i; k < 2 * i + 2; ++k) {
+        if (w.shadow_state[k] != 1) continue;
+        ++w.rays[i];
+        w.shadow_state[k] = scene_.occluded(w.shadow[k]) ? 3 : 2;
+      }
+    });
+    return;
+  }
+  parallel_for(0, w.live.size(), kGrain, [&](std::size_t b, std::size_t e) {
+    thread_local std::vector<Ray> rays;
+    thread_local std::vector<std::uint32_t> slot;
+    thread_local std::vector<std::uint8_t> occluded;
+    rays.clear(), slot.clear();
+    for (std::size_t k = b; k < e; ++k)
+      for (std::uint32_t s = 2 * w.live[k]; s < 2 * w.live[k] + 2; ++s)
+        if (w.shadow_state[s] == 1) {
+          rays.push_back(w.shadow[s]);
+          slot.push_back(s);
+          ++w.rays[s / 2];
+        }
+    occluded.resize(rays.size());
+    if (!rays.empty()) scene_.occluded_stream(rays, occluded);
+    for (std::size_t r = 0; r < rays.size(); ++r) w.shadow_state[slot[r]] = occluded[r] ? 3 : 2;
   });
 }
 
@@ -228,7 +272,8 @@ void WavefrontTracer::run_wave(Wave& w, PathObserver* obs) const {
     if (obs) obs->on_camera({w.x[i], w.y[i], w.sample[i], w.film[i], w.ray[i].origin, w.ray[i].dir});
   });
   while (!w.live.empty()) {
-    intersect_and_add_emission(w, obs);
+    intersect(w);
+    add_emission(w, obs);
     sample_lights(w);
     trace_shadow_rays(w);
     add_light(w, obs);

@@ -20,9 +20,12 @@ namespace pathlab {
 class WavefrontTracer final : public Tracer {
  public:
   static constexpr std::size_t kDefaultWaveSize = std::size_t{1} << 20;
+  // How rays reach Embree: ray streams (rtcIntersect1M / rtcOccluded1M) or
+  // one rtcIntersect1 / rtcOccluded1 per ray.
+  enum class RayQueries { Streams, OneByOne };
 
   WavefrontTracer(const CompiledScene& scene, const RenderSettings& settings,
-                  std::size_t wave_size = kDefaultWaveSize);
+                  std::size_t wave_size = kDefaultWaveSize, RayQueries queries = RayQueries::Streams);
 
   std::string_view name() const override { return "wavefront"; }
   void render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const override;
@@ -36,7 +39,8 @@ class WavefrontTracer final : public Tracer {
  private:
   struct Wave;
   void run_wave(Wave& wave, PathObserver* observer) const;
-  void intersect_and_add_emission(Wave& w, PathObserver* obs) const;
+  void intersect(Wave& w) const;
+  void add_emission(Wave& w, PathObserver* obs) const;
   void sample_lights(Wave& w) const;
   void trace_shadow_rays(Wave& w) const;
   void add_light(Wave& w, PathObserver* obs) const;
@@ -44,6 +48,7 @@ class WavefrontTracer final : public Tracer {
   static void compact(Wave& w);
 
   std::size_t wave_size_;
+  RayQueries queries_;
 };
 
 }  // namespace pathlab
