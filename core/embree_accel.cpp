@@ -91,33 +91,6 @@ EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes) : impl_(std::make_uni
 
 EmbreeAccel::~EmbreeAccel() = default;
 
-bool EmbreeAccel::intersect(const Ray& ray, RayHit* hit) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  RTCRayHit rh;
-  rh.ray.org_x = ray.origin.x;
-  rh.ray.org_y = ray.origin.y;
-  rh.ray.org_z = ray.origin.z;
-  rh.ray.dir_x = ray.dir.x;
-  rh.ray.dir_y = ray.dir.y;
-  rh.ray.dir_z = ray.dir.z;
-  rh.ray.tnear = 0.0f;
-  rh.ray.tfar = ray.tmax;
-  rh.ray.time = 0.0f;
-  rh.ray.mask = 0xffffffffu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(impl_->scene, &context, &rh);
-  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  hit->t = rh.ray.tfar;
-  hit->shape = rh.hit.geomID;
-  hit->prim = rh.hit.primID;
-  hit->uv = vec2(rh.hit.u, rh.hit.v);
-  return true;
-}
-
 namespace {
 
 void fill(RTCRay& r, const Ray& ray) {
@@ -136,6 +109,22 @@ void fill(RTCRay& r, const Ray& ray) {
 }
 
 }  // namespace
+
+bool EmbreeAccel::intersect(const Ray& ray, RayHit* hit) const {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  RTCRayHit rh;
+  fill(rh.ray, ray);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(impl_->scene, &context, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+  hit->t = rh.ray.tfar;
+  hit->shape = rh.hit.geomID;
+  hit->prim = rh.hit.primID;
+  hit->uv = vec2(rh.hit.u, rh.hit.v);
+  return true;
+}
 
 void EmbreeAccel::intersect_stream(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found) const {
   thread_local std::vector<RTCRayHit> buffer;
@@ -169,18 +158,7 @@ bool EmbreeAccel::occluded(const Ray& ray) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay r;
-  r.org_x = ray.origin.x;
-  r.org_y = ray.origin.y;
-  r.org_z = ray.origin.z;
-  r.dir_x = ray.dir.x;
-  r.dir_y = ray.dir.y;
-  r.dir_z = ray.dir.z;
-  r.tnear = 0.0f;
-  r.tfar = ray.tmax;
-  r.time = 0.0f;
-  r.mask = 0xffffffffu;
-  r.id = 0;
-  r.flags = 0;
+  fill(r, ray);
   rtcOccluded1(impl_->scene, &context, &r);
   return r.tfar < 0.0f;  // Embree sets tfar = -inf on a hit
 }
