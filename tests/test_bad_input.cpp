@@ -4,6 +4,8 @@
 // (no light, degenerate triangles) still render.
 #include "apps/cli/cli.h"
 
+#include "tests/temp_dir.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -79,18 +81,8 @@ const char* const kPlyHeader =
     "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
     "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
 
-class BadInput : public ::testing::Test {
+class BadInput : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("pathlab-bad-input-" + std::to_string(::getpid()) + "-" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
 
   // Writes an input file; only such files may be in dir_ after a failure.
   std::string write(const std::string& name, std::string_view bytes) {
@@ -144,7 +136,6 @@ class BadInput : public ::testing::Test {
     }
   }
 
-  fs::path dir_;
   std::set<std::string> inputs_;
 };
 

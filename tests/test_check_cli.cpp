@@ -1,5 +1,6 @@
 // `pathlab check` from the command line: exit codes and what it writes.
 #include "apps/cli/cli.h"
+#include "tests/temp_dir.h"
 
 #include <gtest/gtest.h>
 
@@ -22,7 +23,8 @@ int run(std::vector<std::string> args, std::string* err_text = nullptr) {
 const std::string kScenes = std::string(PATHLAB_SOURCE_DIR) + "/analytic-scenes/";
 
 TEST(CheckCli, PassesAnAnalyticSceneAndPrintsTheVerdict) {
-  const auto dir = std::filesystem::temp_directory_path() / ("pathlab-check-" + std::to_string(::getpid()));
+  const test::ScopedTempDir folder("check-cli");
+  const std::filesystem::path dir = folder.path() / "out";
   std::string err;
   EXPECT_EQ(run({"check", kScenes + "furnace-sphere.json", "--spp", "16", "--resolution", "8x8", "--out", dir.string()}, &err), 0)
       << err;

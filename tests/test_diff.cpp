@@ -7,6 +7,8 @@
 #include "debugtools/image_metrics.h"
 
 #include <OpenImageIO/imageio.h>
+#include "tests/temp_dir.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <unistd.h>
@@ -59,24 +61,13 @@ Image offset(const Image& image, float c) {
 // An 8-bit code from a PNG value read back as float.
 int code(float v) { return static_cast<int>(std::lround(v * 255.0f)); }
 
-class DiffTest : public ::testing::Test {
+class DiffTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("pathlab-diff-" + std::to_string(::getpid()) + "-" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
   std::string exr(const std::string& name, const Image& image) const {
     const fs::path file = dir_ / (name + ".exr");
     write_exr(file, image, {});
     return file.string();
   }
-  fs::path dir_;
 };
 
 TEST_F(DiffTest, HandComputedMetrics) {

@@ -3,6 +3,7 @@
 // where the mistake matters; with no fault the same checks pass.
 #include "core/faults.h"
 #include "tests/check_util.h"
+#include "tests/temp_dir.h"
 
 #include <gtest/gtest.h>
 
@@ -26,14 +27,13 @@ TEST_P(PlantedFault, IsCaughtByCheck) {
   g_fault = Fault::None;
   EXPECT_TRUE(test::run_check(c.scene, c.strategy).pass) << "the unfaulted control must pass";
   g_fault = c.fault;
-  const auto dir = std::filesystem::temp_directory_path() / ("pathlab-fault-" + std::string(c.name));
-  std::filesystem::remove_all(dir);
+  const test::ScopedTempDir folder(std::string("fault-") + c.name);
+  const std::filesystem::path dir = folder.path() / "out";
   const CheckResult r = test::run_check(test::load_with_strategy(c.scene, c.strategy), dir);
   EXPECT_FALSE(r.pass) << c.name << " went unnoticed: worst z " << r.worst.front().z << ", bias z " << r.bias_z;
   // A failed check leaves the four images a person needs to see why.
   for (const char* f : {"rendered.exr", "expected.exr", "error.exr", "zscore.exr"})
     EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
-  std::filesystem::remove_all(dir);
 }
 
 // Each fault on a scene and strategy that exercise the broken code.

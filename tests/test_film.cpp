@@ -6,6 +6,7 @@
 #include "core/parallel.h"
 #include "core/render.h"
 #include "reference/reference_tracer.h"
+#include "tests/temp_dir.h"
 #include "tests/test_scenes.h"
 
 #include <gtest/gtest.h>
@@ -110,8 +111,8 @@ TEST(Film, SameBitsForOneAndTwoThreads) {
 // The user-facing promise: `pathlab render --threads 1` and `--threads 2`
 // write identical pixels.
 TEST(Film, CliThreadsOneAndTwoWriteIdenticalExr) {
-  const auto dir = std::filesystem::temp_directory_path() / ("pathlab-threads-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
+  const test::ScopedTempDir folder("threads");
+  const std::filesystem::path& dir = folder.path();
   std::vector<Image> images;
   for (const char* threads : {"1", "2"}) {
     const std::string out = (dir / (std::string("t") + threads + ".exr")).string();
@@ -123,7 +124,6 @@ TEST(Film, CliThreadsOneAndTwoWriteIdenticalExr) {
   }
   ASSERT_EQ(images[0].pixels.size(), images[1].pixels.size());
   EXPECT_EQ(std::memcmp(images[0].pixels.data(), images[1].pixels.data(), images[0].pixels.size() * sizeof(vec3)), 0);
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

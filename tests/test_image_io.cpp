@@ -3,6 +3,8 @@
 #include "core/error.h"
 
 #include <OpenImageIO/imageio.h>
+#include "tests/temp_dir.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -21,21 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh folder per test, removed afterwards.
-class ImageIoTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("pathlab-image-io-" + std::to_string(::getpid()) + "-" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  fs::path dir_;
-};
+class ImageIoTest : public test::TempDirTest {};
 
 std::vector<std::string> list_folder(const fs::path& dir) {
   std::vector<std::string> names;

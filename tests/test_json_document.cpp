@@ -2,6 +2,8 @@
 
 #include "core/error.h"
 
+#include "tests/temp_dir.h"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -224,15 +226,8 @@ TEST(JsonDocumentErrors, TooDeeplyNested) {
   EXPECT_EQ(error_of(std::string(100, '[') + std::string(100, ']')), "(no error)");
 }
 
-class JsonDocumentLoad : public ::testing::Test {
+class JsonDocumentLoad : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("pathlab_json_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-            "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
 
   std::filesystem::path write(const std::string& name, std::string_view content) {
     const std::filesystem::path path = dir_ / name;
@@ -240,7 +235,6 @@ class JsonDocumentLoad : public ::testing::Test {
     return path;
   }
 
-  std::filesystem::path dir_;
 };
 
 TEST_F(JsonDocumentLoad, ReadsFileAndKeepsItsName) {

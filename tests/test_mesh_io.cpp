@@ -1,6 +1,8 @@
 #include "core/error.h"
 #include "core/mesh.h"
 
+#include "tests/temp_dir.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -27,19 +29,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // A fresh folder per test, removed afterwards.
-class MeshIoTest : public ::testing::Test {
+class MeshIoTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("pathlab-mesh-io-" + std::to_string(::getpid()) + "-" +
-                                        info->test_suite_name() + "-" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
 
   fs::path write(const std::string& name, std::string_view bytes) const {
     const fs::path path = dir_ / name;
@@ -63,7 +54,6 @@ class MeshIoTest : public ::testing::Test {
   void expect_error(const std::string& name, std::string_view bytes,
                     std::initializer_list<std::string_view> keys) const;
 
-  fs::path dir_;
 };
 
 using MeshIoPly = MeshIoTest;

@@ -6,6 +6,8 @@
 #include "core/error.h"
 
 #include <glm/gtc/matrix_transform.hpp>
+#include "tests/temp_dir.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -374,13 +376,12 @@ TEST(SceneLoader, SphereRejectsANonUniformScale) {
 TEST(SceneLoader, TransformThatCollapsesSomeTrianglesWarns) {
   // One triangle 1e-10 across, one 1 across; scaled by 1e-20 the small one's
   // area underflows to zero and is dropped, the large one remains.
-  const fs::path dir = fs::temp_directory_path() / ("pathlab-scene-loader-collapse-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  const test::ScopedTempDir folder("scene-loader-collapse");
+  const fs::path& dir = folder.path();
   std::ofstream(dir / "two.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1e-10 0 0\nv 0 1e-10 0\nf 1 2 3\nf 1 4 5\n";
   const Scene s = parse(scene_text(kMaterials, R"([{"type": "mesh", "file": "two.obj", "material": "lamp",
                                                      "transform": {"scale": 1e-20}}])"),
                         dir / "scene.json");
-  fs::remove_all(dir);
   ASSERT_EQ(s.shapes.size(), 1u);
   EXPECT_EQ(s.shapes[0].mesh.triangles.size(), 1u);
   ASSERT_EQ(s.warnings.size(), 1u);
@@ -418,18 +419,11 @@ TEST(SceneLoader, BlackLightsDoNotCountAsLight) {
 
 // ------------------------------------------------------------ files
 
-class SceneLoaderFiles : public ::testing::Test {
+class SceneLoaderFiles : public test::TempDirTest {
  protected:
   void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("pathlab-scene-loader-" + std::to_string(::getpid()) + "-" + info->name());
-    fs::remove_all(dir_);
+    TempDirTest::SetUp();
     fs::create_directories(dir_ / "scenes" / "meshes");
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
   }
   fs::path write(const fs::path& relative, const std::string& text) const {
     std::ofstream out(dir_ / relative, std::ios::binary);
@@ -437,7 +431,6 @@ class SceneLoaderFiles : public ::testing::Test {
     EXPECT_TRUE(out.good()) << relative;
     return dir_ / relative;
   }
-  fs::path dir_;
 };
 
 // A unit square in z = 0 as one OBJ quad, counter-clockwise seen from +z.
