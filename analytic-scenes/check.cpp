@@ -37,6 +37,7 @@ CheckResult check_against_expected(const Film& film, const ExpectedImage& expect
   double sum_d2 = 0.0, sum_rel = 0.0;
   std::vector<PixelDeviation> all;
   all.reserve(static_cast<std::size_t>(n));
+  const Image film_var = film.variance_of_mean();
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const Spectrum m = film.mean(x, y);
@@ -48,7 +49,7 @@ CheckResult check_against_expected(const Film& film, const ExpectedImage& expect
         double var_3x3 = 0.0;
         for (int ny = std::max(0, y - 1); ny <= std::min(h - 1, y + 1); ++ny)
           for (int nx = std::max(0, x - 1); nx <= std::min(w - 1, x + 1); ++nx)
-            var_3x3 = std::max(var_3x3, double(film.variance_of_mean(nx, ny)[c]));
+            var_3x3 = std::max(var_3x3, double(film_var.at(nx, ny)[c]));
         const double var = std::max(var_3x3, double(expected.footprint_variance.at(x, y)[c]) / n_own);
         const double sigma = std::sqrt(var + q * q + floor * floor);
         const double z = d / sigma;

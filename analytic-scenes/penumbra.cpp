@@ -49,15 +49,6 @@ double mesh_area(const Shape& s) {
   return a;
 }
 
-double polygon_area(const std::vector<glm::dvec2>& p) {
-  double a = 0.0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const glm::dvec2 &u = p[i], &v = p[(i + 1) % p.size()];
-    a += u.x * v.y - u.y * v.x;
-  }
-  return 0.5 * std::abs(a);
-}
-
 // True if every vertex lies on the inner side of every face's plane.
 bool is_convex(const Shape& s) {
   double extent = 0.0;
@@ -83,17 +74,9 @@ std::optional<std::pair<std::size_t, double>> nearest_hit(const std::vector<cons
   std::optional<std::pair<std::size_t, double>> best;
   for (std::size_t i = 0; i < shapes.size(); ++i)
     for (const glm::uvec3& t : shapes[i]->mesh.triangles) {
-      const dvec3 p0(shapes[i]->mesh.positions[t.x]), e1 = dvec3(shapes[i]->mesh.positions[t.y]) - p0,
-          e2 = dvec3(shapes[i]->mesh.positions[t.z]) - p0, q = glm::cross(d, e2);
-      const double det = glm::dot(e1, q);
-      if (det == 0.0) continue;
-      const dvec3 s = o - p0;
-      const double u = glm::dot(s, q) / det;
-      if (u < 0.0 || u > 1.0) continue;
-      const dvec3 r = glm::cross(s, e1);
-      const double v = glm::dot(d, r) / det, dist = glm::dot(e2, r) / det;
-      if (v < 0.0 || u + v > 1.0 || dist <= 0.0) continue;
-      if (!best || dist < best->second) best = std::pair{i, dist};
+      const TriangleMesh& m = shapes[i]->mesh;
+      const auto dist = hit_triangle(o, d, dvec3(m.positions[t.x]), dvec3(m.positions[t.y]), dvec3(m.positions[t.z]));
+      if (dist && (!best || *dist < best->second)) best = std::pair{i, *dist};
     }
   return best;
 }
@@ -198,7 +181,7 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
   std::vector<glm::dvec2> pts;
   for (const vec3& v : model->emitter->mesh.positions) pts.push_back(model->to_2d(dvec3(v)));
   model->emitter_2d = convex_hull(std::move(pts));
-  if (std::abs(polygon_area(model->emitter_2d) - mesh_area(*model->emitter)) > 1e-5 * mesh_area(*model->emitter))
+  if (std::abs(signed_area(model->emitter_2d) - mesh_area(*model->emitter)) > 1e-5 * mesh_area(*model->emitter))
     refuse(scene, kName, "the emitter must be a convex polygon");
   for (const glm::dvec2& p : model->emitter_2d) model->emitter_3d.push_back(model->to_3d(p));
 

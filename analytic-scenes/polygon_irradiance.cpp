@@ -47,25 +47,24 @@ bool lies_in_plane(std::span<const dvec3> polygon, const dvec3& unit_normal, con
   return std::abs(mean_distance) <= kInPlaneTolerance * scale;
 }
 
-// --- 3-D: Sutherland–Hodgman against x's horizon ------------------------------
+// --- Sutherland–Hodgman: one pass against a half-space ------------------------
 
-// The part of the polygon in the closed half-space {p : n·(p − x) ≥ 0}: walk
-// the edges prev → cur, keep every vertex on the upper side, and insert the
-// point where an edge strictly crosses the plane. The crossing is where the
-// signed height h(p) = n·(p − x), linear along the edge, vanishes:
-// p = prev + t (cur − prev) with t = h(prev) / (h(prev) − h(cur)) ∈ (0, 1).
-// A vertex exactly on the plane is kept and creates no crossing, so no
-// duplicate vertices appear. The winding is preserved. For a concave polygon
-// the result can contain "bridge" edges along the horizon traversed once in
-// each direction; their contributions to Lambert's sum cancel exactly, since
-// it is a sum over the boundary.
-std::vector<dvec3> clip_to_upper_half_space(std::span<const dvec3> polygon, const dvec3& x, const dvec3& n) {
-  std::vector<dvec3> clipped;
+// The part of the polygon where the signed distance h (affine in p) is
+// ≥ 0: walk the edges prev → cur, keep every vertex with h ≥ 0, and insert
+// the point where an edge strictly crosses h = 0, p = prev + t (cur − prev)
+// with t = h(prev) / (h(prev) − h(cur)) ∈ (0, 1). A vertex exactly on the
+// boundary is kept and creates no crossing, so no duplicate vertices appear.
+// The winding is preserved. For a concave polygon the result can contain
+// "bridge" edges along the boundary traversed once in each direction.
+template <typename P, typename SignedDistance>
+std::vector<P> clip_to_half_space(std::span<const P> polygon, SignedDistance h) {
+  std::vector<P> clipped;
+  if (polygon.empty()) return clipped;
   clipped.reserve(polygon.size() + 2);
-  dvec3 prev = polygon.back();
-  double h_prev = glm::dot(n, prev - x);
-  for (const dvec3& cur : polygon) {
-    const double h_cur = glm::dot(n, cur - x);
+  P prev = polygon.back();
+  double h_prev = h(prev);
+  for (const P& cur : polygon) {
+    const double h_cur = h(cur);
     if ((h_prev < 0.0 && h_cur > 0.0) || (h_prev > 0.0 && h_cur < 0.0))
       clipped.push_back(prev + (cur - prev) * (h_prev / (h_prev - h_cur)));
     if (h_cur >= 0.0) clipped.push_back(cur);
@@ -73,6 +72,13 @@ std::vector<dvec3> clip_to_upper_half_space(std::span<const dvec3> polygon, cons
     h_prev = h_cur;
   }
   return clipped;
+}
+
+// The part of the polygon above x's horizon, {p : n·(p − x) ≥ 0}. The bridge
+// edges a concave polygon may gain contribute to Lambert's sum once in each
+// direction and cancel exactly, since it is a sum over the boundary.
+std::vector<dvec3> clip_to_upper_half_space(std::span<const dvec3> polygon, const dvec3& x, const dvec3& n) {
+  return clip_to_half_space(polygon, [&](const dvec3& p) { return glm::dot(n, p - x); });
 }
 
 // --- 3-D: Lambert's formula -----------------------------------------------------
@@ -133,7 +139,8 @@ double turn(const dvec2& o, const dvec2& a, const dvec2& b) {
   return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
 }
 
-// Shoelace formula: positive for a counter-clockwise polygon.
+}  // namespace
+
 double signed_area(std::span<const dvec2> polygon) {
   double twice_area = 0.0;
   for (std::size_t i = 0; i < polygon.size(); ++i) {
@@ -144,6 +151,8 @@ double signed_area(std::span<const dvec2> polygon) {
   return 0.5 * twice_area;
 }
 
+namespace {
+
 // Appends `p` to the chain being built in `hull`, first popping every vertex
 // that would no longer be a strict left turn (a right turn or collinear).
 // Vertices at index < `floor` belong to the finished lower chain and stay.
@@ -153,24 +162,10 @@ void push_left_turn(std::vector<dvec2>& hull, const dvec2& p, std::size_t floor)
 }
 
 // The part of `polygon` left of (or on) the directed line a → b, the inside
-// of a counter-clockwise polygon's edge: one Sutherland–Hodgman pass with the
-// same crossing rule as clip_to_upper_half_space, using the signed distance
-// (times |b − a|) s(p) = (b − a) × (p − a).
+// of a counter-clockwise polygon's edge, by the signed distance (times
+// |b − a|) s(p) = (b − a) × (p − a).
 std::vector<dvec2> clip_by_half_plane(const std::vector<dvec2>& polygon, const dvec2& a, const dvec2& b) {
-  std::vector<dvec2> clipped;
-  if (polygon.empty()) return clipped;
-  clipped.reserve(polygon.size() + 1);
-  dvec2 prev = polygon.back();
-  double s_prev = turn(a, b, prev);
-  for (const dvec2& cur : polygon) {
-    const double s_cur = turn(a, b, cur);
-    if ((s_prev < 0.0 && s_cur > 0.0) || (s_prev > 0.0 && s_cur < 0.0))
-      clipped.push_back(prev + (cur - prev) * (s_prev / (s_prev - s_cur)));
-    if (s_cur >= 0.0) clipped.push_back(cur);
-    prev = cur;
-    s_prev = s_cur;
-  }
-  return clipped;
+  return clip_to_half_space(std::span<const dvec2>(polygon), [&](const dvec2& p) { return turn(a, b, p); });
 }
 
 // Drops repeated consecutive vertices and vertices collinear with their

@@ -34,6 +34,10 @@ namespace pathlab::analytic {
 // `n` is assumed unit length: the result scales with |n|.
 double polygon_form_factor(std::span<const dvec3> polygon, const dvec3& x, const dvec3& n);
 
+// The signed area of a simple 2-D polygon by the shoelace formula,
+// positive when its vertices run counter-clockwise.
+double signed_area(std::span<const glm::dvec2> polygon);
+
 // The convex hull of `points` by Andrew's monotone chain, counter-clockwise,
 // starting at the lexicographically smallest point (smallest x, then y),
 // without repeated points or collinear (180°) vertices. Degenerate inputs

@@ -42,22 +42,21 @@ double signed_volume(const TriangleMesh& m) {
   return v / 6.0;
 }
 
-// Möller-Trumbore in double: does the ray from o along d cross the triangle
-// at t > 0?
-bool crosses(const dvec3& o, const dvec3& d, const dvec3& p0, const dvec3& p1, const dvec3& p2) {
+}  // namespace
+
+std::optional<double> hit_triangle(const dvec3& o, const dvec3& d, const dvec3& p0, const dvec3& p1, const dvec3& p2) {
+  // Möller-Trumbore.
   const dvec3 e1 = p1 - p0, e2 = p2 - p0, q = glm::cross(d, e2);
   const double det = glm::dot(e1, q);
-  if (det == 0.0) return false;
+  if (det == 0.0) return std::nullopt;
   const dvec3 s = o - p0;
   const double u = glm::dot(s, q) / det;
-  if (u < 0.0 || u > 1.0) return false;
+  if (u < 0.0 || u > 1.0) return std::nullopt;
   const dvec3 r = glm::cross(s, e1);
-  const double v = glm::dot(d, r) / det;
-  if (v < 0.0 || u + v > 1.0) return false;
-  return glm::dot(e2, r) / det > 0.0;
+  const double v = glm::dot(d, r) / det, t = glm::dot(e2, r) / det;
+  if (v < 0.0 || u + v > 1.0 || t <= 0.0) return std::nullopt;
+  return t;
 }
-
-}  // namespace
 
 bool contains(const Shape& shape, const vec3& p) {
   if (shape.kind == Shape::Kind::Sphere) return glm::length(dvec3(p) - dvec3(shape.center)) < shape.radius;
@@ -66,8 +65,9 @@ bool contains(const Shape& shape, const vec3& p) {
   const dvec3 d = glm::normalize(dvec3(0.5773, 0.6181, 0.5329));
   int crossings = 0;
   for (const glm::uvec3& t : shape.mesh.triangles)
-    crossings += crosses(dvec3(p), d, dvec3(shape.mesh.positions[t.x]), dvec3(shape.mesh.positions[t.y]),
-                         dvec3(shape.mesh.positions[t.z]));
+    crossings += hit_triangle(dvec3(p), d, dvec3(shape.mesh.positions[t.x]), dvec3(shape.mesh.positions[t.y]),
+                              dvec3(shape.mesh.positions[t.z]))
+                     .has_value();
   return crossings % 2 == 1;
 }
 

@@ -23,6 +23,10 @@ bool contains(const Shape& shape, const vec3& p);
 // or the material emits from both sides.
 bool emits_inwards(const Shape& shape, const Material& material);
 
+// Distance t > 0 at which the ray from `o` along `d` crosses the triangle
+// (Möller-Trumbore in double precision), if it does.
+std::optional<double> hit_triangle(const dvec3& o, const dvec3& d, const dvec3& p0, const dvec3& p1, const dvec3& p2);
+
 // Distance along the ray to the first intersection with the sphere in front
 // of the origin, computed in double precision.
 std::optional<double> hit_sphere(const vec3& center, float radius, const Ray& ray);

@@ -391,15 +391,6 @@ TEST(PolygonIrradiance, AdditiveOverPieces) {
 
 // --- convex_hull -------------------------------------------------------------------
 
-double shoelace(const std::vector<dvec2>& polygon) {
-  double twice = 0.0;
-  for (std::size_t i = 0; i < polygon.size(); ++i) {
-    const dvec2& p = polygon[i];
-    const dvec2& q = polygon[(i + 1) % polygon.size()];
-    twice += p.x * q.y - p.y * q.x;
-  }
-  return 0.5 * twice;
-}
 
 double turn(const dvec2& o, const dvec2& a, const dvec2& b) {
   return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
@@ -435,7 +426,7 @@ TEST(PolygonIrradianceHull, GridWithDuplicatesGivesItsCorners) {
   const std::vector<dvec2> hull = convex_hull(points);
   const std::vector<dvec2> expected = {{0, 0}, {10, 0}, {10, 10}, {0, 10}};
   EXPECT_EQ(hull, expected);
-  EXPECT_EQ(shoelace(hull), 100.0);
+  EXPECT_EQ(signed_area(hull), 100.0);
 }
 
 TEST(PolygonIrradianceHull, RandomPointsLieInsideCounterClockwiseHull) {
@@ -452,8 +443,8 @@ TEST(PolygonIrradianceHull, RandomPointsLieInsideCounterClockwiseHull) {
     for (const dvec2& v : hull) EXPECT_NE(std::find(points.begin(), points.end(), v), points.end());
     for (const dvec2& p : points) EXPECT_TRUE(inside(hull, p)) << p.x << ", " << p.y;
     // Inscribed in the unit disk, and with ~1500 points it misses little of it.
-    EXPECT_LT(shoelace(hull), kPiD);
-    EXPECT_GT(shoelace(hull), 0.95 * kPiD);
+    EXPECT_LT(signed_area(hull), kPiD);
+    EXPECT_GT(signed_area(hull), 0.95 * kPiD);
   }
   // Random points in the unit square together with its corners: the hull is
   // the square.
@@ -462,7 +453,7 @@ TEST(PolygonIrradianceHull, RandomPointsLieInsideCounterClockwiseHull) {
   const std::vector<dvec2> hull = convex_hull(points);
   const std::vector<dvec2> square = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
   EXPECT_EQ(hull, square);
-  EXPECT_EQ(shoelace(hull), 1.0);
+  EXPECT_EQ(signed_area(hull), 1.0);
 }
 
 TEST(PolygonIrradianceHull, DegenerateInputs) {
@@ -498,7 +489,7 @@ std::vector<dvec2> box(double x0, double y0, double x1, double y1) { return {{x0
 TEST(PolygonIrradianceClip, SquareAndShiftedSquareGiveRectangle) {
   const std::vector<dvec2> result = clip_convex(box(0, 0, 1, 1), box(0.5, 0.25, 1.5, 1.25));
   EXPECT_TRUE(same_cycle(result, box(0.5, 0.25, 1, 1), 0.0));
-  EXPECT_EQ(shoelace(result), 0.375);
+  EXPECT_EQ(signed_area(result), 0.375);
 }
 
 TEST(PolygonIrradianceClip, DisjointOrTouchingGiveEmpty) {
@@ -545,8 +536,8 @@ TEST(PolygonIrradianceClip, RandomIntersectionAreaMatchesMonteCarlo) {
     ASSERT_FALSE(both.empty());
     expect_strictly_convex_ccw(both);
     for (const dvec2& v : both) EXPECT_TRUE(inside(a, v) && inside(b, v));
-    const double area = shoelace(both);
-    EXPECT_NEAR(shoelace(clip_convex(b, a)), area, 1e-14);  // same region, other order
+    const double area = signed_area(both);
+    EXPECT_NEAR(signed_area(clip_convex(b, a)), area, 1e-14);  // same region, other order
 
     const dvec2 lo(-1.0, -1.0), hi(1.6, 1.6);  // holds both disks
     const double box_area = (hi.x - lo.x) * (hi.y - lo.y);

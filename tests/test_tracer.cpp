@@ -89,7 +89,6 @@ void expect_sphere_image(const Scene& scene_in, const Spectrum& on, const Spectr
   const int w = compiled.scene().film.width, h = compiled.scene().film.height;
   Film film(w, h, FilterKind::Box);
   render(tracer, film);
-  const Shape& sphere = compiled.scene().shapes[0];
   int checked_on = 0, checked_off = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -100,7 +99,6 @@ void expect_sphere_image(const Scene& scene_in, const Spectrum& on, const Spectr
                 s.shape == 0;
       }
       if (hits != 0 && hits != 4) continue;
-      (void)sphere;
       const Spectrum expected = hits == 4 ? on : off;
       (hits == 4 ? checked_on : checked_off)++;
       const Spectrum m = film.mean(x, y), v = film.variance_of_mean(x, y);
