@@ -210,4 +210,10 @@ float linear_to_srgb(float v) {
   return static_cast<float>(1.055 * std::pow(x, 1.0 / 2.4) - 0.055);
 }
 
+float srgb_to_linear(float v) {
+  const double x = std::clamp(static_cast<double>(v), 0.0, 1.0);
+  if (x <= 0.04045) return static_cast<float>(x / 12.92);
+  return static_cast<float>(std::pow((x + 0.055) / 1.055, 2.4));
+}
+
 }  // namespace pathlab

@@ -46,7 +46,9 @@ void write_png(const std::filesystem::path& file, const Image& image, float expo
 // linear float RGB (a one-channel image is replicated). Throws InputError.
 Image read_image(const std::filesystem::path& file, ImageMetadata* metadata = nullptr);
 
-// The sRGB opto-electronic transfer function (IEC 61966-2-1) on [0,1].
+// The sRGB opto-electronic transfer function (IEC 61966-2-1) on [0,1], and
+// its inverse (both clamp their argument to [0,1]).
 float linear_to_srgb(float v);
+float srgb_to_linear(float v);
 
 }  // namespace pathlab

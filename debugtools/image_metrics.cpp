@@ -205,12 +205,6 @@ std::array<std::uint8_t, 3> heatmap_colour(double t) {
   return out;
 }
 
-float srgb_to_linear(float v) {
-  const double x = std::clamp(static_cast<double>(v), 0.0, 1.0);
-  if (x <= 0.04045) return static_cast<float>(x / 12.92);
-  return static_cast<float>(std::pow((x + 0.055) / 1.055, 2.4));
-}
-
 Image error_heatmap(const Image& a, const Image& b, double* scale) {
   check_same_size(a, b);
   const std::size_t n = a.pixels.size();

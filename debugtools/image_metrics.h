@@ -108,7 +108,4 @@ inline constexpr std::array<std::uint8_t, 3> kHeatmapNonFinite = {255, 0, 255}; 
 // Throws InputError if the sizes differ.
 Image error_heatmap(const Image& a, const Image& b, double* scale);
 
-// Inverse of linear_to_srgb on [0, 1].
-float srgb_to_linear(float v);
-
 }  // namespace pathlab

@@ -72,7 +72,8 @@ Difference compare(const PathEvent& ea, const PathEvent& eb, float tol) {
 
 // Loose agreement of the geometric content of two events of one kind.
 bool still_close(const PathEvent& ea, const PathEvent& eb) {
-  return compare(ea, eb, 1e-2f).what.empty() || compare(ea, eb, 1e-2f).discrete;
+  const Difference loose = compare(ea, eb, 1e-2f);
+  return loose.what.empty() || loose.discrete;
 }
 
 }  // namespace

@@ -292,6 +292,15 @@ TEST_F(ImageIoTest, ReadReplicatesOneChannelAndRejectsTwo) {
   }
 }
 
+TEST(ImageIoSrgb, InverseRoundTripsEveryEightBitCode) {
+  for (int c = 0; c < 256; ++c) {
+    const float v = static_cast<float>(c) / 255.0f;
+    EXPECT_EQ(std::lround(linear_to_srgb(srgb_to_linear(v)) * 255.0f), c);
+  }
+  EXPECT_EQ(srgb_to_linear(0.0f), 0.0f);
+  EXPECT_EQ(srgb_to_linear(1.0f), 1.0f);
+}
+
 TEST(ImageIoSrgb, HitsEndpoints) {
   EXPECT_EQ(linear_to_srgb(0.0f), 0.0f);
   EXPECT_EQ(linear_to_srgb(1.0f), 1.0f);

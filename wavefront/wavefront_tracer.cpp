@@ -70,7 +70,10 @@ void for_live(const std::vector<std::uint32_t>& live, Fn&& fn) {
 // stream per task (or one query per ray).
 void WavefrontTracer::intersect(Wave& w) const {
   if (queries_ == RayQueries::OneByOne) {
-    for_live(w.live, [&](std::uint32_t i) { w.found[i] = scene_.intersect(w.ray[i], &w.surfel[i]); });
+    for_live(w.live, [&](std::uint32_t i) {
+      ++w.rays[i];
+      w.found[i] = scene_.intersect(w.ray[i], &w.surfel[i]);
+    });
     return;
   }
   parallel_for(0, w.live.size(), kGrain, [&](std::size_t b, std::size_t e) {
@@ -82,6 +85,7 @@ void WavefrontTracer::intersect(Wave& w) const {
     scene_.intersect_stream(rays, surfels, found);
     for (std::size_t k = b; k < e; ++k) {
       const std::uint32_t i = w.live[k];
+      ++w.rays[i];
       w.found[i] = found[k - b];
       if (found[k - b]) w.surfel[i] = surfels[k - b];
     }
@@ -95,8 +99,7 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
   const int cap = settings_.max_depth >= 0 ? settings_.max_depth : kMaxVerticesUncapped;
   const Strategy strategy = settings_.strategy;
   for_live(w.live, [&](std::uint32_t i) {
-    ++w.rays[i];
-    Surfel& s = w.surfel[i];
+    const Surfel& s = w.surfel[i];
     if (!w.found[i]) {
       const Spectrum Le = scene_.scene().environment.value_or(Spectrum(0.0f));
       const float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf_environment());
