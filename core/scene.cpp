@@ -14,9 +14,15 @@ const char* strategy_name(Strategy s) {
 }
 
 std::optional<Strategy> parse_strategy(std::string_view name) {
-  for (Strategy s : {Strategy::Cosine, Strategy::Bsdf, Strategy::Light, Strategy::LightBsdf, Strategy::Mis})
+  for (Strategy s : kAllStrategies)
     if (name == strategy_name(s)) return s;
   return std::nullopt;
+}
+
+std::vector<std::string_view> strategy_names() {
+  std::vector<std::string_view> names;
+  for (Strategy s : kAllStrategies) names.push_back(strategy_name(s));
+  return names;
 }
 
 }  // namespace pathlab

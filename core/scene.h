@@ -36,8 +36,12 @@ enum class Strategy : std::uint8_t {
   LightBsdf,  // one-sample 50/50 choice of light or BSDF sampling (balance)
   Mis,        // next-event estimation and BSDF sampling, power heuristic
 };
+inline constexpr Strategy kAllStrategies[] = {Strategy::Cosine, Strategy::Bsdf, Strategy::Light, Strategy::LightBsdf,
+                                              Strategy::Mis};
 const char* strategy_name(Strategy s);
 std::optional<Strategy> parse_strategy(std::string_view name);
+// Every strategy's name, in the order of kAllStrategies.
+std::vector<std::string_view> strategy_names();
 
 struct RenderSettings {
   int spp = 16;

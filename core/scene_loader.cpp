@@ -225,8 +225,7 @@ RenderSettings read_render(const Node& node) {
     const std::string name = node.child("strategy").string();
     const auto s = parse_strategy(name);
     if (!s) {
-      const std::array<std::string_view, 5> names{"cosine", "bsdf", "light", "light+bsdf", "mis"};
-      const std::string near = suggestion(name, names);
+      const std::string near = suggestion(name, strategy_names());
       node.child("strategy").fail("unknown strategy " + in_quotes(name) +
                                   (near.empty() ? " (expected cosine, bsdf, light, light+bsdf or mis)" : near));
     }

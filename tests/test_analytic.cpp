@@ -135,7 +135,7 @@ TEST(AnalyticRefusals, FurnaceAssumptions) {
 
 TEST(AnalyticRefusals, PenumbraAssumptions) {
   // shapes: 0 ground, 1 lamp, 2 box
-  expect_refused("penumbra-box.json", [](Scene& s) { s.shapes[2].mesh.positions[0].y += 5.0f; }, "");
+  expect_refused("penumbra-box.json", [](Scene& s) { s.shapes[2].mesh.positions[0].y += 5.0f; }, "closed convex mesh");
   expect_refused("penumbra-box.json", [](Scene& s) { for (vec3& p : s.shapes[2].mesh.positions) p.y += 1.5f; }, "strictly between");
   expect_refused("penumbra-box.json", [](Scene& s) { s.shapes[1].mesh.positions[0].y -= 0.3f; }, "planar");
   expect_refused("penumbra-box.json", [](Scene& s) { s.shapes.push_back(s.shapes[2]); }, "at most one black occluder");

@@ -45,7 +45,6 @@ inline std::string strategy_test_name(const testing::TestParamInfo<Strategy>& p)
   return s;
 }
 
-inline constexpr Strategy kAllStrategies[] = {Strategy::Cosine, Strategy::Bsdf, Strategy::Light, Strategy::LightBsdf,
-                                              Strategy::Mis};
+using pathlab::kAllStrategies;
 
 }  // namespace pathlab::test

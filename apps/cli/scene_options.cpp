@@ -12,6 +12,8 @@
 namespace pathlab::cli {
 
 void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
+  const auto names = strategy_names();
+  const std::vector<std::string> strategies(names.begin(), names.end());
   cmd.add_option("scene", scene_file, "Scene file (JSON); omit for the built-in Cornell box");
   if (allow_both)
     cmd.add_option("--tracer", tracer, "Tracer: reference, wavefront, or both (side by side, marking where they part)")
@@ -19,7 +21,7 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
   else
     cmd.add_option("--tracer", tracer, "Tracer: reference or wavefront")->check(CLI::IsMember({"reference", "wavefront"}));
   cmd.add_option("--strategy", strategy, "Sampling strategy: cosine, bsdf, light, light+bsdf, mis")
-      ->check(CLI::IsMember({"cosine", "bsdf", "light", "light+bsdf", "mis"}));
+      ->check(CLI::IsMember(strategies));
   if (with_spp) cmd.add_option("--spp", spp, "Samples per pixel")->check(CLI::Range(1, 1 << 24));
   cmd.add_option("--max-depth", max_depth, "Maximum bounces; -1 = until Russian roulette")
       ->check(CLI::Range(-1, kMaxVerticesUncapped));
