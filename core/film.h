@@ -26,6 +26,7 @@ struct FilmSample {
   vec2 film{0.0f};          // position in pixels, (0,0) = top-left corner
   Spectrum L{0.0f};         // radiance estimate
   std::uint32_t rays = 0;   // rays it cast (camera, continuation, shadow)
+  std::uint32_t hits = 0;   // surfaces the path reached (its length in vertices)
 };
 
 // A sample left out of the image because its radiance was NaN or infinite.

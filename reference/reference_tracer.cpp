@@ -13,6 +13,7 @@ struct ReferenceTracer::Path {
   SampleStream rng;
   PathObserver* observer;
   std::uint32_t rays = 0;
+  std::uint32_t hits = 0;
   float u(int vertex, Dim dim) const { return rng.get(static_cast<std::uint32_t>(vertex), dim); }
 };
 
@@ -31,6 +32,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
     return w * Le;
   }
 
+  ++path.hits;
   const vec3 wo = -ray.dir;
   const Spectrum Le = s.emitted(wo);
   const float w_e = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, scene.lights().pdf(prev.p, s));
@@ -133,6 +135,7 @@ FilmSample ReferenceTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::
   if (observer) observer->on_camera({x, y, sample, fs.film, ray.origin, ray.dir});
   fs.L = Li(ray, 1, PreviousVertex{}, Spectrum(1.0f), path);
   fs.rays = path.rays;
+  fs.hits = path.hits;
   if (observer) observer->on_result(fs.L);
   return fs;
 }

@@ -36,8 +36,9 @@ Scene load_case(const SameSeedCase& c) {
 
 class SameSeed : public testing::TestWithParam<SameSeedCase> {};
 
-// Every sample of both tracers is compared. A sample counts as equal within
-// 1e-4 relative (plus 1e-6 absolute for values near 0). At least 99.9 % must
+// Every sample of both tracers is compared. A sample counts as equal if its
+// radiance agrees within 1e-4 relative (plus 1e-6 absolute for values near 0)
+// and it reached as many surfaces and cast as many rays. At least 99.9 % must
 // be; each one that is not must be explained by rounding: replayed with both
 // tracers, its paths agree event by event (positions and directions within
 // 1e-3) up to the vertex where they part, i.e. the same path until a float
@@ -59,6 +60,7 @@ TEST_P(SameSeed, WavefrontFollowsTheReferencesPaths) {
     bool same = true;
     for (int c = 0; c < 3; ++c)
       same = same && std::abs(a[i].L[c] - b[i].L[c]) <= 1e-4f * std::max(std::abs(a[i].L[c]), std::abs(b[i].L[c])) + 1e-6f;
+    same = same && a[i].hits == b[i].hits && a[i].rays == b[i].rays;
     if (same) {
       ++equal;
       continue;

@@ -15,6 +15,10 @@ packages=(
   zlib1g-dev              # .gz meshes
   libcli11-dev            # the command line
   libgtest-dev libgmock-dev  # tests
+  libbenchmark-dev        # Google Benchmark: bench/
+  libvtk9-dev             # path polylines as VTK PolyData (debugtools/)
+  libglfw3-dev libgl-dev libimgui-dev  # the pathlab-debug GUI
+  xvfb xauth              # run the GUI headless in tests
 )
 
 as_root=()

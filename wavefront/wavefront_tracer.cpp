@@ -42,6 +42,12 @@ struct WavefrontTracer::Wave {
     shadow_state.resize(2 * n);
     live.resize(n);
   }
+  // A finished path's sample. Its last ray reached vertex `vertex` unless it
+  // found nothing.
+  FilmSample result(std::size_t i) const {
+    const auto hits = static_cast<std::uint32_t>(vertex[i] - (found[i] ? 0 : 1));
+    return FilmSample{film[i], L[i], rays[i], hits};
+  }
   float u(std::uint32_t i, Dim dim) const { return rng[i].get(static_cast<std::uint32_t>(vertex[i]), dim); }
 };
 
@@ -302,7 +308,7 @@ void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std
       w.live[i] = static_cast<std::uint32_t>(i);
     }
     run_wave(w, nullptr);
-    for (std::size_t i = 0; i < n; ++i) out[w.out_index[i]] = FilmSample{w.film[i], w.L[i], w.rays[i]};
+    for (std::size_t i = 0; i < n; ++i) out[w.out_index[i]] = w.result(i);
   }
 }
 
@@ -319,7 +325,7 @@ FilmSample WavefrontTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::
   w.live[0] = 0;
   run_wave(w, observer);
   if (observer) observer->on_result(w.L[0]);
-  return FilmSample{w.film[0], w.L[0], w.rays[0]};
+  return w.result(0);
 }
 
 }  // namespace pathlab
