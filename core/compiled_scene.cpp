@@ -1,6 +1,7 @@
 #include "core/compiled_scene.h"
 
 #include "core/geometry.h"
+#include "core/parallel.h"
 
 namespace pathlab {
 
@@ -24,6 +25,15 @@ CompiledScene::CompiledScene(Scene scene)
     bounds_radius_ = std::max(0.5f * glm::length(hi - lo), 1e-3f);
   }
   accel_ = std::make_unique<EmbreeAccel>(scene_.shapes);
+  triangles_.resize(scene_.shapes.size());
+  for (std::size_t i = 0; i < scene_.shapes.size(); ++i) {
+    const Shape& shape = scene_.shapes[i];
+    if (shape.kind != Shape::Kind::Triangles) continue;
+    triangles_[i].resize(shape.mesh.triangles.size());
+    parallel_for(0, triangles_[i].size(), 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) triangles_[i][t] = make_triangle(shape, static_cast<std::uint32_t>(t));
+    });
+  }
   lights_ = std::make_unique<LightSampler>(scene_, bounds_radius_);
 }
 
@@ -34,20 +44,11 @@ bool CompiledScene::intersect(const Ray& ray, Surfel* s) const {
   return true;
 }
 
-void CompiledScene::intersect_stream(std::span<const Ray> rays, std::span<Surfel> surfels,
-                                     std::span<std::uint8_t> found) const {
-  thread_local std::vector<RayHit> hits;
-  hits.resize(rays.size());
-  accel_->intersect_stream(rays, hits, found);
-  for (std::size_t i = 0; i < rays.size(); ++i)
-    if (found[i]) resolve(rays[i], hits[i], &surfels[i]);
-}
-
 void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const {
   const Shape& shape = scene_.shapes[hit.shape];
   const SurfacePoint sp = shape.kind == Shape::Kind::Sphere
                               ? sphere_point(shape, ray.origin + hit.t * ray.dir)
-                              : triangle_point(shape, hit.prim, hit.uv);
+                              : triangle_point(triangles_[hit.shape][hit.prim], hit.uv);
   s->p = sp.p;
   s->p_error = sp.p_error;
   s->n = sp.n;

@@ -5,12 +5,14 @@
 
 #include "core/camera.h"
 #include "core/embree_accel.h"
+#include "core/geometry.h"
 #include "core/light_sampler.h"
 #include "core/scene.h"
 #include "core/surfel.h"
 
 #include <memory>
 #include <span>
+#include <vector>
 
 namespace pathlab {
 
@@ -37,20 +39,32 @@ class CompiledScene {
   bool intersect(const Ray& ray, Surfel* surfel) const;
   bool occluded(const Ray& ray) const { return accel_->occluded(ray); }
 
-  // Many rays at once through Embree's ray streams; the results equal those
-  // of intersect() / occluded() ray by ray.
-  void intersect_stream(std::span<const Ray> rays, std::span<Surfel> surfels, std::span<std::uint8_t> found) const;
-  void occluded_stream(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const {
-    accel_->occluded_stream(rays, occluded);
+  // Many rays at once (see EmbreeAccel::intersect_batch for `mode` and
+  // `coherent`); the results equal those of intersect() / occluded() ray by
+  // ray. Hits come back unresolved: resolve() turns the ones a caller needs
+  // into Surfels.
+  void intersect_batch(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found,
+                       RayBatchMode mode, bool coherent = false) const {
+    accel_->intersect_batch(rays, hits, found, mode, coherent);
+  }
+  void occluded_batch(std::span<const Ray> rays, std::span<std::uint8_t> occluded, RayBatchMode mode,
+                      bool coherent = false) const {
+    accel_->occluded_batch(rays, occluded, mode, coherent);
+  }
+  // The Surfel of a hit `ray` found.
+  void resolve(const Ray& ray, const RayHit& hit, Surfel* surfel) const;
+  // Starts loading what resolve() will read for `hit` into the cache.
+  void prefetch(const RayHit& hit) const {
+    const std::vector<Triangle>& t = triangles_[hit.shape];
+    if (hit.prim < t.size()) __builtin_prefetch(&t[hit.prim]);
   }
 
  private:
-  void resolve(const Ray& ray, const RayHit& hit, Surfel* surfel) const;
-
   Scene scene_;
   Camera camera_;
   std::unique_ptr<EmbreeAccel> accel_;
   std::unique_ptr<LightSampler> lights_;
+  std::vector<std::vector<Triangle>> triangles_;  // per shape, per triangle (empty for a sphere)
   LobeMask lobes_ = 0;
   vec3 bounds_center_{0.0f};
   float bounds_radius_ = 1.0f;

@@ -4,6 +4,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cstring>
 #include <mutex>
 #include <vector>
@@ -126,32 +127,135 @@ bool EmbreeAccel::intersect(const Ray& ray, RayHit* hit) const {
   return true;
 }
 
-void EmbreeAccel::intersect_stream(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found) const {
-  thread_local std::vector<RTCRayHit> buffer;
-  buffer.resize(rays.size());
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    fill(buffer[i].ray, rays[i]);
-    buffer[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    buffer[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+const char* ray_batch_mode_name(RayBatchMode mode) {
+  switch (mode) {
+    case RayBatchMode::Single: return "single";
+    case RayBatchMode::Packet16: return "packet16";
+    case RayBatchMode::Stream: return "stream";
   }
+  return "?";
+}
+
+namespace {
+
+constexpr int kPacket = 16;
+
+RTCIntersectContext make_context(bool coherent) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  rtcIntersect1M(impl_->scene, &context, buffer.data(), static_cast<unsigned>(buffer.size()), sizeof(RTCRayHit));
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    const RTCRayHit& rh = buffer[i];
-    found[i] = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
-    if (found[i]) hits[i] = RayHit{rh.ray.tfar, rh.hit.geomID, rh.hit.primID, vec2(rh.hit.u, rh.hit.v)};
+  context.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+  return context;
+}
+
+// Lane k of a 16-wide packet (structure of arrays) from one ray.
+template <typename Packet>
+void fill_lane(Packet& r, int k, const Ray& ray) {
+  r.org_x[k] = ray.origin.x;
+  r.org_y[k] = ray.origin.y;
+  r.org_z[k] = ray.origin.z;
+  r.dir_x[k] = ray.dir.x;
+  r.dir_y[k] = ray.dir.y;
+  r.dir_z[k] = ray.dir.z;
+  r.tnear[k] = 0.0f;
+  r.tfar[k] = ray.tmax;
+  r.time[k] = 0.0f;
+  r.mask[k] = 0xffffffffu;
+  r.id[k] = 0;
+  r.flags[k] = 0;
+}
+
+// Lane masks for groups of up to 16 rays: -1 for a lane in use, 0 otherwise.
+struct alignas(64) ValidMask {
+  int lane[kPacket];
+  explicit ValidMask(std::size_t n) {
+    for (int k = 0; k < kPacket; ++k) lane[k] = static_cast<std::size_t>(k) < n ? -1 : 0;
+  }
+};
+
+}  // namespace
+
+void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found,
+                                  RayBatchMode mode, bool coherent) const {
+  RTCIntersectContext context = make_context(coherent);
+  auto record = [&](std::size_t i, float tfar, unsigned geom, unsigned prim, float u, float v) {
+    found[i] = geom != RTC_INVALID_GEOMETRY_ID;
+    if (found[i]) hits[i] = RayHit{tfar, geom, prim, vec2(u, v)};
+  };
+  switch (mode) {
+    case RayBatchMode::Single:
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        RTCRayHit rh;
+        fill(rh.ray, rays[i]);
+        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect1(impl_->scene, &context, &rh);
+        record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v);
+      }
+      return;
+    case RayBatchMode::Packet16:
+      for (std::size_t b = 0; b < rays.size(); b += kPacket) {
+        const std::size_t n = std::min<std::size_t>(kPacket, rays.size() - b);
+        const ValidMask valid(n);
+        RTCRayHit16 rh;
+        for (std::size_t k = 0; k < n; ++k) {
+          fill_lane(rh.ray, static_cast<int>(k), rays[b + k]);
+          rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+          rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid.lane, impl_->scene, &context, &rh);
+        for (std::size_t k = 0; k < n; ++k)
+          record(b + k, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]);
+      }
+      return;
+    case RayBatchMode::Stream: {
+      thread_local std::vector<RTCRayHit> buffer;
+      buffer.resize(rays.size());
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        fill(buffer[i].ray, rays[i]);
+        buffer[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        buffer[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcIntersect1M(impl_->scene, &context, buffer.data(), static_cast<unsigned>(buffer.size()), sizeof(RTCRayHit));
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        const RTCRayHit& rh = buffer[i];
+        record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v);
+      }
+      return;
+    }
   }
 }
 
-void EmbreeAccel::occluded_stream(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const {
-  thread_local std::vector<RTCRay> buffer;
-  buffer.resize(rays.size());
-  for (std::size_t i = 0; i < rays.size(); ++i) fill(buffer[i], rays[i]);
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  rtcOccluded1M(impl_->scene, &context, buffer.data(), static_cast<unsigned>(buffer.size()), sizeof(RTCRay));
-  for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = buffer[i].tfar < 0.0f;
+void EmbreeAccel::occluded_batch(std::span<const Ray> rays, std::span<std::uint8_t> occluded, RayBatchMode mode,
+                                 bool coherent) const {
+  RTCIntersectContext context = make_context(coherent);
+  switch (mode) {
+    case RayBatchMode::Single:
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        RTCRay r;
+        fill(r, rays[i]);
+        rtcOccluded1(impl_->scene, &context, &r);
+        occluded[i] = r.tfar < 0.0f;
+      }
+      return;
+    case RayBatchMode::Packet16:
+      for (std::size_t b = 0; b < rays.size(); b += kPacket) {
+        const std::size_t n = std::min<std::size_t>(kPacket, rays.size() - b);
+        const ValidMask valid(n);
+        RTCRay16 r;
+        for (std::size_t k = 0; k < n; ++k) fill_lane(r, static_cast<int>(k), rays[b + k]);
+        rtcOccluded16(valid.lane, impl_->scene, &context, &r);
+        for (std::size_t k = 0; k < n; ++k) occluded[b + k] = r.tfar[k] < 0.0f;
+      }
+      return;
+    case RayBatchMode::Stream: {
+      thread_local std::vector<RTCRay> buffer;
+      buffer.resize(rays.size());
+      for (std::size_t i = 0; i < rays.size(); ++i) fill(buffer[i], rays[i]);
+      rtcOccluded1M(impl_->scene, &context, buffer.data(), static_cast<unsigned>(buffer.size()), sizeof(RTCRay));
+      for (std::size_t i = 0; i < rays.size(); ++i) occluded[i] = buffer[i].tfar < 0.0f;
+      return;
+    }
+  }
 }
 
 bool EmbreeAccel::occluded(const Ray& ray) const {

@@ -20,6 +20,16 @@ struct RayHit {
   vec2 uv{0.0f};  // Embree's barycentrics (b1, b2) for a triangle
 };
 
+// How a batch of rays reaches Embree.
+enum class RayBatchMode : std::uint8_t {
+  Single,    // one rtcIntersect1 / rtcOccluded1 per ray
+  Packet16,  // rtcIntersect16 / rtcOccluded16 over consecutive groups of 16 rays
+  Stream,    // one rtcIntersect1M / rtcOccluded1M over the whole batch
+};
+const char* ray_batch_mode_name(RayBatchMode mode);
+inline constexpr RayBatchMode kAllRayBatchModes[] = {RayBatchMode::Single, RayBatchMode::Packet16,
+                                                     RayBatchMode::Stream};
+
 class EmbreeAccel {
  public:
   // Builds the BVH. Throws SystemError with Embree's message if the device
@@ -34,11 +44,16 @@ class EmbreeAccel {
   // True if anything lies on the ray with t in (0, ray.tmax).
   bool occluded(const Ray& ray) const;
 
-  // The same queries for many rays at once, through Embree's ray streams
-  // (rtcIntersect1M / rtcOccluded1M): found[i] / occluded[i] is 0 or 1.
-  // This pair is the one place to change for Embree 4, which has no streams.
-  void intersect_stream(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found) const;
-  void occluded_stream(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const;
+  // The same queries for many rays at once: found[i] / occluded[i] is 0 or 1,
+  // and every result equals the one-ray query's. `mode` says how the batch
+  // reaches Embree (the wavefront tracer picks one per kind of ray, by
+  // measurement: bench/bench_tracers.cpp); `coherent` tells Embree the rays
+  // are neighbours (camera rays of adjacent pixels). These two functions are
+  // the one place to change for Embree 4, which has packets but no streams.
+  void intersect_batch(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found,
+                       RayBatchMode mode, bool coherent = false) const;
+  void occluded_batch(std::span<const Ray> rays, std::span<std::uint8_t> occluded, RayBatchMode mode,
+                      bool coherent = false) const;
 
  private:
   struct Impl;

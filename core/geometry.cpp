@@ -17,16 +17,24 @@ vec3 triangle_normal(const Shape& shape, std::uint32_t tri) {
   return shape.flip_normals ? -n : n;
 }
 
-SurfacePoint triangle_point(const Shape& shape, std::uint32_t tri, vec2 b) {
+Triangle make_triangle(const Shape& shape, std::uint32_t tri) {
   const glm::uvec3 t = shape.mesh.triangles[tri];
-  const vec3 &p0 = shape.mesh.positions[t.x], &p1 = shape.mesh.positions[t.y], &p2 = shape.mesh.positions[t.z];
+  return Triangle{shape.mesh.positions[t.x], shape.mesh.positions[t.y], shape.mesh.positions[t.z],
+                  triangle_normal(shape, tri)};
+}
+
+SurfacePoint triangle_point(const Triangle& t, vec2 b) {
   const float b0 = 1.0f - b.x - b.y;
   SurfacePoint sp;
-  sp.p = b0 * p0 + b.x * p1 + b.y * p2;
+  sp.p = b0 * t.p0 + b.x * t.p1 + b.y * t.p2;
   // PBR 4th ed. 6.8.3: interpolation error of barycentric evaluation.
-  sp.p_error = gamma_bound(7) * (glm::abs(b0 * p0) + glm::abs(b.x * p1) + glm::abs(b.y * p2));
-  sp.n = triangle_normal(shape, tri);
+  sp.p_error = gamma_bound(7) * (glm::abs(b0 * t.p0) + glm::abs(b.x * t.p1) + glm::abs(b.y * t.p2));
+  sp.n = t.n;
   return sp;
+}
+
+SurfacePoint triangle_point(const Shape& shape, std::uint32_t tri, vec2 b) {
+  return triangle_point(make_triangle(shape, tri), b);
 }
 
 SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx) {
@@ -40,8 +48,10 @@ SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx) {
   return sp;
 }
 
+SurfacePoint sample_triangle(const Triangle& t, vec2 u) { return triangle_point(t, square_to_uniform_triangle(u)); }
+
 SurfacePoint sample_triangle(const Shape& shape, std::uint32_t tri, vec2 u) {
-  return triangle_point(shape, tri, square_to_uniform_triangle(u));
+  return sample_triangle(make_triangle(shape, tri), u);
 }
 
 SurfacePoint sample_sphere(const Shape& shape, vec2 u) {

@@ -25,12 +25,23 @@ float triangle_area(const TriangleMesh& mesh, std::uint32_t tri);
 // Front normal of a triangle: counter-clockwise winding, unless flipped.
 vec3 triangle_normal(const Shape& shape, std::uint32_t tri);
 
+// One triangle as hits and light samples need it: its vertices and front
+// normal side by side (one or two cache lines instead of four scattered
+// reads, and no normal to recompute). CompiledScene keeps one per triangle.
+struct Triangle {
+  vec3 p0, p1, p2;
+  vec3 n;  // unit front normal, as triangle_normal()
+};
+Triangle make_triangle(const Shape& shape, std::uint32_t tri);
+
 // The point with barycentrics (b1, b2) of a triangle, recomputed from the
 // vertices (more accurate than origin + t * dir far from the origin).
+SurfacePoint triangle_point(const Triangle& t, vec2 b);
 SurfacePoint triangle_point(const Shape& shape, std::uint32_t tri, vec2 b);
 // A point near `p_approx` projected back onto the sphere.
 SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx);
 
+SurfacePoint sample_triangle(const Triangle& t, vec2 u);
 SurfacePoint sample_triangle(const Shape& shape, std::uint32_t tri, vec2 u);
 SurfacePoint sample_sphere(const Shape& shape, vec2 u);
 

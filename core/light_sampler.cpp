@@ -58,19 +58,19 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&sce
     first_entry_[s] = static_cast<std::int64_t>(entries_.size());
     if (shape.kind == Shape::Kind::Sphere) {
       const float area = 4.0f * kPi * shape.radius * shape.radius;
-      entries_.push_back({s, 0, area});
+      entries_.push_back({s, 0, area, {}});
       power.push_back(per_area * area);
     } else {
       for (std::uint32_t t = 0; t < shape.mesh.triangles.size(); ++t) {
         const float area = triangle_area(shape.mesh, t);
-        entries_.push_back({s, t, area});
+        entries_.push_back({s, t, area, make_triangle(shape, t)});
         power.push_back(per_area * area);
       }
     }
   }
   if (scene.environment && !is_black(*scene.environment)) {
     env_index_ = static_cast<std::int64_t>(entries_.size());
-    entries_.push_back({0, 0, 0.0f});
+    entries_.push_back({0, 0, 0.0f, {}});
     power.push_back(4.0 * kPi * kPi * double(scene_radius) * scene_radius * luminance(*scene.environment));
   }
   build_distribution(power, &pmf_, &cdf_);
@@ -108,7 +108,7 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
   }
   const Entry& e = entries_[i];
   const Shape& shape = scene_->shapes[e.shape];
-  const SurfacePoint sp = shape.kind == Shape::Kind::Sphere ? sample_sphere(shape, u) : sample_triangle(shape, e.prim, u);
+  const SurfacePoint sp = shape.kind == Shape::Kind::Sphere ? sample_sphere(shape, u) : sample_triangle(e.triangle, u);
   ls.p = sp.p;
   ls.p_error = sp.p_error;
   ls.n = sp.n;

@@ -13,6 +13,7 @@
 // strategies differ only on lights a ray can find).
 #pragma once
 
+#include "core/geometry.h"
 #include "core/scene.h"
 #include "core/surfel.h"
 
@@ -67,6 +68,7 @@ class LightSampler {
     std::uint32_t shape;
     std::uint32_t prim;
     float area;
+    Triangle triangle;  // the emitting triangle (unused for a sphere or the environment)
   };
   static std::size_t pick(const std::vector<float>& cdf, float u);
   static float area_density(const Entry& e);  // 1 / area

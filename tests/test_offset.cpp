@@ -10,6 +10,10 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cmath>
+#include <limits>
+
 namespace pathlab {
 namespace {
 
@@ -63,6 +67,23 @@ void expect_no_self_hits(const vec3& offset) {
     }
   }
   EXPECT_EQ(self_hits, 0) << "of " << rays << " rays at offset (" << offset.x << ", " << offset.y << ", " << offset.z << ")";
+}
+
+// The inline float steps equal std::nextafter, bit for bit, on every kind
+// of float: zeros, denormals, normals, the largest finite, infinities.
+TEST(RayOffset, NextFloatEqualsNextafter) {
+  std::vector<float> values{0.0f, -0.0f, 1.0f, -1.0f, 1e-40f, -1e-40f, std::numeric_limits<float>::denorm_min(),
+                            -std::numeric_limits<float>::denorm_min(), std::numeric_limits<float>::min(),
+                            -std::numeric_limits<float>::min(), std::numeric_limits<float>::max(),
+                            -std::numeric_limits<float>::max(), kInfinity, -kInfinity, 3.14159f, -2.5e7f};
+  for (std::uint32_t i = 0; i < 100000; ++i) values.push_back(std::bit_cast<float>(i * 2654435761u) * 1.0f);
+  for (float v : values) {
+    if (std::isnan(v)) continue;
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(next_float_up(v)), std::bit_cast<std::uint32_t>(std::nextafter(v, kInfinity))) << v;
+    EXPECT_EQ(std::bit_cast<std::uint32_t>(next_float_down(v)), std::bit_cast<std::uint32_t>(std::nextafter(v, -kInfinity))) << v;
+  }
+  EXPECT_TRUE(std::isnan(next_float_up(std::numeric_limits<float>::quiet_NaN())));
+  EXPECT_TRUE(std::isnan(next_float_down(std::numeric_limits<float>::quiet_NaN())));
 }
 
 TEST(RayOffset, NoSelfIntersectionAtTheOrigin) { expect_no_self_hits(vec3(0.0f)); }

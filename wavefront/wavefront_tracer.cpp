@@ -10,7 +10,8 @@ namespace pathlab {
 
 // The state of every path of a wave, one array per field. Paths keep their
 // slot for the whole wave; `live` lists the slots still being traced, in
-// slot order, and is compacted after each bounce.
+// slot order, and is compacted after each bounce. One thread runs a wave
+// through all its stages; threads run different waves.
 struct WavefrontTracer::Wave {
   // Identity and output.
   std::vector<std::uint32_t> out_index, x, y, sample;
@@ -33,6 +34,12 @@ struct WavefrontTracer::Wave {
   std::vector<float> light_weight;
   std::vector<std::uint8_t> shadow_state;  // 0 none, 1 to trace, 2 visible, 3 occluded
   std::vector<std::uint32_t> live;
+  // Scratch for one batch of ray queries (camera/bounce rays, or the
+  // pending shadow rays): the rays, whose slot each belongs to, the results.
+  std::vector<Ray> query;
+  std::vector<std::uint32_t> query_slot;
+  std::vector<RayHit> query_hit;
+  std::vector<std::uint8_t> query_result;
 
   void resize(std::size_t n) {
     out_index.resize(n), x.resize(n), y.resize(n), sample.resize(n), rng.resize(n, SampleStream(0, 0, 0));
@@ -41,6 +48,7 @@ struct WavefrontTracer::Wave {
     shadow.resize(2 * n), light.resize(2 * n), unoccluded.resize(2 * n), light_weight.resize(2 * n);
     shadow_state.resize(2 * n);
     live.resize(n);
+    query.resize(2 * n), query_slot.resize(2 * n), query_hit.resize(n), query_result.resize(2 * n);
   }
   // A finished path's sample. Its last ray reached vertex `vertex` unless it
   // found nothing.
@@ -48,54 +56,49 @@ struct WavefrontTracer::Wave {
     const auto hits = static_cast<std::uint32_t>(vertex[i] - (found[i] ? 0 : 1));
     return FilmSample{film[i], L[i], rays[i], hits};
   }
+  std::size_t capacity() const { return out_index.size(); }
   float u(std::uint32_t i, Dim dim) const { return rng[i].get(static_cast<std::uint32_t>(vertex[i]), dim); }
 };
 
 std::size_t WavefrontTracer::bytes_per_path() {
   return 4 * sizeof(std::uint32_t) + sizeof(SampleStream) + sizeof(vec2) + sizeof(Ray) + 2 * sizeof(Spectrum) +
          sizeof(PreviousVertex) + sizeof(std::int32_t) + sizeof(std::uint32_t) + 2 + sizeof(Surfel) +
-         2 * (sizeof(Ray) + sizeof(LightSample) + sizeof(Spectrum) + sizeof(float) + 1) + sizeof(std::uint32_t);
+         2 * (sizeof(Ray) + sizeof(LightSample) + sizeof(Spectrum) + sizeof(float) + 1) + sizeof(std::uint32_t) +
+         2 * (sizeof(Ray) + sizeof(std::uint32_t) + 1) + sizeof(RayHit);
 }
 
 WavefrontTracer::WavefrontTracer(const CompiledScene& scene, const RenderSettings& settings, std::size_t wave_size,
-                                 RayQueries queries)
-    : Tracer(scene, settings), wave_size_(std::max<std::size_t>(wave_size, 1)), queries_(queries) {}
+                                 RayModes modes)
+    : Tracer(scene, settings), wave_size_(std::max<std::size_t>(wave_size, 1)), modes_(modes) {}
 
 namespace {
-constexpr std::size_t kGrain = 256;  // paths per parallel task
-
 template <typename Fn>
 void for_live(const std::vector<std::uint32_t>& live, Fn&& fn) {
-  parallel_for(0, live.size(), kGrain, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) fn(live[k]);
-  });
+  for (const std::uint32_t i : live) fn(i);
 }
 }  // namespace
 
-// Stage: the first surface along each live path's ray, one Embree ray
-// stream per task (or one query per ray).
+// Stage: the first surface along each live path's ray. The rays go to
+// Embree as one batch (camera rays as coherent ones); the hits' triangles are
+// prefetched before any is resolved into a Surfel, so their cache misses
+// overlap instead of queueing one behind the other.
 void WavefrontTracer::intersect(Wave& w) const {
-  if (queries_ == RayQueries::OneByOne) {
-    for_live(w.live, [&](std::uint32_t i) {
-      ++w.rays[i];
-      w.found[i] = scene_.intersect(w.ray[i], &w.surfel[i]);
-    });
-    return;
+  const std::size_t n = w.live.size();
+  if (n == 0) return;
+  const bool camera_rays = w.vertex[w.live.front()] == 1;
+  for (std::size_t k = 0; k < n; ++k) w.query[k] = w.ray[w.live[k]];
+  const std::span<const Ray> rays(w.query.data(), n);
+  const std::span<RayHit> hits(w.query_hit.data(), n);
+  const std::span<std::uint8_t> found(w.query_result.data(), n);
+  scene_.intersect_batch(rays, hits, found, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
+  for (std::size_t k = 0; k < n; ++k)
+    if (found[k]) scene_.prefetch(hits[k]);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t i = w.live[k];
+    ++w.rays[i];
+    w.found[i] = found[k];
+    if (found[k]) scene_.resolve(rays[k], hits[k], &w.surfel[i]);
   }
-  parallel_for(0, w.live.size(), kGrain, [&](std::size_t b, std::size_t e) {
-    thread_local std::vector<Ray> rays;
-    thread_local std::vector<Surfel> surfels;
-    thread_local std::vector<std::uint8_t> found;
-    rays.resize(e - b), surfels.resize(e - b), found.resize(e - b);
-    for (std::size_t k = b; k < e; ++k) rays[k - b] = w.ray[w.live[k]];
-    scene_.intersect_stream(rays, surfels, found);
-    for (std::size_t k = b; k < e; ++k) {
-      const std::uint32_t i = w.live[k];
-      ++w.rays[i];
-      w.found[i] = found[k - b];
-      if (found[k - b]) w.surfel[i] = surfels[k - b];
-    }
-  });
 }
 
 // Stage: the emission found at each hit (as the strategy weighs it), and
@@ -171,35 +174,20 @@ void WavefrontTracer::sample_lights(Wave& w) const {
   });
 }
 
-// Stage: occlusion queries for every pending shadow ray, one Embree ray
-// stream per task (or one query per ray).
+// Stage: occlusion queries for every pending shadow ray, as one batch.
 void WavefrontTracer::trace_shadow_rays(Wave& w) const {
-  if (queries_ == RayQueries::OneByOne) {
-    for_live(w.live, [&](std::uint32_t i) {
-      for (std::uint32_t k = 2 * i; k < 2 * i + 2; ++k) {
-        if (w.shadow_state[k] != 1) continue;
+  std::size_t n = 0;
+  for (const std::uint32_t i : w.live)
+    for (std::uint32_t s = 2 * i; s < 2 * i + 2; ++s)
+      if (w.shadow_state[s] == 1) {
+        w.query[n] = w.shadow[s];
+        w.query_slot[n++] = s;
         ++w.rays[i];
-        w.shadow_state[k] = scene_.occluded(w.shadow[k]) ? 3 : 2;
       }
-    });
-    return;
-  }
-  parallel_for(0, w.live.size(), kGrain, [&](std::size_t b, std::size_t e) {
-    thread_local std::vector<Ray> rays;
-    thread_local std::vector<std::uint32_t> slot;
-    thread_local std::vector<std::uint8_t> occluded;
-    rays.clear(), slot.clear();
-    for (std::size_t k = b; k < e; ++k)
-      for (std::uint32_t s = 2 * w.live[k]; s < 2 * w.live[k] + 2; ++s)
-        if (w.shadow_state[s] == 1) {
-          rays.push_back(w.shadow[s]);
-          slot.push_back(s);
-          ++w.rays[s / 2];
-        }
-    occluded.resize(rays.size());
-    if (!rays.empty()) scene_.occluded_stream(rays, occluded);
-    for (std::size_t r = 0; r < rays.size(); ++r) w.shadow_state[slot[r]] = occluded[r] ? 3 : 2;
-  });
+  if (n == 0) return;
+  const std::span<std::uint8_t> occluded(w.query_result.data(), n);
+  scene_.occluded_batch(std::span<const Ray>(w.query.data(), n), occluded, modes_.shadow);
+  for (std::size_t r = 0; r < n; ++r) w.shadow_state[w.query_slot[r]] = occluded[r] ? 3 : 2;
 }
 
 // Stage: the light of visible samples, point light first (the reference's order).
@@ -261,15 +249,16 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
 // Stage: keep the slots still alive, in slot order (a stable compaction, so
 // the work order - and nothing else - changes from bounce to bounce).
 void WavefrontTracer::compact(Wave& w) {
-  const auto end = std::stable_partition(w.live.begin(), w.live.end(), [&](std::uint32_t i) { return w.alive[i] != 0; });
+  // std::remove_if keeps the order of what it keeps, and allocates nothing.
+  const auto end = std::remove_if(w.live.begin(), w.live.end(), [&](std::uint32_t i) { return w.alive[i] == 0; });
   w.live.erase(end, w.live.end());
 }
 
-void WavefrontTracer::run_wave(Wave& w, PathObserver* obs) const {
-  // Generate camera rays.
+// Stage: one camera ray per path.
+void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
   const Camera& camera = scene_.camera();
   for_live(w.live, [&](std::uint32_t i) {
-    w.vertex[i] = 0;
+    w.vertex[i] = 0;  // the camera's random numbers are those of vertex 0
     w.film[i] = vec2(static_cast<float>(w.x[i]) + w.u(i, Dim::FilmX), static_cast<float>(w.y[i]) + w.u(i, Dim::FilmY));
     w.ray[i] = camera.generate_ray(w.film[i], vec2(w.u(i, Dim::LensX), w.u(i, Dim::LensY)));
     w.beta[i] = Spectrum(1.0f);
@@ -280,6 +269,10 @@ void WavefrontTracer::run_wave(Wave& w, PathObserver* obs) const {
     w.vertex[i] = 1;
     if (obs) obs->on_camera({w.x[i], w.y[i], w.sample[i], w.film[i], w.ray[i].origin, w.ray[i].dir});
   });
+}
+
+void WavefrontTracer::run_wave(Wave& w, PathObserver* obs) const {
+  generate_camera_rays(w, obs);
   while (!w.live.empty()) {
     intersect(w);
     add_emission(w, obs);
@@ -293,23 +286,33 @@ void WavefrontTracer::run_wave(Wave& w, PathObserver* obs) const {
 
 void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const {
   const auto width = static_cast<std::uint32_t>(scene_.scene().film.width);
-  Wave w;
-  for (std::size_t begin = 0; begin < out.size(); begin += wave_size_) {
-    const std::size_t n = std::min(wave_size_, out.size() - begin);
-    w.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t id = begin + i;
-      const auto pixel = static_cast<std::uint32_t>(id / count);
-      w.out_index[i] = static_cast<std::uint32_t>(id);
-      w.x[i] = pixel % width;
-      w.y[i] = pixel / width;
-      w.sample[i] = first + static_cast<std::uint32_t>(id % count);
-      w.rng[i] = SampleStream(settings_.seed, pixel, w.sample[i]);
-      w.live[i] = static_cast<std::uint32_t>(i);
+  const std::size_t waves = (out.size() + wave_size_ - 1) / wave_size_;
+  // Wave k always holds the same samples, whichever thread runs it, so the
+  // batches Embree sees - and hence the image - do not depend on threads.
+  parallel_for(0, waves, 1, [&](std::size_t k0, std::size_t k1) {
+    // Each thread keeps its wave's arrays from one batch to the next
+    // (allocating and page-faulting them in per wave cost more than tracing).
+    thread_local Wave w;
+    const std::size_t n_max = std::min(wave_size_, out.size());
+    if (w.capacity() < n_max) w.resize(n_max);
+    for (std::size_t k = k0; k < k1; ++k) {
+      const std::size_t begin = k * wave_size_;
+      const std::size_t n = std::min(wave_size_, out.size() - begin);
+      w.live.resize(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t id = begin + i;
+        const auto pixel = static_cast<std::uint32_t>(id / count);
+        w.out_index[i] = static_cast<std::uint32_t>(id);
+        w.x[i] = pixel % width;
+        w.y[i] = pixel / width;
+        w.sample[i] = first + static_cast<std::uint32_t>(id % count);
+        w.rng[i] = SampleStream(settings_.seed, pixel, w.sample[i]);
+        w.live[i] = static_cast<std::uint32_t>(i);
+      }
+      run_wave(w, nullptr);
+      for (std::size_t i = 0; i < n; ++i) out[w.out_index[i]] = w.result(i);
     }
-    run_wave(w, nullptr);
-    for (std::size_t i = 0; i < n; ++i) out[w.out_index[i]] = w.result(i);
-  }
+  });
 }
 
 FilmSample WavefrontTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::uint32_t sample,

@@ -17,15 +17,22 @@
 
 namespace pathlab {
 
+// How each kind of ray reaches Embree (core/embree_accel.h). The defaults
+// are the fastest on the dragon benchmark on a 2-core AVX-512 machine
+// (bench/bench_tracers.cpp measures every mode; docs/performance.md).
+struct WavefrontRayModes {
+  RayBatchMode camera = RayBatchMode::Packet16;  // coherent: adjacent pixels
+  RayBatchMode bounce = RayBatchMode::Single;
+  RayBatchMode shadow = RayBatchMode::Stream;
+};
+
 class WavefrontTracer final : public Tracer {
  public:
-  static constexpr std::size_t kDefaultWaveSize = std::size_t{1} << 20;
-  // How rays reach Embree: ray streams (rtcIntersect1M / rtcOccluded1M) or
-  // one rtcIntersect1 / rtcOccluded1 per ray.
-  enum class RayQueries { Streams, OneByOne };
+  static constexpr std::size_t kDefaultWaveSize = std::size_t{1} << 12;
+  using RayModes = WavefrontRayModes;
 
   WavefrontTracer(const CompiledScene& scene, const RenderSettings& settings,
-                  std::size_t wave_size = kDefaultWaveSize, RayQueries queries = RayQueries::Streams);
+                  std::size_t wave_size = kDefaultWaveSize, RayModes modes = {});
 
   std::string_view name() const override { return "wavefront"; }
   void render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const override;
@@ -35,10 +42,12 @@ class WavefrontTracer final : public Tracer {
   // Memory the path state of one wave takes per path, in bytes.
   static std::size_t bytes_per_path();
   std::size_t wave_size() const { return wave_size_; }
+  const RayModes& ray_modes() const { return modes_; }
 
  private:
   struct Wave;
   void run_wave(Wave& wave, PathObserver* observer) const;
+  void generate_camera_rays(Wave& w, PathObserver* obs) const;
   void intersect(Wave& w) const;
   void add_emission(Wave& w, PathObserver* obs) const;
   void sample_lights(Wave& w) const;
@@ -48,7 +57,7 @@ class WavefrontTracer final : public Tracer {
   static void compact(Wave& w);
 
   std::size_t wave_size_;
-  RayQueries queries_;
+  RayModes modes_;
 };
 
 }  // namespace pathlab

@@ -1,0 +1,253 @@
+// How fast the tracers are, against what Embree alone can do on the same
+// rays, measured in one run:
+//   Raw/<kind>/<mode>     Embree casting the scene's own camera, bounce and
+//                         shadow rays (captured from the reference tracer's
+//                         paths), in each batch mode of core/embree_accel.h
+//   Tracer/reference      the recursive tracer rendering the frame
+//   Tracer/wavefront/...  the wavefront tracer, for several wave sizes and
+//                         ray modes
+// At the end it prints the ratios the wavefront issue asks for (medians over
+// --benchmark_repetitions): wavefront / reference samples per second, and
+// each tracer's rays per second as a fraction of Embree's raw rate for the
+// same mix of rays.
+//
+//   build/bench/pathlab_bench_tracers [--scene=bench/scenes/dragon.json] [--spp=1]
+//                                      [--cpu-time] [--benchmark_repetitions=5] [--benchmark_filter=...]
+#include "bench/ray_capture.h"
+#include "core/compiled_scene.h"
+#include "core/render.h"
+#include "core/scene_loader.h"
+#include "reference/reference_tracer.h"
+#include "wavefront/wavefront_tracer.h"
+
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace pathlab::bench {
+namespace {
+
+struct Setup {
+  std::string scene_file = PATHLAB_SOURCE_DIR "/bench/scenes/dragon.json";
+  int spp = 1;
+  // Rates per second of process CPU time (all threads) instead of wall
+  // time: steadier on a machine other work is loading, but blind to threads
+  // left idle.
+  bool cpu_time = false;
+  std::unique_ptr<CompiledScene> scene;
+  RenderSettings settings;
+  CapturedRays rays;
+};
+Setup& setup() {
+  static Setup s;
+  return s;
+}
+
+// --- raw Embree ---------------------------------------------------------------
+
+void raw(benchmark::State& state, RayKind kind, RayBatchMode mode) {
+  const Setup& s = setup();
+  const std::vector<Ray>& rays = s.rays.of(kind);
+  std::size_t hits = 0;
+  for (auto _ : state) hits = cast(*s.scene, rays, kind, mode);
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * rays.size()));
+  state.counters["rays/s"] = benchmark::Counter(static_cast<double>(state.iterations() * rays.size()),
+                                                benchmark::Counter::kIsRate);
+  state.counters["hit_fraction"] = rays.empty() ? 0.0 : static_cast<double>(hits) / static_cast<double>(rays.size());
+}
+
+// --- tracers --------------------------------------------------------------------
+
+void run_tracer(benchmark::State& state, const Tracer& tracer) {
+  const Setup& s = setup();
+  const FilmDesc& fd = s.scene->scene().film;
+  RenderStats stats;
+  for (auto _ : state) {
+    Film film(fd.width, fd.height, fd.filter);
+    stats = render(tracer, film);
+    benchmark::DoNotOptimize(film.image().pixels.data());
+  }
+  state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations() * stats.samples),
+                                                   benchmark::Counter::kIsRate);
+  state.counters["rays/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * stats.rays), benchmark::Counter::kIsRate);
+  state.counters["rays/sample"] = static_cast<double>(stats.rays) / static_cast<double>(stats.samples);
+}
+
+void reference(benchmark::State& state) {
+  const ReferenceTracer tracer(*setup().scene, setup().settings);
+  run_tracer(state, tracer);
+}
+
+void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes modes) {
+  const WavefrontTracer tracer(*setup().scene, setup().settings, wave, modes);
+  run_tracer(state, tracer);
+}
+
+// --- the summary ------------------------------------------------------------------
+
+// Keeps every run's counters and prints the ratios when the benchmarks end.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    // Keyed by the name it was registered under, without Google Benchmark's
+    // "/iterations:1/real_time" suffixes. Single runs are kept (their median
+    // is taken below); so are "median" aggregates, which stand for runs that
+    // --benchmark_report_aggregates_only left out.
+    for (const Run& r : runs) {
+      const bool median_aggregate = r.run_type == Run::RT_Aggregate && r.aggregate_name == "median";
+      if (r.run_type == Run::RT_Aggregate && !median_aggregate) continue;
+      auto& counters = (median_aggregate ? medians_ : values_)[r.run_name.function_name];
+      for (const auto& [name, counter] : r.counters) counters[name].push_back(counter.value);
+    }
+  }
+  void Finalize() override {
+    ConsoleReporter::Finalize();
+    print_summary();
+  }
+
+ private:
+  double median(const std::string& run, const std::string& counter) const {
+    const bool aggregated = medians_.count(run) != 0;
+    const auto& source = aggregated ? medians_ : values_;
+    const auto r = source.find(run);
+    if (r == source.end()) return 0.0;
+    const auto c = r->second.find(counter);
+    if (c == r->second.end() || c->second.empty()) return 0.0;
+    std::vector<double> v = c->second;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  }
+  // Embree's raw rate for the tracer's mix of rays, each kind cast in `modes`:
+  // rays per second of the whole mix (harmonic, weighted by the mix).
+  double raw_mix_rate(const WavefrontRayModes& modes) const {
+    const CapturedRays& c = setup().rays;
+    const double total = static_cast<double>(c.total());
+    double seconds_per_ray = 0.0;
+    for (RayKind kind : kAllRayKinds) {
+      const RayBatchMode mode = kind == RayKind::Camera ? modes.camera : kind == RayKind::Bounce ? modes.bounce : modes.shadow;
+      const double rate = median(raw_name(kind, mode), "rays/s");
+      if (rate <= 0.0) return 0.0;
+      seconds_per_ray += static_cast<double>(c.of(kind).size()) / total / rate;
+    }
+    return 1.0 / seconds_per_ray;
+  }
+  void print_summary() const {
+    std::printf("\n== summary (medians) ==\n");
+    const CapturedRays& c = setup().rays;
+    std::printf("ray mix (captured from the reference's paths, %zu samples): camera %.1f%%, bounce %.1f%%, shadow %.1f%%\n",
+                c.samples, 100.0 * static_cast<double>(c.camera.size()) / static_cast<double>(c.total()),
+                100.0 * static_cast<double>(c.bounce.size()) / static_cast<double>(c.total()),
+                100.0 * static_cast<double>(c.shadow.size()) / static_cast<double>(c.total()));
+    for (RayKind kind : kAllRayKinds) {
+      std::printf("raw %-7s", ray_kind_name(kind));
+      for (RayBatchMode mode : kAllRayBatchModes)
+        std::printf("  %s %.3g rays/s", ray_batch_mode_name(mode), median(raw_name(kind, mode), "rays/s"));
+      std::printf("\n");
+    }
+    const double ref_sps = median("Tracer/reference", "samples/s");
+    const double ref_rps = median("Tracer/reference", "rays/s");
+    const WavefrontRayModes single{RayBatchMode::Single, RayBatchMode::Single, RayBatchMode::Single};
+    const double raw_single = raw_mix_rate(single);
+    std::printf("reference: %.4g samples/s, %.4g rays/s = %.2f of raw (all single rays, %.4g rays/s)\n", ref_sps,
+                ref_rps, raw_single > 0 ? ref_rps / raw_single : 0.0, raw_single);
+    std::vector<std::string> runs;
+    for (const auto* source : {&values_, &medians_})
+      for (const auto& entry : *source)
+        if (entry.first.rfind("Tracer/wavefront", 0) == 0 &&
+            std::find(runs.begin(), runs.end(), entry.first) == runs.end())
+          runs.push_back(entry.first);
+    for (const std::string& run : runs) {
+      const WavefrontRayModes modes = parse_modes(run);
+      const double sps = median(run, "samples/s"), rps = median(run, "rays/s");
+      const double raw_rate = raw_mix_rate(modes);
+      std::printf("%s: %.4g samples/s = %.2fx reference; %.4g rays/s = %.2f of raw (%.4g rays/s)\n", run.c_str(), sps,
+                  ref_sps > 0 ? sps / ref_sps : 0.0, rps, raw_rate > 0 ? rps / raw_rate : 0.0, raw_rate);
+    }
+  }
+  static WavefrontRayModes parse_modes(const std::string& run) {
+    WavefrontRayModes m;
+    for (RayBatchMode mode : kAllRayBatchModes) {
+      const std::string n = ray_batch_mode_name(mode);
+      if (run.find("camera:" + n) != std::string::npos) m.camera = mode;
+      if (run.find("bounce:" + n) != std::string::npos) m.bounce = mode;
+      if (run.find("shadow:" + n) != std::string::npos) m.shadow = mode;
+    }
+    return m;
+  }
+  using Counters = std::map<std::string, std::map<std::string, std::vector<double>>>;
+  Counters values_, medians_;
+};
+
+std::string wavefront_name(std::size_t wave, const WavefrontRayModes& m) {
+  return "Tracer/wavefront/wave:" + std::to_string(wave) + "/camera:" + ray_batch_mode_name(m.camera) +
+         "/bounce:" + ray_batch_mode_name(m.bounce) + "/shadow:" + ray_batch_mode_name(m.shadow);
+}
+
+benchmark::internal::Benchmark* timed(benchmark::internal::Benchmark* b) {
+  b->Unit(benchmark::kMillisecond);
+  return setup().cpu_time ? b->MeasureProcessCPUTime() : b->UseRealTime();
+}
+
+void register_benchmarks() {
+  for (RayKind kind : kAllRayKinds)
+    for (RayBatchMode mode : kAllRayBatchModes)
+      timed(benchmark::RegisterBenchmark(raw_name(kind, mode).c_str(), raw, kind, mode))->MinTime(0.5);
+  timed(benchmark::RegisterBenchmark("Tracer/reference", reference))->Iterations(1);
+  std::vector<std::pair<std::size_t, WavefrontRayModes>> configs;
+  const WavefrontRayModes defaults;
+  for (std::size_t wave : {std::size_t{1} << 10, std::size_t{1} << 12, std::size_t{1} << 14, std::size_t{1} << 16})
+    configs.push_back({wave, defaults});
+  for (RayBatchMode mode : kAllRayBatchModes) configs.push_back({WavefrontTracer::kDefaultWaveSize, {mode, mode, mode}});
+  for (const auto& [wave, modes] : configs)
+    timed(benchmark::RegisterBenchmark(wavefront_name(wave, modes).c_str(), wavefront, wave, modes))->Iterations(1);
+}
+
+}  // namespace
+}  // namespace pathlab::bench
+
+int main(int argc, char** argv) {
+  using namespace pathlab;
+  using namespace pathlab::bench;
+  Setup& s = setup();
+  // Our own flags first; the rest go to Google Benchmark.
+  std::vector<char*> rest{argv[0]};
+  for (int i = 1; i < argc; ++i) {
+    if (std::strncmp(argv[i], "--scene=", 8) == 0)
+      s.scene_file = argv[i] + 8;
+    else if (std::strcmp(argv[i], "--cpu-time") == 0)
+      s.cpu_time = true;
+    else if (std::strncmp(argv[i], "--spp=", 6) == 0)
+      s.spp = std::max(1, std::atoi(argv[i] + 6));
+    else
+      rest.push_back(argv[i]);
+  }
+  int rest_argc = static_cast<int>(rest.size());
+  benchmark::Initialize(&rest_argc, rest.data());
+  try {
+    Scene scene = load_scene(s.scene_file);
+    scene.render.spp = s.spp;
+    s.settings = scene.render;
+    s.scene = std::make_unique<CompiledScene>(std::move(scene));
+    std::fprintf(stderr, "pathlab bench: %s, %dx%d, %d spp, %s, max depth %d\n", s.scene_file.c_str(),
+                 s.scene->scene().film.width, s.scene->scene().film.height, s.spp,
+                 strategy_name(s.settings.strategy), s.settings.max_depth);
+    s.rays = capture_rays(*s.scene, s.settings);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pathlab bench: %s\n", e.what());
+    return 1;
+  }
+  register_benchmarks();
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,104 @@
+#include "bench/ray_capture.h"
+
+#include "core/parallel.h"
+#include "reference/reference_tracer.h"
+
+#include <algorithm>
+#include <atomic>
+
+namespace pathlab::bench {
+namespace {
+
+// Rebuilds the rays of one path from its events. Ray origins are offset off
+// their surfaces as the tracers do (a small absolute bound stands in for the
+// position error the events do not carry).
+class RayRecorder final : public PathObserver {
+ public:
+  struct Tagged {
+    int vertex;
+    Ray ray;
+  };
+  std::vector<Tagged> camera, bounce, shadow;
+
+  void on_camera(const CameraEvent& e) override { camera.push_back({0, Ray{e.origin, e.dir, kInfinity}}); }
+  void on_hit(const HitEvent& e) override {
+    p_ = e.p;
+    n_ = e.n;
+  }
+  void on_light(const LightEvent& e) override {
+    const vec3 origin = leave(e.wi);
+    const float tmax = e.infinite ? kInfinity : glm::length(e.point - origin) * (1.0f - 1e-4f);
+    shadow.push_back({e.vertex, Ray{origin, e.wi, tmax}});
+  }
+  void on_scatter(const ScatterEvent& e) override {
+    if (!is_black(e.throughput)) bounce.push_back({e.vertex, Ray{leave(e.wi), e.wi, kInfinity}});
+  }
+
+ private:
+  vec3 leave(const vec3& dir) const {
+    const vec3 side = glm::dot(dir, n_) >= 0.0f ? n_ : -n_;
+    return offset_ray_origin(p_, vec3(1e-6f * (1.0f + max_component(glm::abs(p_)))), side);
+  }
+  vec3 p_{0.0f}, n_{0.0f};
+};
+
+}  // namespace
+
+const char* ray_kind_name(RayKind kind) {
+  switch (kind) {
+    case RayKind::Camera: return "camera";
+    case RayKind::Bounce: return "bounce";
+    case RayKind::Shadow: return "shadow";
+  }
+  return "?";
+}
+
+std::string raw_name(RayKind kind, RayBatchMode mode) {
+  return std::string("Raw/") + ray_kind_name(kind) + "/" + ray_batch_mode_name(mode);
+}
+
+CapturedRays capture_rays(const CompiledScene& scene, const RenderSettings& settings) {
+  const ReferenceTracer tracer(scene, settings);
+  const int width = scene.scene().film.width, height = scene.scene().film.height;
+  std::vector<RayRecorder> rows(static_cast<std::size_t>(height));
+  parallel_for(0, rows.size(), 1, [&](std::size_t y0, std::size_t y1) {
+    for (std::size_t y = y0; y < y1; ++y)
+      for (int x = 0; x < width; ++x)
+        tracer.trace_sample(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), 0, &rows[y]);
+  });
+  auto gather = [&](std::vector<RayRecorder::Tagged> RayRecorder::*list) {
+    std::vector<RayRecorder::Tagged> all;
+    for (RayRecorder& row : rows) all.insert(all.end(), (row.*list).begin(), (row.*list).end());
+    std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.vertex < b.vertex; });
+    std::vector<Ray> rays;
+    rays.reserve(all.size());
+    for (const auto& t : all) rays.push_back(t.ray);
+    return rays;
+  };
+  CapturedRays c;
+  c.camera = gather(&RayRecorder::camera);
+  c.bounce = gather(&RayRecorder::bounce);
+  c.shadow = gather(&RayRecorder::shadow);
+  c.samples = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  return c;
+}
+
+std::size_t cast(const CompiledScene& scene, const std::vector<Ray>& rays, RayKind kind, RayBatchMode mode) {
+  std::atomic<std::size_t> hits{0};
+  parallel_for(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {
+    thread_local std::vector<RayHit> hit;
+    thread_local std::vector<std::uint8_t> found;
+    hit.resize(e - b), found.resize(e - b);
+    const std::span<const Ray> batch(rays.data() + b, e - b);
+    if (kind == RayKind::Shadow)
+      scene.occluded_batch(batch, found, mode);
+    else
+      scene.intersect_batch(batch, hit, found, mode, kind == RayKind::Camera);
+    std::size_t n = 0;
+    for (std::uint8_t f : found) n += f;
+    hits += n;
+  });
+  return hits;
+}
+
+}  // namespace pathlab::bench
