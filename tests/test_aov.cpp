@@ -9,6 +9,7 @@
 #include "core/render.h"
 #include "debugtools/aov.h"
 #include "debugtools/material_override.h"
+#include "debugtools/path_recorder.h"
 #include "tests/temp_dir.h"
 #include "tests/test_scenes.h"
 
@@ -103,6 +104,38 @@ TEST(Aov, PathLengthIsTheMeanOfTheSamplesHitsAndVarianceIsTheFilms) {
   ASSERT_EQ(ch.size(), 6u);
   EXPECT_EQ(ch[3].name, "variance.R");
   EXPECT_EQ(ch[3].values[40], film.variance_of_mean(4, 3).x);
+}
+
+// The AOV pass casts the tracer's own camera rays: its depth and material
+// buffers agree with the first hits recorded by replaying every sample.
+TEST(Aov, FirstSurfaceBuffersFollowTheTracersCameraRays) {
+  Scene scene = test::small_cornell(8, 3, FilterKind::Bilinear);
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const auto tracer = cli::make_tracer("reference", compiled, settings);
+  AovAccumulator aovs(compiled, settings);
+  Film film(8, 8, FilterKind::Bilinear);
+  render(AovTracer(*tracer, aovs), film);
+  const Image depth = aovs.depth(), material = aovs.material();
+  for (std::uint32_t y = 0; y < 8; ++y) {
+    for (std::uint32_t x = 0; x < 8; ++x) {
+      double sum = 0.0;
+      int hits = 0, first_material = -1;
+      for (std::uint32_t s = 0; s < 3; ++s) {
+        PathRecorder rec;
+        tracer->trace_sample(x, y, s, &rec);
+        const auto& cam = std::get<CameraEvent>(rec.events().at(0));
+        if (const auto* h = std::get_if<HitEvent>(&rec.events().at(1))) {
+          sum += glm::length(h->p - cam.origin);
+          ++hits;
+          if (s == 0) first_material = static_cast<int>(h->material);
+        }
+      }
+      const float want = hits ? static_cast<float>(sum / hits) : 0.0f;
+      EXPECT_NEAR(depth.at(static_cast<int>(x), static_cast<int>(y)).x, want, 1e-4f * (1.0f + want)) << x << "," << y;
+      EXPECT_EQ(material.at(static_cast<int>(x), static_cast<int>(y)).x, static_cast<float>(first_material));
+    }
+  }
 }
 
 TEST(MaterialOverride, KeepsEmissionAndReplacesScattering) {

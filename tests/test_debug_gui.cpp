@@ -53,6 +53,24 @@ PathRecorder reference_path(int res, std::uint32_t x, std::uint32_t y, std::uint
   return rec;
 }
 
+// The projection inverts the camera: a point on the ray through a film
+// position projects back to that position.
+TEST(FilmProjection, InvertsTheCameraRays) {
+  Scene scene = builtin_cornell_box();
+  scene.film.width = 64;
+  scene.film.height = 48;
+  const Camera camera(scene.camera, 64, 48);
+  const FilmProjection proj(scene.camera, 64, 48);
+  for (const vec2 film : {vec2(0.5f, 0.5f), vec2(63.2f, 10.0f), vec2(32.0f, 47.9f), vec2(12.25f, 30.5f)}) {
+    const Ray ray = camera.generate_ray(film, vec2(0.5f));
+    const auto back = proj.project(ray.origin + 3.0f * ray.dir);
+    ASSERT_TRUE(back);
+    EXPECT_NEAR(back->x, film.x, 1e-3f);
+    EXPECT_NEAR(back->y, film.y, 1e-3f);
+  }
+  EXPECT_FALSE(proj.project(scene.camera.position - camera.forward()));  // behind the camera
+}
+
 TEST(DebugScript, ParsesCommandsAndNamesTheLineOfAMistake) {
   const auto cmds = parse_script("# a comment\nwait-spp 8\nclick 3 4  # pick\nview albedo\nexport-vtk a.vtp\nquit\n", "s.txt");
   ASSERT_EQ(cmds.size(), 5u);
@@ -191,6 +209,12 @@ TEST_F(DebugGui, ScriptedSessionExportsThePathAndShowsTheImageWithItsOverlay) {
     vertices_seen += seen;
   }
   ASSERT_GT(vertices_on_image, 0);
+  // Vertex 1 lies on the clicked pixel's camera ray: its dot is on that pixel,
+  // whatever the projection code says.
+  bool on_click = false;
+  for (int dy = -2; dy <= 2; ++dy)
+    for (int dx = -2; dx <= 2; ++dx) on_click |= is(screen.at(px + dx, py + dy), kVertexColour);
+  EXPECT_TRUE(on_click) << "no vertex drawn on the clicked pixel";
   EXPECT_EQ(vertices_seen, vertices_on_image);
   int green = 0, green_before = 0;
   for (int y = 0; y < res; ++y)
