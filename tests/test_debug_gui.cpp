@@ -131,6 +131,22 @@ TEST(DebugSession, RendersProgressivelyReadsOutAndRetracesTheRendersSample) {
   EXPECT_GT(max_component(w.beauty.at(12, 12)), 0.0f);
 }
 
+TEST(DebugSession, OpensAnotherSceneAndKeepsTheOldOneOnABadFile) {
+  Session session(small_cornell(16, 1));
+  SessionSettings next = session.settings();
+  next.scene_file = std::string(PATHLAB_SOURCE_DIR) + "/analytic-scenes/furnace-sphere.json";
+  next.width.reset();
+  next.height.reset();
+  session.apply(next);
+  EXPECT_EQ(session.scene().name, "furnace-sphere");
+  ASSERT_TRUE(session.wait_spp(1, 120.0));
+  SessionSettings bad = session.settings();
+  bad.scene_file = "no-such-scene.json";
+  EXPECT_THROW(session.apply(bad), InputError);
+  EXPECT_EQ(session.scene().name, "furnace-sphere");
+  EXPECT_EQ(session.settings().scene_file, next.scene_file);
+}
+
 // The whole program under Xvfb, as in the issue: open the Cornell box, hover,
 // switch views, click a pixel, export VTK, save, screenshot, quit.
 TEST_F(DebugGui, ScriptedSessionExportsThePathAndShowsTheImageWithItsOverlay) {

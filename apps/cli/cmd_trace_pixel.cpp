@@ -55,7 +55,10 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
   if (json && last > first) throw InputError("--json prints one sample: use --sample S (or --samples S..S)");
   if (scene.tracer == "both" && last > first) throw InputError("--tracer both replays one sample: use --sample S");
   if (!vtk.empty() && scene.tracer == "both") throw InputError("--vtk needs one tracer (reference or wavefront), not both");
-  if (!vtk.empty()) ensure_writable(vtk);  // fail before tracing
+  if (!vtk.empty()) {  // fail before tracing
+    if (!vtk_export_available()) write_path_vtp(vtk, {});  // throws: built without VTK
+    ensure_writable(vtk);
+  }
 
   const ThreadLimit one_thread(1);
   const RenderSettings settings = s.render;

@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <ostream>
+#include <utility>
 
 namespace pathlab::debug {
 namespace {
@@ -54,6 +55,7 @@ class App {
   int run();
 
  private:
+  std::pair<int, int> window_size();
   bool open_window();
   void close_window();
   void frame();
@@ -122,6 +124,10 @@ void App::apply(const SessionSettings& next) {
   act("restart", [&] { session_.apply(next); });
   sync_ui();
   texture_dirty_ = true;
+  if (window_) {  // another scene may have another size
+    const auto [w, h] = window_size();
+    glfwSetWindowSize(window_, w, h);
+  }
 }
 
 void App::click(int x, int y) {
@@ -131,16 +137,22 @@ void App::click(int x, int y) {
   });
 }
 
+// The window for the current scene: the image 1:1 (scaled down to fit
+// 1600x1000) and the panel beside it. Sets scale_.
+std::pair<int, int> App::window_size() {
+  const Scene& sc = session_.scene();
+  scale_ = std::min({1.0f, 1000.0f / static_cast<float>(sc.film.height),
+                     (1600.0f - kPanelWidth) / static_cast<float>(sc.film.width)});
+  return {static_cast<int>(static_cast<float>(sc.film.width) * scale_ + kPanelWidth),
+          std::max(static_cast<int>(static_cast<float>(sc.film.height) * scale_), 720)};
+}
+
 bool App::open_window() {
   glfwSetErrorCallback(glfw_error);
   if (!glfwInit()) return false;
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 0);
-  const Scene& sc = session_.scene();
-  scale_ = std::min({1.0f, 1000.0f / static_cast<float>(sc.film.height),
-                     (1600.0f - kPanelWidth) / static_cast<float>(sc.film.width)});
-  const int w = static_cast<int>(static_cast<float>(sc.film.width) * scale_ + kPanelWidth);
-  const int h = std::max(static_cast<int>(static_cast<float>(sc.film.height) * scale_), 720);
+  const auto [w, h] = window_size();
   window_ = glfwCreateWindow(w, h, "pathlab-debug", nullptr, nullptr);
   if (!window_) return false;
   glfwMakeContextCurrent(window_);
