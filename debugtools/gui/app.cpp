@@ -89,7 +89,12 @@ class App {
   bool imgui_ready_ = false;
 
   std::optional<std::pair<int, int>> hover_;  // the pixel under the mouse (or the script's)
-  bool scripted_hover_ = false;
+  // The script's mouse: a position in window coordinates and a click in
+  // progress (1: the button goes down this frame, 2: it comes up), fed to
+  // ImGui in place of the real mouse so that hover and click take the same
+  // path as a person's.
+  std::optional<ImVec2> script_mouse_;
+  int script_click_ = 0;
   int retrace_sample_ = 0;
   std::string scene_path_, vtk_path_ = "out/path.vtp", save_path_ = "out/debug.exr";
   std::string status_;
@@ -237,7 +242,7 @@ void App::draw_image() {
 
   // The mouse, unless a panel has it.
   const ImGuiIO& io = ImGui::GetIO();
-  if (scripted_hover_ || io.WantCaptureMouse) return;
+  if (io.WantCaptureMouse) return;
   const ImVec2 m = io.MousePos;
   if (m.x >= 0 && m.y >= 0 && m.x < size.x && m.y < size.y) {
     const int x = static_cast<int>(m.x / scale_), y = static_cast<int>(m.y / scale_);
@@ -341,10 +346,13 @@ void App::run_command(const ScriptCommand& c) {
   SessionSettings next = session_.settings();
   switch (c.kind) {
     case Kind::WaitSpp: break;  // handled by step_script
-    case Kind::Hover: hover_ = std::pair(c.x, c.y), scripted_hover_ = true; break;
+    case Kind::Hover:
     case Kind::Click:
-      hover_ = std::pair(c.x, c.y), scripted_hover_ = true;
-      click(c.x, c.y);
+      if (c.x >= session_.scene().film.width || c.y >= session_.scene().film.height)
+        throw InputError("pixel (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ") is outside the image");
+      // The centre of the pixel, where it is drawn.
+      script_mouse_ = ImVec2((static_cast<float>(c.x) + 0.5f) * scale_, (static_cast<float>(c.y) + 0.5f) * scale_);
+      if (c.kind == Kind::Click) script_click_ = 1;
       break;
     case Kind::Sample: retrace_sample_ = c.x; break;
     case Kind::View: view_ = *parse_view(c.arg), texture_dirty_ = true; break;
@@ -361,7 +369,7 @@ void App::run_command(const ScriptCommand& c) {
 
 // Runs script commands until one has to wait for a later frame.
 void App::step_script() {
-  while (next_command_ < script_.size() && !quit_ && pending_screenshot_.empty()) {
+  while (next_command_ < script_.size() && !quit_ && pending_screenshot_.empty() && script_click_ == 0) {
     const ScriptCommand& c = script_[next_command_];
     try {
       if (c.kind == ScriptCommand::Kind::WaitSpp) {
@@ -410,6 +418,11 @@ void App::frame() {
   upload_texture();
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
+  if (script_mouse_) {  // after the backend has read the real mouse
+    ImGuiIO& io = ImGui::GetIO();
+    io.MousePos = *script_mouse_;
+    io.MouseDown[0] = script_click_ == 1;
+  }
   ImGui::NewFrame();
   draw_image();
   draw_panel();
@@ -430,6 +443,7 @@ void App::frame() {
     }
     pending_screenshot_.clear();
   }
+  if (script_click_ > 0) script_click_ = script_click_ == 1 ? 2 : 0;  // down one frame, then up
   const bool closing = quit_ || glfwWindowShouldClose(window_);
   if (closing && !options_.screenshot.empty()) {
     try {

@@ -1,6 +1,7 @@
 // The scripted mode of pathlab-debug (--script FILE): one command a line,
 // '#' starts a comment. The app runs them in order, one per frame, through
-// the same code paths as the mouse and the panel:
+// the same code paths as the mouse and the panel (hover and click move
+// ImGui's mouse to the pixel's centre and press the button for one frame):
 //
 //   wait-spp N            wait until the render has N samples per pixel (or its target)
 //   hover X Y             point at pixel (X, Y): the readout panel shows it
