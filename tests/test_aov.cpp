@@ -83,15 +83,24 @@ TEST_F(AovTest, RenderWritesNamedLayers) {
   }
 }
 
+// A small Cornell box rendered by the render driver through AovTracer.
+struct AovRender {
+  AovRender(int res, int spp, FilterKind filter, const std::string& tracer_name)
+      : compiled(test::small_cornell(res, spp, filter)),
+        tracer(cli::make_tracer(tracer_name, compiled, compiled.scene().render)),
+        aovs(compiled, compiled.scene().render),
+        film(res, res, filter) {
+    render(AovTracer(*tracer, aovs), film);
+  }
+  const CompiledScene compiled;
+  const std::unique_ptr<Tracer> tracer;
+  AovAccumulator aovs;
+  Film film;
+};
+
 TEST(Aov, PathLengthIsTheMeanOfTheSamplesHitsAndVarianceIsTheFilms) {
-  Scene scene = test::small_cornell(12, 3, FilterKind::Box);
-  const RenderSettings settings = scene.render;
-  const CompiledScene compiled(std::move(scene));
-  const auto tracer = cli::make_tracer("wavefront", compiled, settings);
-  AovAccumulator aovs(compiled, settings);
-  const AovTracer both(*tracer, aovs);
-  Film film(12, 12, FilterKind::Box);
-  render(both, film);
+  AovRender r(12, 3, FilterKind::Box, "wavefront");
+  const auto& [compiled, tracer, aovs, film] = r;
 
   std::vector<FilmSample> direct(12 * 12 * 3);
   tracer->render_batch(0, 3, direct);
@@ -109,13 +118,8 @@ TEST(Aov, PathLengthIsTheMeanOfTheSamplesHitsAndVarianceIsTheFilms) {
 // The AOV pass casts the tracer's own camera rays: its depth and material
 // buffers agree with the first hits recorded by replaying every sample.
 TEST(Aov, FirstSurfaceBuffersFollowTheTracersCameraRays) {
-  Scene scene = test::small_cornell(8, 3, FilterKind::Bilinear);
-  const RenderSettings settings = scene.render;
-  const CompiledScene compiled(std::move(scene));
-  const auto tracer = cli::make_tracer("reference", compiled, settings);
-  AovAccumulator aovs(compiled, settings);
-  Film film(8, 8, FilterKind::Bilinear);
-  render(AovTracer(*tracer, aovs), film);
+  AovRender r(8, 3, FilterKind::Bilinear, "reference");
+  const auto& [compiled, tracer, aovs, film] = r;
   const Image depth = aovs.depth(), material = aovs.material();
   for (std::uint32_t y = 0; y < 8; ++y) {
     for (std::uint32_t x = 0; x < 8; ++x) {

@@ -282,10 +282,13 @@ void App::draw_panel() {
   for (Strategy s : kAllStrategies) strategies += std::string(strategy_name(s)) + '\0';
   if (ImGui::Combo("strategy", &strategy, strategies.c_str())) next.strategy = static_cast<Strategy>(strategy), changed = true;
   int depth = shown_.max_depth, spp = shown_.spp;
-  if (ImGui::InputInt("max depth", &depth) && depth >= -1) next.max_depth = depth, changed = true;
-  if (ImGui::InputInt("spp target", &spp) && spp >= 1) next.spp = spp, changed = true;
+  // Typed numbers apply on Enter (or the +/- buttons), not at every keystroke.
+  const ImGuiInputTextFlags on_enter = ImGuiInputTextFlags_EnterReturnsTrue;
+  if (ImGui::InputInt("max depth", &depth, 1, 4, on_enter) && depth >= -1) next.max_depth = depth, changed = true;
+  if (ImGui::InputInt("spp target", &spp, 1, 64, on_enter) && spp >= 1) next.spp = spp, changed = true;
   std::uint64_t seed = next.seed.value_or(session_.scene().render.seed);
-  if (ImGui::InputScalar("seed", ImGuiDataType_U64, &seed)) next.seed = seed, changed = true;
+  if (ImGui::InputScalar("seed", ImGuiDataType_U64, &seed, nullptr, nullptr, nullptr, on_enter))
+    next.seed = seed, changed = true;
   changed |= ImGui::Checkbox("freeze seed", &next.freeze_seed);
   int threads = next.all_threads ? 1 : 0;
   bool threads_changed = ImGui::RadioButton("1 thread", &threads, 0);
