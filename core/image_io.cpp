@@ -13,6 +13,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string_view>
 #include <system_error>
@@ -46,34 +47,14 @@ std::string one_line(std::string text) {
   return text.empty() ? std::string("unknown OpenImageIO error") : text;
 }
 
-// Removes the temporary file on scope exit unless the write was committed.
-// Declared before the ImageOutput so that the output is closed first.
-struct TempFileGuard {
-  fs::path path;
-  bool committed = false;
-  ~TempFileGuard() {
-    if (!committed) {
-      std::error_code ec;
-      fs::remove(path, ec);
-    }
-  }
-};
-
 // Writes `spec`-shaped `pixels` of type `type` with the OIIO writer `format`
 // to a hidden sibling of `file`, then renames it into place.
 void write_atomically(const fs::path& file, const char* format, const OIIO::ImageSpec& spec,
                       OIIO::TypeDesc type, const void* pixels) {
-  ensure_writable(file);
   const auto fail = [&](const std::string& reason) {
     throw SystemError(file.string() + ": cannot write image: " + one_line(reason));
   };
-
-  // Keep the real extension: whatever later inspects the temporary name
-  // (OIIO, a file manager) sees the right type.
-  const fs::path temp = folder_of(file) / ("." + file.stem().string() + ".tmp-" + unique_suffix() +
-                                          file.extension().string());
-  TempFileGuard guard{temp};
-  {
+  write_via_temp_file(file, "image", [&](const fs::path& temp) {
     // Created by format name, so write_exr always writes EXR whatever the
     // extension of `file`.
     std::unique_ptr<OIIO::ImageOutput> out = OIIO::ImageOutput::create(format);
@@ -81,11 +62,7 @@ void write_atomically(const fs::path& file, const char* format, const OIIO::Imag
     if (!out->open(temp.string(), spec)) fail(out->geterror());
     if (!out->write_image(type, pixels)) fail(out->geterror());
     if (!out->close()) fail(out->geterror());
-  }
-  std::error_code ec;
-  fs::rename(temp, file, ec);
-  if (ec) fail("cannot move " + temp.string() + " into place: " + ec.message());
-  guard.committed = true;
+  });
 }
 
 void check_shape(const fs::path& file, const Image& image) {
@@ -96,7 +73,48 @@ void check_shape(const fs::path& file, const Image& image) {
   }
 }
 
+OIIO::ImageSpec exr_spec(int width, int height, std::vector<std::string> channels, const ImageMetadata& metadata) {
+  OIIO::ImageSpec spec(width, height, static_cast<int>(channels.size()), OIIO::TypeFloat);
+  spec.channelnames = std::move(channels);
+  spec.attribute("compression", "zip");
+  for (const auto& [key, value] : metadata) {
+    spec.attribute(std::string(kMetadataPrefix) + key, value);
+  }
+  return spec;
+}
+
 }  // namespace
+
+void write_via_temp_file(const fs::path& file, std::string_view what,
+                         const std::function<void(const fs::path& temp)>& write) {
+  ensure_writable(file);
+  // Keep the real extension: whatever later inspects the temporary name
+  // (OIIO, VTK, a file manager) sees the right type.
+  const fs::path temp = folder_of(file) / ("." + file.stem().string() + ".tmp-" + unique_suffix() +
+                                          file.extension().string());
+  bool committed = false;
+  // Removes the temporary file unless the write was committed, also when
+  // `write` throws.
+  const auto cleanup = [&] {
+    if (committed) return;
+    std::error_code ignored;
+    fs::remove(temp, ignored);
+  };
+  try {
+    write(temp);
+  } catch (...) {
+    cleanup();
+    throw;
+  }
+  std::error_code ec;
+  fs::rename(temp, file, ec);
+  if (ec) {
+    cleanup();
+    throw SystemError(file.string() + ": cannot write " + std::string(what) + ": cannot move " + temp.string() +
+                      " into place: " + ec.message());
+  }
+  committed = true;
+}
 
 void ensure_writable(const fs::path& file) {
   const auto fail = [&](const std::string& reason) {
@@ -123,18 +141,43 @@ void ensure_writable(const fs::path& file) {
   fs::remove(probe, ec);
 }
 
+
 void write_exr(const fs::path& file, const Image& image, const ImageMetadata& metadata) {
   check_shape(file, image);
-  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeFloat);
-  spec.channelnames = {"R", "G", "B"};
-  spec.attribute("compression", "zip");
-  for (const auto& [key, value] : metadata) {
-    spec.attribute(std::string(kMetadataPrefix) + key, value);
-  }
+  const OIIO::ImageSpec spec = exr_spec(image.width, image.height, {"R", "G", "B"}, metadata);
   // vec3 is three packed floats (checked below), so the pixel vector is
   // already the interleaved RGB buffer OIIO wants.
   static_assert(sizeof(vec3) == 3 * sizeof(float));
   write_atomically(file, "openexr", spec, OIIO::TypeFloat, image.pixels.data());
+}
+
+void write_exr_channels(const fs::path& file, int width, int height, const std::vector<ExrChannel>& channels,
+                        const ImageMetadata& metadata) {
+  const std::size_t pixels = static_cast<std::size_t>(std::max(width, 0)) * static_cast<std::size_t>(std::max(height, 0));
+  std::vector<std::string> names;
+  for (const ExrChannel& c : channels) {
+    if (c.values.size() != pixels || pixels == 0)
+      throw SystemError(file.string() + ": cannot write image: channel " + c.name + " does not hold " +
+                        std::to_string(width) + "x" + std::to_string(height) + " values");
+    names.push_back(c.name);
+  }
+  if (names.empty()) throw SystemError(file.string() + ": cannot write image: no channels");
+  const std::size_t n = channels.size();
+  std::vector<float> interleaved(pixels * n);
+  for (std::size_t c = 0; c < n; ++c)
+    for (std::size_t i = 0; i < pixels; ++i) interleaved[i * n + c] = channels[c].values[i];
+  write_atomically(file, "openexr", exr_spec(width, height, std::move(names), metadata), OIIO::TypeFloat,
+                   interleaved.data());
+}
+
+void write_png_rgb8(const fs::path& file, int width, int height, const std::vector<std::uint8_t>& rgb) {
+  if (width <= 0 || height <= 0 || rgb.size() != static_cast<std::size_t>(width) * height * 3)
+    throw SystemError(file.string() + ": cannot write image: invalid image size " + std::to_string(width) + "x" +
+                      std::to_string(height));
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeUInt8);
+  spec.channelnames = {"R", "G", "B"};
+  spec.attribute("oiio:ColorSpace", "sRGB");  // tags the PNG with an sRGB chunk
+  write_atomically(file, "png", spec, OIIO::TypeUInt8, rgb.data());
 }
 
 void write_png(const fs::path& file, const Image& image, float exposure) {
@@ -153,10 +196,7 @@ void write_png(const fs::path& file, const Image& image, float exposure) {
       out[c] = static_cast<std::uint8_t>(v * 255.0f + 0.5f);
     }
   }
-  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeUInt8);
-  spec.channelnames = {"R", "G", "B"};
-  spec.attribute("oiio:ColorSpace", "sRGB");  // tags the PNG with an sRGB chunk
-  write_atomically(file, "png", spec, OIIO::TypeUInt8, bytes.data());
+  write_png_rgb8(file, image.width, image.height, bytes);
 }
 
 Image read_image(const fs::path& file, ImageMetadata* metadata) {

@@ -6,8 +6,11 @@
 
 #include "core/math.h"
 
+#include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -33,14 +36,39 @@ using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 // second, not after an hour.
 void ensure_writable(const std::filesystem::path& file);
 
+// Calls write(temp) with a hidden temporary path in `file`'s folder (same
+// extension), then renames the temporary file to `file`. If `write` throws or
+// the rename fails the temporary file is removed, so `file` is either the
+// complete new file or untouched. Throws InputError if `file` is not
+// writable (ensure_writable), SystemError "<file>: cannot write <what>: ..."
+// if the rename fails, and whatever `write` throws.
+void write_via_temp_file(const std::filesystem::path& file, std::string_view what,
+                         const std::function<void(const std::filesystem::path& temp)>& write);
+
 // Writes float32 RGB OpenEXR. Throws InputError / SystemError on failure,
 // leaving no file behind.
 void write_exr(const std::filesystem::path& file, const Image& image, const ImageMetadata& metadata);
+
+// One named channel of a multi-layer EXR ("R", "albedo.G", "depth.Z"):
+// width * height floats, row-major, top row first.
+struct ExrChannel {
+  std::string name;
+  std::vector<float> values;
+};
+
+// Writes float32 OpenEXR with any number of named channels (all of
+// width x height). Throws as write_exr.
+void write_exr_channels(const std::filesystem::path& file, int width, int height, const std::vector<ExrChannel>& channels,
+                        const ImageMetadata& metadata);
 
 // Writes an 8-bit sRGB PNG: radiance scaled by 2^exposure, clamped to [0,1],
 // encoded with the sRGB transfer curve. NaN pixels become magenta so that
 // they cannot hide (the renderer never produces them; diff inputs might).
 void write_png(const std::filesystem::path& file, const Image& image, float exposure = 0.0f);
+
+// Writes 8-bit RGB bytes (already encoded, row-major, top row first) as a
+// PNG, e.g. a screenshot.
+void write_png_rgb8(const std::filesystem::path& file, int width, int height, const std::vector<std::uint8_t>& rgb);
 
 // Reads the first three channels of any image OpenImageIO understands as
 // linear float RGB (a one-channel image is replicated). Throws InputError.

@@ -1,6 +1,6 @@
 // pathlab render [SCENE] [-o out.exr] [--tracer T] [--strategy S] [--spp N]
 //                [--max-depth D] [--rr-depth R] [--seed S] [--threads T]
-//                [--resolution WxH] [--quiet]
+//                [--resolution WxH] [--aov albedo,normal,...] [--quiet]
 #include "apps/cli/commands.h"
 
 #include "apps/cli/progress.h"
@@ -9,10 +9,12 @@
 #include "core/image_io.h"
 #include "core/parallel.h"
 #include "core/render.h"
+#include "debugtools/aov.h"
 #include "wavefront/wavefront_tracer.h"
 
 #include <cctype>
 #include <cstdio>
+#include <optional>
 #include <ostream>
 
 namespace pathlab::cli {
@@ -21,6 +23,11 @@ void RenderCommand::add_to(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("render", "Render a scene to EXR and PNG");
   scene.add_to(*cmd, true);
   cmd->add_option("-o,--output", output, "Output EXR (a tone-mapped PNG is written beside it); default out/<scene>.exr");
+  std::vector<std::string> aov_names;
+  for (Aov a : kAllAovs) aov_names.emplace_back(aov_name(a));
+  cmd->add_option("--aov", aovs, "Extra EXR layers, comma-separated: albedo, normal, depth, material, variance, pathlength")
+      ->delimiter(',')
+      ->check(CLI::IsMember(aov_names));
   cmd->add_option("--threads", threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
   cmd->add_option("--exposure", exposure, "Exposure of the PNG, in stops");
   cmd->add_flag("-q,--quiet", quiet, "Print only warnings and errors");
@@ -44,6 +51,15 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   const RenderSettings settings = s.render;
   const CompiledScene compiled(std::move(s));
   const auto tracer = make_tracer(scene.tracer, compiled, settings);
+  // With --aov the driver renders through a tracer that also fills the AOVs.
+  std::vector<Aov> layers;
+  for (const std::string& name : aovs) layers.push_back(*parse_aov(name));
+  std::optional<AovAccumulator> aov_buffers;
+  std::optional<AovTracer> aov_tracer;
+  if (!layers.empty()) {
+    aov_buffers.emplace(compiled, settings);
+    aov_tracer.emplace(*tracer, *aov_buffers);
+  }
   const Scene& sc = compiled.scene();
   if (const std::size_t n = compiled.lights().unsampled_light_count())
     err << "pathlab: warning: " << n << " light(s) are too dim next to the others ever to be picked for light "
@@ -51,7 +67,7 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   Film film(sc.film.width, sc.film.height, sc.film.filter);
 
   ProgressBar bar(err, "rendering", !quiet && stderr_is_terminal());
-  const RenderStats stats = render(*tracer, film, [&](double f) { bar.update(f); });
+  const RenderStats stats = render(aov_tracer ? static_cast<const Tracer&>(*aov_tracer) : *tracer, film, [&](double f) { bar.update(f); });
   bar.finish();
 
   const Image image = film.image();
@@ -70,7 +86,8 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
       {"bad_samples", std::to_string(stats.bad_samples)},
       {"version", PATHLAB_VERSION},
   };
-  write_exr(exr, image, meta);
+  if (layers.empty()) write_exr(exr, image, meta);
+  else write_exr_channels(exr, film.width(), film.height(), aov_channels(film, *aov_buffers, layers), meta);
   try {
     write_png(png, image, exposure);
   } catch (...) {

@@ -1,16 +1,20 @@
-// pathlab trace-pixel [SCENE] --pixel X,Y [--sample S] [--seed S] [--json] ...
-// Replays one pixel sample on one thread and prints every event of its path.
+// pathlab trace-pixel [SCENE] --pixel X,Y [--sample S | --samples A..B] [--seed S] [--json] [--vtk out.vtp] ...
+// Replays pixel samples on one thread and prints every event of their paths;
+// --vtk also writes them as VTK polylines (docs/path-vtk.md).
 #include "apps/cli/commands.h"
 
 #include "core/compiled_scene.h"
 #include "core/error.h"
+#include "core/image_io.h"
 #include "core/parallel.h"
 #include "core/tracer.h"
 #include "debugtools/path_compare.h"
 #include "debugtools/path_recorder.h"
+#include "debugtools/vtk_export.h"
 
 #include <ostream>
 #include <sstream>
+#include <vector>
 
 namespace pathlab::cli {
 
@@ -18,8 +22,10 @@ void TracePixelCommand::add_to(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("trace-pixel", "Replay one pixel sample and print its path");
   scene.add_to(*cmd, false, true);
   cmd->add_option("--pixel", pixel, "Pixel X,Y (0,0 = top left)")->required();
-  cmd->add_option("--sample", sample, "Sample index within the pixel");
-  cmd->add_flag("--json", json, "Print the path as JSON on stdout (docs/trace-pixel-json.md)");
+  CLI::Option* one = cmd->add_option("--sample", sample, "Sample index within the pixel");
+  cmd->add_option("--samples", samples, "A range of samples A..B (inclusive), e.g. 0..15")->excludes(one);
+  cmd->add_flag("--json", json, "Print the path as JSON on stdout (docs/trace-pixel-json.md); one sample only");
+  cmd->add_option("--vtk", vtk, "Also write the paths as VTK PolyData (.vtp, docs/path-vtk.md)");
   cmd->callback([this] { selected = true; });
 }
 
@@ -35,27 +41,56 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
     throw InputError("--pixel " + pixel + ": outside the " + std::to_string(s.film.width) + "x" +
                      std::to_string(s.film.height) + " image");
 
+  std::uint32_t first = sample, last = sample;
+  if (!samples.empty()) {
+    long a = -1, b = -1;
+    char dot1 = 0, dot2 = 0;
+    std::istringstream range(samples);
+    if (!(range >> a >> dot1 >> dot2 >> b) || dot1 != '.' || dot2 != '.' || (range >> extra) || a < 0 || b < a ||
+        b > 0xffffffffL)
+      throw InputError("--samples " + samples + ": expected A..B with 0 <= A <= B, e.g. --samples 0..15");
+    first = static_cast<std::uint32_t>(a);
+    last = static_cast<std::uint32_t>(b);
+  }
+  if (json && last > first) throw InputError("--json prints one sample: use --sample S (or --samples S..S)");
+  if (scene.tracer == "both" && last > first) throw InputError("--tracer both replays one sample: use --sample S");
+  if (!vtk.empty() && scene.tracer == "both") throw InputError("--vtk needs one tracer (reference or wavefront), not both");
+  if (!vtk.empty()) {  // fail before tracing
+    if (!vtk_export_available()) write_path_vtp(vtk, {});  // throws: built without VTK
+    ensure_writable(vtk);
+  }
+
   const ThreadLimit one_thread(1);
   const RenderSettings settings = s.render;
   const CompiledScene compiled(std::move(s));
   const Scene& sc = compiled.scene();
   const auto ux = static_cast<std::uint32_t>(x), uy = static_cast<std::uint32_t>(y);
-  auto record = [&](const std::string& name, PathRecorder& recorder) {
-    make_tracer(name, compiled, settings)->trace_sample(ux, uy, sample, &recorder);
-    return TraceHeader{sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string(), name, ux, uy, sample, settings,
-                       sc.film.width, sc.film.height};
+  auto record = [&](const std::string& name, std::uint32_t sample_index, PathRecorder& recorder) {
+    make_tracer(name, compiled, settings)->trace_sample(ux, uy, sample_index, &recorder);
+    return TraceHeader{sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string(), name, ux, uy, sample_index,
+                       settings, sc.film.width, sc.film.height};
   };
   if (scene.tracer != "both") {
-    PathRecorder recorder;
-    const TraceHeader header = record(scene.tracer, recorder);
-    if (json) out << path_to_json(header, recorder, sc).dump(2) << "\n";
-    else err << path_to_text(header, recorder, sc);
+    std::vector<PathLine> lines;
+    for (std::uint32_t s_index = first;; ++s_index) {
+      PathRecorder recorder;
+      const TraceHeader header = record(scene.tracer, s_index, recorder);
+      if (json) out << path_to_json(header, recorder, sc).dump(2) << "\n";
+      else err << path_to_text(header, recorder, sc);
+      // Escaping rays end a bounding-sphere diameter away.
+      for (PathLine& l : path_lines(recorder, s_index, 2.0f * compiled.bounds_radius())) lines.push_back(std::move(l));
+      if (s_index == last) break;
+    }
+    if (!vtk.empty()) {
+      write_path_vtp(vtk, lines);
+      err << "pathlab: wrote " << vtk << " (" << (last - first + 1) << " path(s), " << lines.size() << " lines)\n";
+    }
     return 0;
   }
 
   // Both tracers, event by event, marking where the paths part.
   PathRecorder ref, wave;
-  const TraceHeader href = record("reference", ref), hwave = record("wavefront", wave);
+  const TraceHeader href = record("reference", sample, ref), hwave = record("wavefront", sample, wave);
   const PathDivergence d = first_divergence(ref.events(), wave.events(), 1e-4f);
   if (json) {
     nlohmann::json j = {{"format", "pathlab-trace-pair"}, {"version", 1},

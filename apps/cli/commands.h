@@ -9,12 +9,14 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace pathlab::cli {
 
 struct RenderCommand {
   SceneOptions scene;
   std::string output;
+  std::vector<std::string> aovs;  // --aov albedo,normal,...: extra EXR layers
   int threads = 0;
   float exposure = 0.0f;
   bool quiet = false;
@@ -50,6 +52,8 @@ struct TracePixelCommand {
   SceneOptions scene;
   std::string pixel;  // "X,Y"
   std::uint32_t sample = 0;
+  std::string samples;  // "A..B", inclusive; excludes --sample
+  std::string vtk;      // --vtk out.vtp
   bool json = false;
   bool selected = false;
   void add_to(CLI::App& app);

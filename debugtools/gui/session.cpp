@@ -1,0 +1,252 @@
+#include "debugtools/gui/session.h"
+
+#include "core/compiled_scene.h"
+#include "core/error.h"
+#include "core/film.h"
+#include "core/parallel.h"
+#include "core/render.h"
+#include "core/scene_loader.h"
+#include "core/tracer.h"
+#include "debugtools/aov.h"
+#include "debugtools/vtk_export.h"
+#include "reference/reference_tracer.h"
+#include "wavefront/wavefront_tracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+namespace pathlab::debug {
+namespace {
+
+std::unique_ptr<Tracer> make_tracer(const std::string& name, const CompiledScene& scene, const RenderSettings& s) {
+  if (name == "reference") return std::make_unique<ReferenceTracer>(scene, s);
+  if (name == "wavefront") return std::make_unique<WavefrontTracer>(scene, s);
+  throw InputError("unknown tracer '" + name + "' (expected reference or wavefront)");
+}
+
+Scene load(const SessionSettings& s) {
+  Scene scene = s.scene_file.empty() ? builtin_cornell_box() : load_scene(s.scene_file);
+  if (s.width) scene.film.width = *s.width;
+  if (s.height) scene.film.height = *s.height;
+  return scene;
+}
+
+std::string lower_extension(const std::filesystem::path& file) {
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+std::atomic<std::uint64_t> g_version{0};
+
+}  // namespace
+
+Session::Session(SessionSettings settings) { apply(settings); }
+
+Session::~Session() { stop(); }
+
+const Scene& Session::scene() const { return compiled_->scene(); }
+
+void Session::apply(const SessionSettings& next) {
+  if (next.tracer != "reference" && next.tracer != "wavefront")
+    throw InputError("unknown tracer '" + next.tracer + "' (expected reference or wavefront)");
+  // Load before stopping anything: a bad file leaves the current render alone.
+  std::unique_ptr<Scene> authored;
+  const bool reload = !authored_ || next.scene_file != loaded_file_ || next.width != settings_.width ||
+                      next.height != settings_.height;
+  if (reload) authored = std::make_unique<Scene>(load(next));
+  stop();
+  if (reload) {
+    authored_ = std::move(authored);
+    loaded_file_ = next.scene_file;
+    compiled_.reset();
+  }
+  if (!compiled_ || compiled_materials_ != next.materials) {
+    tracer_.reset();
+    compiled_ = std::make_unique<CompiledScene>(override_materials(*authored_, next.materials));
+    compiled_materials_ = next.materials;
+    retrace_.reset();
+  }
+  settings_ = next;
+  RenderSettings r = authored_->render;
+  if (next.strategy) r.strategy = *next.strategy;
+  if (next.max_depth) r.max_depth = *next.max_depth;
+  if (next.spp) r.spp = std::max(1, *next.spp);
+  if (next.seed) r.seed = *next.seed;
+  if (!next.freeze_seed) r.seed += ++restarts_;  // a fresh stream of numbers on every restart
+  render_settings_ = r;
+  tracer_ = make_tracer(next.tracer, *compiled_, r);
+  const Scene& sc = compiled_->scene();
+  projection_ = std::make_unique<FilmProjection>(sc.camera, sc.film.width, sc.film.height);
+  start();
+}
+
+void Session::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+  stop_ = false;
+}
+
+void Session::start() {
+  {
+    const std::lock_guard lock(mutex_);
+    latest_.reset();
+  }
+  thread_ = std::thread([this] { worker(0); });
+}
+
+void Session::worker(std::uint64_t /*generation*/) {
+  const ThreadLimit limit(settings_.all_threads ? 0 : 1);
+  const Scene& sc = compiled_->scene();
+  const int w = sc.film.width, h = sc.film.height, target = render_settings_.spp;
+  const std::size_t pixels = static_cast<std::size_t>(w) * h;
+  Film film(w, h, sc.film.filter);
+  AovAccumulator aovs(*compiled_, render_settings_);
+  const std::uint32_t batch = batch_size(w, h, target);
+  std::vector<FilmSample> samples(pixels * batch);
+  const auto start = std::chrono::steady_clock::now();
+
+  const auto publish = [&](int done) {
+    auto snap = std::make_shared<Snapshot>();
+    snap->version = ++g_version;
+    snap->width = w;
+    snap->height = h;
+    snap->spp_done = done;
+    snap->spp_target = target;
+    snap->seed = render_settings_.seed;
+    snap->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    snap->beauty = film.image();
+    snap->variance = film.variance_of_mean();
+    snap->albedo = aovs.albedo();
+    snap->normal = aovs.normal();
+    snap->depth = aovs.depth();
+    snap->material = aovs.material();
+    snap->path_length = aovs.path_length();
+    snap->nonfinite = aovs.nonfinite();
+    snap->samples.resize(pixels);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        snap->samples[static_cast<std::size_t>(y) * w + x] = static_cast<std::uint32_t>(film.sample_count(x, y));
+    {
+      const std::lock_guard lock(mutex_);
+      latest_ = std::move(snap);
+    }
+    progress_.notify_all();
+  };
+
+  publish(0);
+  for (std::uint32_t first = 0; first < static_cast<std::uint32_t>(target) && !stop_; first += batch) {
+    const std::uint32_t count = std::min<std::uint32_t>(batch, static_cast<std::uint32_t>(target) - first);
+    const std::span<FilmSample> out(samples.data(), pixels * count);
+    tracer_->render_batch(first, count, out);
+    if (stop_) break;
+    film.add_batch(first, count, out);
+    aovs.add_batch(first, count, out);
+    publish(static_cast<int>(first + count));
+  }
+}
+
+bool Session::snapshot(Snapshot& out) const {
+  std::shared_ptr<const Snapshot> snap;
+  {
+    const std::lock_guard lock(mutex_);
+    snap = latest_;
+  }
+  if (!snap || snap->version == out.version) return false;
+  out = *snap;
+  return true;
+}
+
+int Session::spp_done() const {
+  const std::lock_guard lock(mutex_);
+  return latest_ ? latest_->spp_done : 0;
+}
+
+bool Session::finished() const {
+  const std::lock_guard lock(mutex_);
+  return latest_ && latest_->spp_done >= latest_->spp_target;
+}
+
+bool Session::wait_spp(int spp, double timeout_seconds) const {
+  std::unique_lock lock(mutex_);
+  return progress_.wait_for(lock, std::chrono::duration<double>(timeout_seconds), [&] {
+    return latest_ && latest_->spp_done >= std::min(spp, latest_->spp_target);
+  });
+}
+
+PixelReadout Session::readout(const Snapshot& snap, int x, int y) const {
+  PixelReadout r;
+  r.x = x;
+  r.y = y;
+  if (x < 0 || y < 0 || x >= snap.width || y >= snap.height || snap.beauty.pixels.empty()) return r;
+  const std::size_t i = static_cast<std::size_t>(y) * snap.width + x;
+  r.radiance = snap.beauty.pixels[i];
+  r.std_error = glm::sqrt(snap.variance.pixels[i]);
+  r.samples = snap.samples[i];
+  r.path_length = snap.path_length.pixels[i].x;
+  r.nonfinite = static_cast<std::uint32_t>(snap.nonfinite.pixels[i].x);
+  return r;
+}
+
+const Retrace& Session::retrace(std::uint32_t x, std::uint32_t y, std::uint32_t sample) {
+  const Scene& sc = compiled_->scene();
+  if (x >= static_cast<std::uint32_t>(sc.film.width) || y >= static_cast<std::uint32_t>(sc.film.height))
+    throw InputError("pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") is outside the " +
+                     std::to_string(sc.film.width) + "x" + std::to_string(sc.film.height) + " image");
+  Retrace r;
+  r.x = x;
+  r.y = y;
+  r.sample = sample;
+  r.seed = render_settings_.seed;
+  r.tracer = std::string(tracer_->name());
+  // trace_sample runs on the calling thread: the replay is single-threaded
+  // and draws the render's numbers (same seed, pixel, sample).
+  tracer_->trace_sample(x, y, sample, &r.path);
+  if (!r.path.events().empty())
+    if (const auto* cam = std::get_if<CameraEvent>(&r.path.events().front())) r.film = cam->film;
+  r.lines = path_lines(r.path, sample, 2.0f * compiled_->bounds_radius());
+  const TraceHeader header{sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string(), r.tracer, x, y, sample,
+                           render_settings_, sc.film.width, sc.film.height};
+  std::istringstream listing(path_to_text(header, r.path, sc));
+  for (std::string line; std::getline(listing, line);) r.text.push_back(line);
+  retrace_ = std::move(r);
+  return *retrace_;
+}
+
+void Session::export_vtk(const std::filesystem::path& file) const {
+  if (!retrace_) throw InputError("nothing to export: click a pixel first");
+  write_path_vtp(file, retrace_->lines);
+}
+
+void Session::save_image(const std::filesystem::path& file, float exposure) const {
+  Snapshot snap;
+  if (!snapshot(snap)) throw InputError("nothing rendered yet");
+  const std::string ext = lower_extension(file);
+  if (ext == ".png") {
+    write_png(file, snap.beauty, exposure);
+    return;
+  }
+  if (ext != ".exr") throw InputError(file.string() + ": save as .exr or .png");
+  std::vector<ExrChannel> channels;
+  const auto add = [&](const std::string& layer, const Image& img, std::string_view names) {
+    add_exr_layer(channels, layer, img, names);
+  };
+  add("", snap.beauty, "RGB");
+  add("albedo", snap.albedo, "RGB");
+  add("normal", snap.normal, "XYZ");
+  add("depth", snap.depth, "Z");
+  add("material", snap.material, "Y");
+  add("variance", snap.variance, "RGB");
+  add("pathlength", snap.path_length, "Y");
+  const Scene& sc = compiled_->scene();
+  write_exr_channels(file, snap.width, snap.height, channels,
+                     {{"scene", sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string()},
+                      {"tracer", std::string(tracer_->name())},
+                      {"strategy", strategy_name(render_settings_.strategy)},
+                      {"spp", std::to_string(snap.spp_done)},
+                      {"seed", std::to_string(snap.seed)},
+                      {"materials", material_override_name(settings_.materials)}});
+}
+
+}  // namespace pathlab::debug
