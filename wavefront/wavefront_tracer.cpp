@@ -139,7 +139,7 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
 // Stage: next-event estimation, up to two light samples per path (a point
 // light in every strategy; an area light as the strategy says), each with
 // the contribution it brings if nothing blocks its shadow ray.
-void WavefrontTracer::sample_lights(Wave& w) const {
+void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
   const LightSampler& lights = scene_.lights();
   const Strategy strategy = settings_.strategy;
   for_live(w.live, [&](std::uint32_t i) {
@@ -151,7 +151,7 @@ void WavefrontTracer::sample_lights(Wave& w) const {
       if (const auto ls = lights.sample_delta(s.p, w.u(i, Dim::DeltaLightChoice))) {
         const Spectrum f = s.eval(ls->wi, wo);
         if (!is_black(f)) {
-          w.light[2 * i] = *ls;
+          if (obs) w.light[2 * i] = *ls;  // only the observer reads it back
           w.unoccluded[2 * i] = f * ls->Le / ls->pdf;
           w.light_weight[2 * i] = 1.0f;
           w.shadow[2 * i] = s.spawn_to(ls->p, vec3(0.0f), -ls->wi);
@@ -165,7 +165,7 @@ void WavefrontTracer::sample_lights(Wave& w) const {
       const Spectrum f = s.eval(ls->wi, wo);
       if (is_black(f)) return;
       const float lw = light_sample_weight(strategy, ls->pdf, s.pdf(ls->wi, wo));
-      w.light[2 * i + 1] = *ls;
+      if (obs) w.light[2 * i + 1] = *ls;
       w.unoccluded[2 * i + 1] = f * ls->Le * (lw / ls->pdf);
       w.light_weight[2 * i + 1] = lw;
       w.shadow[2 * i + 1] = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, ls->p_error, ls->n);
@@ -276,7 +276,7 @@ void WavefrontTracer::run_wave(Wave& w, PathObserver* obs) const {
   while (!w.live.empty()) {
     intersect(w);
     add_emission(w, obs);
-    sample_lights(w);
+    sample_lights(w, obs);
     trace_shadow_rays(w);
     add_light(w, obs);
     scatter(w, obs);

@@ -50,7 +50,7 @@ class WavefrontTracer final : public Tracer {
   void generate_camera_rays(Wave& w, PathObserver* obs) const;
   void intersect(Wave& w) const;
   void add_emission(Wave& w, PathObserver* obs) const;
-  void sample_lights(Wave& w) const;
+  void sample_lights(Wave& w, PathObserver* obs) const;
   void trace_shadow_rays(Wave& w) const;
   void add_light(Wave& w, PathObserver* obs) const;
   void scatter(Wave& w, PathObserver* obs) const;
