@@ -12,7 +12,8 @@
 // same mix of rays.
 //
 //   build/bench/pathlab_bench_tracers [--scene=bench/scenes/dragon.json] [--spp=4]
-//                                      [--cpu-time] [--benchmark_repetitions=5] [--benchmark_filter=...]
+//                                      [--resolution=WxH] [--raw-min-time=SECONDS] [--cpu-time]
+//                                      [--benchmark_repetitions=5] [--benchmark_filter=...]
 #include "bench/ray_capture.h"
 #include "core/compiled_scene.h"
 #include "core/render.h"
@@ -42,6 +43,8 @@ struct Setup {
   // time: steadier on a machine other work is loading, but blind to threads
   // left idle.
   bool cpu_time = false;
+  double raw_min_seconds = 0.5;  // per Raw/ benchmark
+  int width = 0, height = 0;     // 0: the scene's own resolution
   std::unique_ptr<CompiledScene> scene;
   RenderSettings settings;
   CapturedRays rays;
@@ -202,7 +205,7 @@ benchmark::internal::Benchmark* timed(benchmark::internal::Benchmark* b) {
 void register_benchmarks() {
   for (RayKind kind : kAllRayKinds)
     for (RayBatchMode mode : kAllRayBatchModes)
-      timed(benchmark::RegisterBenchmark(raw_name(kind, mode).c_str(), raw, kind, mode))->MinTime(0.5);
+      timed(benchmark::RegisterBenchmark(raw_name(kind, mode).c_str(), raw, kind, mode))->MinTime(setup().raw_min_seconds);
   timed(benchmark::RegisterBenchmark("Tracer/reference", reference))->Iterations(1);
   std::vector<std::pair<std::size_t, WavefrontRayModes>> configs;
   const WavefrontRayModes defaults;
@@ -225,6 +228,10 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::strncmp(argv[i], "--scene=", 8) == 0)
       s.scene_file = argv[i] + 8;
+    else if (std::strncmp(argv[i], "--raw-min-time=", 15) == 0)
+      s.raw_min_seconds = std::max(0.001, std::atof(argv[i] + 15));
+    else if (std::strncmp(argv[i], "--resolution=", 13) == 0)
+      std::sscanf(argv[i] + 13, "%dx%d", &s.width, &s.height);
     else if (std::strcmp(argv[i], "--cpu-time") == 0)
       s.cpu_time = true;
     else if (std::strncmp(argv[i], "--spp=", 6) == 0)
@@ -237,6 +244,7 @@ int main(int argc, char** argv) {
   try {
     Scene scene = load_scene(s.scene_file);
     scene.render.spp = s.spp;
+    if (s.width > 0 && s.height > 0) scene.film.width = s.width, scene.film.height = s.height;
     s.settings = scene.render;
     s.scene = std::make_unique<CompiledScene>(std::move(scene));
     std::fprintf(stderr, "pathlab bench: %s, %dx%d, %d spp, %s, max depth %d\n", s.scene_file.c_str(),

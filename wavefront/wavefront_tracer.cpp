@@ -286,18 +286,23 @@ void WavefrontTracer::run_wave(Wave& w, PathObserver* obs) const {
 
 void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const {
   const auto width = static_cast<std::uint32_t>(scene_.scene().film.width);
-  const std::size_t waves = (out.size() + wave_size_ - 1) / wave_size_;
+  // At least ~64 waves per batch so that small batches still keep every
+  // thread busy, but never below 256 paths; the size depends only on the
+  // batch, never on the thread count.
+  const std::size_t wave_size =
+      std::min(wave_size_, std::max<std::size_t>(256, ((out.size() + 63) / 64 + 15) / 16 * 16));
+  const std::size_t waves = (out.size() + wave_size - 1) / wave_size;
   // Wave k always holds the same samples, whichever thread runs it, so the
   // batches Embree sees - and hence the image - do not depend on threads.
   parallel_for(0, waves, 1, [&](std::size_t k0, std::size_t k1) {
     // Each thread keeps its wave's arrays from one batch to the next
     // (allocating and page-faulting them in per wave cost more than tracing).
     thread_local Wave w;
-    const std::size_t n_max = std::min(wave_size_, out.size());
+    const std::size_t n_max = std::min(wave_size, out.size());
     if (w.capacity() < n_max) w.resize(n_max);
     for (std::size_t k = k0; k < k1; ++k) {
-      const std::size_t begin = k * wave_size_;
-      const std::size_t n = std::min(wave_size_, out.size() - begin);
+      const std::size_t begin = k * wave_size;
+      const std::size_t n = std::min(wave_size, out.size() - begin);
       w.live.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
         const std::size_t id = begin + i;

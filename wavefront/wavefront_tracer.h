@@ -28,6 +28,10 @@ struct WavefrontRayModes {
 
 class WavefrontTracer final : public Tracer {
  public:
+  // Paths per wave, at most: a batch is cut into waves of this size, or
+  // smaller ones (down to 256 paths) when the batch has fewer than 64 such
+  // waves, so that every thread has work. One thread runs a wave through all
+  // its stages; 4,096 paths of state fit in the caches (docs/performance.md).
   static constexpr std::size_t kDefaultWaveSize = std::size_t{1} << 12;
   using RayModes = WavefrontRayModes;
 
