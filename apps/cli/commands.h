@@ -19,6 +19,8 @@ struct RenderCommand {
   std::vector<std::string> aovs;  // --aov albedo,normal,...: extra EXR layers
   int threads = 0;
   float exposure = 0.0f;
+  std::optional<double> time_budget;    // --time SECONDS: stop at a whole pass before the budget
+  std::optional<double> target_relmse;  // --target-relmse X: stop when the estimated relMSE < X
   bool quiet = false;
   bool selected = false;
   void add_to(CLI::App& app);
@@ -55,6 +57,28 @@ struct TracePixelCommand {
   std::string samples;  // "A..B", inclusive; excludes --sample
   std::string vtk;      // --vtk out.vtp
   bool json = false;
+  bool selected = false;
+  void add_to(CLI::App& app);
+  int run(std::ostream& out, std::ostream& err) const;
+};
+
+// pathlab converge SCENE ... --out DIR: the speed-accuracy sweep
+// (debugtools/converge.h, docs/converge.md).
+struct ConvergeCommand {
+  std::string scene_file;
+  std::string reference;
+  std::vector<std::string> tracers{"reference"};
+  std::vector<std::string> strategies;
+  std::vector<int> spp{1, 4, 16, 64, 256, 1024};
+  std::vector<double> time_budgets;
+  int seeds = 4;
+  std::vector<float> clamps{0.0f};
+  std::vector<int> max_depths;
+  bool exclude_emitters = false;
+  std::optional<double> target_rmse;
+  std::optional<std::string> resolution;  // "WxH"
+  int threads = 0;
+  std::string out_dir;
   bool selected = false;
   void add_to(CLI::App& app);
   int run(std::ostream& out, std::ostream& err) const;
