@@ -292,7 +292,7 @@ std::string converge_markdown(const ConvergeResult& result) {
         << " |\n";
   const double target = default_target_rmse(result);
   if (const auto first = first_to_reach(result, target))
-    out << "\nFirst to reach RMSE " << fmt(target) << " (the largest of the configurations' smallest RMSE): **"
+    out << "\nFirst to reach RMSE " << fmt(target) << ": **"
         << result.configs[first->config].label << "**, in " << (first->at_first_budget ? "at most " : "about ")
         << fmt(first->seconds) << " s" << (first->at_first_budget ? " (already at its first budget)" : "") << ".\n";
   return out.str();
@@ -312,11 +312,10 @@ std::vector<std::pair<double, double>> curve(const ConvergeResult& result, std::
 }  // namespace
 
 double default_target_rmse(const ConvergeResult& result) {
-  double target = 0.0;
+  double target = std::numeric_limits<double>::infinity();
   for (std::size_t c = 0; c < result.configs.size(); ++c) {
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& [x, y] : curve(result, c, true)) best = std::min(best, y);
-    target = std::max(target, best);
+    const auto pts = curve(result, c, true);
+    if (!pts.empty()) target = std::min(target, pts.front().second);
   }
   return target;
 }
@@ -366,8 +365,9 @@ void write_converge_report(const std::filesystem::path& dir, const ConvergeResul
       if (!f) throw SystemError((dir / name).string() + ": cannot write");
     });
   };
-  LogLogPlot by_time{"RMSE against wall time: " + result.scene, "wall time (s)", "RMSE", {}, 0.0, ""};
-  LogLogPlot by_spp{"RMSE against samples per pixel: " + result.scene, "samples per pixel", "RMSE", {}, -0.5,
+  const std::string name = std::filesystem::path(result.scene).filename().string();
+  LogLogPlot by_time{"RMSE against wall time: " + name, "wall time (s)", "RMSE", {}, 0.0, ""};
+  LogLogPlot by_spp{"RMSE against samples per pixel: " + name, "samples per pixel", "RMSE", {}, -0.5,
                     "slope -1/2 (Monte Carlo rate)"};
   for (std::size_t c = 0; c < result.configs.size(); ++c) {
     PlotSeries t{result.configs[c].label, {}, {}}, s{result.configs[c].label, {}, {}};

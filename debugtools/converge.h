@@ -92,8 +92,10 @@ struct FirstToReach {
   bool at_first_budget = false;  // below the target at its first point: seconds is an upper bound
 };
 std::optional<FirstToReach> first_to_reach(const ConvergeResult& result, double target_rmse);
-// A target every configuration reaches within the sweep: the largest over
-// configurations of the smallest mean RMSE measured.
+// The default target: the smallest RMSE any configuration has at its first
+// (cheapest) point, so the configuration that has it reaches it at a
+// measured time and every other one either crosses it between two measured
+// points or never reaches it.
 double default_target_rmse(const ConvergeResult& result);
 
 // Least-squares slope of log y against log x (points with x, y > 0).

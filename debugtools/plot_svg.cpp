@@ -63,7 +63,7 @@ std::string loglog_svg(const LogLogPlot& plot) {
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
     << "\" viewBox=\"0 0 " << width << " " << height << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
     << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << left + w / 2 << "\" y=\"22\" text-anchor=\"middle\" font-size=\"14\">" << escape(plot.title)
+    << "<text x=\"" << left << "\" y=\"22\" font-size=\"14\">" << escape(plot.title)
     << "</text>\n";
   // Grid and ticks: a line and label at each decade, short ticks at 2..9.
   for (int k = x0; k <= x1; ++k) {

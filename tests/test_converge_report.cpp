@@ -180,7 +180,7 @@ TEST(ConvergeReport, CsvMarkdownAndFirstToReach) {
   EXPECT_EQ(first->config, 0u);
   EXPECT_NEAR(first->seconds, 0.04, 1e-12);
   EXPECT_FALSE(first_to_reach(r, 1e-3));
-  EXPECT_DOUBLE_EQ(default_target_rmse(r), 0.2 / 4);
+  EXPECT_DOUBLE_EQ(default_target_rmse(r), 0.1);  // mis at its first point
   EXPECT_NEAR(loglog_slope({1, 4, 16}, {1, 0.5, 0.25}), -0.5, 1e-12);
   EXPECT_NE(converge_markdown(r).find("| reference cosine | 16 spp | 16 |"), std::string::npos) << converge_markdown(r);
 }
