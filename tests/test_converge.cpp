@@ -110,6 +110,36 @@ TEST_F(ConvergeSweep, ClampingShowsBiasAndNoClampDoesNot) {
   }
 }
 
+// Depth caps against the uncapped truth: in the furnace (emission Le and
+// albedo rho everywhere) a cap of D bounces misses Le rho^(D+1) / (1 - rho)
+// per channel, and every path of a capped render carries the same value, so
+// the measured bias must be that, up to float32 rounding of the radiance
+// (a relative 1e-5 allows ~100 roundings of 6e-8); uncapped (Russian
+// roulette) it is unbiased, judged with t at R - 1 dof.
+TEST(ConvergeDepthCaps, ShowTheirTruncationBias) {
+  Scene scene = load_scene(test::analytic_scene("furnace-sphere.json"));
+  scene.film.width = 16;
+  scene.film.height = 12;
+  ConvergeOptions o;
+  o.spp = {16 * test::stat_scale()};
+  o.seeds = kSeeds;
+  o.max_depths = {1, 2, -1};
+  const ConvergeResult r = run_converge(scene, o, make);
+  ASSERT_EQ(r.rows.size(), 3u);
+  EXPECT_NE(r.truth.find("uncapped"), std::string::npos) << r.truth;
+  const double Le[3] = {0.5, 1.0, 2.0}, rho[3] = {0.8, 0.5, 0.2};
+  for (const ConvergeRow& row : r.rows) {
+    const int D = r.configs[row.config].max_depth;
+    if (D < 0) {
+      EXPECT_LT(std::abs(row.bias / row.bias_se), kT7) << "uncapped: " << row.bias << " +- " << row.bias_se;
+      continue;
+    }
+    double missed = 0;
+    for (int c = 0; c < 3; ++c) missed += Le[c] * std::pow(rho[c], D + 1) / (1 - rho[c]) / 3;
+    EXPECT_NEAR(row.bias, -missed, kT7 * row.bias_se + 1e-5 * missed) << "depth " << D;
+  }
+}
+
 // render_until with a time budget: stops at a whole pass, within one pass of
 // the budget on either side, and counts its spp.
 TEST(RenderUntil, TimeBudgetStopsWithinOnePassOfTheBudget) {
