@@ -71,6 +71,21 @@ TEST_F(ConvergeCli, WritesTheTableAndPlotsWithOneRowPerConfigurationAndBudget) {
   EXPECT_NE(r.err.find("first to reach RMSE"), std::string::npos) << r.err;
 }
 
+// A scene with no analytic model is measured against a reference EXR.
+TEST_F(ConvergeCli, UsesAReferenceExrAsTheTruth) {
+  const std::string scene = std::string(PATHLAB_SOURCE_DIR) + "/scenes/cornell-box.json";
+  const fs::path ref = dir_ / "ref.exr";
+  ASSERT_EQ(run_cli({"render", scene, "-o", ref.string(), "--spp", "256", "--resolution", "8x6", "--seed", "99",
+                     "--quiet"}).code, 0);
+  const auto r = run_cli({"converge", scene, "--reference", ref.string(), "--spp", "1,16", "--seeds", "2",
+                          "--resolution", "8x6", "--out", (dir_ / "report").string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string md = read_text(dir_ / "report" / "converge.md");
+  EXPECT_NE(md.find("Ground truth: reference " + ref.string()), std::string::npos) << md;
+  const auto csv = lines(read_text(dir_ / "report" / "converge.csv"));
+  ASSERT_EQ(csv.size(), 3u);
+}
+
 // Each refusal: exit 2, one message naming the problem, nothing written.
 TEST_F(ConvergeCli, RefusesBadInputWithOneMessageAndNoOutput) {
   const fs::path out = dir_ / "report";
