@@ -29,7 +29,7 @@ using TracerFactory =
 struct ConvergeOptions {
   std::vector<std::string> tracers{"reference"};
   std::vector<Strategy> strategies;     // empty: the scene's strategy
-  std::vector<int> spp{1, 4, 16, 64};   // the ladder (progressive: each rung extends the last)
+  std::vector<int> spp{1, 4, 16, 64, 256, 1024};  // the ladder (progressive: each rung extends the last)
   std::vector<double> time_budgets;     // seconds, each rendered from scratch with render_until()
   int seeds = 4;                        // R: seeds scene.render.seed, +1, ..., +R-1
   std::vector<float> clamps{0.0f};      // radiance clamp per configuration, 0 = off

@@ -19,17 +19,17 @@ void ConvergeCommand::add_to(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("converge", "Speed-accuracy sweep: error against time and spp, table and plots");
   cmd->add_option("scene", scene_file, "Scene file (JSON)")->required();
   cmd->add_option("--reference", reference, "Ground-truth EXR (default: the scene's analytic expected image)");
-  cmd->add_option("--tracers", tracers, "Tracers, comma-separated: reference, wavefront")->delimiter(',');
+  cmd->add_option("--tracers", options.tracers, "Tracers, comma-separated: reference, wavefront")->delimiter(',');
   cmd->add_option("--strategies", strategies, "Strategies, comma-separated (default: the scene's)")->delimiter(',');
-  cmd->add_option("--spp", spp, "The samples-per-pixel ladder, increasing, comma-separated")
+  cmd->add_option("--spp", options.spp, "The samples-per-pixel ladder, increasing, comma-separated")
       ->delimiter(',')
       ->check(CLI::Range(1, 1 << 24));
-  cmd->add_option("--time-budgets", time_budgets, "Wall-clock budgets in seconds, comma-separated")->delimiter(',');
-  cmd->add_option("--seeds", seeds, "Independent seeds per budget (R)")->check(CLI::Range(1, 1000));
-  cmd->add_option("--clamps", clamps, "Radiance clamps to compare, comma-separated (0 = off)")->delimiter(',');
-  cmd->add_option("--max-depths", max_depths, "Depth caps to compare against the uncapped answer, comma-separated")
+  cmd->add_option("--time-budgets", options.time_budgets, "Wall-clock budgets in seconds, comma-separated")->delimiter(',');
+  cmd->add_option("--seeds", options.seeds, "Independent seeds per budget (R)")->check(CLI::Range(1, 1000));
+  cmd->add_option("--clamps", options.clamps, "Radiance clamps to compare, comma-separated (0 = off)")->delimiter(',');
+  cmd->add_option("--max-depths", options.max_depths, "Depth caps to compare against the uncapped answer, comma-separated")
       ->delimiter(',');
-  cmd->add_flag("--exclude-emitters", exclude_emitters, "Leave out pixels that see an emitter directly");
+  cmd->add_flag("--exclude-emitters", options.exclude_emitters, "Leave out pixels that see an emitter directly");
   cmd->add_option("--target-rmse", target_rmse, "Report which configuration reaches this RMSE first")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--resolution", resolution, "Image size WxH (the reference EXR must match it)");
@@ -39,20 +39,13 @@ void ConvergeCommand::add_to(CLI::App& app) {
 }
 
 int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
-  ConvergeOptions o;
-  o.tracers = tracers;
+  ConvergeOptions o = options;
+  o.reference = reference;
   for (const std::string& s : strategies) {
     const auto st = parse_strategy(s);
     if (!st) throw InputError("--strategies: unknown strategy '" + s + "' (expected cosine, bsdf, light, light+bsdf or mis)");
     o.strategies.push_back(*st);
   }
-  o.spp = spp;
-  o.time_budgets = time_budgets;
-  o.seeds = seeds;
-  o.clamps = clamps;
-  o.max_depths = max_depths;
-  o.exclude_emitters = exclude_emitters;
-  o.reference = reference;
   // Fail on an unwritable folder now, not after the sweep; on any failure
   // remove the folder again if this run made it and it is still empty.
   const std::filesystem::path dir(out_dir);

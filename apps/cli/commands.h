@@ -3,6 +3,7 @@
 #pragma once
 
 #include "apps/cli/scene_options.h"
+#include "debugtools/converge.h"
 
 #include <CLI/CLI.hpp>
 
@@ -66,15 +67,9 @@ struct TracePixelCommand {
 // (debugtools/converge.h, docs/converge.md).
 struct ConvergeCommand {
   std::string scene_file;
-  std::string reference;
-  std::vector<std::string> tracers{"reference"};
-  std::vector<std::string> strategies;
-  std::vector<int> spp{1, 4, 16, 64, 256, 1024};
-  std::vector<double> time_budgets;
-  int seeds = 4;
-  std::vector<float> clamps{0.0f};
-  std::vector<int> max_depths;
-  bool exclude_emitters = false;
+  ConvergeOptions options;              // the options bind to its fields, but for these two:
+  std::string reference;                // -> options.reference
+  std::vector<std::string> strategies;  // -> options.strategies
   std::optional<double> target_rmse;
   std::optional<std::string> resolution;  // "WxH"
   int threads = 0;
