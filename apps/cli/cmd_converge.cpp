@@ -75,7 +75,8 @@ int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   else
     std::snprintf(line, sizeof line, "no configuration reached RMSE %.4g within its budgets", target);
   err << "pathlab: converge: " << line << "\n"
-      << "pathlab: wrote " << out_dir << "/converge.csv, converge.md, rmse-vs-time.svg and rmse-vs-spp.svg (truth: "
+      << "pathlab: wrote " << (dir / "converge.csv").string()
+      << ", converge.md, rmse-vs-time.svg and rmse-vs-spp.svg (truth: "
       << result.truth << ")\n";
   return 0;
 }
