@@ -34,3 +34,88 @@ RenderStats render(const Tracer& tracer, Film& film, const ProgressFn& progress)
 }
 
 }  // namespace pathlab
+
+namespace pathlab {
+
+namespace {
+
+// Scales each sample whose largest component exceeds `clamp` down to it.
+std::uint64_t clamp_samples(std::span<FilmSample> samples, float clamp) {
+  std::uint64_t clamped = 0;
+  for (FilmSample& s : samples) {
+    const float m = std::max({s.L.x, s.L.y, s.L.z});
+    if (m > clamp) {  // false for NaN: the film counts those
+      s.L *= clamp / m;
+      ++clamped;
+    }
+  }
+  return clamped;
+}
+
+}  // namespace
+
+ProgressiveStats render_samples(const Tracer& tracer, Film& film, std::uint32_t first, std::uint32_t last) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::uint32_t batch = batch_size(film.width(), film.height(), static_cast<int>(std::max(last - std::min(first, last), 1u)));
+  const std::size_t pixels = static_cast<std::size_t>(film.width()) * film.height();
+  std::vector<FilmSample> samples(pixels * batch);
+  const float clamp = tracer.settings().clamp;
+  ProgressiveStats stats;
+  for (std::uint32_t begin = first; begin < last; begin += batch) {
+    const std::uint32_t count = std::min(batch, last - begin);
+    const std::span<FilmSample> out(samples.data(), pixels * count);
+    tracer.render_batch(begin, count, out);
+    if (clamp > 0.0f) stats.clamped_samples += clamp_samples(out, clamp);
+    film.add_batch(begin, count, out);
+    for (const FilmSample& s : out) stats.render.rays += s.rays;
+    stats.render.samples += out.size();
+  }
+  stats.render.bad_samples = film.bad_sample_count();
+  stats.render.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return stats;
+}
+
+double estimated_relmse(const Film& film) {
+  double sum = 0.0;
+  for (int y = 0; y < film.height(); ++y)
+    for (int x = 0; x < film.width(); ++x) {
+      const Spectrum m = film.mean(x, y), v = film.variance_of_mean(x, y);
+      for (int c = 0; c < 3; ++c) sum += static_cast<double>(v[c]) / ((m[c] + 0.01) * (m[c] + 0.01));
+    }
+  return sum / (3.0 * film.width() * film.height());
+}
+
+UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule, const ProgressFn& progress) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  const std::uint32_t max_spp = static_cast<std::uint32_t>(std::max(rule.max_spp, 1));
+  const std::uint32_t pass = rule.pass_spp > 0 ? rule.pass_spp : batch_size(film.width(), film.height(), rule.max_spp);
+  UntilResult r;
+  while (r.spp < max_spp) {
+    if (r.passes > 0) {
+      const double now = elapsed();
+      if (rule.time_budget_seconds > 0.0 && now + now / r.passes > rule.time_budget_seconds) break;
+      if (rule.target_relmse > 0.0 && r.estimated_relmse < rule.target_relmse) break;
+    }
+    const std::uint32_t last = std::min(max_spp, r.spp + pass);
+    const ProgressiveStats s = render_samples(tracer, film, r.spp, last);
+    r.stats.render.samples += s.render.samples;
+    r.stats.render.rays += s.render.rays;
+    r.stats.clamped_samples += s.clamped_samples;
+    r.last_pass_seconds = s.render.seconds;
+    r.spp = last;
+    ++r.passes;
+    if (rule.target_relmse > 0.0) r.estimated_relmse = estimated_relmse(film);
+    if (progress) {
+      double f = static_cast<double>(r.spp) / max_spp;
+      if (rule.time_budget_seconds > 0.0) f = std::max(f, elapsed() / rule.time_budget_seconds);
+      progress(std::min(f, 1.0));
+    }
+  }
+  if (rule.target_relmse <= 0.0) r.estimated_relmse = estimated_relmse(film);
+  r.stats.render.bad_samples = film.bad_sample_count();
+  r.stats.render.seconds = elapsed();
+  return r;
+}
+
+}  // namespace pathlab

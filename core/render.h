@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <span>
 
 namespace pathlab {
 
@@ -23,6 +24,45 @@ using ProgressFn = std::function<void(double fraction)>;
 // Renders settings.spp samples per pixel into `film` (which must match the
 // scene's resolution and filter).
 RenderStats render(const Tracer& tracer, Film& film, const ProgressFn& progress = {});
+
+// Progressive rendering. The film accumulates and samples are keyed by
+// (seed, pixel, sample index), so rendering samples [first, last) into a film
+// that holds samples [0, first) gives exactly the film of a render with
+// `last` samples per pixel. With settings.clamp > 0 each sample's radiance is
+// scaled so that its largest component is at most clamp (counted in
+// stats.clamped_samples).
+struct ProgressiveStats {
+  RenderStats render;
+  std::uint64_t clamped_samples = 0;
+};
+ProgressiveStats render_samples(const Tracer& tracer, Film& film, std::uint32_t first, std::uint32_t last);
+
+// When render_until() stops. Zero fields are off; max_spp always applies.
+struct StopRule {
+  double time_budget_seconds = 0.0;  // wall clock: no pass that would end past it is started
+  double target_relmse = 0.0;        // stop once estimated_relmse(film) < target
+  int max_spp = 1 << 24;
+  // Samples per pixel per pass; 0: batch_size(width, height, max_spp).
+  std::uint32_t pass_spp = 0;
+};
+struct UntilResult {
+  ProgressiveStats stats;
+  std::uint32_t spp = 0;          // samples per pixel reached (whole passes)
+  std::uint32_t passes = 0;
+  double estimated_relmse = 0.0;  // of the final film
+  double last_pass_seconds = 0.0;
+};
+// Renders whole passes into an empty `film` until the rule says stop. Before
+// each pass after the first it predicts the pass's time as the mean of the
+// passes so far and does not start it if it would end past the time budget,
+// so the render ends at most about one pass before the budget.
+UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule, const ProgressFn& progress = {});
+
+// The relative error of the film's image estimated from its own per-pixel
+// variance: the mean over pixels and channels of Var(I) / (I + 0.01)^2,
+// with I the pixel mean (the same denominator as rel_mse in
+// debugtools/image_metrics.h, with the estimate standing in for the truth).
+double estimated_relmse(const Film& film);
 
 // Samples per pixel in one batch: about 2^18 samples per batch, at least one
 // sample per pixel. Depends only on the resolution and spp.

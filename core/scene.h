@@ -53,6 +53,10 @@ struct RenderSettings {
   int rr_depth = 5;
   Strategy strategy = Strategy::Mis;
   std::uint64_t seed = 0;
+  // Radiance clamp: a sample whose largest component exceeds this is scaled
+  // down to it (biased, removes fireflies). 0 = off. Applied by
+  // render_samples() (core/render.h).
+  float clamp = 0.0f;
 };
 inline constexpr int kMaxVerticesUncapped = 1000;
 

@@ -2,8 +2,7 @@
 // one clear "pathlab: error:" line naming the file and the problem, exit
 // code 2, no crash, and nothing left behind in the output folder. Warnings
 // (no light, degenerate triangles) still render.
-#include "apps/cli/cli.h"
-
+#include "tests/cli_util.h"
 #include "tests/temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -26,21 +25,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-  int code = -1;
-  std::string out, err;
-};
-
-CliResult run_cli(const std::vector<std::string>& args) {
-  std::vector<const char*> argv{"pathlab"};
-  for (const std::string& a : args) argv.push_back(a.c_str());
-  std::ostringstream out, err;
-  CliResult r;
-  r.code = cli::run(static_cast<int>(argv.size()), argv.data(), out, err);
-  r.out = out.str();
-  r.err = err.str();
-  return r;
-}
+using test::CliResult;
+using test::run_cli;
 
 std::size_t count(std::string_view text, std::string_view needle) {
   std::size_t n = 0;

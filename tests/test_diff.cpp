@@ -1,7 +1,7 @@
 // pathlab diff: the metrics (exact values on inputs whose float arithmetic is
 // exact), non-finite pixels, bad input, tolerance exit codes, stable JSON and
 // the heatmap. The CLI runs in-process.
-#include "apps/cli/cli.h"
+#include "tests/cli_util.h"
 #include "core/error.h"
 #include "core/image_io.h"
 #include "debugtools/image_metrics.h"
@@ -27,19 +27,8 @@ using json = nlohmann::json;
 
 constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
 
-struct CliResult {
-  int code;
-  std::string out, err;
-};
-
-CliResult run_cli(std::vector<std::string> args) {
-  args.insert(args.begin(), "pathlab");
-  std::vector<const char*> argv;
-  for (const std::string& a : args) argv.push_back(a.c_str());
-  std::ostringstream out, err;
-  const int code = cli::run(static_cast<int>(argv.size()), argv.data(), out, err);
-  return {code, out.str(), err.str()};
-}
+using test::CliResult;
+using test::run_cli;
 
 // Channel values k/16 in [0, 2): sums, differences and means of these are
 // exact in float and double, so the expected metrics below are exact.

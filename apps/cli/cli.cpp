@@ -17,10 +17,12 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
   TracePixelCommand trace_pixel;
   DiffCommand diff;
   CheckCommand check;
+  ConvergeCommand converge;
   render.add_to(app);
   check.add_to(app);
   diff.add_to(app);
   trace_pixel.add_to(app);
+  converge.add_to(app);
 
   try {
     app.parse(argc, argv);
@@ -38,6 +40,7 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
     if (trace_pixel.selected) return trace_pixel.run(out, err);
     if (diff.selected) return diff.run(out, err);
     if (check.selected) return check.run(out, err);
+    if (converge.selected) return converge.run(out, err);
   } catch (const InputError& e) {
     err << "pathlab: error: " << e.what() << "\n";
     return 2;

@@ -1,6 +1,7 @@
 // pathlab render [SCENE] [-o out.exr] [--tracer T] [--strategy S] [--spp N]
 //                [--max-depth D] [--rr-depth R] [--seed S] [--threads T]
 //                [--resolution WxH] [--aov albedo,normal,...] [--quiet]
+//                [--time SECONDS] [--target-relmse X]   (progressive: --spp is then the most it renders)
 #include "apps/cli/commands.h"
 
 #include "apps/cli/progress.h"
@@ -30,6 +31,11 @@ void RenderCommand::add_to(CLI::App& app) {
       ->check(CLI::IsMember(aov_names));
   cmd->add_option("--threads", threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
   cmd->add_option("--exposure", exposure, "Exposure of the PNG, in stops");
+  cmd->add_option("--time", time_budget, "Stop at this wall-clock budget (whole passes); --spp is then a cap")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--target-relmse", target_relmse,
+                  "Stop when the relative MSE estimated from per-pixel variance falls below X; --spp is then a cap")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("-q,--quiet", quiet, "Print only warnings and errors");
   cmd->callback([this] { selected = true; });
 }
@@ -67,17 +73,27 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   Film film(sc.film.width, sc.film.height, sc.film.filter);
 
   ProgressBar bar(err, "rendering", !quiet && stderr_is_terminal());
-  const RenderStats stats = render(aov_tracer ? static_cast<const Tracer&>(*aov_tracer) : *tracer, film, [&](double f) { bar.update(f); });
+  const Tracer& driven = aov_tracer ? static_cast<const Tracer&>(*aov_tracer) : *tracer;
+  const bool progressive = time_budget || target_relmse;
+  std::optional<UntilResult> until;
+  if (progressive) {
+    // Without an explicit --spp the budget or target decides alone.
+    until = render_until(driven, film, {time_budget.value_or(0.0), target_relmse.value_or(0.0),
+                                        scene.spp ? settings.spp : 1 << 24, 0},
+                         [&](double f) { bar.update(f); });
+  }
+  const RenderStats stats = progressive ? until->stats.render : render(driven, film, [&](double f) { bar.update(f); });
+  const int spp_done = progressive ? static_cast<int>(until->spp) : settings.spp;
   bar.finish();
 
   const Image image = film.image();
   char seconds[32];
   std::snprintf(seconds, sizeof seconds, "%.3f", stats.seconds);
-  const ImageMetadata meta = {
+  ImageMetadata meta = {
       {"scene", sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string()},
       {"tracer", std::string(tracer->name())},
       {"strategy", strategy_name(settings.strategy)},
-      {"spp", std::to_string(settings.spp)},
+      {"spp", std::to_string(spp_done)},
       {"seed", std::to_string(settings.seed)},
       {"max_depth", std::to_string(settings.max_depth)},
       {"rr_depth", std::to_string(settings.rr_depth)},
@@ -86,6 +102,14 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
       {"bad_samples", std::to_string(stats.bad_samples)},
       {"version", PATHLAB_VERSION},
   };
+  if (progressive) {
+    char relmse[32];
+    std::snprintf(relmse, sizeof relmse, "%.6g", until->estimated_relmse);
+    meta.emplace_back("spp_reached", std::to_string(spp_done));
+    meta.emplace_back("estimated_relmse", relmse);
+    if (time_budget) meta.emplace_back("time_budget_seconds", std::to_string(*time_budget));
+    if (target_relmse) meta.emplace_back("target_relmse", std::to_string(*target_relmse));
+  }
   if (layers.empty()) write_exr(exr, image, meta);
   else write_exr_channels(exr, film.width(), film.height(), aov_channels(film, *aov_buffers, layers), meta);
   try {
@@ -109,7 +133,7 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
                   static_cast<double>(stats.samples) / std::max(stats.seconds, 1e-9),
                   static_cast<double>(stats.rays) / std::max(stats.seconds, 1e-9));
     err << "pathlab: wrote " << exr.string() << " and " << png.string() << " (" << sc.film.width << "x"
-        << sc.film.height << ", " << settings.spp << " spp, " << tracer->name() << ", "
+        << sc.film.height << ", " << spp_done << " spp, " << tracer->name() << ", "
         << strategy_name(settings.strategy) << "): " << line << "\n";
     if (const auto* wf = dynamic_cast<const WavefrontTracer*>(tracer.get()))
       err << "pathlab: wavefront: one wave of up to " << wf->wave_size() << " paths per thread, "

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "apps/cli/scene_options.h"
+#include "debugtools/converge.h"
 
 #include <CLI/CLI.hpp>
 
@@ -19,6 +20,8 @@ struct RenderCommand {
   std::vector<std::string> aovs;  // --aov albedo,normal,...: extra EXR layers
   int threads = 0;
   float exposure = 0.0f;
+  std::optional<double> time_budget;    // --time SECONDS: stop at a whole pass before the budget
+  std::optional<double> target_relmse;  // --target-relmse X: stop when the estimated relMSE < X
   bool quiet = false;
   bool selected = false;
   void add_to(CLI::App& app);
@@ -55,6 +58,22 @@ struct TracePixelCommand {
   std::string samples;  // "A..B", inclusive; excludes --sample
   std::string vtk;      // --vtk out.vtp
   bool json = false;
+  bool selected = false;
+  void add_to(CLI::App& app);
+  int run(std::ostream& out, std::ostream& err) const;
+};
+
+// pathlab converge SCENE ... --out DIR: the speed-accuracy sweep
+// (debugtools/converge.h, docs/converge.md).
+struct ConvergeCommand {
+  std::string scene_file;
+  ConvergeOptions options;              // the options bind to its fields, but for these two:
+  std::string reference;                // -> options.reference
+  std::vector<std::string> strategies;  // -> options.strategies
+  std::optional<double> target_rmse;
+  std::optional<std::string> resolution;  // "WxH"
+  int threads = 0;
+  std::string out_dir;
   bool selected = false;
   void add_to(CLI::App& app);
   int run(std::ostream& out, std::ostream& err) const;

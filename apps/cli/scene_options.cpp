@@ -46,16 +46,18 @@ Scene SceneOptions::load() const {
       throw InputError("--seed " + *seed + ": expected an integer in [0, 18446744073709551615]");
     r.seed = value;
   }
-  if (resolution) {
-    int w = 0, h = 0;
-    char x = 0, extra = 0;
-    std::istringstream in(*resolution);
-    if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || (in >> extra) || w < 1 || h < 1 || w > 65536 || h > 65536)
-      throw InputError("--resolution " + *resolution + ": expected WIDTHxHEIGHT with each in [1, 65536], e.g. 640x480");
-    scene.film.width = w;
-    scene.film.height = h;
-  }
+  if (resolution) apply_resolution(*resolution, scene.film);
   return scene;
+}
+
+void apply_resolution(const std::string& text, FilmDesc& film) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  std::istringstream in(text);
+  if (!(in >> w >> x >> h) || (x != 'x' && x != 'X') || (in >> extra) || w < 1 || h < 1 || w > 65536 || h > 65536)
+    throw InputError("--resolution " + text + ": expected WIDTHxHEIGHT with each in [1, 65536], e.g. 640x480");
+  film.width = w;
+  film.height = h;
 }
 
 std::string SceneOptions::trace_pixel_command(const Scene& scene, std::uint32_t x, std::uint32_t y,

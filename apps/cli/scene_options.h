@@ -35,6 +35,9 @@ struct SceneOptions {
   std::string trace_pixel_command(const Scene& scene, std::uint32_t x, std::uint32_t y, std::uint32_t sample) const;
 };
 
+// Parses --resolution "WxH" into `film`. Throws InputError.
+void apply_resolution(const std::string& text, FilmDesc& film);
+
 // Builds the named tracer. Throws InputError for an unknown name.
 std::unique_ptr<Tracer> make_tracer(const std::string& name, const CompiledScene& scene, const RenderSettings& settings);
 

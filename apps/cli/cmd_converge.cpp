@@ -1,0 +1,84 @@
+// pathlab converge SCENE [--reference ref.exr] [--tracers T,...] [--strategies S,...]
+//                  [--spp 1,4,16,...] [--time-budgets SEC,...] [--seeds R] [--clamps C,...]
+//                  [--max-depths D,...] [--exclude-emitters] [--target-rmse X] [--threads N] --out DIR
+#include "apps/cli/commands.h"
+
+#include "core/error.h"
+#include "core/image_io.h"
+#include "core/parallel.h"
+#include "core/scene_loader.h"
+#include "core/tracer.h"
+#include "debugtools/converge.h"
+
+#include <cstdio>
+#include <ostream>
+
+namespace pathlab::cli {
+
+void ConvergeCommand::add_to(CLI::App& app) {
+  CLI::App* cmd = app.add_subcommand("converge", "Speed-accuracy sweep: error against time and spp, table and plots");
+  cmd->add_option("scene", scene_file, "Scene file (JSON)")->required();
+  cmd->add_option("--reference", reference, "Ground-truth EXR (default: the scene's analytic expected image)");
+  cmd->add_option("--tracers", options.tracers, "Tracers, comma-separated: reference, wavefront")->delimiter(',');
+  cmd->add_option("--strategies", strategies, "Strategies, comma-separated (default: the scene's)")->delimiter(',');
+  cmd->add_option("--spp", options.spp, "The samples-per-pixel ladder, increasing, comma-separated")
+      ->delimiter(',')
+      ->check(CLI::Range(1, 1 << 24));
+  cmd->add_option("--time-budgets", options.time_budgets, "Wall-clock budgets in seconds, comma-separated")->delimiter(',');
+  cmd->add_option("--seeds", options.seeds, "Independent seeds per budget (R)")->check(CLI::Range(1, 1000));
+  cmd->add_option("--clamps", options.clamps, "Radiance clamps to compare, comma-separated (0 = off)")->delimiter(',');
+  cmd->add_option("--max-depths", options.max_depths, "Depth caps to compare against the uncapped answer, comma-separated")
+      ->delimiter(',');
+  cmd->add_flag("--exclude-emitters", options.exclude_emitters, "Leave out pixels that see an emitter directly");
+  cmd->add_option("--target-rmse", target_rmse, "Report which configuration reaches this RMSE first")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--resolution", resolution, "Image size WxH (the reference EXR must match it)");
+  cmd->add_option("--threads", threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
+  cmd->add_option("--out", out_dir, "Folder for converge.csv, converge.md and the SVG plots")->required();
+  cmd->callback([this] { selected = true; });
+}
+
+int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
+  ConvergeOptions o = options;
+  o.reference = reference;
+  for (const std::string& s : strategies) {
+    const auto st = parse_strategy(s);
+    if (!st) throw InputError("--strategies: unknown strategy '" + s + "' (expected cosine, bsdf, light, light+bsdf or mis)");
+    o.strategies.push_back(*st);
+  }
+  // Fail on an unwritable folder now, not after the sweep; on any failure
+  // remove the folder again if this run made it and it is still empty.
+  const std::filesystem::path dir(out_dir);
+  const bool existed = std::filesystem::exists(dir);
+  ConvergeResult result;
+  try {
+    ensure_writable(dir / "converge.csv");
+    Scene scene = load_scene(scene_file);
+    if (resolution) apply_resolution(*resolution, scene.film);
+    for (const std::string& w : scene.warnings) err << "pathlab: warning: " << w << "\n";
+    const ThreadLimit limit(threads);
+    result = run_converge(scene, o, make_tracer,
+                          [&](const std::string& line) { err << "pathlab: converge: " << line << "\n"; });
+    write_converge_report(dir, result);
+  } catch (...) {
+    std::error_code ignored;
+    if (!existed && std::filesystem::is_empty(dir, ignored)) std::filesystem::remove(dir, ignored);
+    throw;
+  }
+
+  const double target = target_rmse.value_or(default_target_rmse(result));
+  char line[512];
+  if (const auto first = first_to_reach(result, target))
+    std::snprintf(line, sizeof line, "first to reach RMSE %.4g: %s, in %s%.3g s%s", target,
+                  result.configs[first->config].label.c_str(), first->at_first_budget ? "at most " : "about ",
+                  first->seconds, first->at_first_budget ? " (already at its first budget)" : "");
+  else
+    std::snprintf(line, sizeof line, "no configuration reached RMSE %.4g within its budgets", target);
+  err << "pathlab: converge: " << line << "\n"
+      << "pathlab: wrote " << (dir / "converge.csv").string()
+      << ", converge.md, rmse-vs-time.svg and rmse-vs-spp.svg (truth: "
+      << result.truth << ")\n";
+  return 0;
+}
+
+}  // namespace pathlab::cli

@@ -1,0 +1,109 @@
+// The speed-accuracy sweep behind `pathlab converge`: renders a scene with
+// every configuration (tracer x strategy x clamp x depth cap) at every
+// budget (a samples-per-pixel ladder and wall-clock budgets) over R seeds,
+// and measures each against the ground truth (the scene's analytic expected
+// image, or a reference EXR). Formulas and columns: docs/converge.md.
+#pragma once
+
+#include "core/image_io.h"
+#include "core/scene.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace pathlab {
+
+class Tracer;
+class CompiledScene;
+
+// Builds a tracer by name; throws InputError for an unknown one.
+using TracerFactory =
+    std::function<std::unique_ptr<Tracer>(const std::string& name, const CompiledScene&, const RenderSettings&)>;
+
+struct ConvergeOptions {
+  std::vector<std::string> tracers{"reference"};
+  std::vector<Strategy> strategies;     // empty: the scene's strategy
+  std::vector<int> spp{1, 4, 16, 64, 256, 1024};  // the ladder (progressive: each rung extends the last)
+  std::vector<double> time_budgets;     // seconds, each rendered from scratch with render_until()
+  int seeds = 4;                        // R: seeds scene.render.seed, +1, ..., +R-1
+  std::vector<float> clamps{0.0f};      // radiance clamp per configuration, 0 = off
+  std::vector<int> max_depths;          // depth caps; empty: the scene's. Non-empty: truth is uncapped
+  bool exclude_emitters = false;        // leave out pixels that see an emitter directly
+  std::filesystem::path reference;      // ground-truth EXR; empty: the analytic model
+};
+
+// One configuration: what a curve of the plots follows.
+struct ConvergeConfig {
+  std::string tracer;
+  Strategy strategy = Strategy::Mis;
+  float clamp = 0.0f;
+  int max_depth = 0;
+  std::string label;  // "reference mis", "+ clamp 4", "+ depth 2" when the sweep varies them
+};
+
+// One budget of one configuration, averaged over the seeds.
+struct ConvergeRow {
+  std::size_t config = 0;       // index into ConvergeResult::configs
+  bool time_budget = false;     // false: an spp rung
+  double budget = 0.0;          // spp, or seconds
+  double spp = 0.0;             // mean samples per pixel reached
+  double seconds = 0.0;         // mean wall time of the render (cumulative over the ladder)
+  double samples_per_second = 0.0;
+  double rmse = 0.0, rmse_sd = 0.0;  // mean over seeds, standard deviation over seeds
+  double rel_mse = 0.0;         // mean over seeds
+  double bias = 0.0, bias_se = 0.0;
+  double efficiency = 0.0;      // 1 / (rel_mse * seconds)
+  std::vector<double> rmse_per_seed;
+};
+
+struct ConvergeResult {
+  std::string scene;
+  std::string truth;  // "analytic <model>", "analytic <model>, uncapped", "reference <file>"
+  int width = 0, height = 0;
+  std::size_t compared_pixels = 0;   // pixels in the metrics (all unless --exclude-emitters)
+  int seeds = 0;
+  std::vector<ConvergeConfig> configs;
+  std::vector<ConvergeRow> rows;      // config-major, then spp rungs, then time budgets
+};
+
+// Runs the sweep. Checks everything that can be checked before rendering
+// (tracer names, spp >= 1, budgets > 0, seeds >= 1, reference size, a truth
+// to compare with) and throws InputError naming the problem. `log` receives
+// one line per configuration.
+ConvergeResult run_converge(const Scene& scene, const ConvergeOptions& options, const TracerFactory& make_tracer,
+                            const std::function<void(const std::string&)>& log = {});
+
+// The table as CSV (header + one line per row) and as Markdown.
+std::string converge_csv(const ConvergeResult& result);
+std::string converge_markdown(const ConvergeResult& result);
+
+// The configuration whose mean RMSE first falls to `target_rmse`, by the
+// time it takes (log-log interpolation between budgets, over spp rungs and
+// time budgets); nullopt if none reaches it.
+struct FirstToReach {
+  std::size_t config = 0;
+  double seconds = 0.0;
+  bool at_first_budget = false;  // below the target at its first point: seconds is an upper bound
+};
+std::optional<FirstToReach> first_to_reach(const ConvergeResult& result, double target_rmse);
+// The default target: the smallest RMSE any configuration has at its first
+// (cheapest) point, so the configuration that has it reaches it at a
+// measured time and every other one either crosses it between two measured
+// points or never reaches it.
+double default_target_rmse(const ConvergeResult& result);
+
+// Least-squares slope of log y against log x (points with x, y > 0).
+double loglog_slope(const std::vector<double>& x, const std::vector<double>& y);
+
+// Writes converge.csv, converge.md, rmse-vs-time.svg and rmse-vs-spp.svg
+// into `dir` (each through a temporary file). Throws InputError if `dir`
+// cannot be written.
+void write_converge_report(const std::filesystem::path& dir, const ConvergeResult& result);
+
+}  // namespace pathlab
