@@ -15,6 +15,12 @@ struct RenderStats {
   std::uint64_t samples = 0;
   std::uint64_t rays = 0;
   std::uint64_t bad_samples = 0;
+  // Radiance clamping (RenderSettings::clamp): samples scaled down, and the
+  // sum over all samples of the mean RGB radiance before clamping and of
+  // what clamping removed (their ratio is the relative energy removed).
+  std::uint64_t clamped_samples = 0;
+  double energy_total = 0.0;
+  double energy_clamped = 0.0;
 };
 
 // Called after each batch with the fraction done (0..1].
