@@ -19,13 +19,15 @@ inline float exponent_from_alpha(float alpha) {
 
 // Local frame about r (unit).
 inline vec3 sample(const vec3& r, float n, vec2 u) {
-  // cos = u^(1/(n+1)); via exp/log1p-free form, pow is exact enough and
-  // gives cos in (0, 1] for u in (0, 1); u = 0 gives cos 0 (the rim).
-  const float c = std::pow(u.x, 1.0f / (n + 1.0f));
-  const float s = std::sqrt(std::max(0.0f, 1.0f - c * c));  // c <= 1, but c*c may round
+  // cos = u^(1/(n+1)), but through 1 - cos = -expm1(ln(u) / (n+1)): at
+  // n = 1e6 cos itself is within 1e-6 of 1, where floats are 6e-8 apart, so
+  // the angles would come out quantised (and exactly 0 for most u).
+  const float one_minus_c = u.x > 0.0f ? -std::expm1(std::log(u.x) / (n + 1.0f)) : 1.0f;  // u = 0: the rim
+  const float c = 1.0f - one_minus_c;
+  const float s = std::sqrt(std::max(0.0f, one_minus_c * (2.0f - one_minus_c)));
   const float phi = 2.0f * kPi * u.y;
   const Frame f(r);
-  return f.to_world(vec3(s * std::cos(phi), s * std::sin(phi), c));
+  return glm::normalize(f.to_world(vec3(s * std::cos(phi), s * std::sin(phi), c)));
 }
 
 inline float pdf(const vec3& r, float n, const vec3& wi) {

@@ -48,10 +48,12 @@ float clearcoat_pdf(const Closure& c, const vec3& wo, const vec3& wi, BsdfSampli
     return cospow::pdf(microfacet::reflect(wo, vec3(0, 0, 1)), cospow::exponent_from_alpha(c.clearcoat_alpha), wi);
   const vec3 h = microfacet::half_vector(wo, wi);
   const float wo_h = glm::dot(wo, h);
-  // D(h) cos_h / (4 wo.h); wo.h >= wo.z / 1 > 0 for wo, wi both above, but
-  // it can underflow with wo.z: then the density is unbounded there and
-  // the direction carries no energy; report 0.
-  return wo_h > 0.0f ? gtr1::D(h.z, c.clearcoat_alpha) * h.z / (4.0f * wo_h) : 0.0f;
+  // D(h) cos_h / (4 wo.h). The Jacobian 1 / (4 wo.h) is unbounded where h
+  // turns perpendicular to wo (wi grazing back along -wo, reachable only
+  // when wo itself grazes): below wo.h = 1e-20 report 0, a set of measure
+  // zero, instead of an infinity (D <= 2.3e4, so the quotient stays below
+  // 6e23 above the cut).
+  return wo_h > 1e-20f ? gtr1::D(h.z, c.clearcoat_alpha) * h.z / (4.0f * wo_h) : 0.0f;
 }
 
 std::optional<vec3> specular_sample(const Closure& c, const vec3& wo, vec2 u, BsdfSampling sampling) {
@@ -87,7 +89,7 @@ bool above(const vec3& wo, const vec3& wi) {
 
 }  // namespace
 
-LobeProbabilities lobe_probabilities(const Closure& c, const vec3& wo, unsigned features) {
+LobeProbabilities lobe_probabilities(const Closure& c, const vec3& wo, unsigned features, BsdfSampling sampling) {
   // Estimated energy of each family at this view angle: its colour's
   // luminance, Fresnel-weighted by Schlick at the view cosine. A lobe that
   // can reflect anything keeps at least 5 % of the samples, so that its pdf
@@ -110,6 +112,11 @@ LobeProbabilities lobe_probabilities(const Closure& c, const vec3& wo, unsigned 
     e[2] = c.clearcoat * (0.04f + 0.96f * Fw);
     present[2] = c.clearcoat > 0.0f;
   }
+  // Cospow: a cosine-power tail decays exponentially where GGX's decays as
+  // a power, so f / pdf would be unbounded (it overflows at exponent 1e6).
+  // The cosine lobe is always kept (at least the 5 % floor) as a defensive
+  // component: then f cos / pdf <= f pi / 0.05, finite.
+  if (sampling == BsdfSampling::Cospow && (features & kDisneyLobes)) present[0] = true;
   float total = 0.0f;
   for (int i = 0; i < 3; ++i) total += e[i];
   int n_present = 0;
@@ -147,7 +154,7 @@ template <unsigned F> Spectrum eval(const Closure& c, const vec3& wo, const vec3
 
 template <unsigned F> float pdf(const Closure& c, const vec3& wo, const vec3& wi, BsdfSampling sampling) {
   if (!above(wo, wi)) return 0.0f;
-  const LobeProbabilities p = lobe_probabilities(c, wo, F);
+  const LobeProbabilities p = lobe_probabilities(c, wo, F, sampling);
   float density = p[0] * cosine_hemisphere_pdf(wi);
   if constexpr ((F & kDisneyLobes) != 0) density += p[1] * specular_pdf(c, wo, wi, sampling);
   if constexpr ((F & kClearcoat) != 0) density += p[2] * clearcoat_pdf(c, wo, wi, sampling);
@@ -157,7 +164,7 @@ template <unsigned F> float pdf(const Closure& c, const vec3& wo, const vec3& wi
 template <unsigned F>
 std::optional<DirectionSample> sample(const Closure& c, const vec3& wo, float u_lobe, vec2 u, BsdfSampling sampling) {
   if (!(wo.z > 0.0f)) return std::nullopt;
-  const LobeProbabilities p = lobe_probabilities(c, wo, F);
+  const LobeProbabilities p = lobe_probabilities(c, wo, F, sampling);
   // u_lobe only chooses the family; the direction uses u.
   if (u_lobe < p[0]) {
     const vec3 wi = square_to_cosine_hemisphere(u);

@@ -18,7 +18,9 @@
 //   the diffuse lobes (Lambert, Disney diffuse, sheen): cosine-weighted;
 //   specular: BsdfSampling::Vndf samples GGX's visible normals exactly,
 //             BsdfSampling::Cospow a cosine-power lobe about the mirror
-//             direction with exponent 2/alpha^2 - 2 (alpha = sqrt(ax ay));
+//             direction with exponent 2/alpha^2 - 2 (alpha = sqrt(ax ay)),
+//             always mixed with at least 5 % of the cosine lobe (even for a
+//             metal) so that f cos / pdf stays bounded;
 //   clearcoat: Vndf draws GTR1 half vectors in proportion to D cos,
 //             Cospow a cosine-power lobe from the clearcoat alpha;
 // with each lobe chosen in proportion to its estimated energy (Schlick at
@@ -61,7 +63,7 @@ struct DirectionSample {
 template <unsigned F>
 std::optional<DirectionSample> sample(const Closure& c, const vec3& wo, float u_lobe, vec2 u, BsdfSampling sampling);
 
-LobeProbabilities lobe_probabilities(const Closure& c, const vec3& wo, unsigned features);
+LobeProbabilities lobe_probabilities(const Closure& c, const vec3& wo, unsigned features, BsdfSampling sampling);
 
 // One lobe family alone (for the tests: chi-square per lobe). eval is f cos
 // of that family only.
