@@ -82,12 +82,9 @@ class RoughSphere final : public AnalyticModel {
                                                  std::max(1e-4, static_cast<double>(mu)) * c.ax}};
       Spectrum a(0.0f);
       if (depth != 0 && mu > 0.0f)
-        for (int k = 0; k < 3; ++k)
-          a[k] = static_cast<float>(quadrature::integrate_hemisphere(
-              [&](double z, double phi) {
-                return static_cast<double>(disney::eval<disney::kGeneral>(c, wo, quadrature::dir_of(z, phi))[k]);
-              },
-              peaks, 1e-6, 4, 8));
+        a = Spectrum(quadrature::integrate_hemisphere(
+            [&](double z, double phi) { return dvec3(disney::eval<disney::kGeneral>(c, wo, quadrature::dir_of(z, phi))); },
+            peaks, 1e-6, 4, 8));
       albedo_[i] = a;
     }
     cache[key] = albedo_;

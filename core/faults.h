@@ -21,6 +21,7 @@ enum class Fault {
   SpecularPdfOff5Percent, // bsdf/disney.cpp: the GGX lobe reports pdf * 1.05
   VndfPdfWithoutJacobian, // bsdf/disney.cpp: the VNDF pdf lacks the reflection Jacobian 1 / (4 wo.h)
   SmithG1Dropped,         // bsdf/disney.cpp: the specular f loses the masking G1(wi) of the light direction
+  SpecularNoDenominator,  // bsdf/disney.cpp: the specular f = D F G without its 1 / (4 cos_i cos_o)
   HorizonUnclamped,       // bsdf/disney.cpp: eval and pdf no longer return 0 for wi below the surface
   DielectricFresnelIgnored,// surfel.cpp: glass always refracts (Fresnel reflection dropped, TIR kept)
 };

@@ -260,12 +260,8 @@ inline void consistency(const Material& m, const vec3& wo, long n, std::uint64_t
 // Directional albedo of the material seen from wo, per channel, by quadrature.
 inline dvec3 albedo_quadrature(const Material& m, const vec3& wo) {
   const Surfel s = flat_surfel(m);
-  dvec3 a(0.0);
-  for (int c = 0; c < 3; ++c)
-    a[c] = quadrature::integrate_hemisphere(
-        [&](double z, double phi) { return static_cast<double>(s.eval(quadrature::dir_of(z, phi), wo)[c]); },
-        peaks_of(m.closure, wo), 1e-5);
-  return a;
+  return quadrature::integrate_hemisphere(
+      [&](double z, double phi) { return dvec3(s.eval(quadrature::dir_of(z, phi), wo)); }, peaks_of(m.closure, wo), 1e-5);
 }
 
 // ... and by Monte Carlo (mean weight), with its standard error.

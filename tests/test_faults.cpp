@@ -111,9 +111,26 @@ TEST_F(PlantedBsdfFault, ConsistencyCatchesSmithG1Dropped) {
   EXPECT_EQ(control.reciprocity_mismatch, 0) << control.first_failure;
   g_fault = Fault::SmithG1Dropped;
   test::bsdf::consistency(m, test::bsdf::view_dir(0.5f), 2000, 3, faulty);
-  std::printf("[ fault    ] G1(wi) dropped: %ld of %ld reciprocity checks fail (worst %.3g)\n", faulty.reciprocity_mismatch,
+  std::printf("[ fault    ] G1(wi) dropped: %ld channel mismatches in reciprocity over %ld samples (worst relative %.3g)\n", faulty.reciprocity_mismatch,
               faulty.samples, faulty.worst_reciprocity);
   EXPECT_GT(faulty.reciprocity_mismatch, 0);
+}
+
+// The energy check (albedo by quadrature <= 1 for a GGX metal) against a
+// specular f that lost its 1 / (4 cos_i cos_o).
+TEST_F(PlantedBsdfFault, EnergyCatchesSpecularWithoutDenominator) {
+  DisneyParams p;
+  p.roughness = 0.5f;
+  p.metallic = 1.0f;
+  p.base_color = Spectrum(1.0f);
+  const Material m = test::bsdf::configured(disney_material(p), BsdfSampling::Vndf);
+  const double control = test::bsdf::albedo_quadrature(m, test::bsdf::view_dir(1.0f)).x;
+  EXPECT_LE(control, 1.0 + 1e-4);
+  g_fault = Fault::SpecularNoDenominator;
+  const double faulty = test::bsdf::albedo_quadrature(m, test::bsdf::view_dir(1.0f)).x;
+  std::printf("[ fault    ] specular without 1/(4 cos cos): albedo of a white metal at normal view %.4f (control %.4f)\n",
+              faulty, control);
+  EXPECT_GT(faulty, 1.0 + 1e-4);
 }
 
 TEST_F(PlantedBsdfFault, ExtremesCatchHorizonUnclamped) {

@@ -19,6 +19,8 @@ Spectrum specular_eval(const Closure& c, const vec3& wo, const vec3& wi, const v
   const microfacet::Ggx ggx{c.ax, c.ay};
   // G_s / (4 NL NV) * NL = g(wo) g(wi) NL (microfacet.h)
   const float gi = PATHLAB_FAULT(SmithG1Dropped) ? 0.5f / std::max(wi.z, 1e-20f) : ggx.g(wi);
+  if (PATHLAB_FAULT(SpecularNoDenominator))
+    return glm::mix(c.spec0, Spectrum(1.0f), FH) * (ggx.D(h) * ggx.G1(wo) * ggx.G1(wi) * wi.z);
   return glm::mix(c.spec0, Spectrum(1.0f), FH) * (ggx.D(h) * ggx.g(wo) * gi * wi.z);
 }
 

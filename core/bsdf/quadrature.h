@@ -8,6 +8,7 @@
 
 #include "core/math.h"
 
+#include <utility>
 #include <vector>
 
 namespace pathlab::quadrature {
@@ -30,10 +31,16 @@ inline double angle_between(const vec3& a, const vec3& b) {
 
 namespace detail {
 
-template <typename F> double gauss2x2(const F& f, double z0, double z1, double p0, double p1) {
+// The integrand may be a number or an RGB triple (dvec3): one pass for all
+// three channels.
+inline double magnitude(double v) { return std::abs(v); }
+inline double magnitude(const dvec3& v) { return std::max(std::abs(v.x), std::max(std::abs(v.y), std::abs(v.z))); }
+template <typename F> using value_of = decltype(std::declval<const F&>()(0.0, 0.0));
+
+template <typename F> value_of<F> gauss2x2(const F& f, double z0, double z1, double p0, double p1) {
   constexpr double g = 0.5773502691896257;  // 1/sqrt(3)
   const double zc = 0.5 * (z0 + z1), zh = 0.5 * (z1 - z0), pc = 0.5 * (p0 + p1), ph = 0.5 * (p1 - p0);
-  double s = 0.0;
+  value_of<F> s{0.0};
   for (const double a : {-g, g})
     for (const double b : {-g, g}) s += f(zc + a * zh, pc + b * ph);
   return s * zh * ph;
@@ -55,8 +62,8 @@ template <typename F> double gauss2x2(const F& f, double z0, double z1, double p
 // 10 alpha: a coarse cell there sees nearly nothing at its Gauss points and
 // agrees with its equally blind children.
 template <typename F>
-double refine(const F& f, double z0, double z1, double p0, double p1, double coarse, const std::vector<Peak>& peaks,
-              double tol, int depth) {
+value_of<F> refine(const F& f, double z0, double z1, double p0, double p1, const value_of<F>& coarse,
+                   const std::vector<Peak>& peaks, double tol, int depth) {
   const double t0 = std::acos(z0), t1 = std::acos(z1);  // t0 >= t1
   const double side_theta = t0 - t1;
   const double side_phi = (p1 - p0) * std::sqrt(std::max(0.0, 1.0 - std::min(z0 * z0, z1 * z1)));
@@ -85,11 +92,11 @@ double refine(const F& f, double z0, double z1, double p0, double p1, double coa
   }
   const bool split_z = near_peak ? peak_wants_z : side_theta >= side_phi;
   const double zm = split_z ? std::cos(tc) : 0.0, pm = pc;
-  const double a = split_z ? gauss2x2(f, z0, zm, p0, p1) : gauss2x2(f, z0, z1, p0, pm);
-  const double b = split_z ? gauss2x2(f, zm, z1, p0, p1) : gauss2x2(f, z0, z1, pm, p1);
-  const double fine = a + b;
+  const value_of<F> a = split_z ? gauss2x2(f, z0, zm, p0, p1) : gauss2x2(f, z0, z1, p0, pm);
+  const value_of<F> b = split_z ? gauss2x2(f, zm, z1, p0, p1) : gauss2x2(f, z0, z1, pm, p1);
+  const value_of<F> fine = a + b;
   if (depth >= 96) return fine;
-  if (!near_peak && depth >= 4 && std::abs(fine - coarse) <= std::max(tol, 1e-4 * std::abs(fine))) return fine;
+  if (!near_peak && depth >= 4 && magnitude(fine - coarse) <= std::max(tol, 1e-4 * magnitude(fine))) return fine;
   // Away from the peaks, cells below 1e-4 rad are not refined further: an
   // integrable singularity (GTR1's reflection Jacobian 1 / (4 wo.h) where h
   // turns perpendicular to a grazing wo) would otherwise take the
@@ -111,16 +118,17 @@ double refine(const F& f, double z0, double z1, double p0, double p1, double coa
 // Integral of f(z, phi) over [z0, z1] x [phi0, phi1] to about `tol` absolute
 // or 1e-4 relative.
 template <typename F>
-double integrate_cell(const F& f, double z0, double z1, double phi0, double phi1, const std::vector<Peak>& peaks,
-                      double tol) {
+detail::value_of<F> integrate_cell(const F& f, double z0, double z1, double phi0, double phi1,
+                                   const std::vector<Peak>& peaks, double tol) {
   return detail::refine(f, z0, z1, phi0, phi1, detail::gauss2x2(f, z0, z1, phi0, phi1), peaks, tol, 0);
 }
 
 // Integral over the upper hemisphere (z in [0, 1]) on an nz x nphi grid of
 // cells, each integrated adaptively.
 template <typename F>
-double integrate_hemisphere(const F& f, const std::vector<Peak>& peaks, double tol, int nz = 8, int nphi = 16) {
-  double sum = 0.0;
+detail::value_of<F> integrate_hemisphere(const F& f, const std::vector<Peak>& peaks, double tol, int nz = 8,
+                                         int nphi = 16) {
+  detail::value_of<F> sum{0.0};
   const double cell_tol = tol / (nz * nphi);
   for (int i = 0; i < nz; ++i)
     for (int j = 0; j < nphi; ++j)
