@@ -103,12 +103,15 @@ TEST(BsdfChi2, FullMaterialOverTheGrid) {
 }
 
 // NOT DONE: at view cos 0.001 the reflected lobe of a low-roughness
-// material is a ridge ~alpha * 0.001 wide lying on the horizon, and the
-// expected-count quadrature (core/bsdf/quadrature.h) does not yet resolve it:
-// the density's integral comes out 0.5-2.5 % off the sampler's measured
-// success rate for metallic roughness <= 0.1, so this grid point fails on
-// the quadrature, not (as far as the lobe tests and the extremes show) on
-// the sampler. Run with --gtest_also_run_disabled_tests.
+// material is a ridge lying on the horizon, ~alpha * 0.001 (down to 1e-6
+// rad) across: a few dozen float ulps of a unit vector's components. The
+// density's quadrature then comes out 0.5-2.5 % off the sampler's measured
+// success rate (e.g. metallic, roughness 0.001: success 0.9701 of 1e6
+// draws, quadrature 0.9760), for metals of roughness <= 0.1 (and for cospow
+// at roughness <= 0.01), so this grid point fails. Not yet settled whether
+// the quadrature or float rounding of the sampled directions is at fault;
+// the extremes test shows the values stay finite and non-negative there.
+// Run with --gtest_also_run_disabled_tests.
 TEST(BsdfChi2, DISABLED_FullMaterialAtGrazingView) {
   std::vector<Target> targets;
   for (const GridPoint& g : grid(true))
