@@ -17,6 +17,8 @@ constexpr Entry kModels[] = {
     {"furnace", analytic::make_furnace},
     {"sphere-in-uniform-light", analytic::make_sphere_in_uniform_light},
     {"penumbra", analytic::make_penumbra},
+    {"rough-sphere-in-environment", analytic::make_rough_sphere_in_environment},
+    {"glass-sphere-in-environment", analytic::make_glass_sphere_in_environment},
 };
 
 }  // namespace

@@ -7,6 +7,7 @@ namespace pathlab {
 
 CompiledScene::CompiledScene(Scene scene)
     : scene_(std::move(scene)), camera_(scene_.camera, scene_.film.width, scene_.film.height) {
+  configure_shading(scene_);  // materials: shading path for the scene's lobes, sampling flavour, min pdf
   vec3 lo(kInfinity), hi(-kInfinity);
   for (const Shape& shape : scene_.shapes) {
     if (shape.kind == Shape::Kind::Sphere) {

@@ -18,6 +18,12 @@ enum class Fault {
   LightPdfWithoutArea,    // light_sampler.cpp: area density 1 instead of 1 / area
   LightPdfWithoutDistance,// light_sampler.cpp: no distance^2 in the area -> solid-angle conversion
   RouletteNotReweighted,  // reference: a roulette survivor is not divided by its probability
+  SpecularPdfOff5Percent, // bsdf/disney.cpp: the GGX lobe reports pdf * 1.05
+  VndfPdfWithoutJacobian, // bsdf/disney.cpp: the VNDF pdf lacks the reflection Jacobian 1 / (4 wo.h)
+  SmithG1Dropped,         // bsdf/disney.cpp: the specular f loses the masking G1(wi) of the light direction
+  SpecularNoDenominator,  // bsdf/disney.cpp: the specular f = D F G without its 1 / (4 cos_i cos_o)
+  HorizonUnclamped,       // bsdf/disney.cpp: eval and pdf no longer return 0 for wi below the surface
+  DielectricFresnelIgnored,// surfel.cpp: glass always refracts (Fresnel reflection dropped, TIR kept)
 };
 
 #ifdef PATHLAB_FAULT_INJECTION

@@ -2,8 +2,8 @@
 // resolved by name when the scene is loaded. The lobes a material is made of
 // are listed in `Lobe`; a compiled scene records which lobes any of its
 // materials use (its LobeMask) so that shading can skip what a scene does not
-// need. The Disney model will add its lobes here without changing the
-// Surfel interface.
+// need (core/shading.h). The lobes themselves live one per file in
+// core/bsdf/.
 //
 // Scene-file parameters (object "materials": { "<name>": {...} }):
 //
@@ -18,6 +18,32 @@
 //     reflectance   [r,g,b] in [0,1]                                default [1,1,1]
 //     emission, two_sided, light        as for "diffuse"
 //
+//   type "disney"    Burley's principled BRDF (core/bsdf/disney.h); every
+//                    parameter but base_color is a number in [0, 1]
+//     base_color      [r,g,b] in [0,1]  diffuse colour / metal F0       default [0.8,0.8,0.8]
+//     metallic        0 dielectric .. 1 metal                           default 0
+//     subsurface      0 Disney diffuse .. 1 subsurface approximation    default 0
+//     specular        dielectric F0 = 0.08 specular (0.5 = ior 1.5)     default 0.5
+//     specular_tint   tints the dielectric F0 towards base_color        default 0
+//     roughness       GGX alpha = roughness^2 (floored at 1e-3)         default 0.5
+//     anisotropic     aspect sqrt(1 - 0.9 anisotropic), along tangent x default 0
+//     sheen           grazing cloth sheen                               default 0
+//     sheen_tint      tints the sheen towards base_color                default 0.5
+//     clearcoat       strength of the GTR1 clear coat (weight 0.25 x)   default 0
+//     clearcoat_gloss GTR1 alpha = mix(0.1, 0.001, clearcoat_gloss)     default 1
+//     emission, two_sided, light        as for "diffuse"
+//
+//   type "dielectric" smooth glass: Fresnel reflection + Snell refraction
+//                    (two impulses, chosen by probability). The geometric
+//                    normal's side is the outside ("flip_normals" swaps it).
+//     ior             index of refraction inside / outside, in [1, 10]  default 1.5
+//     reflectance     [r,g,b] in [0,1]  tint of the reflected part      default [1,1,1]
+//     transmittance   [r,g,b] in [0,1]  tint of the refracted part      default [1,1,1]
+//     Radiance is not rescaled by eta^2 across the interface: the factors
+//     cancel on every path that enters and leaves, which is every path when
+//     camera and lights are outside; this keeps the weight of white glass at
+//     exactly 1 so Russian roulette never ends its paths early.
+//
 //   type "emissive"  emits, reflects nothing (a black body that glows)
 //     radiance      [r,g,b] >= 0       emitted radiance            required
 //     two_sided, light                  as for "diffuse"
@@ -26,25 +52,42 @@
 // points to (see each shape's "flip_normals"), or both sides if two_sided.
 #pragma once
 
+#include "core/bsdf/closure.h"
 #include "core/math.h"
+#include "core/shading.h"
 
 #include <cstdint>
 #include <string>
 
 namespace pathlab {
 
-enum class MaterialType : std::uint8_t { Diffuse, Mirror, Emissive };
+enum class MaterialType : std::uint8_t { Diffuse, Mirror, Emissive, Disney, Dielectric };
 
 // The lobes materials are built from. A path event names the lobe that
 // scattered it; a LobeMask has bit (1 << lobe) set for each lobe in use.
 enum class Lobe : std::uint8_t {
   Lambert,       // cos/pi diffuse
   MirrorImpulse, // perfect specular reflection (a Dirac delta)
+  DisneyDiffuse, // Burley diffuse with retro-reflection and subsurface approximation
+  Sheen,         // Burley sheen
+  Specular,      // anisotropic GGX (GTR2) with Smith masking, Schlick Fresnel
+  Clearcoat,     // GTR1 clear coat
+  DielectricReflection,    // smooth dielectric, Fresnel-reflected impulse
+  DielectricTransmission,  // smooth dielectric, refracted impulse
   Count
 };
 using LobeMask = std::uint32_t;
 inline constexpr LobeMask lobe_bit(Lobe l) { return LobeMask{1} << static_cast<unsigned>(l); }
+inline constexpr LobeMask kDisneyLobeMask =
+    lobe_bit(Lobe::DisneyDiffuse) | lobe_bit(Lobe::Sheen) | lobe_bit(Lobe::Specular) | lobe_bit(Lobe::Clearcoat);
 const char* lobe_name(Lobe lobe);
+
+// Parameters of type "dielectric".
+struct DielectricParams {
+  float ior = 1.5f;
+  Spectrum reflectance{1.0f};
+  Spectrum transmittance{1.0f};
+};
 
 struct Material {
   std::string name;
@@ -53,15 +96,37 @@ struct Material {
   Spectrum emission{0.0f};     // emitted radiance
   bool two_sided_emission = false;
   bool sampled_as_light = true;  // false: only rays that hit it find its emission
+  DisneyParams disney{};       // type Disney
+  DielectricParams glass{};    // type Dielectric
+  // Derived from `disney` (or, for the general path, from `albedo`) by the
+  // factories below and configure_shading().
+  disney::Closure closure{};
 
   bool emits() const { return !is_black(emission); }
   // True if the material scatters light at all (an "emissive" does not).
-  bool scatters() const { return type != MaterialType::Emissive && !is_black(albedo); }
+  bool scatters() const;
   // True if every way this material scatters is an impulse: next-event
   // estimation can never connect through it.
-  bool is_pure_impulse() const { return type == MaterialType::Mirror; }
+  bool is_pure_impulse() const { return type == MaterialType::Mirror || type == MaterialType::Dielectric; }
   LobeMask lobes() const;
+
+  // Set by configure_shading() when a scene is compiled; the default suits
+  // a material used on its own (tests).
+  ShadingConfig shading{};
 };
+
+// Materials of each type with the given parameters (and no emission).
+Material diffuse_material(const Spectrum& albedo);
+Material disney_material(const DisneyParams& params);
+Material dielectric_material(const DielectricParams& params);
+
+struct Scene;
+// The shading path a scene with these lobes runs; `force_general` routes
+// every material through the full Disney-capable closure.
+ShadingPath shading_path_for(LobeMask lobes, bool force_general);
+// Stamps every material of `scene` with the scene's ShadingConfig (from its
+// render settings and the lobes its shapes' materials use).
+void configure_shading(Scene& scene);
 
 const char* material_type_name(MaterialType type);
 

@@ -5,6 +5,26 @@
 #include <vector>
 
 namespace pathlab {
+namespace {
+
+// pbrt-style firefly clamp: scale a finite sample down so that its largest
+// component is `limit`, keeping its colour. Biased: off unless asked for.
+// Non-finite samples pass through untouched (the film counts and locates them).
+void clamp_samples(std::span<FilmSample> out, float limit, RenderStats& stats) {
+  for (FilmSample& s : out) {
+    if (!is_finite(s.L)) continue;
+    const double before = average(s.L);
+    stats.energy_total += before;
+    const float m = max_component(s.L);
+    if (m > limit) {
+      s.L *= limit / m;
+      ++stats.clamped_samples;
+      stats.energy_clamped += before - average(s.L);
+    }
+  }
+}
+
+}  // namespace
 
 std::uint32_t batch_size(int width, int height, int spp) {
   const std::uint64_t pixels = static_cast<std::uint64_t>(width) * height;
@@ -13,65 +33,31 @@ std::uint32_t batch_size(int width, int height, int spp) {
 }
 
 RenderStats render(const Tracer& tracer, Film& film, const ProgressFn& progress) {
+  return render_samples(tracer, film, 0, static_cast<std::uint32_t>(std::max(tracer.settings().spp, 0)), progress);
+}
+
+RenderStats render_samples(const Tracer& tracer, Film& film, std::uint32_t first, std::uint32_t last,
+                           const ProgressFn& progress) {
   const auto start = std::chrono::steady_clock::now();
-  const int spp = tracer.settings().spp;
-  const std::uint32_t batch = batch_size(film.width(), film.height(), spp);
-  const std::size_t pixels = static_cast<std::size_t>(film.width()) * film.height();
-  std::vector<FilmSample> samples(pixels * batch);
   RenderStats stats;
-  for (std::uint32_t first = 0; first < static_cast<std::uint32_t>(spp); first += batch) {
-    const std::uint32_t count = std::min<std::uint32_t>(batch, static_cast<std::uint32_t>(spp) - first);
-    const std::span<FilmSample> out(samples.data(), pixels * count);
-    tracer.render_batch(first, count, out);
-    film.add_batch(first, count, out);
-    for (const FilmSample& s : out) stats.rays += s.rays;
-    stats.samples += out.size();
-    if (progress) progress(static_cast<double>(first + count) / spp);
+  if (last > first) {
+    const std::uint32_t batch = batch_size(film.width(), film.height(), static_cast<int>(last - first));
+    const std::size_t pixels = static_cast<std::size_t>(film.width()) * film.height();
+    std::vector<FilmSample> samples(pixels * batch);
+    const float clamp = tracer.settings().clamp;
+    for (std::uint32_t begin = first; begin < last; begin += batch) {
+      const std::uint32_t count = std::min(batch, last - begin);
+      const std::span<FilmSample> out(samples.data(), pixels * count);
+      tracer.render_batch(begin, count, out);
+      if (clamp > 0.0f) clamp_samples(out, clamp, stats);
+      film.add_batch(begin, count, out);
+      for (const FilmSample& s : out) stats.rays += s.rays;
+      stats.samples += out.size();
+      if (progress) progress(static_cast<double>(begin + count - first) / (last - first));
+    }
   }
   stats.bad_samples = film.bad_sample_count();
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return stats;
-}
-
-}  // namespace pathlab
-
-namespace pathlab {
-
-namespace {
-
-// Scales each sample whose largest component exceeds `clamp` down to it.
-std::uint64_t clamp_samples(std::span<FilmSample> samples, float clamp) {
-  std::uint64_t clamped = 0;
-  for (FilmSample& s : samples) {
-    const float m = std::max({s.L.x, s.L.y, s.L.z});
-    if (m > clamp) {  // false for NaN: the film counts those
-      s.L *= clamp / m;
-      ++clamped;
-    }
-  }
-  return clamped;
-}
-
-}  // namespace
-
-ProgressiveStats render_samples(const Tracer& tracer, Film& film, std::uint32_t first, std::uint32_t last) {
-  const auto start = std::chrono::steady_clock::now();
-  const std::uint32_t batch = batch_size(film.width(), film.height(), static_cast<int>(std::max(last - std::min(first, last), 1u)));
-  const std::size_t pixels = static_cast<std::size_t>(film.width()) * film.height();
-  std::vector<FilmSample> samples(pixels * batch);
-  const float clamp = tracer.settings().clamp;
-  ProgressiveStats stats;
-  for (std::uint32_t begin = first; begin < last; begin += batch) {
-    const std::uint32_t count = std::min(batch, last - begin);
-    const std::span<FilmSample> out(samples.data(), pixels * count);
-    tracer.render_batch(begin, count, out);
-    if (clamp > 0.0f) stats.clamped_samples += clamp_samples(out, clamp);
-    film.add_batch(begin, count, out);
-    for (const FilmSample& s : out) stats.render.rays += s.rays;
-    stats.render.samples += out.size();
-  }
-  stats.render.bad_samples = film.bad_sample_count();
-  stats.render.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return stats;
 }
 
@@ -98,11 +84,13 @@ UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule,
       if (rule.target_relmse > 0.0 && r.estimated_relmse < rule.target_relmse) break;
     }
     const std::uint32_t last = std::min(max_spp, r.spp + pass);
-    const ProgressiveStats s = render_samples(tracer, film, r.spp, last);
-    r.stats.render.samples += s.render.samples;
-    r.stats.render.rays += s.render.rays;
+    const RenderStats s = render_samples(tracer, film, r.spp, last);
+    r.stats.samples += s.samples;
+    r.stats.rays += s.rays;
     r.stats.clamped_samples += s.clamped_samples;
-    r.last_pass_seconds = s.render.seconds;
+    r.stats.energy_total += s.energy_total;
+    r.stats.energy_clamped += s.energy_clamped;
+    r.last_pass_seconds = s.seconds;
     r.spp = last;
     ++r.passes;
     if (rule.target_relmse > 0.0) r.estimated_relmse = estimated_relmse(film);
@@ -113,8 +101,8 @@ UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule,
     }
   }
   if (rule.target_relmse <= 0.0) r.estimated_relmse = estimated_relmse(film);
-  r.stats.render.bad_samples = film.bad_sample_count();
-  r.stats.render.seconds = elapsed();
+  r.stats.bad_samples = film.bad_sample_count();
+  r.stats.seconds = elapsed();
   return r;
 }
 

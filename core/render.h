@@ -16,13 +16,19 @@ struct RenderStats {
   std::uint64_t samples = 0;
   std::uint64_t rays = 0;
   std::uint64_t bad_samples = 0;
+  // Radiance clamping (RenderSettings::clamp): samples scaled down, and the
+  // sum over all samples of the mean RGB radiance before clamping and of
+  // what clamping removed (their ratio is the relative energy removed).
+  std::uint64_t clamped_samples = 0;
+  double energy_total = 0.0;
+  double energy_clamped = 0.0;
 };
 
 // Called after each batch with the fraction done (0..1].
 using ProgressFn = std::function<void(double fraction)>;
 
 // Renders settings.spp samples per pixel into `film` (which must match the
-// scene's resolution and filter).
+// scene's resolution and filter): render_samples(tracer, film, 0, spp).
 RenderStats render(const Tracer& tracer, Film& film, const ProgressFn& progress = {});
 
 // Progressive rendering. The film accumulates and samples are keyed by
@@ -30,12 +36,9 @@ RenderStats render(const Tracer& tracer, Film& film, const ProgressFn& progress 
 // that holds samples [0, first) gives exactly the film of a render with
 // `last` samples per pixel. With settings.clamp > 0 each sample's radiance is
 // scaled so that its largest component is at most clamp (counted in
-// stats.clamped_samples).
-struct ProgressiveStats {
-  RenderStats render;
-  std::uint64_t clamped_samples = 0;
-};
-ProgressiveStats render_samples(const Tracer& tracer, Film& film, std::uint32_t first, std::uint32_t last);
+// clamped_samples, energy_clamped).
+RenderStats render_samples(const Tracer& tracer, Film& film, std::uint32_t first, std::uint32_t last,
+                           const ProgressFn& progress = {});
 
 // When render_until() stops. Zero fields are off; max_spp always applies.
 struct StopRule {
@@ -46,7 +49,7 @@ struct StopRule {
   std::uint32_t pass_spp = 0;
 };
 struct UntilResult {
-  ProgressiveStats stats;
+  RenderStats stats;
   std::uint32_t spp = 0;          // samples per pixel reached (whole passes)
   std::uint32_t passes = 0;
   double estimated_relmse = 0.0;  // of the final film

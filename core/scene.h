@@ -53,10 +53,18 @@ struct RenderSettings {
   int rr_depth = 5;
   Strategy strategy = Strategy::Mis;
   std::uint64_t seed = 0;
-  // Radiance clamp: a sample whose largest component exceeds this is scaled
-  // down to it (biased, removes fireflies). 0 = off. Applied by
-  // render_samples() (core/render.h).
+  // How glossy lobes are sampled (core/shading.h).
+  BsdfSampling bsdf_sampling = BsdfSampling::Vndf;
+  // Firefly controls, both biased and off (0) by default; never on in a test
+  // of unbiasedness. `clamp`: a sample's radiance is scaled down so that its
+  // largest component is at most this (core/render.cpp). `min_pdf`: BSDF
+  // samples with a smaller density are discarded (Surfel::scatter).
   float clamp = 0.0f;
+  float min_pdf = 0.0f;
+  // Route every material through the general, Disney-capable shading code
+  // instead of the code specialised to the scene's lobes (for benchmarks
+  // and tests; the image is the same).
+  bool force_general_shading = false;
 };
 inline constexpr int kMaxVerticesUncapped = 1000;
 

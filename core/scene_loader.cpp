@@ -204,7 +204,7 @@ FilmDesc read_film(const Node& node) {
 }
 
 RenderSettings read_render(const Node& node) {
-  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed"});
+  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf"});
   RenderSettings r;
   if (node.has("spp")) {
     const std::int64_t spp = node.child("spp").integer();
@@ -242,7 +242,37 @@ RenderSettings read_render(const Node& node) {
       r.seed = static_cast<std::uint64_t>(seed);
     }
   }
+  if (node.has("bsdf_sampling")) {
+    const std::string name = node.child("bsdf_sampling").string();
+    const auto s = parse_bsdf_sampling(name);
+    if (!s) {
+      const std::array<std::string_view, 2> names{"vndf", "cospow"};
+      const std::string near = suggestion(name, names);
+      node.child("bsdf_sampling").fail("unknown BSDF sampling " + in_quotes(name) + (near.empty() ? " (expected vndf or cospow)" : near));
+    }
+    r.bsdf_sampling = *s;
+  }
+  if (node.has("clamp")) {
+    r.clamp = static_cast<float>(node.child("clamp").number());
+    if (r.clamp < 0.0f) node.child("clamp").fail("clamp must not be negative (0 turns clamping off)");
+  }
+  if (node.has("min_pdf")) {
+    r.min_pdf = static_cast<float>(node.child("min_pdf").number());
+    if (r.min_pdf < 0.0f) node.child("min_pdf").fail("min_pdf must not be negative (0 turns it off)");
+  }
   return r;
+}
+
+// A number in [lo, hi] (the message names the range).
+float unit_number(const Node& node, const char* key, float fallback, float lo = 0.0f, float hi = 1.0f) {
+  if (!node.has(key)) return fallback;
+  const float v = static_cast<float>(node.child(key).number());
+  if (!(v >= lo && v <= hi)) {
+    std::ostringstream range;
+    range << key << " must lie in [" << lo << ", " << hi << "], found " << v;
+    node.child(key).fail(range.str());
+  }
+  return v;
 }
 
 // A key that belongs to another material type gets a pointed message, not
@@ -278,11 +308,50 @@ Material read_material(const Node& node, const std::string& name) {
     m.type = MaterialType::Emissive;
     m.albedo = Spectrum(0.0f);
     m.emission = node.required("radiance").color(false);
+  } else if (type == "disney") {
+    reject_misplaced(node, type,
+                     {{"albedo", "its colour is 'base_color'"},
+                      {"baseColor", "parameters are snake_case: 'base_color'"},
+                      {"radiance", "emitted light is 'emission'"}});
+    node.allow_only({"type", "base_color", "metallic", "subsurface", "specular", "specular_tint", "roughness",
+                     "anisotropic", "sheen", "sheen_tint", "clearcoat", "clearcoat_gloss", "emission", "two_sided",
+                     "light"});
+    DisneyParams p;
+    if (node.has("base_color")) p.base_color = node.child("base_color").color(true);
+    p.metallic = unit_number(node, "metallic", p.metallic);
+    p.subsurface = unit_number(node, "subsurface", p.subsurface);
+    p.specular = unit_number(node, "specular", p.specular);
+    p.specular_tint = unit_number(node, "specular_tint", p.specular_tint);
+    p.roughness = unit_number(node, "roughness", p.roughness);
+    // 0.9 * 1 would leave an aspect of sqrt(0.1); the range stops at 1.
+    p.anisotropic = unit_number(node, "anisotropic", p.anisotropic);
+    p.sheen = unit_number(node, "sheen", p.sheen);
+    p.sheen_tint = unit_number(node, "sheen_tint", p.sheen_tint);
+    p.clearcoat = unit_number(node, "clearcoat", p.clearcoat);
+    p.clearcoat_gloss = unit_number(node, "clearcoat_gloss", p.clearcoat_gloss);
+    const std::string keep = m.name;
+    m = disney_material(p);
+    m.name = keep;
+    if (node.has("emission")) m.emission = node.child("emission").color(false);
+  } else if (type == "dielectric") {
+    reject_misplaced(node, type,
+                     {{"albedo", "its tints are 'reflectance' and 'transmittance'"},
+                      {"eta", "the index of refraction is 'ior'"},
+                      {"emission", "glass does not emit"}});
+    node.allow_only({"type", "ior", "reflectance", "transmittance"});
+    DielectricParams p;
+    p.ior = unit_number(node, "ior", p.ior, 1.0f, 10.0f);
+    if (node.has("reflectance")) p.reflectance = node.child("reflectance").color(true);
+    if (node.has("transmittance")) p.transmittance = node.child("transmittance").color(true);
+    const std::string keep = m.name;
+    m = dielectric_material(p);
+    m.name = keep;
+    m.albedo = Spectrum(0.0f);
   } else {
-    const std::array<std::string_view, 3> types{"diffuse", "mirror", "emissive"};
+    const std::array<std::string_view, 5> types{"diffuse", "mirror", "emissive", "disney", "dielectric"};
     const std::string near = suggestion(type, types);
     node.child("type").fail("unknown material type " + in_quotes(type) +
-                            (near.empty() ? " (expected diffuse, mirror or emissive)" : near));
+                            (near.empty() ? " (expected diffuse, mirror, emissive, disney or dielectric)" : near));
   }
   m.two_sided_emission = node.boolean_or("two_sided", false);
   m.sampled_as_light = node.boolean_or("light", true);

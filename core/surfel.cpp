@@ -1,5 +1,7 @@
 #include "core/surfel.h"
 
+#include "core/bsdf/dielectric.h"
+#include "core/bsdf/disney.h"
 #include "core/bsdf/lambert.h"
 #include "core/bsdf/mirror.h"
 #include "core/faults.h"
@@ -7,7 +9,8 @@
 namespace pathlab {
 namespace {
 
-// The BSDFs are two-sided: flip the local frame so that wo is on +z.
+// The reflection models are two-sided: flip the local frame so that wo is
+// on +z. (The dielectric is not: it reads the side from the geometric normal.)
 struct LocalDirs {
   vec3 wo, wi;
 };
@@ -20,6 +23,72 @@ LocalDirs to_local_upper(const Frame& frame, const vec3& wo, const vec3& wi) {
   return d;
 }
 
+using disney::kClearcoat;
+using disney::kDisneyLobes;
+using disney::kGeneral;
+
+// Shading specialised to a feature set (disney::Features); 0 = the
+// Lambert-only path, which contains no Disney code at all. In the general
+// path a "diffuse" material goes through the closure too.
+template <unsigned F> bool via_closure(const Material& m) {
+  if constexpr (F == 0) return false;
+  else if constexpr ((F & disney::kLambertLobe) != 0) return m.type == MaterialType::Disney || m.type == MaterialType::Diffuse;
+  else return m.type == MaterialType::Disney;
+}
+
+template <unsigned F> Spectrum eval_as(const Material& m, const LocalDirs& d) {
+  if constexpr (F != 0) {
+    if (via_closure<F>(m)) return disney::eval<F>(m.closure, d.wo, d.wi);
+  }
+  if (m.type != MaterialType::Diffuse) return Spectrum(0.0f);
+  if (PATHLAB_FAULT(CosineDropped)) return d.wi.z > 0.0f ? m.albedo * kInvPi : Spectrum(0.0f);
+  return lambert::eval(m.albedo, d.wi);
+}
+
+template <unsigned F> float pdf_as(const Material& m, const LocalDirs& d) {
+  if constexpr (F != 0) {
+    if (via_closure<F>(m)) return disney::pdf<F>(m.closure, d.wo, d.wi, m.shading.sampling);
+  }
+  if (m.type != MaterialType::Diffuse) return 0.0f;
+  if (PATHLAB_FAULT(BsdfPdfOff5Percent)) return 1.05f * lambert::pdf(d.wi);
+  return lambert::pdf(d.wi);
+}
+
+template <unsigned F>
+std::optional<BsdfSample> scatter_closure(const Material& m, const Frame& frame, const vec3& wo_local, float side,
+                                          float u_lobe, vec2 u) {
+  const std::optional<disney::DirectionSample> ds = disney::sample<F>(m.closure, wo_local, u_lobe, u, m.shading.sampling);
+  if (!ds) return std::nullopt;
+  // The weight is the true f cos over the mixture's density at the final
+  // direction, whatever lobe drew it.
+  const float pdf = disney::pdf<F>(m.closure, wo_local, ds->wi, m.shading.sampling);
+  if (!(pdf > 0.0f) || pdf < m.shading.min_pdf) return std::nullopt;
+  const Spectrum f = disney::eval<F>(m.closure, wo_local, ds->wi);
+  vec3 wi = ds->wi;
+  wi.z *= side;
+  return BsdfSample{frame.to_world(wi), f / pdf, pdf, ds->lobe, false};
+}
+
+std::optional<BsdfSample> scatter_dielectric(const Material& m, const Frame& frame, const vec3& wo, float u_lobe) {
+  // The geometric normal's side is the outside: entering or leaving decides
+  // eta (dielectric.h).
+  const vec3 wo_local = frame.to_local(wo);
+  if (wo_local.z == 0.0f) return std::nullopt;  // grazing exactly: no projected area, nothing scatters
+  const dielectric::Interface in = dielectric::at(wo_local, m.glass.ior);
+  const float F = PATHLAB_FAULT(DielectricFresnelIgnored) ? (in.F >= 1.0f ? 1.0f : 0.0f) : in.F;
+  // Reflect or refract with probability proportional to the energy each
+  // carries (absorbed otherwise), so that for white tints the weight is 1.
+  const float p_r = F * average(m.glass.reflectance);
+  const float p_t = (1.0f - F) * average(m.glass.transmittance);
+  if (u_lobe < p_r)
+    return BsdfSample{frame.to_world(dielectric::reflect(wo_local)), m.glass.reflectance * (F / p_r), p_r,
+                      Lobe::DielectricReflection, true};
+  if (u_lobe < p_r + p_t)
+    return BsdfSample{frame.to_world(dielectric::refract(wo_local, in)), m.glass.transmittance * ((1.0f - F) / p_t), p_t,
+                      Lobe::DielectricTransmission, true};
+  return std::nullopt;
+}
+
 }  // namespace
 
 Spectrum Surfel::emitted(const vec3& wo) const {
@@ -29,46 +98,76 @@ Spectrum Surfel::emitted(const vec3& wo) const {
 }
 
 Spectrum Surfel::eval(const vec3& wi, const vec3& wo) const {
-  if (material->type != MaterialType::Diffuse) return Spectrum(0.0f);
+  const Material& m = *material;
+  if (m.is_pure_impulse() || m.type == MaterialType::Emissive) return Spectrum(0.0f);
   const LocalDirs d = to_local_upper(frame, wo, wi);
-  if (PATHLAB_FAULT(CosineDropped)) return d.wi.z > 0.0f ? material->albedo * kInvPi : Spectrum(0.0f);
-  return lambert::eval(material->albedo, d.wi);
+  switch (m.shading.path) {
+    case ShadingPath::LambertOnly: return eval_as<0>(m, d);
+    case ShadingPath::Disney: return eval_as<kDisneyLobes>(m, d);
+    case ShadingPath::DisneyClearcoat: return eval_as<kDisneyLobes | kClearcoat>(m, d);
+    case ShadingPath::General: return eval_as<kGeneral>(m, d);
+  }
+  return Spectrum(0.0f);
 }
 
 float Surfel::pdf(const vec3& wi, const vec3& wo) const {
-  if (material->type != MaterialType::Diffuse) return 0.0f;
+  const Material& m = *material;
+  if (m.is_pure_impulse() || m.type == MaterialType::Emissive) return 0.0f;
   const LocalDirs d = to_local_upper(frame, wo, wi);
-  if (PATHLAB_FAULT(BsdfPdfOff5Percent)) return 1.05f * lambert::pdf(d.wi);
-  return lambert::pdf(d.wi);
+  switch (m.shading.path) {
+    case ShadingPath::LambertOnly: return pdf_as<0>(m, d);
+    case ShadingPath::Disney: return pdf_as<kDisneyLobes>(m, d);
+    case ShadingPath::DisneyClearcoat: return pdf_as<kDisneyLobes | kClearcoat>(m, d);
+    case ShadingPath::General: return pdf_as<kGeneral>(m, d);
+  }
+  return 0.0f;
 }
 
 std::optional<BsdfSample> Surfel::scatter(const vec3& wo, float u_lobe, vec2 u) const {
+  const Material& m = *material;
+  if (m.type == MaterialType::Dielectric) return scatter_dielectric(m, frame, wo, u_lobe);
   vec3 wo_local = frame.to_local(wo);
   const float side = wo_local.z < 0.0f ? -1.0f : 1.0f;
   wo_local.z *= side;
-  switch (material->type) {
+  switch (m.shading.path) {
+    case ShadingPath::LambertOnly: break;
+    case ShadingPath::Disney:
+      if (via_closure<kDisneyLobes>(m)) return scatter_closure<kDisneyLobes>(m, frame, wo_local, side, u_lobe, u);
+      break;
+    case ShadingPath::DisneyClearcoat:
+      if (via_closure<kDisneyLobes | kClearcoat>(m))
+        return scatter_closure<kDisneyLobes | kClearcoat>(m, frame, wo_local, side, u_lobe, u);
+      break;
+    case ShadingPath::General:
+      if (via_closure<kGeneral>(m)) return scatter_closure<kGeneral>(m, frame, wo_local, side, u_lobe, u);
+      break;
+  }
+  switch (m.type) {
     case MaterialType::Diffuse: {
       vec3 wi = lambert::sample(u);
       const float pdf = lambert::pdf(wi);
       if (pdf <= 0.0f) return std::nullopt;  // u on the disk's rim: grazing, no energy
+      if (pdf < m.shading.min_pdf) return std::nullopt;
       wi.z *= side;
       if (PATHLAB_FAULT(BsdfPdfOff5Percent) || PATHLAB_FAULT(CosineDropped)) {
         const vec3 w = frame.to_world(wi);
         const float faulty_pdf = this->pdf(w, wo);
         return BsdfSample{w, eval(w, wo) / faulty_pdf, faulty_pdf, Lobe::Lambert, false};
       }
-      return BsdfSample{frame.to_world(wi), material->albedo, pdf, Lobe::Lambert, false};
+      return BsdfSample{frame.to_world(wi), m.albedo, pdf, Lobe::Lambert, false};
     }
     case MaterialType::Mirror: {
       // The impulse is chosen with probability equal to its mean reflectance
       // (absorbed otherwise), so its weight stays near 1 and paths end in
       // proportion to the energy they would lose.
-      const float prob = std::min(1.0f, average(material->albedo));
+      const float prob = std::min(1.0f, average(m.albedo));
       if (!(u_lobe < prob)) return std::nullopt;
       vec3 wi = mirror::reflect_local(wo_local);
       wi.z *= side;
-      return BsdfSample{frame.to_world(wi), material->albedo / prob, prob, Lobe::MirrorImpulse, true};
+      return BsdfSample{frame.to_world(wi), m.albedo / prob, prob, Lobe::MirrorImpulse, true};
     }
+    case MaterialType::Disney:       // only reached with a path that cannot shade it (never configured so)
+    case MaterialType::Dielectric:   // handled above
     case MaterialType::Emissive: return std::nullopt;
   }
   return std::nullopt;

@@ -7,6 +7,18 @@
 
 namespace pathlab {
 
+namespace {
+// The colour the albedo AOV shows for a material: the parameter a user
+// thinks of as its colour.
+Spectrum surface_colour(const Material& m) {
+  switch (m.type) {
+    case MaterialType::Disney: return m.disney.base_color;
+    case MaterialType::Dielectric: return m.glass.transmittance;
+    default: return m.albedo;
+  }
+}
+}  // namespace
+
 const char* aov_name(Aov a) {
   switch (a) {
     case Aov::Albedo: return "albedo";
@@ -53,7 +65,7 @@ void AovAccumulator::add_batch(std::uint32_t first, std::uint32_t count, std::sp
           if (first + j == 0) px.material = hit ? static_cast<int>(s.material - scene_.scene().materials.data()) : -1;
           if (!hit) continue;
           ++px.surface_hits;
-          if (s.material->scatters()) px.albedo += dvec3(s.material->albedo);
+          if (s.material->scatters()) px.albedo += dvec3(surface_colour(*s.material));
           px.normal += dvec3(s.frame.n);
           px.depth += static_cast<double>(glm::length(s.p - ray.origin));
         }

@@ -224,10 +224,10 @@ ConvergeResult run_converge(const Scene& scene, const ConvergeOptions& options, 
       std::uint32_t done = 0;
       for (std::size_t k = 0; k < rungs; ++k) {
         const auto spp = static_cast<std::uint32_t>(options.spp[k]);
-        const ProgressiveStats s = render_samples(*tracer, film, done, spp);
+        const RenderStats s = render_samples(*tracer, film, done, spp);
         done = spp;
-        seconds += s.render.seconds;
-        samples += static_cast<double>(s.render.samples);
+        seconds += s.seconds;
+        samples += static_cast<double>(s.samples);
         const Measure m = measure(film, truth.image);
         points[k].push_back({static_cast<double>(spp), seconds, samples, m.rmse, m.rel_mse, m.bias, m.bias_se_pixels});
       }
@@ -238,8 +238,8 @@ ConvergeResult run_converge(const Scene& scene, const ConvergeOptions& options, 
         rule.time_budget_seconds = options.time_budgets[k];
         const UntilResult u = render_until(*tracer, f, rule);
         const Measure m = measure(f, truth.image);
-        points[rungs + k].push_back({static_cast<double>(u.spp), u.stats.render.seconds,
-                                     static_cast<double>(u.stats.render.samples), m.rmse, m.rel_mse, m.bias,
+        points[rungs + k].push_back({static_cast<double>(u.spp), u.stats.seconds,
+                                     static_cast<double>(u.stats.samples), m.rmse, m.rel_mse, m.bias,
                                      m.bias_se_pixels});
       }
     }

@@ -236,6 +236,37 @@ TEST_F(BadInput, NanMaterialParameter) {
                   {"huge.json:" + where_in(huge, "1e999"), "malformed JSON: number '1e999' is out of range"});
 }
 
+TEST_F(BadInput, DisneyParameterOutOfRange) {
+  const std::string text = scene("    \"white\": {\"type\": \"disney\", \"roughness\": -0.2}", kSphere);
+  expect_rejected(render(write("rough.json", text)), {"rough.json:" + where_in(text, "\"roughness\""),
+                                                      "/materials/white/roughness", "roughness must lie in [0, 1], found -0.2"});
+  const std::string aniso = scene("    \"white\": {\"type\": \"disney\", \"anisotropic\": 1.5}", kSphere);
+  expect_rejected(render(write("aniso.json", aniso)), {"aniso.json:", "/materials/white/anisotropic", "must lie in [0, 1]"});
+  const std::string camel = scene("    \"white\": {\"type\": \"disney\", \"baseColor\": 0.5}", kSphere);
+  expect_rejected(render(write("camel.json", camel)),
+                  {"camel.json:", "/materials/white/baseColor", "parameters are snake_case: 'base_color'"});
+  const std::string base = scene("    \"white\": {\"type\": \"disney\", \"base_color\": [0.5, 1.2, 0.5]}", kSphere);
+  expect_rejected(render(write("base.json", base)), {"base.json:", "/materials/white/base_color", "must lie in [0, 1]"});
+}
+
+TEST_F(BadInput, DielectricParameterOutOfRange) {
+  const std::string text = scene("    \"white\": {\"type\": \"dielectric\", \"ior\": 0.5}", kSphere);
+  expect_rejected(render(write("ior.json", text)),
+                  {"ior.json:" + where_in(text, "\"ior\""), "/materials/white/ior", "ior must lie in [1, 10], found 0.5"});
+  const std::string tint = scene("    \"white\": {\"type\": \"dielectric\", \"transmittance\": -1}", kSphere);
+  expect_rejected(render(write("tint.json", tint)), {"tint.json:", "/materials/white/transmittance", "must not be negative"});
+  const std::string eta = scene("    \"white\": {\"type\": \"dielectric\", \"eta\": 1.5}", kSphere);
+  expect_rejected(render(write("eta.json", eta)), {"eta.json:", "/materials/white/eta", "the index of refraction is 'ior'"});
+}
+
+TEST_F(BadInput, UnknownBsdfSamplingAndNegativeFireflyControls) {
+  const std::string text = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"bsdf_sampling\": \"vndff\"}");
+  expect_rejected(render(write("flavour.json", text)),
+                  {"flavour.json:", "/render/bsdf_sampling", "unknown BSDF sampling 'vndff' (did you mean 'vndf'?)"});
+  const std::string clamp = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"clamp\": -1}");
+  expect_rejected(render(write("clamp.json", clamp)), {"clamp.json:", "/render/clamp", "clamp must not be negative"});
+}
+
 TEST_F(BadInput, AlbedoAboveOne) {
   const std::string text = scene("    \"white\": {\"type\": \"diffuse\", \"albedo\": 1.5}", kSphere);
   expect_rejected(render(write("albedo.json", text)),

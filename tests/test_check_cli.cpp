@@ -33,6 +33,18 @@ TEST(CheckCli, PassesAnAnalyticSceneAndPrintsTheVerdict) {
   EXPECT_FALSE(std::filesystem::exists(dir)) << "nothing is written when the check passes";
 }
 
+// With a firefly control on, check reports the bias it introduces.
+TEST(CheckCli, ReportsTheBiasOfFireflyControls) {
+  const test::ScopedTempDir folder("check-clamp");
+  std::string err;
+  run({"check", kScenes + "sphere-in-environment.json", "--spp", "16", "--resolution", "8x8", "--clamp", "0.5", "--out",
+       (folder.path() / "out").string()},
+      &err);
+  EXPECT_NE(err.find("firefly controls on (clamp 0.5"), std::string::npos) << err;
+  EXPECT_NE(err.find("relative energy removed"), std::string::npos) << err;
+  EXPECT_NE(err.find("measured bias vs the analytic image: -"), std::string::npos) << err;
+}
+
 // Refusals exit 2. (The failing path, exit 1 with images written, needs a
 // planted fault: tests/test_faults.cpp.)
 TEST(CheckCli, RefusesScenesItCannotCheck) {

@@ -152,13 +152,13 @@ TEST(RenderUntil, TimeBudgetStopsWithinOnePassOfTheBudget) {
   rule.time_budget_seconds = 0.5;
   rule.pass_spp = 32;
   const UntilResult r = render_until(tracer, film, rule);
-  const double mean_pass = r.stats.render.seconds / r.passes;
+  const double mean_pass = r.stats.seconds / r.passes;
   EXPECT_GT(r.passes, 1u);
   EXPECT_EQ(r.spp, r.passes * rule.pass_spp);
   EXPECT_EQ(film.sample_count(5, 5), r.spp);
-  EXPECT_EQ(r.stats.render.samples, std::uint64_t{r.spp} * 32 * 24);
-  EXPECT_GE(r.stats.render.seconds, rule.time_budget_seconds - mean_pass);
-  EXPECT_LE(r.stats.render.seconds, rule.time_budget_seconds + r.last_pass_seconds);
+  EXPECT_EQ(r.stats.samples, std::uint64_t{r.spp} * 32 * 24);
+  EXPECT_GE(r.stats.seconds, rule.time_budget_seconds - mean_pass);
+  EXPECT_LE(r.stats.seconds, rule.time_budget_seconds + r.last_pass_seconds);
 }
 
 // Extending a film with render_samples gives the same image as one render.

@@ -581,7 +581,7 @@ TEST(SceneLoaderErrors, UnknownNamesSuggestTheNearest) {
   const std::string type = scene_text(R"({"m": {"type": "difuse"}})", "[]");
   expect_error(type, where_in(type, "\"type\""), "/materials/m/type", "unknown material type 'difuse' (did you mean 'diffuse'?)");
   const std::string other = scene_text(R"({"m": {"type": "glass"}})", "[]");
-  EXPECT_NE(error_of(other).find("expected diffuse, mirror or emissive"), std::string::npos) << error_of(other);
+  EXPECT_NE(error_of(other).find("expected diffuse, mirror, emissive, disney or dielectric"), std::string::npos) << error_of(other);
   const std::string ref = scene_text(kMaterials, R"([{"type": "sphere", "material": "whit"}])");
   expect_error(ref, where_in(ref, "\"material\""), "/shapes/0/material", "no material named 'whit' (did you mean 'white'?)");
   const std::string shape = scene_text(kMaterials, R"([{"type": "spere", "material": "white"}])");

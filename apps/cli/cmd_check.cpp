@@ -70,6 +70,25 @@ int CheckCommand::run(std::ostream& /*out*/, std::ostream& err) const {
       << ", threshold " << fmt("%.2f", r.bias_threshold) << ")" << (r.bias_pass ? "" : "  <- biased") << "\n"
       << "        RMSE " << fmt("%.3g", r.rmse) << ", relative MSE " << fmt("%.3g", r.rel_mse) << "\n";
   if (stats.bad_samples > 0) err << "  " << stats.bad_samples << " NaN/Inf sample(s) left out of the image\n";
+  if (settings.clamp > 0.0f || settings.min_pdf > 0.0f) {
+    // Firefly controls trade bias for variance: report the bias they
+    // introduce instead of passing or failing silently.
+    double rendered = 0.0, wanted = 0.0;
+    for (int y = 0; y < sc.film.height; ++y)
+      for (int x = 0; x < sc.film.width; ++x) {
+        rendered += average(film.mean(x, y));
+        wanted += average(expected.mean.at(x, y));
+      }
+    err << "  firefly controls on (clamp " << settings.clamp << ", min-pdf " << settings.min_pdf
+        << "): this check measures their bias, it does not test unbiasedness\n";
+    if (settings.clamp > 0.0f)
+      err << "    clamp: " << stats.clamped_samples << " of " << stats.samples << " samples clamped ("
+          << fmt("%.3g", 100.0 * static_cast<double>(stats.clamped_samples) / static_cast<double>(std::max<std::uint64_t>(stats.samples, 1)))
+          << " %), relative energy removed " << fmt("%.3g", stats.energy_total > 0.0 ? stats.energy_clamped / stats.energy_total : 0.0)
+          << "\n";
+    err << "    measured bias vs the analytic image: " << fmt("%+.3g", wanted > 0.0 ? rendered / wanted - 1.0 : 0.0)
+        << " relative (mean over the image)\n";
+  }
   err << "  worst pixels:\n";
   for (const PixelDeviation& p : r.worst)
     err << "    (" << p.x << ", " << p.y << ") " << channel[p.channel] << ": rendered " << fmt("%.5g", p.rendered)

@@ -82,7 +82,7 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
                                         scene.spp ? settings.spp : 1 << 24, 0},
                          [&](double f) { bar.update(f); });
   }
-  const RenderStats stats = progressive ? until->stats.render : render(driven, film, [&](double f) { bar.update(f); });
+  const RenderStats stats = progressive ? until->stats : render(driven, film, [&](double f) { bar.update(f); });
   const int spp_done = progressive ? static_cast<int>(until->spp) : settings.spp;
   bar.finish();
 

@@ -29,6 +29,15 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
       ->check(CLI::Range(0, kMaxVerticesUncapped));
   cmd.add_option("--seed", seed, "Random seed");
   cmd.add_option("--resolution", resolution, "Image size WxH, e.g. 640x480");
+  cmd.add_option("--bsdf-sampling", bsdf_sampling, "Glossy lobe sampling: vndf (exact GGX visible normals) or cospow")
+      ->check(CLI::IsMember({"vndf", "cospow"}));
+  cmd.add_option("--clamp", clamp, "Clamp each sample's radiance to this maximum component (biased; 0 = off)")
+      ->check(CLI::Range(0.0f, 3.4e38f));
+  cmd.add_option("--min-pdf", min_pdf, "Discard BSDF samples with a smaller density (biased; 0 = off)")
+      ->check(CLI::Range(0.0f, 3.4e38f));
+  cmd.add_flag("--general-shading", general_shading,
+               "Shade every material through the general Disney-capable code instead of code specialised to the "
+               "scene's lobes (same image, slower)");
 }
 
 Scene SceneOptions::load() const {
@@ -38,6 +47,10 @@ Scene SceneOptions::load() const {
   if (spp) r.spp = *spp;
   if (max_depth) r.max_depth = *max_depth;
   if (rr_depth) r.rr_depth = *rr_depth;
+  if (bsdf_sampling) r.bsdf_sampling = *parse_bsdf_sampling(*bsdf_sampling);
+  if (clamp) r.clamp = *clamp;
+  if (min_pdf) r.min_pdf = *min_pdf;
+  if (general_shading) r.force_general_shading = true;
   if (seed) {
     std::uint64_t value = 0;
     const char* end = seed->data() + seed->size();
@@ -68,6 +81,9 @@ std::string SceneOptions::trace_pixel_command(const Scene& scene, std::uint32_t 
   cmd << " --pixel " << x << "," << y << " --sample " << sample << " --seed " << scene.render.seed << " --tracer "
       << tracer << " --strategy " << strategy_name(scene.render.strategy) << " --max-depth " << scene.render.max_depth
       << " --rr-depth " << scene.render.rr_depth << " --resolution " << scene.film.width << "x" << scene.film.height;
+  if (scene.render.bsdf_sampling != BsdfSampling::Vndf) cmd << " --bsdf-sampling " << bsdf_sampling_name(scene.render.bsdf_sampling);
+  if (scene.render.min_pdf > 0.0f) cmd << " --min-pdf " << scene.render.min_pdf;
+  if (scene.render.force_general_shading) cmd << " --general-shading";
   return cmd.str();
 }
 

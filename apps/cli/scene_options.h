@@ -24,6 +24,9 @@ struct SceneOptions {
   std::optional<int> spp, max_depth, rr_depth;
   std::optional<std::string> seed;  // parsed by load(): CLI11 would wrap "-1" around
   std::optional<std::string> resolution;  // "WxH"
+  std::optional<std::string> bsdf_sampling;  // vndf | cospow
+  std::optional<float> clamp, min_pdf;       // firefly controls (biased; 0 = off)
+  bool general_shading = false;              // force the general shading path
 
   // Registers the options on `cmd`; `with_spp` for commands that render,
   // `allow_both` for trace-pixel's --tracer both.

@@ -1,0 +1,37 @@
+// Fresnel terms, in the local shading frame.
+//   schlick_weight(c)   (1 - c)^5, Schlick's interpolation weight
+//   schlick(F0, c)      F0 + (1 - F0) (1 - c)^5
+//   dielectric(c, eta)  exact unpolarised reflectance of a smooth interface,
+//                       eta = n_transmitted / n_incident, c = cos of the
+//                       incident angle (>= 0); 1 under total internal reflection
+#pragma once
+
+#include "core/math.h"
+
+namespace pathlab::fresnel {
+
+inline float schlick_weight(float c) {
+  // c is a dot product of unit vectors and can round a hair above 1 (or, for
+  // a denormal input, below 0): clamp so that the weight stays in [0, 1]
+  // and never turns negative.
+  const float m = std::clamp(1.0f - c, 0.0f, 1.0f);
+  const float m2 = m * m;
+  return m2 * m2 * m;
+}
+
+inline Spectrum schlick(const Spectrum& f0, float c) { return glm::mix(f0, Spectrum(1.0f), schlick_weight(c)); }
+inline float schlick(float f0, float c) { return f0 + (1.0f - f0) * schlick_weight(c); }
+
+// Unpolarised Fresnel reflectance of a smooth dielectric interface.
+inline float dielectric(float cos_i, float eta) {
+  cos_i = std::clamp(cos_i, 0.0f, 1.0f);
+  const float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
+  if (sin2_t >= 1.0f) return 1.0f;  // total internal reflection
+  const float cos_t = std::sqrt(1.0f - sin2_t);
+  const float r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+  const float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+  // At cos_i = 0 both ratios are -1 exactly (denominators > 0 since cos_t > 0).
+  return 0.5f * (r_par * r_par + r_perp * r_perp);
+}
+
+}  // namespace pathlab::fresnel
