@@ -109,15 +109,20 @@ void fill(RTCRay& r, const Ray& ray) {
   r.flags = 0;
 }
 
+// A closest-hit query for `ray`, with no hit yet.
+void fill(RTCRayHit& rh, const Ray& ray) {
+  fill(rh.ray, ray);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
 }  // namespace
 
 bool EmbreeAccel::intersect(const Ray& ray, RayHit* hit) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
-  fill(rh.ray, ray);
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  fill(rh, ray);
   rtcIntersect1(impl_->scene, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit->t = rh.ray.tfar;
@@ -185,9 +190,7 @@ void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> h
     case RayBatchMode::Single:
       for (std::size_t i = 0; i < rays.size(); ++i) {
         RTCRayHit rh;
-        fill(rh.ray, rays[i]);
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        fill(rh, rays[i]);
         rtcIntersect1(impl_->scene, &context, &rh);
         record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v);
       }
@@ -210,11 +213,7 @@ void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> h
     case RayBatchMode::Stream: {
       thread_local std::vector<RTCRayHit> buffer;
       buffer.resize(rays.size());
-      for (std::size_t i = 0; i < rays.size(); ++i) {
-        fill(buffer[i].ray, rays[i]);
-        buffer[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        buffer[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-      }
+      for (std::size_t i = 0; i < rays.size(); ++i) fill(buffer[i], rays[i]);
       rtcIntersect1M(impl_->scene, &context, buffer.data(), static_cast<unsigned>(buffer.size()), sizeof(RTCRayHit));
       for (std::size_t i = 0; i < rays.size(); ++i) {
         const RTCRayHit& rh = buffer[i];

@@ -85,11 +85,7 @@ UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule,
     }
     const std::uint32_t last = std::min(max_spp, r.spp + pass);
     const RenderStats s = render_samples(tracer, film, r.spp, last);
-    r.stats.samples += s.samples;
-    r.stats.rays += s.rays;
-    r.stats.clamped_samples += s.clamped_samples;
-    r.stats.energy_total += s.energy_total;
-    r.stats.energy_clamped += s.energy_clamped;
+    r.stats += s;
     r.last_pass_seconds = s.seconds;
     r.spp = last;
     ++r.passes;

@@ -22,6 +22,17 @@ struct RenderStats {
   std::uint64_t clamped_samples = 0;
   double energy_total = 0.0;
   double energy_clamped = 0.0;
+
+  // Adds the counts of another render of the same film (seconds and
+  // bad_samples, which describe the whole film, are left to the caller).
+  RenderStats& operator+=(const RenderStats& o) {
+    samples += o.samples;
+    rays += o.rays;
+    clamped_samples += o.clamped_samples;
+    energy_total += o.energy_total;
+    energy_clamped += o.energy_clamped;
+    return *this;
+  }
 };
 
 // Called after each batch with the fraction done (0..1].

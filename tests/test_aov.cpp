@@ -2,7 +2,7 @@
 // from the scene (albedo of the wall a pixel sees, unit normals, positive
 // depths), the film (variance) and the tracer's FilmSamples (path length).
 #include "apps/cli/cli.h"
-#include "apps/cli/scene_options.h"
+#include "debugtools/tracers.h"
 #include "core/compiled_scene.h"
 #include "core/film.h"
 #include "core/image_io.h"
@@ -87,7 +87,7 @@ TEST_F(AovTest, RenderWritesNamedLayers) {
 struct AovRender {
   AovRender(int res, int spp, FilterKind filter, const std::string& tracer_name)
       : compiled(test::small_cornell(res, spp, filter)),
-        tracer(cli::make_tracer(tracer_name, compiled, compiled.scene().render)),
+        tracer(make_tracer(tracer_name, compiled, compiled.scene().render)),
         aovs(compiled, compiled.scene().render),
         film(res, res, filter) {
     render(AovTracer(*tracer, aovs), film);

@@ -2,7 +2,7 @@
 // polyline per path and one two-point line per shadow ray, with the point
 // arrays of docs/path-vtk.md holding the recorded events' values.
 #include "apps/cli/cli.h"
-#include "apps/cli/scene_options.h"
+#include "debugtools/tracers.h"
 #include "core/compiled_scene.h"
 #include "core/scene_loader.h"
 #include "core/tracer.h"
@@ -42,7 +42,7 @@ Expected record(const std::string& tracer, std::uint32_t x, std::uint32_t y, std
   const CompiledScene compiled(std::move(scene));
   Expected e;
   e.escape_length = 2.0f * compiled.bounds_radius();
-  const auto t = cli::make_tracer(tracer, compiled, settings);
+  const auto t = make_tracer(tracer, compiled, settings);
   for (std::uint32_t s = 0; s < samples; ++s) t->trace_sample(x, y, s, &e.paths.emplace_back());
   return e;
 }

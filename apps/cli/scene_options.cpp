@@ -3,8 +3,6 @@
 #include "core/compiled_scene.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
-#include "reference/reference_tracer.h"
-#include "wavefront/wavefront_tracer.h"
 
 #include <charconv>
 #include <sstream>
@@ -85,12 +83,6 @@ std::string SceneOptions::trace_pixel_command(const Scene& scene, std::uint32_t 
   if (scene.render.min_pdf > 0.0f) cmd << " --min-pdf " << scene.render.min_pdf;
   if (scene.render.force_general_shading) cmd << " --general-shading";
   return cmd.str();
-}
-
-std::unique_ptr<Tracer> make_tracer(const std::string& name, const CompiledScene& scene, const RenderSettings& settings) {
-  if (name == "reference") return std::make_unique<ReferenceTracer>(scene, settings);
-  if (name == "wavefront") return std::make_unique<WavefrontTracer>(scene, settings);
-  throw InputError("unknown tracer '" + name + "' (expected reference or wavefront)");
 }
 
 }  // namespace pathlab::cli

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/scene.h"
+#include "debugtools/tracers.h"
 
 #include <CLI/CLI.hpp>
 
@@ -41,7 +42,7 @@ struct SceneOptions {
 // Parses --resolution "WxH" into `film`. Throws InputError.
 void apply_resolution(const std::string& text, FilmDesc& film);
 
-// Builds the named tracer. Throws InputError for an unknown name.
-std::unique_ptr<Tracer> make_tracer(const std::string& name, const CompiledScene& scene, const RenderSettings& settings);
+// The tracers by name live in debugtools/tracers.h (shared with pathlab-debug).
+using pathlab::make_tracer;
 
 }  // namespace pathlab::cli

@@ -8,9 +8,8 @@
 #include "core/scene_loader.h"
 #include "core/tracer.h"
 #include "debugtools/aov.h"
+#include "debugtools/tracers.h"
 #include "debugtools/vtk_export.h"
-#include "reference/reference_tracer.h"
-#include "wavefront/wavefront_tracer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -18,12 +17,6 @@
 
 namespace pathlab::debug {
 namespace {
-
-std::unique_ptr<Tracer> make_tracer(const std::string& name, const CompiledScene& scene, const RenderSettings& s) {
-  if (name == "reference") return std::make_unique<ReferenceTracer>(scene, s);
-  if (name == "wavefront") return std::make_unique<WavefrontTracer>(scene, s);
-  throw InputError("unknown tracer '" + name + "' (expected reference or wavefront)");
-}
 
 Scene load(const SessionSettings& s) {
   Scene scene = s.scene_file.empty() ? builtin_cornell_box() : load_scene(s.scene_file);
