@@ -15,6 +15,7 @@
 //                  every range: no NaN, no Inf, no negative value.
 #pragma once
 
+#include "core/bsdf/cospow.h"
 #include "core/bsdf/disney.h"
 #include "core/bsdf/quadrature.h"
 #include "core/material.h"
@@ -76,12 +77,28 @@ inline Material configured(Material m, BsdfSampling sampling, bool force_general
 }
 
 // Where the lobes of `c` peak for view wo (the quadrature refines there).
-// A reflected microfacet lobe of width alpha is squeezed across the plane
-// of incidence by the Jacobian 1 / (4 wo.h): at grazing views it is only
-// ~2 alpha wo.z wide, so the width the quadrature must resolve shrinks with
-// wo.z (floored at 1e-4 of it).
-inline std::vector<quadrature::Peak> peaks_of(const disney::Closure& c, const vec3& wo) {
+// The quadrature trusts these widths: a cell many widths from a peak may be
+// tall enough to step over it, so a width must never exceed the lobe's.
+//  - A reflected microfacet lobe (f, and the vndf pdf) of width alpha is
+//    squeezed across the plane of incidence by the Jacobian 1 / (4 wo.h):
+//    at grazing views it is only ~2 alpha wo.z wide, so the width across
+//    shrinks with wo.z (floored at 1e-4 of it).
+//  - The cospow pdf is a round lobe about the mirror direction, ~1/sqrt(n)
+//    wide both ways. Given the squeezed widths, the quadrature found 0.275
+//    of a lobe that is 0.84 above the horizon (n = 1e6, wo.z = 1e-3).
+inline std::vector<quadrature::Peak> peaks_of(const disney::Closure& c, const vec3& wo,
+                                              std::optional<BsdfSampling> pdf_of = std::nullopt) {
   const vec3 r(-wo.x, -wo.y, wo.z);
+  if (pdf_of == BsdfSampling::Cospow) {
+    // cos^n vanishes at the lobe's rim, 90 degrees from r, except for n = 0
+    // (alpha >= 1), a uniform hemisphere: a jump there.
+    const auto peak = [&](float alpha) {
+      const float n = cospow::exponent_from_alpha(alpha);
+      const double w = 1.0 / std::sqrt(1.0 + n);
+      return quadrature::Peak{r, w, w, n < 1.0f};
+    };
+    return {peak(std::sqrt(c.ax * c.ay)), peak(c.clearcoat_alpha)};
+  }
   const double squeeze = std::max(1e-4, static_cast<double>(wo.z));
   const double a = std::min(c.ax, c.ay);
   return {{r, a, squeeze * a}, {r, static_cast<double>(c.clearcoat_alpha), squeeze * c.clearcoat_alpha}};
@@ -192,7 +209,7 @@ inline Target material_target(const std::string& name, const Material& m, const 
                   return bs->wi;
                 },
                 [mat, wo](const vec3& wi) { return static_cast<double>(flat_surfel(*mat).pdf(wi, wo)); },
-                peaks_of(mat->closure, wo)};
+                peaks_of(mat->closure, wo, mat->shading.sampling)};
 }
 
 // One lobe family alone.
@@ -201,7 +218,7 @@ inline Target lobe_target(const std::string& name, const disney::Closure& c, dis
   return Target{name,
                 [c, lobe, wo, sampling](float, vec2 u) { return disney::lobe_sample(c, lobe, wo, u, sampling); },
                 [c, lobe, wo, sampling](const vec3& wi) { return static_cast<double>(disney::lobe_pdf(c, lobe, wo, wi, sampling)); },
-                peaks_of(c, wo)};
+                peaks_of(c, wo, sampling)};
 }
 
 // --- consistency ---------------------------------------------------------------
