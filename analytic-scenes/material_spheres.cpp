@@ -68,7 +68,7 @@ class RoughSphere final : public AnalyticModel {
     const DisneyParams& q = m.disney;
     const std::vector<float> key{q.base_color.x, q.base_color.y, q.base_color.z, q.metallic, q.subsurface, q.specular,
                                  q.specular_tint, q.roughness, q.sheen, q.sheen_tint, q.clearcoat, q.clearcoat_gloss,
-                                 depth == 0 ? 0.0f : 1.0f};
+                                 q.energy_compensation ? 1.0f : 0.0f, depth == 0 ? 0.0f : 1.0f};
     const std::lock_guard<std::mutex> lock(mutex);
     if (const auto it = cache.find(key); it != cache.end()) {
       albedo_ = it->second;

@@ -23,6 +23,8 @@ enum class Fault {
   SmithG1Dropped,         // bsdf/disney.cpp: the specular f loses the masking G1(wi) of the light direction
   SpecularNoDenominator,  // bsdf/disney.cpp: the specular f = D F G without its 1 / (4 cos_i cos_o)
   HorizonUnclamped,       // bsdf/disney.cpp: eval and pdf no longer return 0 for wi below the surface
+  CoatNotCoupled,         // bsdf/disney.cpp: energy compensation forgets to dim what lies under the clearcoat
+  DiffuseNotCoupled,      // bsdf/disney.cpp: energy compensation forgets to dim the diffuse under the specular layer
   DielectricFresnelIgnored,// surfel.cpp: glass always refracts (Fresnel reflection dropped, TIR kept)
 };
 

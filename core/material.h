@@ -31,6 +31,10 @@
 //     sheen_tint      tints the sheen towards base_color                default 0.5
 //     clearcoat       strength of the GTR1 clear coat (weight 0.25 x)   default 0
 //     clearcoat_gloss GTR1 alpha = mix(0.1, 0.001, clearcoat_gloss)     default 1
+//     energy_compensation  bool: couple the lobes as layers so that the   default false
+//                     directional albedo never exceeds 1 (core/bsdf/energy.h);
+//                     false is Burley's published model, which reflects up
+//                     to 1.65x the incident light at grazing views
 //     emission, two_sided, light        as for "diffuse"
 //
 //   type "dielectric" smooth glass: Fresnel reflection + Snell refraction

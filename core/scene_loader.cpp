@@ -314,8 +314,8 @@ Material read_material(const Node& node, const std::string& name) {
                       {"baseColor", "parameters are snake_case: 'base_color'"},
                       {"radiance", "emitted light is 'emission'"}});
     node.allow_only({"type", "base_color", "metallic", "subsurface", "specular", "specular_tint", "roughness",
-                     "anisotropic", "sheen", "sheen_tint", "clearcoat", "clearcoat_gloss", "emission", "two_sided",
-                     "light"});
+                     "anisotropic", "sheen", "sheen_tint", "clearcoat", "clearcoat_gloss", "energy_compensation", "emission",
+                     "two_sided", "light"});
     DisneyParams p;
     if (node.has("base_color")) p.base_color = node.child("base_color").color(true);
     p.metallic = unit_number(node, "metallic", p.metallic);
@@ -329,6 +329,7 @@ Material read_material(const Node& node, const std::string& name) {
     p.sheen_tint = unit_number(node, "sheen_tint", p.sheen_tint);
     p.clearcoat = unit_number(node, "clearcoat", p.clearcoat);
     p.clearcoat_gloss = unit_number(node, "clearcoat_gloss", p.clearcoat_gloss);
+    p.energy_compensation = node.boolean_or("energy_compensation", false);
     const std::string keep = m.name;
     m = disney_material(p);
     m.name = keep;

@@ -281,6 +281,24 @@ inline dvec3 albedo_quadrature(const Material& m, const vec3& wo) {
       [&](double z, double phi) { return dvec3(s.eval(quadrature::dir_of(z, phi), wo)); }, peaks_of(m.closure, wo), 1e-5);
 }
 
+// The second moment of a sample's weight, E[w^2] = integral of (f cos)^2 /
+// pdf, by quadrature: the standard error of the Monte Carlo albedo without
+// trusting the sample. Where most weights are equal and a rare few are not
+// (a near-mirror metal: w = F G1(wi) = 1 except for the 1e-4 of samples
+// that masking or the horizon takes), 20,000 samples may see none of the
+// rare ones and report a standard error of ~0.
+inline dvec3 weight_second_moment_quadrature(const Material& m, const vec3& wo) {
+  const Surfel s = flat_surfel(m);
+  return quadrature::integrate_hemisphere(
+      [&](double z, double phi) {
+        const vec3 wi = quadrature::dir_of(z, phi);
+        const double pdf = s.pdf(wi, wo);
+        const dvec3 f(s.eval(wi, wo));
+        return pdf > 0.0 ? f * f / pdf : dvec3(0.0);
+      },
+      peaks_of(m.closure, wo, m.shading.sampling), 1e-5);
+}
+
 // ... and by Monte Carlo (mean weight), with its standard error.
 inline std::pair<dvec3, dvec3> albedo_monte_carlo(const Material& m, const vec3& wo, long n, std::uint64_t seed) {
   const Surfel s = flat_surfel(m);

@@ -4,6 +4,7 @@
 // is forced, is a closure with only a Lambert weight.
 #pragma once
 
+#include "core/bsdf/energy.h"
 #include "core/bsdf/gtr1.h"
 #include "core/bsdf/microfacet.h"
 #include "core/math.h"
@@ -23,6 +24,8 @@ struct DisneyParams {
   float sheen_tint = 0.5f;
   float clearcoat = 0.0f;
   float clearcoat_gloss = 1.0f;
+  // Couple the lobes so that no light is created (core/bsdf/energy.h).
+  bool energy_compensation = false;
 };
 
 namespace disney {
@@ -38,6 +41,7 @@ struct Closure {
   float ax = 1.0f, ay = 1.0f;
   float clearcoat = 0.0f;   // 0.25 clearcoat
   float clearcoat_alpha = 0.1f;
+  EnergyTables energy{};    // on: the lobes are coupled (energy.h)
 };
 
 inline Closure make_closure(const DisneyParams& p) {
@@ -56,6 +60,7 @@ inline Closure make_closure(const DisneyParams& p) {
   c.ay = a.y;
   c.clearcoat = 0.25f * p.clearcoat;
   c.clearcoat_alpha = gtr1::alpha_from_gloss(p.clearcoat_gloss);
+  if (p.energy_compensation) c.energy = make_energy_tables(c);
   return c;
 }
 

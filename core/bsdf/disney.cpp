@@ -114,6 +114,11 @@ LobeProbabilities lobe_probabilities(const Closure& c, const vec3& wo, unsigned 
     e[2] = c.clearcoat * (0.04f + 0.96f * Fw);
     present[2] = c.clearcoat > 0.0f;
   }
+  if (c.energy.on) {  // what the layers above let through, seen from wo
+    const float coat = (features & kClearcoat) ? c.energy.coat_transmit(wo.z) : 1.0f;
+    e[0] *= coat * luminance(c.energy.diffuse_scale * c.energy.specular_transmit(wo.z));
+    e[1] *= coat;
+  }
   // Cospow: a cosine-power tail decays exponentially where GGX's decays as
   // a power, so f / pdf would be unbounded (it overflows at exponent 1e6).
   // The cosine lobe is always kept (at least the 5 % floor) as a defensive
@@ -145,11 +150,16 @@ template <unsigned F> Spectrum eval(const Closure& c, const vec3& wo, const vec3
     const float LdotH = std::max(0.0f, glm::dot(wi, h));
     const float FH = fresnel::schlick_weight(LdotH);
     if constexpr ((F & kDisneyLobes) != 0) {
-      f += c.diffuse * disney_diffuse::eval_cos(c.roughness, c.subsurface, NL, NV, LdotH);
-      f += c.sheen * sheen::eval_cos(NL, LdotH);
-      f += c.specular * specular_eval(c, wo, wi, h, FH);
+      Spectrum base = c.diffuse * disney_diffuse::eval_cos(c.roughness, c.subsurface, NL, NV, LdotH) +
+                      c.sheen * sheen::eval_cos(NL, LdotH);
+      if (c.energy.on && !PATHLAB_FAULT(DiffuseNotCoupled))
+        base *= c.energy.diffuse_scale * c.energy.specular_transmit(NV) * c.energy.specular_transmit(NL);
+      f += base + c.specular * specular_eval(c, wo, wi, h, FH);
     }
-    if constexpr ((F & kClearcoat) != 0) f += Spectrum(clearcoat_eval(c, wo, wi, h, FH));
+    if constexpr ((F & kClearcoat) != 0) {
+      if (c.energy.on && !PATHLAB_FAULT(CoatNotCoupled)) f *= c.energy.coat_transmit(NV) * c.energy.coat_transmit(NL);
+      f += Spectrum(clearcoat_eval(c, wo, wi, h, FH));
+    }
   }
   return f;
 }

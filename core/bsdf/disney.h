@@ -9,6 +9,9 @@
 //     + D_GTR2 F_s G_s / (4 NL NV)        F_s = mix(Cspec0, 1, FH)
 //     + 0.25 clearcoat D_GTR1 F_r G_r / (4 NL NV)    F_r = mix(0.04, 1, FH)
 //   Cspec0 = mix(0.08 specular mix(1, Ctint, specular_tint), Cd, metallic)
+// With energy_compensation the lobes are coupled as a coated surface's
+// (energy.h): the diffuse family is scaled by k Ts(NV) Ts(NL) and
+// everything under the clearcoat by Tc(NV) Tc(NL).
 //
 // Everything works in the local shading frame with wo on the +z side (the
 // Surfel flips the frame; the BRDF is two-sided) and returns f cos(theta_i).
@@ -65,8 +68,9 @@ std::optional<DirectionSample> sample(const Closure& c, const vec3& wo, float u_
 
 LobeProbabilities lobe_probabilities(const Closure& c, const vec3& wo, unsigned features, BsdfSampling sampling);
 
-// One lobe family alone (for the tests: chi-square per lobe). eval is f cos
-// of that family only.
+// One lobe family alone (the per-lobe chi-square tests; the energy tables).
+// eval is f cos of that family only, as Burley defines it: without the
+// coupling of energy compensation.
 Spectrum lobe_eval(const Closure& c, SampledLobe lobe, const vec3& wo, const vec3& wi);
 float lobe_pdf(const Closure& c, SampledLobe lobe, const vec3& wo, const vec3& wi, BsdfSampling sampling);
 std::optional<vec3> lobe_sample(const Closure& c, SampledLobe lobe, const vec3& wo, vec2 u, BsdfSampling sampling);
