@@ -150,7 +150,9 @@ std::unique_ptr<AnalyticModel> make_rough_sphere_in_environment(const Scene& sce
   const int D = scene.render.max_depth;
   std::ostringstream d;
   d << "disney sphere '" << m.name << "' base_color " << fmt(m.disney.base_color) << " metallic " << m.disney.metallic
-    << " roughness " << m.disney.roughness << " in environment " << fmt(*scene.environment) << ", depth cap " << D
+    << " roughness " << m.disney.roughness << (m.disney.clearcoat > 0.0f ? ", clear-coated" : "")
+    << (m.disney.energy_compensation ? ", energy-compensated" : "") << " in environment " << fmt(*scene.environment)
+    << ", depth cap " << D
     << ": L x directional albedo by quadrature";
   return std::make_unique<RoughSphere>(s, *scene.environment, m, D, d.str());
 }
