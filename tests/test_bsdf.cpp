@@ -18,37 +18,28 @@ using namespace test::bsdf;
 
 std::vector<Material> materials_over_the_grid(BsdfSampling sampling) {
   std::vector<Material> out;
+  const auto add = [&](float r, float a, float m, float c, bool compensated) {
+    DisneyParams p;
+    p.base_color = Spectrum(0.9f, 0.6f, 0.3f);
+    p.subsurface = 0.3f;
+    p.sheen = 0.5f;
+    p.specular_tint = 0.2f;
+    p.roughness = r;
+    p.anisotropic = a;
+    p.metallic = m;
+    p.clearcoat = c;
+    p.energy_compensation = compensated;
+    out.push_back(configured(disney_material(p), sampling));
+  };
   for (const float r : {0.001f, 0.01f, 0.1f, 0.5f, 1.0f})
     for (const float a : {0.0f, 0.5f, 0.9f})
       for (const float m : {0.0f, 1.0f})
-        for (const float c : {0.0f, 1.0f}) {
-          DisneyParams p;
-          p.base_color = Spectrum(0.9f, 0.6f, 0.3f);
-          p.subsurface = 0.3f;
-          p.sheen = 0.5f;
-          p.specular_tint = 0.2f;
-          p.roughness = r;
-          p.anisotropic = a;
-          p.metallic = m;
-          p.clearcoat = c;
-          out.push_back(configured(disney_material(p), sampling));
-        }
+        for (const float c : {0.0f, 1.0f}) add(r, a, m, c, false);
   // Energy compensation changes eval and the lobe choice: a sub-grid.
   for (const float r : {0.01f, 0.5f, 1.0f})
     for (const float a : {0.0f, 0.9f})
       for (const float m : {0.0f, 1.0f})
-        for (const float c : {0.0f, 1.0f}) {
-          DisneyParams p;
-          p.base_color = Spectrum(0.9f, 0.6f, 0.3f);
-          p.subsurface = 0.3f;
-          p.sheen = 0.5f;
-          p.roughness = r;
-          p.anisotropic = a;
-          p.metallic = m;
-          p.clearcoat = c;
-          p.energy_compensation = true;
-          out.push_back(configured(disney_material(p), sampling));
-        }
+        for (const float c : {0.0f, 1.0f}) add(r, a, m, c, true);
   out.push_back(configured(diffuse_material(Spectrum(0.2f, 0.5f, 0.8f)), sampling));
   return out;
 }
