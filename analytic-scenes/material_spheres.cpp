@@ -82,9 +82,8 @@ class RoughSphere final : public AnalyticModel {
                                                  std::max(1e-4, static_cast<double>(mu)) * c.ax}};
       Spectrum a(0.0f);
       if (depth != 0 && mu > 0.0f)
-        a = Spectrum(quadrature::integrate_hemisphere(
-            [&](double z, double phi) { return dvec3(disney::eval<disney::kGeneral>(c, wo, quadrature::dir_of(z, phi))); },
-            peaks, 1e-6, 4, 8));
+        a = Spectrum(quadrature::integrate_directions(
+            [&](const vec3& wi) { return dvec3(disney::eval<disney::kGeneral>(c, wo, wi)); }, peaks, 1e-6, 4, 8));
       albedo_[i] = a;
     }
     cache[key] = albedo_;

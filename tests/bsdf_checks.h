@@ -277,8 +277,8 @@ inline void consistency(const Material& m, const vec3& wo, long n, std::uint64_t
 // Directional albedo of the material seen from wo, per channel, by quadrature.
 inline dvec3 albedo_quadrature(const Material& m, const vec3& wo) {
   const Surfel s = flat_surfel(m);
-  return quadrature::integrate_hemisphere(
-      [&](double z, double phi) { return dvec3(s.eval(quadrature::dir_of(z, phi), wo)); }, peaks_of(m.closure, wo), 1e-5);
+  return quadrature::integrate_directions([&](const vec3& wi) { return dvec3(s.eval(wi, wo)); }, peaks_of(m.closure, wo),
+                                          1e-5);
 }
 
 // The second moment of a sample's weight, E[w^2] = integral of (f cos)^2 /
@@ -289,9 +289,8 @@ inline dvec3 albedo_quadrature(const Material& m, const vec3& wo) {
 // rare ones and report a standard error of ~0.
 inline dvec3 weight_second_moment_quadrature(const Material& m, const vec3& wo) {
   const Surfel s = flat_surfel(m);
-  return quadrature::integrate_hemisphere(
-      [&](double z, double phi) {
-        const vec3 wi = quadrature::dir_of(z, phi);
+  return quadrature::integrate_directions(
+      [&](const vec3& wi) {
         const double pdf = s.pdf(wi, wo);
         const dvec3 f(s.eval(wi, wo));
         return pdf > 0.0 ? f * f / pdf : dvec3(0.0);

@@ -79,9 +79,8 @@ TEST(EnergyTables, BoundTheLayersAlbedoAtEveryView) {
         const float s = std::sqrt(1.0f - mu * mu);
         const vec3 wo(s * std::cos(0.3f), s * std::sin(0.3f), mu);
         for (const auto lobe : {disney::SampledLobe::Specular, disney::SampledLobe::Clearcoat}) {
-          const dvec3 albedo = quadrature::integrate_hemisphere(
-              [&](double z, double phi) { return dvec3(disney::lobe_eval(bare, lobe, wo, quadrature::dir_of(z, phi))); },
-              peaks_of(bare, wo), 1e-6);
+          const dvec3 albedo = quadrature::integrate_directions(
+              [&](const vec3& wi) { return dvec3(disney::lobe_eval(bare, lobe, wo, wi)); }, peaks_of(bare, wo), 1e-6);
           const Spectrum bound = lobe == disney::SampledLobe::Specular ? Spectrum(1.0f) - t.specular_transmit(mu)
                                                                         : Spectrum(1.0f - t.coat_transmit(mu));
           for (int k = 0; k < 3; ++k) {

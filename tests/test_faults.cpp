@@ -134,37 +134,34 @@ TEST_F(PlantedBsdfFault, EnergyCatchesSpecularWithoutDenominator) {
 }
 
 // The energy check with compensation on (albedo <= 1 for every
-// configuration) against a coupling that forgets one of its layers.
-double compensated_albedo(float metallic, float clearcoat, float cos_view) {
-  DisneyParams p;
-  p.base_color = Spectrum(1.0f);
-  p.metallic = metallic;
-  p.clearcoat = clearcoat;
-  p.roughness = 0.1f;
-  p.energy_compensation = true;
-  const Material m = test::bsdf::configured(disney_material(p), BsdfSampling::Vndf);
-  const dvec3 a = test::bsdf::albedo_quadrature(m, test::bsdf::view_dir(cos_view));
-  return std::max(a.x, std::max(a.y, a.z));
+// configuration) against a coupling that forgets one of its layers: the
+// control passes, the fault pushes a white material above 1 at view cos 0.1.
+void expect_energy_check_catches(Fault fault, float metallic, float clearcoat, const char* what) {
+  const auto albedo = [&] {
+    DisneyParams p;
+    p.base_color = Spectrum(1.0f);
+    p.metallic = metallic;
+    p.clearcoat = clearcoat;
+    p.roughness = 0.1f;
+    p.energy_compensation = true;
+    const Material m = test::bsdf::configured(disney_material(p), BsdfSampling::Vndf);
+    const dvec3 a = test::bsdf::albedo_quadrature(m, test::bsdf::view_dir(0.1f));
+    return std::max(a.x, std::max(a.y, a.z));
+  };
+  const double control = albedo();
+  EXPECT_LE(control, 1.0 + 1e-4);
+  g_fault = fault;
+  const double faulty = albedo();
+  std::printf("[ fault    ] %s: albedo at view cos 0.1 %.4f (control %.4f)\n", what, faulty, control);
+  EXPECT_GT(faulty, 1.0 + 1e-4);
 }
 
 TEST_F(PlantedBsdfFault, EnergyCatchesCoatNotCoupled) {
-  const double control = compensated_albedo(1.0f, 1.0f, 0.1f);
-  EXPECT_LE(control, 1.0 + 1e-4);
-  g_fault = Fault::CoatNotCoupled;
-  const double faulty = compensated_albedo(1.0f, 1.0f, 0.1f);
-  std::printf("[ fault    ] clearcoat not coupled: albedo of a coated white metal at view cos 0.1 %.4f (control %.4f)\n",
-              faulty, control);
-  EXPECT_GT(faulty, 1.0 + 1e-4);
+  expect_energy_check_catches(Fault::CoatNotCoupled, 1.0f, 1.0f, "clearcoat not coupled, coated white metal");
 }
 
 TEST_F(PlantedBsdfFault, EnergyCatchesDiffuseNotCoupled) {
-  const double control = compensated_albedo(0.0f, 0.0f, 0.1f);
-  EXPECT_LE(control, 1.0 + 1e-4);
-  g_fault = Fault::DiffuseNotCoupled;
-  const double faulty = compensated_albedo(0.0f, 0.0f, 0.1f);
-  std::printf("[ fault    ] diffuse not coupled: albedo of a white dielectric at view cos 0.1 %.4f (control %.4f)\n",
-              faulty, control);
-  EXPECT_GT(faulty, 1.0 + 1e-4);
+  expect_energy_check_catches(Fault::DiffuseNotCoupled, 0.0f, 0.0f, "diffuse not coupled, white dielectric");
 }
 
 TEST_F(PlantedBsdfFault, ExtremesCatchHorizonUnclamped) {

@@ -55,9 +55,8 @@ Spectrum family_albedo(const Closure& c, SampledLobe lobe, const vec3& wo) {
 // The diffuse family's albedo seen from view cosine mu, by quadrature.
 Spectrum diffuse_albedo(const Closure& c, float mu) {
   const vec3 wo = view(mu, 0.0f);
-  return Spectrum(quadrature::integrate_hemisphere(
-      [&](double z, double phi) { return dvec3(lobe_eval(c, SampledLobe::Diffuse, wo, quadrature::dir_of(z, phi))); }, {},
-      1e-5));
+  return Spectrum(quadrature::integrate_directions(
+      [&](const vec3& wi) { return dvec3(lobe_eval(c, SampledLobe::Diffuse, wo, wi)); }, {}, 1e-5));
 }
 
 // The largest albedo over the view azimuths that matter: one for an
@@ -76,13 +75,14 @@ EnergyTables compute(const Closure& compensated) {
   Closure c = compensated;
   c.energy = EnergyTables{};  // the lobes as Burley defines them
   constexpr int kPoints = (kEnergyTableSize - 1) * kSub + 1;
-  std::vector<Spectrum> es(kPoints), ec(kPoints, Spectrum(0.0f));
+  std::vector<Spectrum> es(kPoints);
+  std::vector<float> ec(kPoints, 0.0f);  // the clearcoat is white: one channel
   Spectrum diffuse_max(0.0f);
   for (int p = 0; p < kPoints; ++p) {
     const float x = static_cast<float>(p) / static_cast<float>(kPoints - 1);
     const float mu = x * x;
     es[p] = worst_albedo(c, SampledLobe::Specular, mu);
-    if (c.clearcoat > 0.0f) ec[p] = worst_albedo(c, SampledLobe::Clearcoat, mu);
+    if (c.clearcoat > 0.0f) ec[p] = worst_albedo(c, SampledLobe::Clearcoat, mu).x;
   }
   for (const float mu : kDiffuseViews) diffuse_max = glm::max(diffuse_max, diffuse_albedo(c, mu));
   EnergyTables t;
@@ -93,7 +93,7 @@ EnergyTables compute(const Closure& compensated) {
     float k = 0.0f;
     for (int p = std::max(0, (i - 1) * kSub); p <= std::min(kPoints - 1, (i + 1) * kSub); ++p) {
       s = glm::max(s, es[p]);
-      k = std::max(k, ec[p].x);
+      k = std::max(k, ec[p]);
     }
     t.specular[i] = glm::min(Spectrum(1.0f), s + kEnergyMargin);
     t.coat[i] = c.clearcoat > 0.0f ? std::min(1.0f, k + kEnergyMargin) : 0.0f;

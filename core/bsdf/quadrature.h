@@ -151,4 +151,11 @@ detail::value_of<F> integrate_hemisphere(const F& f, const std::vector<Peak>& pe
   return sum;
 }
 
+// The same, for an integrand of the direction (a unit vec3 from dir_of): the
+// form every BSDF integral takes (albedos, densities, moments).
+template <typename F>
+auto integrate_directions(const F& f, const std::vector<Peak>& peaks, double tol, int nz = 8, int nphi = 16) {
+  return integrate_hemisphere([&](double z, double phi) { return f(dir_of(z, phi)); }, peaks, tol, nz, nphi);
+}
+
 }  // namespace pathlab::quadrature
