@@ -8,24 +8,29 @@
 
 namespace pathlab {
 
-// The state of every path of a wave, one array per field. Paths keep their
-// slot for the whole wave; `live` lists the slots still being traced, in
-// slot order, and is compacted after each bounce. One thread runs a wave
+// The state of every path of a wave, one array per field. The paths still
+// being traced occupy slots [0, n), in the order they were created: after
+// each bounce compact() writes out the finished ones and moves the
+// survivors down (a stable compaction), so every stage walks its arrays
+// front to back with no index list and no holes. One thread runs a wave
 // through all its stages; threads run different waves.
 struct WavefrontTracer::Wave {
-  // Identity and output.
+  std::size_t n = 0;  // live paths
+  // Identity and output. x, y and sample are read only when the camera ray
+  // is made; the rest is moved with the path.
   std::vector<std::uint32_t> out_index, x, y, sample;
   std::vector<SampleStream> rng;
   std::vector<vec2> film;
-  // The path so far.
+  // The path so far; moved with the path.
   std::vector<Ray> ray;
   std::vector<Spectrum> beta, L;
   std::vector<PreviousVertex> prev;
   std::vector<std::int32_t> vertex;  // the vertex the current ray will reach
   std::vector<std::uint32_t> rays;
+  // This bounce only.
   std::vector<std::uint8_t> alive;
-  // This bounce.
   std::vector<Surfel> surfel;
+  std::vector<RayHit> hit;
   std::vector<std::uint8_t> found;
   // Two shadow rays per path: [0] a point light, [1] an area light.
   std::vector<Ray> shadow;
@@ -33,22 +38,19 @@ struct WavefrontTracer::Wave {
   std::vector<Spectrum> unoccluded;  // f Le w / pdf, before visibility
   std::vector<float> light_weight;
   std::vector<std::uint8_t> shadow_state;  // 0 none, 1 to trace, 2 visible, 3 occluded
-  std::vector<std::uint32_t> live;
-  // Scratch for one batch of ray queries (camera/bounce rays, or the
-  // pending shadow rays): the rays, whose slot each belongs to, the results.
+  // Scratch for the pending shadow rays: the rays, whose slot each belongs
+  // to, and whether it is blocked.
   std::vector<Ray> query;
   std::vector<std::uint32_t> query_slot;
-  std::vector<RayHit> query_hit;
   std::vector<std::uint8_t> query_result;
 
-  void resize(std::size_t n) {
-    out_index.resize(n), x.resize(n), y.resize(n), sample.resize(n), rng.resize(n, SampleStream(0, 0, 0));
-    film.resize(n), ray.resize(n), beta.resize(n), L.resize(n), prev.resize(n), vertex.resize(n), rays.resize(n);
-    alive.resize(n), surfel.resize(n), found.resize(n);
-    shadow.resize(2 * n), light.resize(2 * n), unoccluded.resize(2 * n), light_weight.resize(2 * n);
-    shadow_state.resize(2 * n);
-    live.resize(n);
-    query.resize(2 * n), query_slot.resize(2 * n), query_hit.resize(n), query_result.resize(2 * n);
+  void resize(std::size_t size) {
+    out_index.resize(size), x.resize(size), y.resize(size), sample.resize(size), rng.resize(size, SampleStream(0, 0, 0));
+    film.resize(size), ray.resize(size), beta.resize(size), L.resize(size), prev.resize(size), vertex.resize(size);
+    rays.resize(size), alive.resize(size), surfel.resize(size), hit.resize(size), found.resize(size);
+    shadow.resize(2 * size), light.resize(2 * size), unoccluded.resize(2 * size), light_weight.resize(2 * size);
+    shadow_state.resize(2 * size);
+    query.resize(2 * size), query_slot.resize(2 * size), query_result.resize(2 * size);
   }
   // A finished path's sample. Its last ray reached vertex `vertex` unless it
   // found nothing.
@@ -56,48 +58,45 @@ struct WavefrontTracer::Wave {
     const auto hits = static_cast<std::uint32_t>(vertex[i] - (found[i] ? 0 : 1));
     return FilmSample{film[i], L[i], rays[i], hits};
   }
+  // Slot `from`'s path into slot `to` (to < from): the fields that outlive a
+  // bounce (x, y and sample are read only by the camera stage).
+  void move(std::size_t from, std::size_t to) {
+    out_index[to] = out_index[from], rng[to] = rng[from], film[to] = film[from], ray[to] = ray[from];
+    beta[to] = beta[from], L[to] = L[from], prev[to] = prev[from], vertex[to] = vertex[from], rays[to] = rays[from];
+  }
   std::size_t capacity() const { return out_index.size(); }
-  float u(std::uint32_t i, Dim dim) const { return rng[i].get(static_cast<std::uint32_t>(vertex[i]), dim); }
+  float u(std::size_t i, Dim dim) const { return rng[i].get(static_cast<std::uint32_t>(vertex[i]), dim); }
 };
 
 std::size_t WavefrontTracer::bytes_per_path() {
   return 4 * sizeof(std::uint32_t) + sizeof(SampleStream) + sizeof(vec2) + sizeof(Ray) + 2 * sizeof(Spectrum) +
-         sizeof(PreviousVertex) + sizeof(std::int32_t) + sizeof(std::uint32_t) + 2 + sizeof(Surfel) +
-         2 * (sizeof(Ray) + sizeof(LightSample) + sizeof(Spectrum) + sizeof(float) + 1) + sizeof(std::uint32_t) +
-         2 * (sizeof(Ray) + sizeof(std::uint32_t) + 1) + sizeof(RayHit);
+         sizeof(PreviousVertex) + sizeof(std::int32_t) + sizeof(std::uint32_t) + 1 + sizeof(Surfel) + sizeof(RayHit) +
+         1 + 2 * (sizeof(Ray) + sizeof(LightSample) + sizeof(Spectrum) + sizeof(float) + 1) +
+         2 * (sizeof(Ray) + sizeof(std::uint32_t) + 1);
 }
 
 WavefrontTracer::WavefrontTracer(const CompiledScene& scene, const RenderSettings& settings, std::size_t wave_size,
                                  RayModes modes)
     : Tracer(scene, settings), wave_size_(std::max<std::size_t>(wave_size, 1)), modes_(modes) {}
 
-namespace {
-template <typename Fn>
-void for_live(const std::vector<std::uint32_t>& live, Fn&& fn) {
-  for (const std::uint32_t i : live) fn(i);
-}
-}  // namespace
-
 // Stage: the first surface along each live path's ray. The rays go to
-// Embree as one batch (camera rays as coherent ones); the hits' triangles are
-// prefetched before any is resolved into a Surfel, so their cache misses
-// overlap instead of queueing one behind the other.
+// Embree straight from the path state, as one batch (camera rays as coherent
+// ones); the hits' triangles are prefetched before any is resolved into a
+// Surfel, so their cache misses overlap instead of queueing one behind the
+// other.
 void WavefrontTracer::intersect(Wave& w) const {
-  const std::size_t n = w.live.size();
+  const std::size_t n = w.n;
   if (n == 0) return;
-  const bool camera_rays = w.vertex[w.live.front()] == 1;
-  for (std::size_t k = 0; k < n; ++k) w.query[k] = w.ray[w.live[k]];
-  const std::span<const Ray> rays(w.query.data(), n);
-  const std::span<RayHit> hits(w.query_hit.data(), n);
-  const std::span<std::uint8_t> found(w.query_result.data(), n);
+  const bool camera_rays = w.vertex[0] == 1;
+  const std::span<const Ray> rays(w.ray.data(), n);
+  const std::span<RayHit> hits(w.hit.data(), n);
+  const std::span<std::uint8_t> found(w.found.data(), n);
   scene_.intersect_batch(rays, hits, found, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
-  for (std::size_t k = 0; k < n; ++k)
-    if (found[k]) scene_.prefetch(hits[k]);
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::uint32_t i = w.live[k];
+  for (std::size_t i = 0; i < n; ++i)
+    if (found[i]) scene_.prefetch(hits[i]);
+  for (std::size_t i = 0; i < n; ++i) {
     ++w.rays[i];
-    w.found[i] = found[k];
-    if (found[k]) scene_.resolve(rays[k], hits[k], &w.surfel[i]);
+    if (found[i]) scene_.resolve(rays[i], hits[i], &w.surfel[i]);
   }
 }
 
@@ -107,7 +106,7 @@ void WavefrontTracer::intersect(Wave& w) const {
 void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
   const int cap = settings_.max_depth >= 0 ? settings_.max_depth : kMaxVerticesUncapped;
   const Strategy strategy = settings_.strategy;
-  for_live(w.live, [&](std::uint32_t i) {
+  for (std::size_t i = 0; i < w.n; ++i) {
     const Surfel& s = w.surfel[i];
     if (!w.found[i]) {
       const Spectrum Le = scene_.scene().environment.value_or(Spectrum(0.0f));
@@ -118,7 +117,7 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
         obs->on_end({w.vertex[i], PathEnd::Escaped});
       }
       w.alive[i] = 0;
-      return;
+      continue;
     }
     const vec3 wo = -w.ray[i].dir;
     const Spectrum Le = s.emitted(wo);
@@ -133,7 +132,7 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
       if (obs) obs->on_end({w.vertex[i], w.vertex[i] > cap ? PathEnd::MaxDepth : PathEnd::Absorbed});
       w.alive[i] = 0;
     }
-  });
+  }
 }
 
 // Stage: next-event estimation, up to two light samples per path (a point
@@ -142,9 +141,9 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
 void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
   const LightSampler& lights = scene_.lights();
   const Strategy strategy = settings_.strategy;
-  for_live(w.live, [&](std::uint32_t i) {
+  for (std::size_t i = 0; i < w.n; ++i) {
     w.shadow_state[2 * i] = w.shadow_state[2 * i + 1] = 0;
-    if (!w.alive[i]) return;
+    if (!w.alive[i]) continue;
     const Surfel& s = w.surfel[i];
     const vec3 wo = -w.ray[i].dir;
     if (lights.has_delta_lights()) {
@@ -161,9 +160,9 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
     }
     if (samples_area_lights(strategy, w.u(i, Dim::Technique))) {
       const auto ls = lights.sample(s.p, w.u(i, Dim::LightChoice), vec2(w.u(i, Dim::LightX), w.u(i, Dim::LightY)));
-      if (!ls) return;
+      if (!ls) continue;
       const Spectrum f = s.eval(ls->wi, wo);
-      if (is_black(f)) return;
+      if (is_black(f)) continue;
       const float lw = light_sample_weight(strategy, ls->pdf, s.pdf(ls->wi, wo));
       if (obs) w.light[2 * i + 1] = *ls;
       w.unoccluded[2 * i + 1] = f * ls->Le * (lw / ls->pdf);
@@ -171,17 +170,17 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
       w.shadow[2 * i + 1] = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, ls->p_error, ls->n);
       w.shadow_state[2 * i + 1] = 1;
     }
-  });
+  }
 }
 
 // Stage: occlusion queries for every pending shadow ray, as one batch.
 void WavefrontTracer::trace_shadow_rays(Wave& w) const {
   std::size_t n = 0;
-  for (const std::uint32_t i : w.live)
-    for (std::uint32_t s = 2 * i; s < 2 * i + 2; ++s)
+  for (std::size_t i = 0; i < w.n; ++i)
+    for (std::size_t s = 2 * i; s < 2 * i + 2; ++s)
       if (w.shadow_state[s] == 1) {
         w.query[n] = w.shadow[s];
-        w.query_slot[n++] = s;
+        w.query_slot[n++] = static_cast<std::uint32_t>(s);
         ++w.rays[i];
       }
   if (n == 0) return;
@@ -192,8 +191,8 @@ void WavefrontTracer::trace_shadow_rays(Wave& w) const {
 
 // Stage: the light of visible samples, point light first (the reference's order).
 void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
-  for_live(w.live, [&](std::uint32_t i) {
-    for (std::uint32_t k = 2 * i; k < 2 * i + 2; ++k) {
+  for (std::size_t i = 0; i < w.n; ++i) {
+    for (std::size_t k = 2 * i; k < 2 * i + 2; ++k) {
       if (w.shadow_state[k] == 0) continue;
       const bool visible = w.shadow_state[k] == 2;
       const Spectrum added = visible ? w.beta[i] * w.unoccluded[k] : Spectrum(0.0f);
@@ -204,14 +203,14 @@ void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
                        w.light_weight[k], added});
       }
     }
-  });
+  }
 }
 
 // Stage: sample the continuation, apply Russian roulette, spawn the next ray.
 void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
   const Strategy strategy = settings_.strategy;
-  for_live(w.live, [&](std::uint32_t i) {
-    if (!w.alive[i]) return;
+  for (std::size_t i = 0; i < w.n; ++i) {
+    if (!w.alive[i]) continue;
     const Surfel& s = w.surfel[i];
     const vec3 wo = -w.ray[i].dir;
     const int v = w.vertex[i];
@@ -221,7 +220,7 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
     if (!bs || is_black(bs->weight)) {
       if (obs) obs->on_end({v, bs ? PathEnd::NoSample : PathEnd::Absorbed});
       w.alive[i] = 0;
-      return;
+      continue;
     }
     Spectrum weight = bs->weight;
     float survival = 1.0f;
@@ -233,7 +232,7 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
           obs->on_end({v, PathEnd::Roulette});
         }
         w.alive[i] = 0;
-        return;
+        continue;
       }
       weight /= survival;
     }
@@ -243,21 +242,33 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
                                !(strategy == Strategy::LightBsdf && w.u(i, Dim::Technique) < 0.5f)};
     w.ray[i] = s.spawn(bs->wi);
     w.vertex[i] = v + 1;
-  });
+  }
 }
 
-// Stage: keep the slots still alive, in slot order (a stable compaction, so
-// the work order - and nothing else - changes from bounce to bounce).
-void WavefrontTracer::compact(Wave& w) {
-  // std::remove_if keeps the order of what it keeps, and allocates nothing.
-  const auto end = std::remove_if(w.live.begin(), w.live.end(), [&](std::uint32_t i) { return w.alive[i] == 0; });
-  w.live.erase(end, w.live.end());
+// Stage: write out the paths that ended and move the survivors down to the
+// front, keeping their order (a stable compaction: the work order - and
+// nothing else - changes from bounce to bounce). A slot is only ever
+// overwritten by a later one, after its own path has been written or moved.
+void WavefrontTracer::compact(Wave& w, std::span<FilmSample> out) {
+  std::size_t m = 0;
+  for (std::size_t i = 0; i < w.n; ++i) {
+    if (!w.alive[i]) {
+      out[w.out_index[i]] = w.result(i);
+      continue;
+    }
+    if (m != i) {
+      w.move(i, m);
+      w.alive[m] = 1;
+    }
+    ++m;
+  }
+  w.n = m;
 }
 
 // Stage: one camera ray per path.
 void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
   const Camera& camera = scene_.camera();
-  for_live(w.live, [&](std::uint32_t i) {
+  for (std::size_t i = 0; i < w.n; ++i) {
     w.vertex[i] = 0;  // the camera's random numbers are those of vertex 0
     w.film[i] = vec2(static_cast<float>(w.x[i]) + w.u(i, Dim::FilmX), static_cast<float>(w.y[i]) + w.u(i, Dim::FilmY));
     w.ray[i] = camera.generate_ray(w.film[i], vec2(w.u(i, Dim::LensX), w.u(i, Dim::LensY)));
@@ -268,19 +279,19 @@ void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
     w.alive[i] = 1;
     w.vertex[i] = 1;
     if (obs) obs->on_camera({w.x[i], w.y[i], w.sample[i], w.film[i], w.ray[i].origin, w.ray[i].dir});
-  });
+  }
 }
 
-void WavefrontTracer::run_wave(Wave& w, PathObserver* obs) const {
+void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver* obs) const {
   generate_camera_rays(w, obs);
-  while (!w.live.empty()) {
+  while (w.n > 0) {
     intersect(w);
     add_emission(w, obs);
     sample_lights(w, obs);
     trace_shadow_rays(w);
     add_light(w, obs);
     scatter(w, obs);
-    compact(w);
+    compact(w, out);
   }
 }
 
@@ -302,20 +313,25 @@ void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std
     if (w.capacity() < n_max) w.resize(n_max);
     for (std::size_t k = k0; k < k1; ++k) {
       const std::size_t begin = k * wave_size;
-      const std::size_t n = std::min(wave_size, out.size() - begin);
-      w.live.resize(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        const std::size_t id = begin + i;
-        const auto pixel = static_cast<std::uint32_t>(id / count);
-        w.out_index[i] = static_cast<std::uint32_t>(id);
-        w.x[i] = pixel % width;
-        w.y[i] = pixel / width;
-        w.sample[i] = first + static_cast<std::uint32_t>(id % count);
+      w.n = std::min(wave_size, out.size() - begin);
+      // Sample j of pixel p is entry p * count + j of the batch; step through
+      // them without a division per path.
+      auto pixel = static_cast<std::uint32_t>(begin / count);
+      auto j = static_cast<std::uint32_t>(begin % count);
+      std::uint32_t x = pixel % width, y = pixel / width;
+      for (std::size_t i = 0; i < w.n; ++i) {
+        w.out_index[i] = static_cast<std::uint32_t>(begin + i);
+        w.x[i] = x;
+        w.y[i] = y;
+        w.sample[i] = first + j;
         w.rng[i] = SampleStream(settings_.seed, pixel, w.sample[i]);
-        w.live[i] = static_cast<std::uint32_t>(i);
+        if (++j == count) {
+          j = 0;
+          ++pixel;
+          if (++x == width) x = 0, ++y;
+        }
       }
-      run_wave(w, nullptr);
-      for (std::size_t i = 0; i < n; ++i) out[w.out_index[i]] = w.result(i);
+      run_wave(w, out, nullptr);
     }
   });
 }
@@ -330,10 +346,11 @@ FilmSample WavefrontTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::
   w.y[0] = y;
   w.sample[0] = sample;
   w.rng[0] = SampleStream(settings_.seed, pixel, sample);
-  w.live[0] = 0;
-  run_wave(w, observer);
-  if (observer) observer->on_result(w.L[0]);
-  return w.result(0);
+  w.n = 1;
+  FilmSample result;
+  run_wave(w, std::span<FilmSample>(&result, 1), observer);
+  if (observer) observer->on_result(result.L);
+  return result;
 }
 
 }  // namespace pathlab

@@ -50,7 +50,9 @@ class WavefrontTracer final : public Tracer {
 
  private:
   struct Wave;
-  void run_wave(Wave& wave, PathObserver* observer) const;
+  // Traces the wave's paths to their ends, writing each one's sample to
+  // out[its out_index] as it ends.
+  void run_wave(Wave& wave, std::span<FilmSample> out, PathObserver* observer) const;
   void generate_camera_rays(Wave& w, PathObserver* obs) const;
   void intersect(Wave& w) const;
   void add_emission(Wave& w, PathObserver* obs) const;
@@ -58,7 +60,7 @@ class WavefrontTracer final : public Tracer {
   void trace_shadow_rays(Wave& w) const;
   void add_light(Wave& w, PathObserver* obs) const;
   void scatter(Wave& w, PathObserver* obs) const;
-  static void compact(Wave& w);
+  static void compact(Wave& w, std::span<FilmSample> out);
 
   std::size_t wave_size_;
   RayModes modes_;
