@@ -24,6 +24,9 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <cstring>
 #include <map>
@@ -69,15 +72,22 @@ void raw(benchmark::State& state, RayKind kind, RayBatchMode mode) {
 
 // --- tracers --------------------------------------------------------------------
 
-void run_tracer(benchmark::State& state, const Tracer& tracer) {
-  const Setup& s = setup();
-  const FilmDesc& fd = s.scene->scene().film;
-  RenderStats stats;
-  for (auto _ : state) {
-    Film film(fd.width, fd.height, fd.filter);
-    stats = render(tracer, film);
-    benchmark::DoNotOptimize(film.image().pixels.data());
-  }
+// Seconds on the clock the run is measured by: wall time, or the process's
+// CPU time (all threads) with --cpu-time.
+double now_seconds() {
+  if (setup().cpu_time) return static_cast<double>(std::clock()) / CLOCKS_PER_SEC;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+RenderStats render_frame(const Tracer& tracer) {
+  const FilmDesc& fd = setup().scene->scene().film;
+  Film film(fd.width, fd.height, fd.filter);
+  const RenderStats stats = render(tracer, film);
+  benchmark::DoNotOptimize(film.image().pixels.data());
+  return stats;
+}
+
+void set_rates(benchmark::State& state, const RenderStats& stats) {
   state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations() * stats.samples),
                                                    benchmark::Counter::kIsRate);
   state.counters["rays/s"] =
@@ -87,12 +97,39 @@ void run_tracer(benchmark::State& state, const Tracer& tracer) {
 
 void reference(benchmark::State& state) {
   const ReferenceTracer tracer(*setup().scene, setup().settings);
-  run_tracer(state, tracer);
+  RenderStats stats;
+  for (auto _ : state) stats = render_frame(tracer);
+  set_rates(state, stats);
 }
 
+// The wavefront, paired with the reference: each iteration also renders the
+// frame with the reference, just before or just after (alternating), outside
+// the timed region. Its counter x_reference = reference time / wavefront time
+// compares two renders taken seconds apart, so a machine whose speed drifts
+// by 10 % between repetitions (as this shared one does) moves both alike.
 void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes modes) {
+  const ReferenceTracer reference_tracer(*setup().scene, setup().settings);
   const WavefrontTracer tracer(*setup().scene, setup().settings, wave, modes);
-  run_tracer(state, tracer);
+  static std::uint64_t pairs = 0;
+  RenderStats stats;
+  double reference_seconds = 0.0, wavefront_seconds = 0.0;
+  auto time_reference = [&] {
+    state.PauseTiming();
+    const double t0 = now_seconds();
+    render_frame(reference_tracer);
+    reference_seconds += now_seconds() - t0;
+    state.ResumeTiming();
+  };
+  for (auto _ : state) {
+    const bool reference_first = (pairs++ % 2) == 0;
+    if (reference_first) time_reference();
+    const double t0 = now_seconds();
+    stats = render_frame(tracer);
+    wavefront_seconds += now_seconds() - t0;
+    if (!reference_first) time_reference();
+  }
+  set_rates(state, stats);
+  state.counters["x_reference"] = wavefront_seconds > 0.0 ? reference_seconds / wavefront_seconds : 0.0;
 }
 
 // --- the summary ------------------------------------------------------------------
@@ -107,9 +144,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
     // is taken below); so are "median" aggregates, which stand for runs that
     // --benchmark_report_aggregates_only left out.
     for (const Run& r : runs) {
-      const bool median_aggregate = r.run_type == Run::RT_Aggregate && r.aggregate_name == "median";
-      if (r.run_type == Run::RT_Aggregate && !median_aggregate) continue;
-      auto& counters = (median_aggregate ? medians_ : values_)[r.run_name.function_name];
+      const bool aggregate = r.run_type == Run::RT_Aggregate;
+      if (aggregate && r.aggregate_name != "median" && r.aggregate_name != "stddev") continue;
+      auto& counters = (!aggregate ? values_ : r.aggregate_name == "median" ? medians_ : stddevs_)[r.run_name.function_name];
       for (const auto& [name, counter] : r.counters) counters[name].push_back(counter.value);
     }
   }
@@ -164,6 +201,29 @@ class RatioReporter : public benchmark::ConsoleReporter {
     const double raw_single = raw_mix_rate(single);
     std::printf("reference: %.4g samples/s, %.4g rays/s = %.2f of raw (all single rays, %.4g rays/s)\n", ref_sps,
                 ref_rps, raw_single > 0 ? ref_rps / raw_single : 0.0, raw_single);
+    // The speed of light: Embree alone, each kind of ray in its fastest mode.
+    // A tracer whose every other cost were zero would reach this rate; what
+    // the reference spends beyond its own (single-ray) Embree time is its
+    // "rest", and a target of 1.3x leaves the wavefront this share of it.
+    WavefrontRayModes best = single;
+    for (RayBatchMode mode : kAllRayBatchModes) {
+      if (median(raw_name(RayKind::Camera, mode), "rays/s") > median(raw_name(RayKind::Camera, best.camera), "rays/s")) best.camera = mode;
+      if (median(raw_name(RayKind::Bounce, mode), "rays/s") > median(raw_name(RayKind::Bounce, best.bounce), "rays/s")) best.bounce = mode;
+      if (median(raw_name(RayKind::Shadow, mode), "rays/s") > median(raw_name(RayKind::Shadow, best.shadow), "rays/s")) best.shadow = mode;
+    }
+    const double raw_best = raw_mix_rate(best);
+    const double rays_per_sample = median("Tracer/reference", "rays/sample");
+    if (ref_sps > 0 && raw_best > 0 && raw_single > 0 && rays_per_sample > 0) {
+      const double t_ref = 1.0 / ref_sps, embree_ref = rays_per_sample / raw_single;
+      const double embree_best = rays_per_sample / raw_best, rest_ref = t_ref - embree_ref;
+      std::printf("speed of light: Embree alone in the fastest modes (camera %s, bounce %s, shadow %s) = %.2fx the "
+                  "reference;\n  the reference spends %.0f%% of its time outside Embree; at 1.3x the wavefront may "
+                  "spend %.2f of that, at 75%% of raw %.2f\n",
+                  ray_batch_mode_name(best.camera), ray_batch_mode_name(best.bounce), ray_batch_mode_name(best.shadow),
+                  t_ref / embree_best, 100.0 * rest_ref / t_ref,
+                  rest_ref > 0 ? (t_ref / 1.3 - embree_best) / rest_ref : 0.0,
+                  rest_ref > 0 ? (embree_best / 0.75 - embree_best) / rest_ref : 0.0);
+    }
     std::vector<std::string> runs;
     for (const auto* source : {&values_, &medians_})
       for (const auto& entry : *source)
@@ -174,8 +234,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const WavefrontRayModes modes = parse_modes(run);
       const double sps = median(run, "samples/s"), rps = median(run, "rays/s");
       const double raw_rate = raw_mix_rate(modes);
-      std::printf("%s: %.4g samples/s = %.2fx reference; %.4g rays/s = %.2f of raw (%.4g rays/s)\n", run.c_str(), sps,
-                  ref_sps > 0 ? sps / ref_sps : 0.0, rps, raw_rate > 0 ? rps / raw_rate : 0.0, raw_rate);
+      std::printf("%s: %.4g samples/s = %.2fx reference (paired, sd %.2f); %.4g rays/s = %.2f of raw (%.4g rays/s)\n",
+                  run.c_str(), sps, median(run, "x_reference"), stddev(run, "x_reference"), rps,
+                  raw_rate > 0 ? rps / raw_rate : 0.0, raw_rate);
     }
   }
   static WavefrontRayModes parse_modes(const std::string& run) {
@@ -188,8 +249,25 @@ class RatioReporter : public benchmark::ConsoleReporter {
     }
     return m;
   }
+  // The sample standard deviation of a counter over the repetitions (0 for
+  // fewer than two).
+  double stddev(const std::string& run, const std::string& counter) const {
+    if (const auto r = stddevs_.find(run); r != stddevs_.end()) {
+      const auto c = r->second.find(counter);
+      return c == r->second.end() || c->second.empty() ? 0.0 : c->second.front();
+    }
+    const auto r = values_.find(run);
+    if (r == values_.end()) return 0.0;
+    const auto c = r->second.find(counter);
+    if (c == r->second.end() || c->second.size() < 2) return 0.0;
+    const std::vector<double>& v = c->second;
+    double mean = 0.0, ss = 0.0;
+    for (double x : v) mean += x / static_cast<double>(v.size());
+    for (double x : v) ss += (x - mean) * (x - mean);
+    return std::sqrt(ss / static_cast<double>(v.size() - 1));
+  }
   using Counters = std::map<std::string, std::map<std::string, std::vector<double>>>;
-  Counters values_, medians_;
+  Counters values_, medians_, stddevs_;
 };
 
 std::string wavefront_name(std::size_t wave, const WavefrontRayModes& m) {
