@@ -16,6 +16,7 @@
 //                                      [--benchmark_repetitions=5] [--benchmark_filter=...]
 #include "bench/ray_capture.h"
 #include "core/compiled_scene.h"
+#include "core/parallel.h"
 #include "core/render.h"
 #include "core/scene_loader.h"
 #include "reference/reference_tracer.h"
@@ -130,6 +131,14 @@ void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes mode
   }
   set_rates(state, stats);
   state.counters["x_reference"] = wavefront_seconds > 0.0 ? reference_seconds / wavefront_seconds : 0.0;
+  // Embree as the wavefront meets it, between its stages: the share of the
+  // waves' time it takes, and its rates on all threads, to set beside Raw/.
+  const WavefrontTimes t = tracer.times();
+  const double threads = static_cast<double>(max_threads());
+  state.counters["embree_share"] = t.waves_seconds > 0.0 ? t.query_seconds() / t.waves_seconds : 0.0;
+  state.counters["camera_in_context"] = threads * t.camera.rays_per_second();
+  state.counters["bounce_in_context"] = threads * t.bounce.rays_per_second();
+  state.counters["shadow_in_context"] = threads * t.shadow.rays_per_second();
 }
 
 // --- the summary ------------------------------------------------------------------
@@ -237,6 +246,16 @@ class RatioReporter : public benchmark::ConsoleReporter {
       std::printf("%s: %.4g samples/s = %.2fx reference (paired, sd %.2f); %.4g rays/s = %.2f of raw (%.4g rays/s)\n",
                   run.c_str(), sps, median(run, "x_reference"), stddev(run, "x_reference"), rps,
                   raw_rate > 0 ? rps / raw_rate : 0.0, raw_rate);
+      // Embree's rate inside the tracer against its raw rate in the same mode.
+      auto in_context = [&](const char* counter, RayKind kind, RayBatchMode mode) {
+        const double raw_kind = median(raw_name(kind, mode), "rays/s");
+        return raw_kind > 0 ? median(run, counter) / raw_kind : 0.0;
+      };
+      std::printf("  Embree %.0f%% of the waves' time; in context at %.2f (camera), %.2f (bounce), %.2f (shadow) of "
+                  "its raw rates\n",
+                  100.0 * median(run, "embree_share"), in_context("camera_in_context", RayKind::Camera, modes.camera),
+                  in_context("bounce_in_context", RayKind::Bounce, modes.bounce),
+                  in_context("shadow_in_context", RayKind::Shadow, modes.shadow));
     }
   }
   static WavefrontRayModes parse_modes(const std::string& run) {

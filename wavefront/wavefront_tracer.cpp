@@ -5,6 +5,7 @@
 #include "core/strategy_weights.h"
 
 #include <algorithm>
+#include <chrono>
 
 namespace pathlab {
 
@@ -16,6 +17,9 @@ namespace pathlab {
 // through all its stages; threads run different waves.
 struct WavefrontTracer::Wave {
   std::size_t n = 0;  // live paths
+  // Clock time of this wave's queries (camera, bounce, shadow) and of the
+  // whole wave, in nanoseconds, and the rays of each kind.
+  std::uint64_t nanoseconds[4] = {}, queries[3] = {};
   // Identity and output. x, y and sample are read only when the camera ray
   // is made; the rest is moved with the path.
   std::vector<std::uint32_t> out_index, x, y, sample;
@@ -68,6 +72,13 @@ struct WavefrontTracer::Wave {
   float u(std::size_t i, Dim dim) const { return rng[i].get(static_cast<std::uint32_t>(vertex[i]), dim); }
 };
 
+namespace {
+std::uint64_t clock_ns() {
+  return static_cast<std::uint64_t>(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count());
+}
+}  // namespace
+
 std::size_t WavefrontTracer::bytes_per_path() {
   return 4 * sizeof(std::uint32_t) + sizeof(SampleStream) + sizeof(vec2) + sizeof(Ray) + 2 * sizeof(Spectrum) +
          sizeof(PreviousVertex) + sizeof(std::int32_t) + sizeof(std::uint32_t) + 1 + sizeof(Surfel) + sizeof(RayHit) +
@@ -91,7 +102,10 @@ void WavefrontTracer::intersect(Wave& w) const {
   const std::span<const Ray> rays(w.ray.data(), n);
   const std::span<RayHit> hits(w.hit.data(), n);
   const std::span<std::uint8_t> found(w.found.data(), n);
+  const std::uint64_t t0 = clock_ns();
   scene_.intersect_batch(rays, hits, found, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
+  w.nanoseconds[camera_rays ? 0 : 1] += clock_ns() - t0;
+  w.queries[camera_rays ? 0 : 1] += n;
   for (std::size_t i = 0; i < n; ++i)
     if (found[i]) scene_.prefetch(hits[i]);
   for (std::size_t i = 0; i < n; ++i) {
@@ -185,7 +199,10 @@ void WavefrontTracer::trace_shadow_rays(Wave& w) const {
       }
   if (n == 0) return;
   const std::span<std::uint8_t> occluded(w.query_result.data(), n);
+  const std::uint64_t t0 = clock_ns();
   scene_.occluded_batch(std::span<const Ray>(w.query.data(), n), occluded, modes_.shadow);
+  w.nanoseconds[2] += clock_ns() - t0;
+  w.queries[2] += n;
   for (std::size_t r = 0; r < n; ++r) w.shadow_state[w.query_slot[r]] = occluded[r] ? 3 : 2;
 }
 
@@ -283,6 +300,9 @@ void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
 }
 
 void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver* obs) const {
+  std::fill(std::begin(w.nanoseconds), std::end(w.nanoseconds), 0);
+  std::fill(std::begin(w.queries), std::end(w.queries), 0);
+  const std::uint64_t t0 = clock_ns();
   generate_camera_rays(w, obs);
   while (w.n > 0) {
     intersect(w);
@@ -293,6 +313,15 @@ void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver*
     scatter(w, obs);
     compact(w, out);
   }
+  w.nanoseconds[3] = clock_ns() - t0;
+  for (int k = 0; k < 4; ++k) nanoseconds_[k].fetch_add(w.nanoseconds[k], std::memory_order_relaxed);
+  for (int k = 0; k < 3; ++k) rays_[k].fetch_add(w.queries[k], std::memory_order_relaxed);
+}
+
+WavefrontTimes WavefrontTracer::times() const {
+  auto seconds = [&](int k) { return 1e-9 * static_cast<double>(nanoseconds_[k].load(std::memory_order_relaxed)); };
+  auto queries = [&](int k) { return WavefrontTimes::Queries{rays_[k].load(std::memory_order_relaxed), seconds(k)}; };
+  return WavefrontTimes{queries(0), queries(1), queries(2), seconds(3)};
 }
 
 void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const {

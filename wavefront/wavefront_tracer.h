@@ -13,7 +13,9 @@
 
 #include "core/tracer.h"
 
+#include <atomic>
 #include <cstddef>
+#include <cstdint>
 
 namespace pathlab {
 
@@ -24,6 +26,20 @@ struct WavefrontRayModes {
   RayBatchMode camera = RayBatchMode::Packet16;  // coherent: adjacent pixels
   RayBatchMode bounce = RayBatchMode::Single;
   RayBatchMode shadow = RayBatchMode::Stream;
+};
+
+// Where a wavefront's time went, summed over its renders and threads: the
+// ray queries of each kind (time inside EmbreeAccel's batch calls) against
+// the whole of tracing its waves. Rays per second here are per thread.
+struct WavefrontTimes {
+  struct Queries {
+    std::uint64_t rays = 0;
+    double seconds = 0.0;
+    double rays_per_second() const { return seconds > 0.0 ? static_cast<double>(rays) / seconds : 0.0; }
+  };
+  Queries camera, bounce, shadow;
+  double waves_seconds = 0.0;  // run_wave, start to end, all waves
+  double query_seconds() const { return camera.seconds + bounce.seconds + shadow.seconds; }
 };
 
 class WavefrontTracer final : public Tracer {
@@ -47,6 +63,8 @@ class WavefrontTracer final : public Tracer {
   static std::size_t bytes_per_path();
   std::size_t wave_size() const { return wave_size_; }
   const RayModes& ray_modes() const { return modes_; }
+  // Time spent so far (a clock read per batch of rays, not per ray).
+  WavefrontTimes times() const;
 
  private:
   struct Wave;
@@ -64,6 +82,8 @@ class WavefrontTracer final : public Tracer {
 
   std::size_t wave_size_;
   RayModes modes_;
+  // Nanoseconds and rays: camera, bounce, shadow queries, then whole waves.
+  mutable std::atomic<std::uint64_t> nanoseconds_[4] = {}, rays_[3] = {};
 };
 
 }  // namespace pathlab
