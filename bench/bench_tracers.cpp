@@ -214,12 +214,13 @@ class RatioReporter : public benchmark::ConsoleReporter {
     // A tracer whose every other cost were zero would reach this rate; what
     // the reference spends beyond its own (single-ray) Embree time is its
     // "rest", and a target of 1.3x leaves the wavefront this share of it.
-    WavefrontRayModes best = single;
-    for (RayBatchMode mode : kAllRayBatchModes) {
-      if (median(raw_name(RayKind::Camera, mode), "rays/s") > median(raw_name(RayKind::Camera, best.camera), "rays/s")) best.camera = mode;
-      if (median(raw_name(RayKind::Bounce, mode), "rays/s") > median(raw_name(RayKind::Bounce, best.bounce), "rays/s")) best.bounce = mode;
-      if (median(raw_name(RayKind::Shadow, mode), "rays/s") > median(raw_name(RayKind::Shadow, best.shadow), "rays/s")) best.shadow = mode;
-    }
+    auto fastest = [&](RayKind kind) {
+      RayBatchMode best = RayBatchMode::Single;
+      for (RayBatchMode mode : kAllRayBatchModes)
+        if (median(raw_name(kind, mode), "rays/s") > median(raw_name(kind, best), "rays/s")) best = mode;
+      return best;
+    };
+    const WavefrontRayModes best{fastest(RayKind::Camera), fastest(RayKind::Bounce), fastest(RayKind::Shadow)};
     const double raw_best = raw_mix_rate(best);
     const double rays_per_sample = median("Tracer/reference", "rays/sample");
     if (ref_sps > 0 && raw_best > 0 && raw_single > 0 && rays_per_sample > 0) {

@@ -114,5 +114,23 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
   EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
 }
 
+// times() counts every ray the render counts, by kind, and the time inside
+// Embree is part of the waves' time.
+TEST(Wavefront, TimesCountEveryQuery) {
+  Scene scene = test::small_cornell(16, 4, FilterKind::Box);
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const WavefrontTracer tracer(compiled, settings);
+  Film film(16, 16, FilterKind::Box);
+  const RenderStats stats = render(tracer, film);
+  const WavefrontTimes t = tracer.times();
+  EXPECT_EQ(t.camera.rays, stats.samples);
+  EXPECT_GT(t.bounce.rays, 0u);
+  EXPECT_GT(t.shadow.rays, 0u);
+  EXPECT_EQ(t.camera.rays + t.bounce.rays + t.shadow.rays, stats.rays);
+  EXPECT_GT(t.query_seconds(), 0.0);
+  EXPECT_LE(t.query_seconds(), t.waves_seconds);
+}
+
 }  // namespace
 }  // namespace pathlab
