@@ -17,9 +17,9 @@ namespace pathlab {
 // through all its stages; threads run different waves.
 struct WavefrontTracer::Wave {
   std::size_t n = 0;  // live paths
-  // Clock time of this wave's queries (camera, bounce, shadow) and of the
-  // whole wave, in nanoseconds, and the rays of each kind.
-  std::uint64_t nanoseconds[4] = {}, queries[3] = {};
+  // Clock time of this wave's queries of each kind and of the whole wave, in
+  // nanoseconds (indexed by Clocked), and the rays of each kind.
+  std::uint64_t nanoseconds[kClocked] = {}, queries[kWave] = {};
   // Identity and output. x, y and sample are read only when the camera ray
   // is made; the rest is moved with the path.
   std::vector<std::uint32_t> out_index, x, y, sample;
@@ -104,8 +104,9 @@ void WavefrontTracer::intersect(Wave& w) const {
   const std::span<std::uint8_t> found(w.found.data(), n);
   const std::uint64_t t0 = clock_ns();
   scene_.intersect_batch(rays, hits, found, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
-  w.nanoseconds[camera_rays ? 0 : 1] += clock_ns() - t0;
-  w.queries[camera_rays ? 0 : 1] += n;
+  const Clocked kind = camera_rays ? kCameraQueries : kBounceQueries;
+  w.nanoseconds[kind] += clock_ns() - t0;
+  w.queries[kind] += n;
   for (std::size_t i = 0; i < n; ++i)
     if (found[i]) scene_.prefetch(hits[i]);
   for (std::size_t i = 0; i < n; ++i) {
@@ -201,8 +202,8 @@ void WavefrontTracer::trace_shadow_rays(Wave& w) const {
   const std::span<std::uint8_t> occluded(w.query_result.data(), n);
   const std::uint64_t t0 = clock_ns();
   scene_.occluded_batch(std::span<const Ray>(w.query.data(), n), occluded, modes_.shadow);
-  w.nanoseconds[2] += clock_ns() - t0;
-  w.queries[2] += n;
+  w.nanoseconds[kShadowQueries] += clock_ns() - t0;
+  w.queries[kShadowQueries] += n;
   for (std::size_t r = 0; r < n; ++r) w.shadow_state[w.query_slot[r]] = occluded[r] ? 3 : 2;
 }
 
@@ -313,15 +314,15 @@ void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver*
     scatter(w, obs);
     compact(w, out);
   }
-  w.nanoseconds[3] = clock_ns() - t0;
-  for (int k = 0; k < 4; ++k) nanoseconds_[k].fetch_add(w.nanoseconds[k], std::memory_order_relaxed);
-  for (int k = 0; k < 3; ++k) rays_[k].fetch_add(w.queries[k], std::memory_order_relaxed);
+  w.nanoseconds[kWave] = clock_ns() - t0;
+  for (int k = 0; k < kClocked; ++k) nanoseconds_[k].fetch_add(w.nanoseconds[k], std::memory_order_relaxed);
+  for (int k = 0; k < kWave; ++k) rays_[k].fetch_add(w.queries[k], std::memory_order_relaxed);
 }
 
 WavefrontTimes WavefrontTracer::times() const {
   auto seconds = [&](int k) { return 1e-9 * static_cast<double>(nanoseconds_[k].load(std::memory_order_relaxed)); };
   auto queries = [&](int k) { return WavefrontTimes::Queries{rays_[k].load(std::memory_order_relaxed), seconds(k)}; };
-  return WavefrontTimes{queries(0), queries(1), queries(2), seconds(3)};
+  return WavefrontTimes{queries(kCameraQueries), queries(kBounceQueries), queries(kShadowQueries), seconds(kWave)};
 }
 
 void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const {

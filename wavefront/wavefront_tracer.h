@@ -82,8 +82,9 @@ class WavefrontTracer final : public Tracer {
 
   std::size_t wave_size_;
   RayModes modes_;
-  // Nanoseconds and rays: camera, bounce, shadow queries, then whole waves.
-  mutable std::atomic<std::uint64_t> nanoseconds_[4] = {}, rays_[3] = {};
+  // What times() reports: nanoseconds of each, and rays of each kind of query.
+  enum Clocked { kCameraQueries, kBounceQueries, kShadowQueries, kWave, kClocked };
+  mutable std::atomic<std::uint64_t> nanoseconds_[kClocked] = {}, rays_[kWave] = {};
 };
 
 }  // namespace pathlab

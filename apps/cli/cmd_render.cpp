@@ -135,20 +135,19 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     err << "pathlab: wrote " << exr.string() << " and " << png.string() << " (" << sc.film.width << "x"
         << sc.film.height << ", " << spp_done << " spp, " << tracer->name() << ", "
         << strategy_name(settings.strategy) << "): " << line << "\n";
-    if (const auto* wf = dynamic_cast<const WavefrontTracer*>(tracer.get()))
+    if (const auto* wf = dynamic_cast<const WavefrontTracer*>(tracer.get())) {
       err << "pathlab: wavefront: one wave of up to " << wf->wave_size() << " paths per thread, "
           << WavefrontTracer::bytes_per_path() << " bytes of path state per path ("
           << (wf->wave_size() * WavefrontTracer::bytes_per_path() * static_cast<std::size_t>(max_threads()) + 512 * 1024) /
                  (1024 * 1024)
           << " MiB in flight on " << max_threads() << " threads)\n";
-    if (const auto* wf = dynamic_cast<const WavefrontTracer*>(tracer.get()); wf && wf->times().waves_seconds > 0.0) {
-      const WavefrontTimes t = wf->times();
-      char line2[256];
-      std::snprintf(line2, sizeof line2,
-                    "%.0f%% of the waves' time in Embree; per thread, camera %.3g, bounce %.3g, shadow %.3g rays/s",
-                    100.0 * t.query_seconds() / t.waves_seconds, t.camera.rays_per_second(), t.bounce.rays_per_second(),
-                    t.shadow.rays_per_second());
-      err << "pathlab: wavefront: " << line2 << "\n";
+      if (const WavefrontTimes t = wf->times(); t.waves_seconds > 0.0) {
+        std::snprintf(line, sizeof line,
+                      "%.0f%% of the waves' time in Embree; per thread, camera %.3g, bounce %.3g, shadow %.3g rays/s",
+                      100.0 * t.query_seconds() / t.waves_seconds, t.camera.rays_per_second(),
+                      t.bounce.rays_per_second(), t.shadow.rays_per_second());
+        err << "pathlab: wavefront: " << line << "\n";
+      }
     }
   }
   return 0;
