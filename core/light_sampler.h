@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace pathlab {
@@ -63,13 +64,23 @@ class LightSampler {
   // A point light picked in proportion to its intensity.
   std::optional<LightSample> sample_delta(const vec3& ref, float u_choice) const;
 
- private:
+  // The area-light distribution itself, for code that samples lights in
+  // bulk (the wavefront's vectorised stages) and must pick exactly as
+  // sample() does: entry i is chosen when cdf[i - 1] <= u_choice < cdf[i]
+  // (the first entry whose cdf exceeds u; the last one if none does), with
+  // probability pmf[i]; its density on the light is 1 / area.
   struct Entry {
     std::uint32_t shape;
     std::uint32_t prim;
     float area;
     Triangle triangle;  // the emitting triangle (unused for a sphere or the environment)
   };
+  std::span<const Entry> entries() const { return entries_; }
+  std::span<const float> cdf() const { return cdf_; }
+  std::span<const float> pmf() const { return pmf_; }
+  bool samples_environment() const { return env_index_ >= 0; }
+
+ private:
   static std::size_t pick(const std::vector<float>& cdf, float u);
   static float area_density(const Entry& e);  // 1 / area
 

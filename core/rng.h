@@ -37,6 +37,9 @@ class SampleStream {
     return to_unit_float(
         mix64(key_ ^ ((static_cast<std::uint64_t>(bounce) << 32) | static_cast<std::uint32_t>(dim))));
   }
+  // The hashed (seed, pixel, sample): get() is to_unit_float(mix64(key() ^
+  // (bounce << 32 | dim))), for code that draws many streams' numbers at once.
+  constexpr std::uint64_t key() const { return key_; }
 
  private:
   std::uint64_t key_;

@@ -9,6 +9,7 @@
 #include "debugtools/path_recorder.h"
 #include "reference/reference_tracer.h"
 #include "tests/test_scenes.h"
+#include "wavefront/lambert_stages.h"
 #include "wavefront/wavefront_tracer.h"
 
 #include <gtest/gtest.h>
@@ -112,6 +113,99 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
               c = render_image(2, 17);
   EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
   EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
+}
+
+// The vectorised stages (wavefront/lambert_stages.h) give every sample the
+// bits the scalar stages give it, on every scene and strategy they take:
+// several lights (the pick's binary search), a two-sided emitting box, a
+// min_pdf cut-off, roulette from the first bounce, and waves whose size is
+// not a multiple of 16 lanes.
+struct VectorCase {
+  std::string scene;  // as SameSeedCase
+  Strategy strategy;
+  float min_pdf = 0.0f;
+  int rr_depth = -1;  // -1: the scene's
+};
+
+class VectorStages : public testing::TestWithParam<VectorCase> {};
+
+TEST_P(VectorStages, GiveTheScalarStagesBits) {
+  if (!lambert_stages::cpu_supported()) GTEST_SKIP() << "this processor has no AVX-512";
+  const VectorCase& c = GetParam();
+  Scene scene = load_case({c.scene, c.strategy});
+  scene.render.min_pdf = c.min_pdf;
+  if (c.rr_depth >= 0) scene.render.rr_depth = c.rr_depth;
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const std::size_t pixels = static_cast<std::size_t>(compiled.scene().film.width) * compiled.scene().film.height;
+  const auto count = static_cast<std::uint32_t>(settings.spp);
+  for (std::size_t wave : {std::size_t{997}, std::size_t{4096}}) {
+    const WavefrontTracer vectorised(compiled, settings, wave, {}, WavefrontStages::Auto);
+    const WavefrontTracer scalar(compiled, settings, wave, {}, WavefrontStages::Scalar);
+    ASSERT_TRUE(vectorised.vectorised());
+    ASSERT_FALSE(scalar.vectorised());
+    std::vector<FilmSample> a(pixels * count), b(pixels * count);
+    vectorised.render_batch(0, count, a);
+    scalar.render_batch(0, count, b);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+      differ += std::memcmp(&a[i].L, &b[i].L, sizeof(Spectrum)) != 0 || a[i].film != b[i].film ||
+                a[i].rays != b[i].rays || a[i].hits != b[i].hits;
+    EXPECT_EQ(differ, 0u) << "of " << a.size() << " samples, wave size " << wave;
+  }
+}
+
+std::vector<VectorCase> vector_cases() {
+  std::vector<VectorCase> cases;
+  for (const char* s : {"", "penumbra-box.json", "penumbra-emissive-polygon.json", "furnace-box.json",
+                        "white-sphere-emissive-room.json"})
+    for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf}) cases.push_back({s, st});
+  cases.push_back({"", Strategy::Mis, 0.2f, 0});
+  cases.push_back({"", Strategy::LightBsdf, 0.0f, 0});
+  return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(LambertScenes, VectorStages, testing::ValuesIn(vector_cases()),
+                         [](const testing::TestParamInfo<VectorCase>& p) {
+                           std::string s = (p.param.scene.empty() ? std::string("cornell") : p.param.scene) + "_" +
+                                           strategy_name(p.param.strategy) + (p.param.min_pdf > 0 ? "_min_pdf" : "") +
+                                           (p.param.rr_depth >= 0 ? "_rr" + std::to_string(p.param.rr_depth) : "");
+                           for (char& ch : s)
+                             if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+                           return s;
+                         });
+
+// Scenes or settings the vectorised stages do not model run the scalar ones.
+TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
+  auto vectorised = [](Scene scene, Strategy strategy, bool general = false) {
+    scene.render.strategy = strategy;
+    scene.render.force_general_shading = general;
+    const RenderSettings settings = scene.render;
+    const CompiledScene compiled(std::move(scene));
+    return WavefrontTracer(compiled, settings).vectorised();
+  };
+  const Scene cornell = builtin_cornell_box();
+  EXPECT_EQ(vectorised(cornell, Strategy::Mis), lambert_stages::cpu_supported());
+  EXPECT_FALSE(vectorised(cornell, Strategy::Cosine));
+  EXPECT_FALSE(vectorised(cornell, Strategy::Mis, true));  // --general-shading
+  const auto analytic = std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes";
+  Scene sphere_light = cornell;
+  Shape bulb;
+  bulb.kind = Shape::Kind::Sphere;
+  bulb.center = vec3(0.0f, 1.0f, 0.0f);
+  bulb.radius = 0.1f;
+  for (std::uint32_t m = 0; m < sphere_light.materials.size(); ++m)
+    if (sphere_light.materials[m].emits()) bulb.material = m;
+  ASSERT_TRUE(sphere_light.materials[bulb.material].emits());
+  sphere_light.shapes.push_back(bulb);
+  EXPECT_FALSE(vectorised(sphere_light, Strategy::Mis));
+  Scene point_light = cornell;
+  point_light.point_lights.push_back({vec3(0.0f, 1.0f, 0.0f), Spectrum(1.0f)});
+  EXPECT_FALSE(vectorised(point_light, Strategy::Mis));
+  EXPECT_FALSE(vectorised(load_scene(analytic / "sphere-in-environment.json"), Strategy::Mis));      // environment
+  EXPECT_FALSE(vectorised(load_scene(analytic / "mirror-sphere-gray-room.json"), Strategy::Mis));    // mirror
+  EXPECT_FALSE(vectorised(load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "scenes" / "materials.json"),
+                          Strategy::Mis));  // Disney, glass
 }
 
 // times() counts every ray the render counts, by kind, and the time inside

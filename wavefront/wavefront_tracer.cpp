@@ -1,11 +1,14 @@
 #include "wavefront/wavefront_tracer.h"
 
 #include "core/parallel.h"
+#include "wavefront/lambert_stages.h"
 #include "core/rng.h"
 #include "core/strategy_weights.h"
 
 #include <algorithm>
 #include <chrono>
+#include <cstddef>
+#include <type_traits>
 
 namespace pathlab {
 
@@ -86,9 +89,100 @@ std::size_t WavefrontTracer::bytes_per_path() {
          2 * (sizeof(Ray) + sizeof(std::uint32_t) + 1);
 }
 
+// The scene as the vectorised stages read it (lambert_stages.h), with the
+// storage of its light table.
+struct WavefrontTracer::VectorStages {
+  lambert_stages::Scene scene;
+  std::vector<float> inv_area, triangle;
+
+  // Null unless the processor and the scene allow the vectorised stages.
+  static std::unique_ptr<const VectorStages> make(const CompiledScene& compiled, const RenderSettings& settings) {
+    namespace ls = lambert_stages;
+    if (!ls::cpu_supported()) return nullptr;
+    auto v = std::make_unique<VectorStages>();
+    switch (settings.strategy) {
+      case Strategy::Cosine: return nullptr;
+      case Strategy::Bsdf: v->scene.strategy = ls::Strategy::Bsdf; break;
+      case Strategy::Light: v->scene.strategy = ls::Strategy::Light; break;
+      case Strategy::Mis: v->scene.strategy = ls::Strategy::Mis; break;
+      case Strategy::LightBsdf: v->scene.strategy = ls::Strategy::LightBsdf; break;
+    }
+    v->scene.rr_depth = settings.rr_depth;
+    // Every material Lambert (shaded by the Lambert-only code) or an
+    // emitter that does not scatter, with one min_pdf.
+    const Scene& scene = compiled.scene();
+    const Material* diffuse = nullptr;
+    for (const Material& m : scene.materials) {
+      if (m.type == MaterialType::Emissive && !m.scatters()) continue;
+      if (m.type != MaterialType::Diffuse || m.shading.path != ShadingPath::LambertOnly) return nullptr;
+      if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return nullptr;
+      diffuse = &m;
+    }
+    if (diffuse) {
+      v->scene.min_pdf = diffuse->shading.min_pdf;
+      v->scene.albedo_offset = reinterpret_cast<const char*>(&diffuse->albedo) - reinterpret_cast<const char*>(diffuse);
+    }
+    // Only triangle area lights: no point light, sphere or environment.
+    const LightSampler& lights = compiled.lights();
+    if (lights.has_delta_lights() || lights.samples_environment()) return nullptr;
+    for (const LightSampler::Entry& e : lights.entries()) {
+      const Shape& shape = scene.shapes[e.shape];
+      if (shape.kind != Shape::Kind::Triangles) return nullptr;
+      const Material& m = scene.materials[shape.material];
+      const Triangle& t = e.triangle;
+      for (const vec3& c : {t.p0, t.p1, t.p2, t.n, m.emission}) v->triangle.insert(v->triangle.end(), {c.x, c.y, c.z});
+      v->triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
+      v->inv_area.push_back(1.0f / e.area);
+    }
+    v->scene.lights = {lights.entries().size(), lights.cdf().data(), lights.pmf().data(), v->inv_area.data(),
+                       v->triangle.data()};
+    return v;
+  }
+};
+
 WavefrontTracer::WavefrontTracer(const CompiledScene& scene, const RenderSettings& settings, std::size_t wave_size,
-                                 RayModes modes)
-    : Tracer(scene, settings), wave_size_(std::max<std::size_t>(wave_size, 1)), modes_(modes) {}
+                                 RayModes modes, WavefrontStages stages)
+    : Tracer(scene, settings),
+      wave_size_(std::max<std::size_t>(wave_size, 1)),
+      modes_(modes),
+      vector_(stages == WavefrontStages::Auto ? VectorStages::make(scene, settings) : nullptr) {}
+
+WavefrontTracer::~WavefrontTracer() = default;
+
+namespace {
+// The layouts lambert_stages.h hard-codes.
+using namespace lambert_stages::layout;
+static_assert(sizeof(Ray) == kRaySize && offsetof(Ray, origin) == kRayOrigin && offsetof(Ray, dir) == kRayDir &&
+              offsetof(Ray, tmax) == kRayTmax);
+static_assert(sizeof(Surfel) == kSurfelSize && offsetof(Surfel, p) == kSurfelP &&
+              offsetof(Surfel, p_error) == kSurfelPError && offsetof(Surfel, n) == kSurfelN &&
+              offsetof(Surfel, frame) + offsetof(Frame, s) == kSurfelFrameS &&
+              offsetof(Surfel, frame) + offsetof(Frame, t) == kSurfelFrameT &&
+              offsetof(Surfel, frame) + offsetof(Frame, n) == kSurfelFrameN &&
+              offsetof(Surfel, material) == kSurfelMaterial);
+static_assert(sizeof(PreviousVertex) == kPrevSize && offsetof(PreviousVertex, p) == kPrevP &&
+              offsetof(PreviousVertex, pdf) == kPrevPdf && offsetof(PreviousVertex, impulse) == kPrevImpulse &&
+              offsetof(PreviousVertex, bsdf_technique) == kPrevBsdfTechnique && sizeof(bool) == 1);
+static_assert(sizeof(Spectrum) == 3 * sizeof(float) && sizeof(SampleStream) == sizeof(std::uint64_t) &&
+              std::is_trivially_copyable_v<SampleStream>);
+}  // namespace
+
+lambert_stages::WaveView WavefrontTracer::view(Wave& w) {
+  lambert_stages::WaveView v;
+  v.n = w.n;
+  v.rng = reinterpret_cast<const std::uint64_t*>(w.rng.data());
+  v.vertex = w.vertex.data();
+  v.ray = w.ray.data();
+  v.beta = &w.beta.data()->x;
+  v.prev = w.prev.data();
+  v.alive = w.alive.data();
+  v.surfel = w.surfel.data();
+  v.shadow = w.shadow.data();
+  v.unoccluded = &w.unoccluded.data()->x;
+  v.light_weight = w.light_weight.data();
+  v.shadow_state = w.shadow_state.data();
+  return v;
+}
 
 // Stage: the first surface along each live path's ray. The rays go to
 // Embree straight from the path state, as one batch (camera rays as coherent
@@ -154,6 +248,7 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
 // light in every strategy; an area light as the strategy says), each with
 // the contribution it brings if nothing blocks its shadow ray.
 void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
+  if (vector_ && !obs) return lambert_stages::sample_lights(vector_->scene, view(w));
   const LightSampler& lights = scene_.lights();
   const Strategy strategy = settings_.strategy;
   for (std::size_t i = 0; i < w.n; ++i) {
@@ -226,6 +321,7 @@ void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
 
 // Stage: sample the continuation, apply Russian roulette, spawn the next ray.
 void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
+  if (vector_ && !obs) return lambert_stages::scatter(vector_->scene, view(w));
   const Strategy strategy = settings_.strategy;
   for (std::size_t i = 0; i < w.n; ++i) {
     if (!w.alive[i]) continue;

@@ -16,8 +16,13 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 
 namespace pathlab {
+
+namespace lambert_stages {
+struct WaveView;
+}
 
 // How each kind of ray reaches Embree (core/embree_accel.h). The defaults
 // are the fastest on the dragon benchmark on a 2-core AVX-512 machine
@@ -42,6 +47,12 @@ struct WavefrontTimes {
   double query_seconds() const { return camera.seconds + bounce.seconds + shadow.seconds; }
 };
 
+// Which implementation runs the stages that have two (lambert_stages.h).
+enum class WavefrontStages : std::uint8_t {
+  Auto,    // the AVX-512 stages when the scene and the processor allow them
+  Scalar,  // the scalar stages everywhere
+};
+
 class WavefrontTracer final : public Tracer {
  public:
   // Paths per wave, at most: a batch is cut into waves of this size, or
@@ -52,7 +63,9 @@ class WavefrontTracer final : public Tracer {
   using RayModes = WavefrontRayModes;
 
   WavefrontTracer(const CompiledScene& scene, const RenderSettings& settings,
-                  std::size_t wave_size = kDefaultWaveSize, RayModes modes = {});
+                  std::size_t wave_size = kDefaultWaveSize, RayModes modes = {},
+                  WavefrontStages stages = WavefrontStages::Auto);
+  ~WavefrontTracer() override;
 
   std::string_view name() const override { return "wavefront"; }
   void render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const override;
@@ -63,6 +76,12 @@ class WavefrontTracer final : public Tracer {
   static std::size_t bytes_per_path();
   std::size_t wave_size() const { return wave_size_; }
   const RayModes& ray_modes() const { return modes_; }
+  // Whether light sampling and scattering run vectorised (16 paths per
+  // AVX-512 register): the scene needs only Lambert surfaces and triangle
+  // area lights, the strategy is not "cosine", and the processor has
+  // AVX-512. Tracing one sample with an observer always runs the scalar
+  // stages (they report every event); the paths are the same either way.
+  bool vectorised() const { return vector_ != nullptr; }
   // Time spent so far (a clock read per batch of rays, not per ray).
   WavefrontTimes times() const;
 
@@ -79,9 +98,12 @@ class WavefrontTracer final : public Tracer {
   void add_light(Wave& w, PathObserver* obs) const;
   void scatter(Wave& w, PathObserver* obs) const;
   static void compact(Wave& w, std::span<FilmSample> out);
+  static lambert_stages::WaveView view(Wave& w);
 
+  struct VectorStages;
   std::size_t wave_size_;
   RayModes modes_;
+  std::unique_ptr<const VectorStages> vector_;  // null: scalar stages
   // What times() reports: nanoseconds of each, and rays of each kind of query.
   enum Clocked { kCameraQueries, kBounceQueries, kShadowQueries, kWave, kClocked };
   mutable std::atomic<std::uint64_t> nanoseconds_[kClocked] = {}, rays_[kWave] = {};

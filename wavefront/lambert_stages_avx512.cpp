@@ -1,0 +1,334 @@
+// The vectorised stages of lambert_stages.h, 16 paths per AVX-512 register.
+//
+// Compiled with -mavx512f/dq/bw/vl -ffp-contract=off (wavefront/CMakeLists.txt)
+// and called only when lambert_stages::cpu_supported(). Every function here
+// has internal linkage except the two stages, and nothing is included but the
+// plain-data header and <immintrin.h>: see lambert_stages.h for why.
+//
+// Each step names the scalar code it mirrors. The order of every sum and
+// product follows that code (GLM's dot is (x + y) + z; a vec3 divided by a
+// float divides each component; std::max(a, b) is _mm512_max_ps(b, a)), so
+// that a lane's result has the same bits as the scalar one.
+#include "wavefront/lambert_stages.h"
+
+#include <immintrin.h>
+
+namespace pathlab::lambert_stages {
+namespace {
+
+using F = __m512;
+using I = __m512i;
+using M = __mmask16;
+
+constexpr float kInvPi = 1.0f / 3.14159265358979323846f;  // core/math.h
+constexpr float kGamma7 = (7.0f * 0x1p-24f) / (1.0f - 7.0f * 0x1p-24f);  // gamma_bound(7), core/geometry.h
+
+F k(float v) { return _mm512_set1_ps(v); }
+F add(F a, F b) { return _mm512_add_ps(a, b); }
+F sub(F a, F b) { return _mm512_sub_ps(a, b); }
+F mul(F a, F b) { return _mm512_mul_ps(a, b); }
+F div(F a, F b) { return _mm512_div_ps(a, b); }
+F neg(F a) { return _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(a), _mm512_set1_epi32(INT32_MIN))); }
+F select(M m, F if_true, F if_false) { return _mm512_mask_blend_ps(m, if_false, if_true); }
+M lt(F a, F b) { return _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ); }
+M le(F a, F b) { return _mm512_cmp_ps_mask(a, b, _CMP_LE_OQ); }
+M gt(F a, F b) { return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ); }
+M ge(F a, F b) { return _mm512_cmp_ps_mask(a, b, _CMP_GE_OQ); }
+M eq(F a, F b) { return _mm512_cmp_ps_mask(a, b, _CMP_EQ_OQ); }
+
+struct V3 {
+  F x, y, z;
+};
+V3 add(const V3& a, const V3& b) { return {add(a.x, b.x), add(a.y, b.y), add(a.z, b.z)}; }
+V3 sub(const V3& a, const V3& b) { return {sub(a.x, b.x), sub(a.y, b.y), sub(a.z, b.z)}; }
+V3 mul(const V3& a, const V3& b) { return {mul(a.x, b.x), mul(a.y, b.y), mul(a.z, b.z)}; }
+V3 mul(F s, const V3& a) { return {mul(s, a.x), mul(s, a.y), mul(s, a.z)}; }
+V3 div(const V3& a, F s) { return {div(a.x, s), div(a.y, s), div(a.z, s)}; }
+V3 neg(const V3& a) { return {neg(a.x), neg(a.y), neg(a.z)}; }
+V3 abs(const V3& a) { return {_mm512_abs_ps(a.x), _mm512_abs_ps(a.y), _mm512_abs_ps(a.z)}; }
+V3 select(M m, const V3& a, const V3& b) { return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)}; }
+F dot(const V3& a, const V3& b) { return add(add(mul(a.x, b.x), mul(a.y, b.y)), mul(a.z, b.z)); }
+M is_black(const V3& a) { return eq(a.x, k(0.0f)) & eq(a.y, k(0.0f)) & eq(a.z, k(0.0f)); }
+
+// Lane k's float at base + offset + idx[k] bytes (0 in lanes outside m).
+F gather(M m, I idx, const void* base, std::size_t offset) {
+  return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, idx, static_cast<const char*>(base) + offset, 1);
+}
+V3 gather3(M m, I idx, const void* base, std::size_t offset) {
+  return {gather(m, idx, base, offset), gather(m, idx, base, offset + 4), gather(m, idx, base, offset + 8)};
+}
+void scatter(M m, I idx, void* base, std::size_t offset, F v) {
+  _mm512_mask_i32scatter_ps(static_cast<char*>(base) + offset, m, idx, v, 1);
+}
+void scatter3(M m, I idx, void* base, std::size_t offset, const V3& v) {
+  scatter(m, idx, base, offset, v.x);
+  scatter(m, idx, base, offset + 4, v.y);
+  scatter(m, idx, base, offset + 8, v.z);
+}
+// Byte offsets of 16 consecutive records of `size` bytes.
+I strided(std::size_t size) {
+  return _mm512_mullo_epi32(_mm512_set_epi32(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0),
+                            _mm512_set1_epi32(static_cast<int>(size)));
+}
+void* advance(void* p, std::size_t bytes) { return static_cast<char*>(p) + bytes; }
+const void* advance(const void* p, std::size_t bytes) { return static_cast<const char*>(p) + bytes; }
+
+// next_float_up / next_float_down (core/ray.h), lane by lane.
+F next_float(F v, bool up) {
+  const I bits = _mm512_castps_si512(v);
+  const M positive = gt(v, k(0.0f));
+  const I away = _mm512_add_epi32(bits, _mm512_set1_epi32(1)), toward = _mm512_sub_epi32(bits, _mm512_set1_epi32(1));
+  I r = up ? _mm512_mask_blend_epi32(positive, toward, away) : _mm512_mask_blend_epi32(positive, away, toward);
+  r = _mm512_mask_mov_epi32(r, eq(v, k(0.0f)), _mm512_set1_epi32(up ? 1 : INT32_MIN + 1));  // +-denorm_min
+  const M keep = _mm512_cmp_ps_mask(v, v, _CMP_UNORD_Q) | eq(v, k(up ? __builtin_inff() : -__builtin_inff()));
+  return _mm512_castsi512_ps(_mm512_mask_mov_epi32(r, keep, bits));
+}
+
+// offset_ray_origin (core/ray.cpp).
+V3 offset_ray_origin(const V3& p, const V3& error, const V3& n) {
+  const F d = dot(abs(n), error);
+  const V3 offset = mul(d, n);
+  const V3 po = add(p, offset);
+  auto step = [](F c, F o) {
+    c = _mm512_mask_mov_ps(c, gt(o, k(0.0f)), next_float(c, true));
+    return _mm512_mask_mov_ps(c, lt(o, k(0.0f)), next_float(c, false));
+  };
+  return {step(po.x, offset.x), step(po.y, offset.y), step(po.z, offset.z)};
+}
+
+// mix64 (core/rng.h) on 8 64-bit lanes.
+I mix64(I z) {
+  z = _mm512_mullo_epi64(_mm512_xor_si512(z, _mm512_srli_epi64(z, 30)),
+                         _mm512_set1_epi64(static_cast<long long>(0xbf58476d1ce4e5b9ull)));
+  z = _mm512_mullo_epi64(_mm512_xor_si512(z, _mm512_srli_epi64(z, 27)),
+                         _mm512_set1_epi64(static_cast<long long>(0x94d049bb133111ebull)));
+  return _mm512_xor_si512(z, _mm512_srli_epi64(z, 31));
+}
+
+// SampleStream::get for 16 paths at their current vertex: the key with the
+// vertex already xored into its high half (lanes 0-7 and 8-15).
+struct Streams {
+  I lo, hi;
+  F u(Dim dim) const {
+    const I d = _mm512_set1_epi64(static_cast<long long>(dim));
+    const __m256 a = _mm512_cvtepi64_ps(_mm512_srli_epi64(mix64(_mm512_xor_si512(lo, d)), 40));
+    const __m256 b = _mm512_cvtepi64_ps(_mm512_srli_epi64(mix64(_mm512_xor_si512(hi, d)), 40));
+    return mul(_mm512_insertf32x8(_mm512_castps256_ps512(a), b, 1), k(0x1p-24f));
+  }
+};
+Streams streams(const WaveView& w, std::size_t i0, M m, I vertex) {
+  const auto m_lo = static_cast<__mmask8>(m & 0xff), m_hi = static_cast<__mmask8>(m >> 8);
+  const I key_lo = _mm512_maskz_loadu_epi64(m_lo, w.rng + i0), key_hi = _mm512_maskz_loadu_epi64(m_hi, w.rng + i0 + 8);
+  const I v_lo = _mm512_slli_epi64(_mm512_cvtepu32_epi64(_mm512_castsi512_si256(vertex)), 32);
+  const I v_hi = _mm512_slli_epi64(_mm512_cvtepu32_epi64(_mm512_extracti64x4_epi64(vertex, 1)), 32);
+  return {_mm512_xor_si512(key_lo, v_lo), _mm512_xor_si512(key_hi, v_hi)};
+}
+
+// The lanes of slots [i0, i0 + 16) that exist, and which of them are alive.
+M lanes(std::size_t n, std::size_t i0) {
+  return n - i0 >= 16 ? M(0xffff) : static_cast<M>((1u << (n - i0)) - 1u);
+}
+M alive_lanes(const WaveView& w, std::size_t i0, M in) {
+  const I a = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(in, w.alive + i0));
+  return _mm512_test_epi32_mask(a, a);
+}
+
+// Each surfel's material's albedo (Material::albedo through Surfel::material).
+V3 albedo(M m, const Scene& sc, const void* surfels, I surfel_idx) {
+  const I half_idx[2] = {surfel_idx, _mm512_shuffle_i64x2(surfel_idx, surfel_idx, 0x4e)};
+  F c[3];
+  __m256 part[3][2];
+  for (int h = 0; h < 2; ++h) {
+    const auto mh = static_cast<__mmask8>(h == 0 ? (m & 0xff) : (m >> 8));
+    const I ptr = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), mh, _mm512_castsi512_si256(half_idx[h]),
+                                              advance(surfels, layout::kSurfelMaterial), 1);
+    const I at = _mm512_add_epi64(ptr, _mm512_set1_epi64(static_cast<long long>(sc.albedo_offset)));
+    for (int j = 0; j < 3; ++j)
+      part[j][h] = _mm512_mask_i64gather_ps(_mm256_setzero_ps(), mh, _mm512_add_epi64(at, _mm512_set1_epi64(4 * j)),
+                                            nullptr, 1);
+  }
+  for (int j = 0; j < 3; ++j) c[j] = _mm512_insertf32x8(_mm512_castps256_ps512(part[j][0]), part[j][1], 1);
+  return {c[0], c[1], c[2]};
+}
+
+// LightSampler::pick: the first entry whose cdf exceeds u (the last entry if
+// none does), as a branch-free binary search.
+I pick(M m, const Lights& lights, F u) {
+  const auto count = static_cast<std::uint32_t>(lights.count);
+  std::uint32_t step = 1;
+  while (step * 2 <= count) step *= 2;
+  I idx = _mm512_setzero_si512();
+  for (; step > 0; step /= 2) {
+    const I cand = _mm512_add_epi32(idx, _mm512_set1_epi32(static_cast<int>(step)));
+    const M valid = m & _mm512_cmple_epu32_mask(cand, _mm512_set1_epi32(static_cast<int>(count)));
+    const F c = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), valid, _mm512_sub_epi32(cand, _mm512_set1_epi32(1)),
+                                         lights.cdf, 4);
+    idx = _mm512_mask_mov_epi32(idx, valid & le(c, u), cand);
+  }
+  return _mm512_min_epu32(idx, _mm512_set1_epi32(static_cast<int>(count - 1)));
+}
+
+}  // namespace
+
+void sample_lights(const Scene& sc, const WaveView& w) {
+  using namespace layout;
+  const I surfel_idx = strided(kSurfelSize), ray_idx = strided(kRaySize), shadow_idx = strided(2 * kRaySize);
+  const I pair_spectrum_idx = strided(2 * 12), pair_float_idx = strided(2 * 4);
+  for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
+    const M in = lanes(w.n, i0);
+    const void* surfels = advance(w.surfel, i0 * kSurfelSize);
+    const I vertex = _mm512_maskz_loadu_epi32(in, w.vertex + i0);
+    const Streams rng = streams(w, i0, in, vertex);
+    // samples_area_lights (core/strategy_weights.h).
+    M ok = alive_lanes(w, i0, in);
+    if (sc.strategy == Strategy::Bsdf || sc.lights.count == 0) ok = 0;
+    if (sc.strategy == Strategy::LightBsdf) ok &= lt(rng.u(Dim::Technique), k(0.5f));
+
+    if (ok != 0) {
+      // LightSampler::sample: pick a triangle, then a point uniformly on it
+      // (square_to_uniform_triangle, triangle_point).
+      const I light = pick(ok, sc.lights, rng.u(Dim::LightChoice));
+      const F ux = rng.u(Dim::LightX), uy = rng.u(Dim::LightY);
+      const F s = _mm512_sqrt_ps(ux);
+      const F b1 = mul(uy, s), b2 = sub(k(1.0f), s);
+      const F b0 = sub(sub(k(1.0f), b1), b2);
+      const I tri = _mm512_slli_epi32(light, 6);  // 16 floats per light
+      const V3 p0 = gather3(ok, tri, sc.lights.triangle, 0), p1 = gather3(ok, tri, sc.lights.triangle, 12),
+               p2 = gather3(ok, tri, sc.lights.triangle, 24), ln = gather3(ok, tri, sc.lights.triangle, 36),
+               Le = gather3(ok, tri, sc.lights.triangle, 48);
+      const F two_sided = gather(ok, tri, sc.lights.triangle, 60);
+      const V3 lp = add(add(mul(b0, p0), mul(b1, p1)), mul(b2, p2));
+      const V3 lerr = mul(k(kGamma7), add(add(abs(mul(b0, p0)), abs(mul(b1, p1))), abs(mul(b2, p2))));
+
+      const V3 sp = gather3(ok, surfel_idx, surfels, kSurfelP);
+      const V3 d = sub(lp, sp);
+      const F dist = _mm512_sqrt_ps(dot(d, d));
+      ok &= gt(dist, k(0.0f));
+      const V3 wi = div(d, dist);
+      const F cos_light = dot(ln, neg(wi));
+      ok &= ~eq(two_sided, k(0.0f)) | _mm512_cmp_ps_mask(cos_light, k(0.0f), _CMP_NLE_UQ);  // back of a one-sided emitter
+      // pmf * area_to_solid_angle(1 / area, dist, cos_light) (core/sampling.h).
+      const F c = _mm512_abs_ps(cos_light);
+      const F inv_area = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), ok, light, sc.lights.inv_area, 4);
+      const F pmf = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), ok, light, sc.lights.pmf, 4);
+      const F to_solid_angle = select(gt(c, k(0.0f)), div(mul(mul(inv_area, dist), dist), c), k(0.0f));
+      const F pdf_light = mul(pmf, to_solid_angle);
+      ok &= gt(pdf_light, k(0.0f)) & ~_mm512_fpclass_ps_mask(pdf_light, 0x18);  // seen edge-on
+
+      // Surfel::eval and Surfel::pdf of the Lambert lobe (core/surfel.cpp,
+      // bsdf/lambert.h): only the local z of wo and wi matters.
+      const V3 wo = neg(gather3(ok, ray_idx, advance(w.ray, i0 * kRaySize), kRayDir));
+      const V3 fn = gather3(ok, surfel_idx, surfels, kSurfelFrameN);
+      const F wo_z = dot(wo, fn);
+      F wi_z = dot(wi, fn);
+      wi_z = select(lt(wo_z, k(0.0f)), neg(wi_z), wi_z);
+      const M upper = gt(wi_z, k(0.0f));
+      const F cos_pi = mul(wi_z, k(kInvPi));
+      const V3 rho = albedo(ok, sc, surfels, surfel_idx);
+      const V3 zero{k(0.0f), k(0.0f), k(0.0f)};
+      const V3 f = select(upper, mul(cos_pi, rho), zero);
+      ok &= ~is_black(f);
+      const F pdf_bsdf = select(upper, cos_pi, k(0.0f));
+
+      // light_sample_weight (core/strategy_weights.h); pdf_light is finite and > 0 here.
+      F weight = k(1.0f);
+      if (sc.strategy == Strategy::Mis) {
+        const F r = div(pdf_bsdf, pdf_light);
+        weight = div(k(1.0f), add(k(1.0f), mul(r, r)));
+      } else if (sc.strategy == Strategy::LightBsdf) {
+        weight = div(mul(k(2.0f), pdf_light), add(pdf_light, pdf_bsdf));
+      }
+      const V3 unoccluded = mul(div(weight, pdf_light), mul(f, Le));
+
+      // Surfel::spawn_to(lp, lerr, ln).
+      const V3 sn = gather3(ok, surfel_idx, surfels, kSurfelN), serr = gather3(ok, surfel_idx, surfels, kSurfelPError);
+      const V3 origin = offset_ray_origin(sp, serr, select(ge(dot(d, sn), k(0.0f)), sn, neg(sn)));
+      const V3 end = offset_ray_origin(lp, lerr, select(ge(dot(sub(origin, lp), ln), k(0.0f)), ln, neg(ln)));
+      const V3 dd = sub(end, origin);
+      const F len = _mm512_sqrt_ps(dot(dd, dd));
+
+      void* shadow = advance(w.shadow, (2 * i0 + 1) * kRaySize);
+      scatter3(ok, shadow_idx, shadow, kRayOrigin, origin);
+      scatter3(ok, shadow_idx, shadow, kRayDir, div(dd, len));
+      scatter(ok, shadow_idx, shadow, kRayTmax, len);
+      scatter3(ok, pair_spectrum_idx, w.unoccluded + 3 * (2 * i0 + 1), 0, unoccluded);
+      scatter(ok, pair_float_idx, w.light_weight + 2 * i0 + 1, 0, weight);
+    }
+    // Slot [2i] (point lights) is empty; slot [2i + 1] is to be traced or empty.
+    const I state = _mm512_maskz_mov_epi32(ok, _mm512_set1_epi32(0x0100));
+    _mm512_mask_cvtepi32_storeu_epi16(w.shadow_state + 2 * i0, in, state);
+  }
+}
+
+void scatter(const Scene& sc, const WaveView& w) {
+  using namespace layout;
+  const I surfel_idx = strided(kSurfelSize), ray_idx = strided(kRaySize), spectrum_idx = strided(12),
+          prev_idx = strided(kPrevSize);
+  alignas(64) float ux[16], uy[16], dx[16], dy[16];
+  for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
+    const M in = lanes(w.n, i0);
+    M ok = alive_lanes(w, i0, in);
+    if (ok == 0) continue;
+    const void* surfels = advance(w.surfel, i0 * kSurfelSize);
+    void* rays = advance(w.ray, i0 * kRaySize);
+    I vertex = _mm512_maskz_loadu_epi32(in, w.vertex + i0);
+    const Streams rng = streams(w, i0, in, vertex);
+
+    // square_to_cosine_hemisphere (core/sampling.cpp); the disk point by the
+    // scalar function itself, for its sine and cosine.
+    _mm512_store_ps(ux, rng.u(Dim::DirectionX));
+    _mm512_store_ps(uy, rng.u(Dim::DirectionY));
+    for (unsigned lane = 0; lane < 16; ++lane)
+      if ((ok >> lane) & 1u) concentric_disk(ux[lane], uy[lane], &dx[lane], &dy[lane]);
+      else dx[lane] = dy[lane] = 0.0f;
+    const F x = _mm512_load_ps(dx), y = _mm512_load_ps(dy);
+    const F z = _mm512_sqrt_ps(_mm512_max_ps(sub(sub(k(1.0f), mul(x, x)), mul(y, y)), k(0.0f)));
+
+    // Surfel::scatter, Lambert: no sample on the disk's rim, or below min_pdf.
+    const F pdf = select(gt(z, k(0.0f)), mul(z, k(kInvPi)), k(0.0f));
+    ok &= _mm512_cmp_ps_mask(pdf, k(0.0f), _CMP_NLE_UQ) & _mm512_cmp_ps_mask(pdf, k(sc.min_pdf), _CMP_NLT_UQ);
+    const V3 wo = neg(gather3(ok, ray_idx, rays, kRayDir));
+    const V3 fs = gather3(ok, surfel_idx, surfels, kSurfelFrameS), ft = gather3(ok, surfel_idx, surfels, kSurfelFrameT),
+             fn = gather3(ok, surfel_idx, surfels, kSurfelFrameN);
+    const F side = select(lt(dot(wo, fn), k(0.0f)), k(-1.0f), k(1.0f));
+    const F wz = mul(z, side);
+    const V3 wi = add(add(mul(x, fs), mul(y, ft)), mul(wz, fn));  // Frame::to_world
+    V3 weight = albedo(ok, sc, surfels, surfel_idx);
+    ok &= ~is_black(weight);
+
+    // Russian roulette (the scatter stage).
+    V3 beta = gather3(ok, spectrum_idx, w.beta + 3 * i0, 0);
+    const M rr = ok & _mm512_cmpgt_epi32_mask(vertex, _mm512_set1_epi32(sc.rr_depth));
+    if (rr != 0) {
+      const V3 bw = mul(beta, weight);
+      const F survival = _mm512_min_ps(_mm512_max_ps(_mm512_max_ps(bw.z, bw.y), bw.x), k(1.0f));
+      ok &= ~(rr & ~lt(rng.u(Dim::Roulette), survival));
+      weight = select(rr, div(weight, survival), weight);
+    }
+    beta = mul(beta, weight);
+    scatter3(ok, spectrum_idx, w.beta + 3 * i0, 0, beta);
+
+    // PreviousVertex{s.p, pdf, impulse = false, bsdf_technique}.
+    const V3 sp = gather3(ok, surfel_idx, surfels, kSurfelP);
+    void* prev = advance(w.prev, i0 * kPrevSize);
+    scatter3(ok, prev_idx, prev, kPrevP, sp);
+    scatter(ok, prev_idx, prev, kPrevPdf, pdf);
+    M bsdf_technique = 0xffff;
+    if (sc.strategy == Strategy::LightBsdf) bsdf_technique = ~lt(rng.u(Dim::Technique), k(0.5f));
+    static_assert(layout::kPrevBsdfTechnique == layout::kPrevImpulse + 1);
+    const I flags = _mm512_maskz_mov_epi32(bsdf_technique, _mm512_set1_epi32(0x0100));  // impulse 0, bsdf_technique
+    _mm512_mask_i32scatter_epi32(advance(prev, kPrevImpulse), ok, prev_idx, flags, 1);
+
+    // Surfel::spawn(wi).
+    const V3 sn = gather3(ok, surfel_idx, surfels, kSurfelN), serr = gather3(ok, surfel_idx, surfels, kSurfelPError);
+    const V3 origin = offset_ray_origin(sp, serr, select(ge(dot(wi, sn), k(0.0f)), sn, neg(sn)));
+    scatter3(ok, ray_idx, rays, kRayOrigin, origin);
+    scatter3(ok, ray_idx, rays, kRayDir, wi);
+    scatter(ok, ray_idx, rays, kRayTmax, k(__builtin_inff()));
+    vertex = _mm512_mask_add_epi32(vertex, ok, vertex, _mm512_set1_epi32(1));
+    _mm512_mask_storeu_epi32(w.vertex + i0, ok, vertex);
+    _mm512_mask_cvtepi32_storeu_epi8(w.alive + i0, in, _mm512_maskz_mov_epi32(ok, _mm512_set1_epi32(1)));
+  }
+}
+
+}  // namespace pathlab::lambert_stages
