@@ -108,9 +108,9 @@ void reference(benchmark::State& state) {
 // the timed region. Its counter x_reference = reference time / wavefront time
 // compares two renders taken seconds apart, so a machine whose speed drifts
 // by 10 % between repetitions (as this shared one does) moves both alike.
-void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes modes) {
+void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes modes, WavefrontStages stages) {
   const ReferenceTracer reference_tracer(*setup().scene, setup().settings);
-  const WavefrontTracer tracer(*setup().scene, setup().settings, wave, modes);
+  const WavefrontTracer tracer(*setup().scene, setup().settings, wave, modes, stages);
   static std::uint64_t pairs = 0;
   RenderStats stats;
   double reference_seconds = 0.0, wavefront_seconds = 0.0;
@@ -131,6 +131,7 @@ void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes mode
   }
   set_rates(state, stats);
   state.counters["x_reference"] = wavefront_seconds > 0.0 ? reference_seconds / wavefront_seconds : 0.0;
+  state.counters["vectorised"] = tracer.vectorised() ? 1.0 : 0.0;
   // Embree as the wavefront meets it, between its stages: the share of the
   // waves' time it takes, and its rates on all threads, to set beside Raw/.
   const WavefrontTimes t = tracer.times();
@@ -244,9 +245,10 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const WavefrontRayModes modes = parse_modes(run);
       const double sps = median(run, "samples/s"), rps = median(run, "rays/s");
       const double raw_rate = raw_mix_rate(modes);
-      std::printf("%s: %.4g samples/s = %.2fx reference (paired, sd %.2f); %.4g rays/s = %.2f of raw (%.4g rays/s)\n",
+      std::printf("%s: %.4g samples/s = %.2fx reference (paired, sd %.2f); %.4g rays/s = %.2f of raw (%.4g rays/s); "
+                  "%s stages\n",
                   run.c_str(), sps, median(run, "x_reference"), stddev(run, "x_reference"), rps,
-                  raw_rate > 0 ? rps / raw_rate : 0.0, raw_rate);
+                  raw_rate > 0 ? rps / raw_rate : 0.0, raw_rate, median(run, "vectorised") > 0.5 ? "vectorised" : "scalar");
       // Embree's rate inside the tracer against its raw rate in the same mode.
       auto in_context = [&](const char* counter, RayKind kind, RayBatchMode mode) {
         const double raw_kind = median(raw_name(kind, mode), "rays/s");
@@ -290,9 +292,10 @@ class RatioReporter : public benchmark::ConsoleReporter {
   Counters values_, medians_, stddevs_;
 };
 
-std::string wavefront_name(std::size_t wave, const WavefrontRayModes& m) {
+std::string wavefront_name(std::size_t wave, const WavefrontRayModes& m, WavefrontStages stages) {
   return "Tracer/wavefront/wave:" + std::to_string(wave) + "/camera:" + ray_batch_mode_name(m.camera) +
-         "/bounce:" + ray_batch_mode_name(m.bounce) + "/shadow:" + ray_batch_mode_name(m.shadow);
+         "/bounce:" + ray_batch_mode_name(m.bounce) + "/shadow:" + ray_batch_mode_name(m.shadow) +
+         (stages == WavefrontStages::Scalar ? "/stages:scalar" : "");
 }
 
 benchmark::internal::Benchmark* timed(benchmark::internal::Benchmark* b) {
@@ -305,13 +308,23 @@ void register_benchmarks() {
     for (RayBatchMode mode : kAllRayBatchModes)
       timed(benchmark::RegisterBenchmark(raw_name(kind, mode).c_str(), raw, kind, mode))->MinTime(setup().raw_min_seconds);
   timed(benchmark::RegisterBenchmark("Tracer/reference", reference))->Iterations(1);
-  std::vector<std::pair<std::size_t, WavefrontRayModes>> configs;
+  struct Config {
+    std::size_t wave;
+    WavefrontRayModes modes;
+    WavefrontStages stages = WavefrontStages::Auto;
+  };
+  std::vector<Config> configs;
   const WavefrontRayModes defaults;
-  for (std::size_t wave : {std::size_t{1} << 10, WavefrontTracer::kDefaultWaveSize, std::size_t{1} << 16})
-    configs.push_back({wave, defaults});
-  for (RayBatchMode mode : kAllRayBatchModes) configs.push_back({WavefrontTracer::kDefaultWaveSize, {mode, mode, mode}});
-  for (const auto& [wave, modes] : configs)
-    timed(benchmark::RegisterBenchmark(wavefront_name(wave, modes).c_str(), wavefront, wave, modes))->Iterations(1);
+  const std::size_t wave = WavefrontTracer::kDefaultWaveSize;
+  for (std::size_t w : {std::size_t{1} << 10, wave, std::size_t{1} << 16}) configs.push_back({w, defaults});
+  for (RayBatchMode mode : kAllRayBatchModes) configs.push_back({wave, {mode, mode, mode}});
+  // The scalar stages, the baseline of the vectorised ones.
+  configs.push_back({wave, defaults, WavefrontStages::Scalar});
+  configs.push_back({wave, {RayBatchMode::Single, RayBatchMode::Single, RayBatchMode::Single}, WavefrontStages::Scalar});
+  for (const Config& c : configs)
+    timed(benchmark::RegisterBenchmark(wavefront_name(c.wave, c.modes, c.stages).c_str(), wavefront, c.wave, c.modes,
+                                       c.stages))
+        ->Iterations(1);
 }
 
 }  // namespace

@@ -33,6 +33,13 @@ class Camera {
   Ray generate_ray(vec2 film, vec2 u_lens) const;
 
   const CameraDesc& desc() const { return desc_; }
+  // The image plane as generate_ray() computes it, for code that makes rays
+  // in bulk and must make the same ones (the wavefront's vectorised camera).
+  struct Plane {
+    vec3 forward, right, up;
+    float tan_half_fov, aspect, inv_width, inv_height;
+  };
+  Plane plane() const { return {forward_, right_, up_, tan_half_fov_, aspect_, inv_width_, inv_height_}; }
   vec3 forward() const { return forward_; }
 
  private:

@@ -9,7 +9,7 @@
 #include "debugtools/path_recorder.h"
 #include "reference/reference_tracer.h"
 #include "tests/test_scenes.h"
-#include "wavefront/lambert_stages.h"
+#include "wavefront/vector_stages.h"
 #include "wavefront/wavefront_tracer.h"
 
 #include <gtest/gtest.h>
@@ -115,7 +115,7 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
   EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
 }
 
-// The vectorised stages (wavefront/lambert_stages.h) give every sample the
+// The vectorised stages (wavefront/vector_stages.h) give every sample the
 // bits the scalar stages give it, on every scene and strategy they take:
 // several lights (the pick's binary search), a two-sided emitting box, a
 // min_pdf cut-off, roulette from the first bounce, and waves whose size is
@@ -125,12 +125,13 @@ struct VectorCase {
   Strategy strategy;
   float min_pdf = 0.0f;
   int rr_depth = -1;  // -1: the scene's
+  bool lambert = true;  // false: only the camera stage is vectorised
 };
 
 class VectorStages : public testing::TestWithParam<VectorCase> {};
 
 TEST_P(VectorStages, GiveTheScalarStagesBits) {
-  if (!lambert_stages::cpu_supported()) GTEST_SKIP() << "this processor has no AVX-512";
+  if (!vector_stages::cpu_supported()) GTEST_SKIP() << "this processor has no AVX-512";
   const VectorCase& c = GetParam();
   Scene scene = load_case({c.scene, c.strategy});
   scene.render.min_pdf = c.min_pdf;
@@ -142,8 +143,9 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   for (std::size_t wave : {std::size_t{997}, std::size_t{4096}}) {
     const WavefrontTracer vectorised(compiled, settings, wave, {}, WavefrontStages::Auto);
     const WavefrontTracer scalar(compiled, settings, wave, {}, WavefrontStages::Scalar);
-    ASSERT_TRUE(vectorised.vectorised());
-    ASSERT_FALSE(scalar.vectorised());
+    ASSERT_EQ(vectorised.vectorised(), c.lambert);
+    ASSERT_TRUE(vectorised.camera_vectorised());
+    ASSERT_FALSE(scalar.vectorised() || scalar.camera_vectorised());
     std::vector<FilmSample> a(pixels * count), b(pixels * count);
     vectorised.render_batch(0, count, a);
     scalar.render_batch(0, count, b);
@@ -162,6 +164,10 @@ std::vector<VectorCase> vector_cases() {
     for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf}) cases.push_back({s, st});
   cases.push_back({"", Strategy::Mis, 0.2f, 0});
   cases.push_back({"", Strategy::LightBsdf, 0.0f, 0});
+  // Only the camera rays.
+  cases.push_back({"mirror-sphere-gray-room.json", Strategy::Mis, 0.0f, -1, false});
+  cases.push_back({"glass-sphere-tinted.json", Strategy::Mis, 0.0f, -1, false});
+  cases.push_back({"", Strategy::Cosine, 0.0f, -1, false});
   return cases;
 }
 
@@ -185,7 +191,13 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
     return WavefrontTracer(compiled, settings).vectorised();
   };
   const Scene cornell = builtin_cornell_box();
-  EXPECT_EQ(vectorised(cornell, Strategy::Mis), lambert_stages::cpu_supported());
+  EXPECT_EQ(vectorised(cornell, Strategy::Mis), vector_stages::cpu_supported());
+  {
+    Scene thin_lens = cornell;
+    thin_lens.camera.aperture_radius = 0.05f;
+    const CompiledScene compiled(std::move(thin_lens));
+    EXPECT_FALSE(WavefrontTracer(compiled, compiled.scene().render).camera_vectorised());
+  }
   EXPECT_FALSE(vectorised(cornell, Strategy::Cosine));
   EXPECT_FALSE(vectorised(cornell, Strategy::Mis, true));  // --general-shading
   const auto analytic = std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes";

@@ -1,12 +1,13 @@
 #include "wavefront/wavefront_tracer.h"
 
 #include "core/parallel.h"
-#include "wavefront/lambert_stages.h"
+#include "wavefront/vector_stages.h"
 #include "core/rng.h"
 #include "core/strategy_weights.h"
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <cstddef>
 #include <type_traits>
 
@@ -89,54 +90,78 @@ std::size_t WavefrontTracer::bytes_per_path() {
          2 * (sizeof(Ray) + sizeof(std::uint32_t) + 1);
 }
 
-// The scene as the vectorised stages read it (lambert_stages.h), with the
-// storage of its light table.
+// What the vectorised stages read of the scene (vector_stages.h), and the
+// storage of its light table. Exists when the processor has AVX-512.
 struct WavefrontTracer::VectorStages {
-  lambert_stages::Scene scene;
+  std::optional<vector_stages::Camera> camera;  // a pinhole camera
+  std::optional<vector_stages::Scene> lambert;  // Lambert surfaces and triangle lights
   std::vector<float> inv_area, triangle;
 
-  // Null unless the processor and the scene allow the vectorised stages.
-  static std::unique_ptr<const VectorStages> make(const CompiledScene& compiled, const RenderSettings& settings) {
-    namespace ls = lambert_stages;
-    if (!ls::cpu_supported()) return nullptr;
-    auto v = std::make_unique<VectorStages>();
-    switch (settings.strategy) {
-      case Strategy::Cosine: return nullptr;
-      case Strategy::Bsdf: v->scene.strategy = ls::Strategy::Bsdf; break;
-      case Strategy::Light: v->scene.strategy = ls::Strategy::Light; break;
-      case Strategy::Mis: v->scene.strategy = ls::Strategy::Mis; break;
-      case Strategy::LightBsdf: v->scene.strategy = ls::Strategy::LightBsdf; break;
+  static std::unique_ptr<const VectorStages> make(const CompiledScene& compiled, const RenderSettings& settings,
+                                                  std::string* why_not) {
+    if (!vector_stages::cpu_supported()) {
+      *why_not = "the processor has no AVX-512";
+      return nullptr;
     }
-    v->scene.rr_depth = settings.rr_depth;
+    auto v = std::make_unique<VectorStages>();
+    const Camera& camera = compiled.camera();
+    if (camera.desc().aperture_radius <= 0.0f) {
+      const Camera::Plane p = camera.plane();
+      const vec3 o = camera.desc().position;
+      v->camera = vector_stages::Camera{{o.x, o.y, o.z},
+                                        {p.forward.x, p.forward.y, p.forward.z},
+                                        {p.right.x, p.right.y, p.right.z},
+                                        {p.up.x, p.up.y, p.up.z},
+                                        p.tan_half_fov, p.aspect, p.inv_width, p.inv_height};
+    }
+    *why_not = v->make_lambert(compiled, settings);
+    return v;
+  }
+
+  // Fills `lambert`, or says why the scene needs more than it models.
+  std::string make_lambert(const CompiledScene& compiled, const RenderSettings& settings) {
+    namespace vs = vector_stages;
+    vs::Scene sc;
+    switch (settings.strategy) {
+      case Strategy::Cosine: return "strategy cosine";
+      case Strategy::Bsdf: sc.strategy = vs::Strategy::Bsdf; break;
+      case Strategy::Light: sc.strategy = vs::Strategy::Light; break;
+      case Strategy::Mis: sc.strategy = vs::Strategy::Mis; break;
+      case Strategy::LightBsdf: sc.strategy = vs::Strategy::LightBsdf; break;
+    }
+    sc.rr_depth = settings.rr_depth;
     // Every material Lambert (shaded by the Lambert-only code) or an
     // emitter that does not scatter, with one min_pdf.
     const Scene& scene = compiled.scene();
     const Material* diffuse = nullptr;
     for (const Material& m : scene.materials) {
       if (m.type == MaterialType::Emissive && !m.scatters()) continue;
-      if (m.type != MaterialType::Diffuse || m.shading.path != ShadingPath::LambertOnly) return nullptr;
-      if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return nullptr;
+      if (m.type != MaterialType::Diffuse)
+        return "material '" + m.name + "' is " + material_type_name(m.type) + ", not diffuse";
+      if (m.shading.path != ShadingPath::LambertOnly) return std::string("shading path ") + shading_path_name(m.shading.path);
+      if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return "materials with different min_pdf";
       diffuse = &m;
     }
     if (diffuse) {
-      v->scene.min_pdf = diffuse->shading.min_pdf;
-      v->scene.albedo_offset = reinterpret_cast<const char*>(&diffuse->albedo) - reinterpret_cast<const char*>(diffuse);
+      sc.min_pdf = diffuse->shading.min_pdf;
+      sc.albedo_offset = reinterpret_cast<const char*>(&diffuse->albedo) - reinterpret_cast<const char*>(diffuse);
     }
     // Only triangle area lights: no point light, sphere or environment.
     const LightSampler& lights = compiled.lights();
-    if (lights.has_delta_lights() || lights.samples_environment()) return nullptr;
+    if (lights.has_delta_lights()) return "point lights";
+    if (lights.samples_environment()) return "an environment light";
     for (const LightSampler::Entry& e : lights.entries()) {
       const Shape& shape = scene.shapes[e.shape];
-      if (shape.kind != Shape::Kind::Triangles) return nullptr;
+      if (shape.kind != Shape::Kind::Triangles) return "a sphere light (" + shape.description + ")";
       const Material& m = scene.materials[shape.material];
       const Triangle& t = e.triangle;
-      for (const vec3& c : {t.p0, t.p1, t.p2, t.n, m.emission}) v->triangle.insert(v->triangle.end(), {c.x, c.y, c.z});
-      v->triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
-      v->inv_area.push_back(1.0f / e.area);
+      for (const vec3& c : {t.p0, t.p1, t.p2, t.n, m.emission}) triangle.insert(triangle.end(), {c.x, c.y, c.z});
+      triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
+      inv_area.push_back(1.0f / e.area);
     }
-    v->scene.lights = {lights.entries().size(), lights.cdf().data(), lights.pmf().data(), v->inv_area.data(),
-                       v->triangle.data()};
-    return v;
+    sc.lights = {lights.entries().size(), lights.cdf().data(), lights.pmf().data(), inv_area.data(), triangle.data()};
+    lambert = sc;
+    return "";
   }
 };
 
@@ -145,13 +170,26 @@ WavefrontTracer::WavefrontTracer(const CompiledScene& scene, const RenderSetting
     : Tracer(scene, settings),
       wave_size_(std::max<std::size_t>(wave_size, 1)),
       modes_(modes),
-      vector_(stages == WavefrontStages::Auto ? VectorStages::make(scene, settings) : nullptr) {}
+      vector_(stages == WavefrontStages::Auto ? VectorStages::make(scene, settings, &scalar_reason_) : nullptr) {
+  if (stages == WavefrontStages::Scalar) scalar_reason_ = "asked for";
+}
+
+bool WavefrontTracer::vectorised() const { return vector_ && vector_->lambert; }
+bool WavefrontTracer::camera_vectorised() const { return vector_ && vector_->camera; }
+
+std::string WavefrontTracer::stages_description() const {
+  if (!vector_) return "scalar stages (" + scalar_reason_ + ")";
+  std::string d = "vectorised stages (AVX-512, 16 paths at a time): ";
+  d += camera_vectorised() ? "camera rays" : "camera rays no (a thin lens)";
+  d += vectorised() ? ", light sampling and scattering" : ", light sampling and scattering no (" + scalar_reason_ + ")";
+  return d;
+}
 
 WavefrontTracer::~WavefrontTracer() = default;
 
 namespace {
-// The layouts lambert_stages.h hard-codes.
-using namespace lambert_stages::layout;
+// The layouts vector_stages.h hard-codes.
+using namespace vector_stages::layout;
 static_assert(sizeof(Ray) == kRaySize && offsetof(Ray, origin) == kRayOrigin && offsetof(Ray, dir) == kRayDir &&
               offsetof(Ray, tmax) == kRayTmax);
 static_assert(sizeof(Surfel) == kSurfelSize && offsetof(Surfel, p) == kSurfelP &&
@@ -167,10 +205,15 @@ static_assert(sizeof(Spectrum) == 3 * sizeof(float) && sizeof(SampleStream) == s
               std::is_trivially_copyable_v<SampleStream>);
 }  // namespace
 
-lambert_stages::WaveView WavefrontTracer::view(Wave& w) {
-  lambert_stages::WaveView v;
+vector_stages::WaveView WavefrontTracer::view(Wave& w) {
+  vector_stages::WaveView v;
   v.n = w.n;
   v.rng = reinterpret_cast<const std::uint64_t*>(w.rng.data());
+  v.x = w.x.data();
+  v.y = w.y.data();
+  v.film = &w.film.data()->x;
+  v.L = &w.L.data()->x;
+  v.rays = w.rays.data();
   v.vertex = w.vertex.data();
   v.ray = w.ray.data();
   v.beta = &w.beta.data()->x;
@@ -248,7 +291,7 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
 // light in every strategy; an area light as the strategy says), each with
 // the contribution it brings if nothing blocks its shadow ray.
 void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
-  if (vector_ && !obs) return lambert_stages::sample_lights(vector_->scene, view(w));
+  if (vectorised() && !obs) return vector_stages::sample_lights(*vector_->lambert, view(w));
   const LightSampler& lights = scene_.lights();
   const Strategy strategy = settings_.strategy;
   for (std::size_t i = 0; i < w.n; ++i) {
@@ -321,7 +364,7 @@ void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
 
 // Stage: sample the continuation, apply Russian roulette, spawn the next ray.
 void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
-  if (vector_ && !obs) return lambert_stages::scatter(vector_->scene, view(w));
+  if (vectorised() && !obs) return vector_stages::scatter(*vector_->lambert, view(w));
   const Strategy strategy = settings_.strategy;
   for (std::size_t i = 0; i < w.n; ++i) {
     if (!w.alive[i]) continue;
@@ -381,6 +424,7 @@ void WavefrontTracer::compact(Wave& w, std::span<FilmSample> out) {
 
 // Stage: one camera ray per path.
 void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
+  if (camera_vectorised() && !obs) return vector_stages::generate_camera_rays(*vector_->camera, view(w));
   const Camera& camera = scene_.camera();
   for (std::size_t i = 0; i < w.n; ++i) {
     w.vertex[i] = 0;  // the camera's random numbers are those of vertex 0

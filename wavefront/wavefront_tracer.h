@@ -17,10 +17,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 
 namespace pathlab {
 
-namespace lambert_stages {
+namespace vector_stages {
 struct WaveView;
 }
 
@@ -47,7 +48,7 @@ struct WavefrontTimes {
   double query_seconds() const { return camera.seconds + bounce.seconds + shadow.seconds; }
 };
 
-// Which implementation runs the stages that have two (lambert_stages.h).
+// Which implementation runs the stages that have two (vector_stages.h).
 enum class WavefrontStages : std::uint8_t {
   Auto,    // the AVX-512 stages when the scene and the processor allow them
   Scalar,  // the scalar stages everywhere
@@ -81,7 +82,14 @@ class WavefrontTracer final : public Tracer {
   // area lights, the strategy is not "cosine", and the processor has
   // AVX-512. Tracing one sample with an observer always runs the scalar
   // stages (they report every event); the paths are the same either way.
-  bool vectorised() const { return vector_ != nullptr; }
+  bool vectorised() const;
+  // Whether camera rays are made vectorised: a pinhole camera and AVX-512.
+  bool camera_vectorised() const;
+  // Why light sampling and scattering run scalar ("" when vectorised),
+  // e.g. "strategy cosine".
+  const std::string& scalar_reason() const { return scalar_reason_; }
+  // Which stages run vectorised, in a line for people.
+  std::string stages_description() const;
   // Time spent so far (a clock read per batch of rays, not per ray).
   WavefrontTimes times() const;
 
@@ -98,11 +106,12 @@ class WavefrontTracer final : public Tracer {
   void add_light(Wave& w, PathObserver* obs) const;
   void scatter(Wave& w, PathObserver* obs) const;
   static void compact(Wave& w, std::span<FilmSample> out);
-  static lambert_stages::WaveView view(Wave& w);
+  static vector_stages::WaveView view(Wave& w);
 
   struct VectorStages;
   std::size_t wave_size_;
   RayModes modes_;
+  std::string scalar_reason_;
   std::unique_ptr<const VectorStages> vector_;  // null: scalar stages
   // What times() reports: nanoseconds of each, and rays of each kind of query.
   enum Clocked { kCameraQueries, kBounceQueries, kShadowQueries, kWave, kClocked };

@@ -140,7 +140,9 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
           << WavefrontTracer::bytes_per_path() << " bytes of path state per path ("
           << (wf->wave_size() * WavefrontTracer::bytes_per_path() * static_cast<std::size_t>(max_threads()) + 512 * 1024) /
                  (1024 * 1024)
-          << " MiB in flight on " << max_threads() << " threads)\n";
+          << " MiB in flight on " << max_threads() << " threads); "
+          << wf->stages_description()
+          << "\n";
       if (const WavefrontTimes t = wf->times(); t.waves_seconds > 0.0) {
         std::snprintf(line, sizeof line,
                       "%.0f%% of the waves' time in Embree; per thread, camera %.3g, bounce %.3g, shadow %.3g rays/s",

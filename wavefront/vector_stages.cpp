@@ -1,9 +1,9 @@
-// The parts of lambert_stages.h compiled for the baseline instruction set.
-#include "wavefront/lambert_stages.h"
+// The parts of vector_stages.h compiled for the baseline instruction set.
+#include "wavefront/vector_stages.h"
 
 #include "core/sampling.h"
 
-namespace pathlab::lambert_stages {
+namespace pathlab::vector_stages {
 
 bool cpu_supported() {
   __builtin_cpu_init();
@@ -17,4 +17,4 @@ void concentric_disk(float ux, float uy, float* dx, float* dy) {
   *dy = d.y;
 }
 
-}  // namespace pathlab::lambert_stages
+}  // namespace pathlab::vector_stages

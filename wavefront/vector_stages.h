@@ -1,8 +1,10 @@
-// Two of the wavefront's stages - sampling lights and scattering - run 16
-// paths at a time in AVX-512 registers, for scenes that need nothing more
-// than Lambert surfaces and triangle area lights (the dragon benchmark, the
-// Cornell box). Other scenes, and machines without AVX-512, run the scalar
-// stages of wavefront_tracer.cpp.
+// Wavefront stages that run 16 paths at a time in AVX-512 registers:
+// - making camera rays, for any scene seen through a pinhole camera;
+// - sampling lights and scattering, for scenes that need nothing more than
+//   Lambert surfaces and triangle area lights (the dragon benchmark, the
+//   Cornell box).
+// Other scenes, and machines without AVX-512, run the scalar stages of
+// wavefront_tracer.cpp.
 //
 // Same paths: every lane computes what the scalar code computes, operation
 // for operation and in the same order (IEEE add, multiply, divide and square
@@ -12,7 +14,7 @@
 // function the reference calls. tests/test_wavefront.cpp checks every sample
 // of several scenes bit for bit against the scalar stages.
 //
-// This header is plain data on purpose: lambert_stages_avx512.cpp is compiled
+// This header is plain data on purpose: vector_stages_avx512.cpp is compiled
 // for AVX-512 and must not instantiate any inline function (GLM, the standard
 // library) that another translation unit also instantiates - the linker would
 // keep one copy, possibly the AVX-512 one, for everybody.
@@ -23,7 +25,7 @@
 #include <cstddef>
 #include <cstdint>
 
-namespace pathlab::lambert_stages {
+namespace pathlab::vector_stages {
 
 // The sampling strategies the vectorised stages support ("cosine" scatters
 // differently and stays scalar).
@@ -49,12 +51,23 @@ struct Scene {
   Lights lights;
 };
 
+// A pinhole camera (Camera::generate_ray without an aperture).
+struct Camera {
+  float position[3], forward[3], right[3], up[3];
+  float tan_half_fov, aspect, inv_width, inv_height;
+};
+
 // The wave's arrays (wavefront_tracer.cpp's Wave), as raw memory. The record
 // layouts (Ray, Surfel, PreviousVertex) are fixed below and checked with
 // static_asserts where the real types are visible.
 struct WaveView {
   std::size_t n = 0;                   // paths in slots [0, n)
   const std::uint64_t* rng = nullptr;  // SampleStream::key() per path
+  const std::uint32_t* x = nullptr;    // pixel per path
+  const std::uint32_t* y = nullptr;
+  float* film = nullptr;               // vec2 per path
+  float* L = nullptr;                  // Spectrum per path
+  std::uint32_t* rays = nullptr;
   std::int32_t* vertex = nullptr;
   void* ray = nullptr;                 // Ray per path
   float* beta = nullptr;               // Spectrum per path
@@ -78,6 +91,8 @@ inline constexpr std::size_t kPrevSize = 20, kPrevP = 0, kPrevPdf = 12, kPrevImp
 // Whether this processor runs the vectorised stages.
 bool cpu_supported();
 
+// generate_camera_rays: every path's camera ray, and its state reset.
+void generate_camera_rays(const Camera& camera, const WaveView& wave);
 // sample_lights: for every live path, next-event estimation towards one
 // area light (the scalar stage's slot [2i + 1]; slot [2i] is cleared, as
 // the scene has no point lights).
@@ -89,4 +104,4 @@ void scatter(const Scene& scene, const WaveView& wave);
 // compiled function the reference calls.
 void concentric_disk(float ux, float uy, float* dx, float* dy);
 
-}  // namespace pathlab::lambert_stages
+}  // namespace pathlab::vector_stages

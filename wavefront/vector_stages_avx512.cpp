@@ -1,19 +1,19 @@
-// The vectorised stages of lambert_stages.h, 16 paths per AVX-512 register.
+// The vectorised stages of vector_stages.h, 16 paths per AVX-512 register.
 //
 // Compiled with -mavx512f/dq/bw/vl -ffp-contract=off (wavefront/CMakeLists.txt)
-// and called only when lambert_stages::cpu_supported(). Every function here
+// and called only when vector_stages::cpu_supported(). Every function here
 // has internal linkage except the two stages, and nothing is included but the
-// plain-data header and <immintrin.h>: see lambert_stages.h for why.
+// plain-data header and <immintrin.h>: see vector_stages.h for why.
 //
 // Each step names the scalar code it mirrors. The order of every sum and
 // product follows that code (GLM's dot is (x + y) + z; a vec3 divided by a
 // float divides each component; std::max(a, b) is _mm512_max_ps(b, a)), so
 // that a lane's result has the same bits as the scalar one.
-#include "wavefront/lambert_stages.h"
+#include "wavefront/vector_stages.h"
 
 #include <immintrin.h>
 
-namespace pathlab::lambert_stages {
+namespace pathlab::vector_stages {
 namespace {
 
 using F = __m512;
@@ -169,6 +169,45 @@ I pick(M m, const Lights& lights, F u) {
 }
 
 }  // namespace
+
+void generate_camera_rays(const Camera& c, const WaveView& w) {
+  using namespace layout;
+  const I ray_idx = strided(kRaySize), film_idx = strided(8), spectrum_idx = strided(12), prev_idx = strided(kPrevSize);
+  const V3 position{k(c.position[0]), k(c.position[1]), k(c.position[2])};
+  const V3 forward{k(c.forward[0]), k(c.forward[1]), k(c.forward[2])};
+  const V3 right{k(c.right[0]), k(c.right[1]), k(c.right[2])};
+  const V3 up{k(c.up[0]), k(c.up[1]), k(c.up[2])};
+  const V3 zero{k(0.0f), k(0.0f), k(0.0f)}, one{k(1.0f), k(1.0f), k(1.0f)};
+  for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
+    const M in = lanes(w.n, i0);
+    const Streams rng = streams(w, i0, in, _mm512_setzero_si512());  // the camera's numbers are vertex 0's
+    // The film position: pixel + FilmX/Y (wavefront_tracer.cpp).
+    const F fx = add(_mm512_cvtepu32_ps(_mm512_maskz_loadu_epi32(in, w.x + i0)), rng.u(Dim::FilmX));
+    const F fy = add(_mm512_cvtepu32_ps(_mm512_maskz_loadu_epi32(in, w.y + i0)), rng.u(Dim::FilmY));
+    scatter(in, film_idx, w.film + 2 * i0, 0, fx);
+    scatter(in, film_idx, w.film + 2 * i0, 4, fy);
+    // Camera::generate_ray, pinhole.
+    const F sx = mul(mul(sub(mul(mul(k(2.0f), fx), k(c.inv_width)), k(1.0f)), k(c.tan_half_fov)), k(c.aspect));
+    const F sy = mul(sub(k(1.0f), mul(mul(k(2.0f), fy), k(c.inv_height))), k(c.tan_half_fov));
+    const V3 v = add(add(forward, mul(sx, right)), mul(sy, up));
+    const V3 d = mul(div(k(1.0f), _mm512_sqrt_ps(dot(v, v))), v);  // glm::normalize: v * (1 / sqrt(v.v))
+    void* rays = advance(w.ray, i0 * kRaySize);
+    scatter3(in, ray_idx, rays, kRayOrigin, position);
+    scatter3(in, ray_idx, rays, kRayDir, d);
+    scatter(in, ray_idx, rays, kRayTmax, k(__builtin_inff()));
+    // A fresh path: beta 1, L 0, PreviousVertex{} (at 0, pdf 0, impulse, BSDF
+    // technique), no rays yet, alive, about to reach vertex 1.
+    scatter3(in, spectrum_idx, w.beta + 3 * i0, 0, one);
+    scatter3(in, spectrum_idx, w.L + 3 * i0, 0, zero);
+    void* prev = advance(w.prev, i0 * kPrevSize);
+    scatter3(in, prev_idx, prev, kPrevP, zero);
+    scatter(in, prev_idx, prev, kPrevPdf, k(0.0f));
+    _mm512_mask_i32scatter_epi32(advance(prev, kPrevImpulse), in, prev_idx, _mm512_set1_epi32(0x0101), 1);
+    _mm512_mask_storeu_epi32(w.rays + i0, in, _mm512_setzero_si512());
+    _mm512_mask_storeu_epi32(w.vertex + i0, in, _mm512_set1_epi32(1));
+    _mm512_mask_cvtepi32_storeu_epi8(w.alive + i0, in, _mm512_set1_epi32(1));
+  }
+}
 
 void sample_lights(const Scene& sc, const WaveView& w) {
   using namespace layout;
@@ -331,4 +370,4 @@ void scatter(const Scene& sc, const WaveView& w) {
   }
 }
 
-}  // namespace pathlab::lambert_stages
+}  // namespace pathlab::vector_stages
