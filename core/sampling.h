@@ -7,6 +7,17 @@
 
 namespace pathlab {
 
+// sin and cos of x for |x| <= pi/4, by fixed polynomials in plain float
+// arithmetic (the coefficients of Cephes' sinf and cosf), within 2 ulp of
+// the true values. Unlike libm's, the result is the same bits in any build
+// and on any machine, and a vector lane that evaluates the same expression
+// gets it too: the warps below use it so that the wavefront's AVX-512 stages
+// (wavefront/vector_stages.h) draw the directions the reference draws.
+struct SinCos {
+  float sin, cos;
+};
+SinCos sin_cos_quarter(float x);
+
 // Shirley-Chiu concentric map: square [0,1)^2 -> unit disk, area-preserving.
 vec2 square_to_concentric_disk(vec2 u);
 vec2 concentric_disk_to_square(vec2 p);

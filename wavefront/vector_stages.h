@@ -8,11 +8,12 @@
 //
 // Same paths: every lane computes what the scalar code computes, operation
 // for operation and in the same order (IEEE add, multiply, divide and square
-// root round the same in a vector lane as in a scalar register), the
-// translation unit is compiled without FMA contraction, and the one
-// transcendental step (the concentric disk's sine and cosine) calls the very
-// function the reference calls. tests/test_wavefront.cpp checks every sample
-// of several scenes bit for bit against the scalar stages.
+// root round the same in a vector lane as in a scalar register), nothing is
+// contracted into FMAs (-ffp-contract=off, project-wide), and the one
+// transcendental step, the concentric disk's sine and cosine, is
+// core/sampling.h's sin_cos_quarter polynomial rather than libm's.
+// tests/test_wavefront.cpp checks every sample of several scenes bit for
+// bit against the scalar stages.
 //
 // This header is plain data on purpose: vector_stages_avx512.cpp is compiled
 // for AVX-512 and must not instantiate any inline function (GLM, the standard
@@ -99,9 +100,5 @@ void generate_camera_rays(const Camera& camera, const WaveView& wave);
 void sample_lights(const Scene& scene, const WaveView& wave);
 // scatter: a cosine-weighted continuation, Russian roulette and the next ray.
 void scatter(const Scene& scene, const WaveView& wave);
-
-// The concentric-disk point of u (core/sampling.h), computed by the same
-// compiled function the reference calls.
-void concentric_disk(float ux, float uy, float* dx, float* dy);
 
 }  // namespace pathlab::vector_stages

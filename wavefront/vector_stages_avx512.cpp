@@ -96,6 +96,30 @@ V3 offset_ray_origin(const V3& p, const V3& error, const V3& n) {
   return {step(po.x, offset.x), step(po.y, offset.y), step(po.z, offset.z)};
 }
 
+// sin_cos_quarter (core/sampling.cpp), term by term.
+void sin_cos_quarter(F x, F* sin, F* cos) {
+  const F z = mul(x, x);
+  *sin = add(mul(mul(sub(mul(add(mul(k(-1.9515295891e-4f), z), k(8.3321608736e-3f)), z), k(1.6666654611e-1f)), z), x), x);
+  *cos = add(sub(mul(mul(add(mul(sub(mul(k(2.443315711809948e-5f), z), k(1.388731625493765e-3f)), z),
+                             k(4.166664568298827e-2f)),
+                         z),
+                     z),
+                 mul(k(0.5f), z)),
+             k(1.0f));
+}
+
+// square_to_concentric_disk (core/sampling.cpp).
+void concentric_disk(F ux, F uy, F* dx, F* dy) {
+  const F ox = sub(mul(k(2.0f), ux), k(1.0f)), oy = sub(mul(k(2.0f), uy), k(1.0f));
+  const M wide = gt(_mm512_abs_ps(ox), _mm512_abs_ps(oy));  // the left and right wedges
+  const F r = select(wide, ox, oy);
+  F s, c;
+  sin_cos_quarter(mul(k(3.14159265358979323846f / 4.0f), select(wide, div(oy, ox), div(ox, oy))), &s, &c);
+  const M centre = eq(ox, k(0.0f)) & eq(oy, k(0.0f));
+  *dx = _mm512_maskz_mov_ps(~centre, mul(r, select(wide, c, s)));
+  *dy = _mm512_maskz_mov_ps(~centre, mul(r, select(wide, s, c)));
+}
+
 // mix64 (core/rng.h) on 8 64-bit lanes.
 I mix64(I z) {
   z = _mm512_mullo_epi64(_mm512_xor_si512(z, _mm512_srli_epi64(z, 30)),
@@ -303,7 +327,6 @@ void scatter(const Scene& sc, const WaveView& w) {
   using namespace layout;
   const I surfel_idx = strided(kSurfelSize), ray_idx = strided(kRaySize), spectrum_idx = strided(12),
           prev_idx = strided(kPrevSize);
-  alignas(64) float ux[16], uy[16], dx[16], dy[16];
   for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
     const M in = lanes(w.n, i0);
     M ok = alive_lanes(w, i0, in);
@@ -313,14 +336,9 @@ void scatter(const Scene& sc, const WaveView& w) {
     I vertex = _mm512_maskz_loadu_epi32(in, w.vertex + i0);
     const Streams rng = streams(w, i0, in, vertex);
 
-    // square_to_cosine_hemisphere (core/sampling.cpp); the disk point by the
-    // scalar function itself, for its sine and cosine.
-    _mm512_store_ps(ux, rng.u(Dim::DirectionX));
-    _mm512_store_ps(uy, rng.u(Dim::DirectionY));
-    for (unsigned lane = 0; lane < 16; ++lane)
-      if ((ok >> lane) & 1u) concentric_disk(ux[lane], uy[lane], &dx[lane], &dy[lane]);
-      else dx[lane] = dy[lane] = 0.0f;
-    const F x = _mm512_load_ps(dx), y = _mm512_load_ps(dy);
+    // square_to_cosine_hemisphere (core/sampling.cpp).
+    F x, y;
+    concentric_disk(rng.u(Dim::DirectionX), rng.u(Dim::DirectionY), &x, &y);
     const F z = _mm512_sqrt_ps(_mm512_max_ps(sub(sub(k(1.0f), mul(x, x)), mul(y, y)), k(0.0f)));
 
     // Surfel::scatter, Lambert: no sample on the disk's rim, or below min_pdf.
