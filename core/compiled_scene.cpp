@@ -26,13 +26,18 @@ CompiledScene::CompiledScene(Scene scene)
     bounds_radius_ = std::max(0.5f * glm::length(hi - lo), 1e-3f);
   }
   accel_ = std::make_unique<EmbreeAccel>(scene_.shapes);
-  triangles_.resize(scene_.shapes.size());
+  first_triangle_.resize(scene_.shapes.size() + 1, 0);
   for (std::size_t i = 0; i < scene_.shapes.size(); ++i) {
     const Shape& shape = scene_.shapes[i];
-    if (shape.kind != Shape::Kind::Triangles) continue;
-    triangles_[i].resize(shape.mesh.triangles.size());
-    parallel_for(0, triangles_[i].size(), 4096, [&](std::size_t b, std::size_t e) {
-      for (std::size_t t = b; t < e; ++t) triangles_[i][t] = make_triangle(shape, static_cast<std::uint32_t>(t));
+    first_triangle_[i + 1] =
+        first_triangle_[i] + (shape.kind == Shape::Kind::Triangles ? shape.mesh.triangles.size() : std::size_t{0});
+  }
+  triangles_.resize(first_triangle_.back());
+  for (std::size_t i = 0; i < scene_.shapes.size(); ++i) {
+    const Shape& shape = scene_.shapes[i];
+    Triangle* out = triangles_.data() + first_triangle_[i];
+    parallel_for(0, first_triangle_[i + 1] - first_triangle_[i], 4096, [&](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) out[t] = make_triangle(shape, static_cast<std::uint32_t>(t));
     });
   }
   lights_ = std::make_unique<LightSampler>(scene_, bounds_radius_);
@@ -49,7 +54,7 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const 
   const Shape& shape = scene_.shapes[hit.shape];
   const SurfacePoint sp = shape.kind == Shape::Kind::Sphere
                               ? sphere_point(shape, ray.origin + hit.t * ray.dir)
-                              : triangle_point(triangles_[hit.shape][hit.prim], hit.uv);
+                              : triangle_point(triangles_[first_triangle_[hit.shape] + hit.prim], hit.uv);
   s->p = sp.p;
   s->p_error = sp.p_error;
   s->n = sp.n;

@@ -53,10 +53,15 @@ class CompiledScene {
   }
   // The Surfel of a hit `ray` found.
   void resolve(const Ray& ray, const RayHit& hit, Surfel* surfel) const;
+  // Every shape's triangles as resolve() reads them, one shape after the
+  // other: triangle k of shape s is triangles()[first_triangle(s) + k]
+  // (a sphere has none).
+  std::span<const Triangle> triangles() const { return triangles_; }
+  std::size_t first_triangle(std::uint32_t shape) const { return first_triangle_[shape]; }
   // Starts loading what resolve() will read for `hit` into the cache.
   void prefetch(const RayHit& hit) const {
-    const std::vector<Triangle>& t = triangles_[hit.shape];
-    if (hit.prim < t.size()) __builtin_prefetch(&t[hit.prim]);
+    const std::size_t t = first_triangle_[hit.shape] + hit.prim;
+    if (t < first_triangle_[hit.shape + 1]) __builtin_prefetch(&triangles_[t]);
   }
 
  private:
@@ -64,7 +69,8 @@ class CompiledScene {
   Camera camera_;
   std::unique_ptr<EmbreeAccel> accel_;
   std::unique_ptr<LightSampler> lights_;
-  std::vector<std::vector<Triangle>> triangles_;  // per shape, per triangle (empty for a sphere)
+  std::vector<Triangle> triangles_;           // every shape's, in shape order
+  std::vector<std::size_t> first_triangle_;  // per shape, and one past the last
   LobeMask lobes_ = 0;
   vec3 bounds_center_{0.0f};
   float bounds_radius_ = 1.0f;

@@ -79,6 +79,9 @@ class LightSampler {
   std::span<const float> cdf() const { return cdf_; }
   std::span<const float> pmf() const { return pmf_; }
   bool samples_environment() const { return env_index_ >= 0; }
+  // The entry of shape `shape`'s triangle 0 (its triangle k is entry
+  // first_entry + k), or -1 if the shape is not sampled as a light.
+  std::int64_t first_entry(std::uint32_t shape) const { return first_entry_[shape]; }
 
  private:
   static std::size_t pick(const std::vector<float>& cdf, float u);

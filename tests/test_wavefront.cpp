@@ -12,6 +12,7 @@
 #include "wavefront/vector_stages.h"
 #include "wavefront/wavefront_tracer.h"
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -126,7 +127,20 @@ struct VectorCase {
   float min_pdf = 0.0f;
   int rr_depth = -1;  // -1: the scene's
   bool lambert = true;  // false: only the camera stage is vectorised
+  bool tilted = false;  // the whole scene turned off the axes, so that no normal is axis-aligned
 };
+
+// The scene and its camera turned by 37 degrees about (1, 2, 3).
+void tilt(Scene& scene) {
+  const mat3 r(glm::rotate(mat4(1.0f), glm::radians(37.0f), glm::normalize(vec3(1.0f, 2.0f, 3.0f))));
+  for (Shape& shape : scene.shapes) {
+    for (vec3& p : shape.mesh.positions) p = r * p;
+    shape.center = r * shape.center;
+  }
+  scene.camera.position = r * scene.camera.position;
+  scene.camera.look_at = r * scene.camera.look_at;
+  scene.camera.up = r * scene.camera.up;
+}
 
 class VectorStages : public testing::TestWithParam<VectorCase> {};
 
@@ -136,6 +150,7 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   Scene scene = load_case({c.scene, c.strategy});
   scene.render.min_pdf = c.min_pdf;
   if (c.rr_depth >= 0) scene.render.rr_depth = c.rr_depth;
+  if (c.tilted) tilt(scene);
   const RenderSettings settings = scene.render;
   const CompiledScene compiled(std::move(scene));
   const std::size_t pixels = static_cast<std::size_t>(compiled.scene().film.width) * compiled.scene().film.height;
@@ -164,6 +179,10 @@ std::vector<VectorCase> vector_cases() {
     for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf}) cases.push_back({s, st});
   cases.push_back({"", Strategy::Mis, 0.2f, 0});
   cases.push_back({"", Strategy::LightBsdf, 0.0f, 0});
+  for (Strategy st : {Strategy::Mis, Strategy::LightBsdf}) {
+    cases.push_back({"", st, 0.0f, 0, true, true});
+    cases.push_back({"white-sphere-emissive-room.json", st, 0.0f, -1, true, true});
+  }
   // Only the camera rays.
   cases.push_back({"mirror-sphere-gray-room.json", Strategy::Mis, 0.0f, -1, false});
   cases.push_back({"glass-sphere-tinted.json", Strategy::Mis, 0.0f, -1, false});
@@ -175,7 +194,8 @@ INSTANTIATE_TEST_SUITE_P(LambertScenes, VectorStages, testing::ValuesIn(vector_c
                          [](const testing::TestParamInfo<VectorCase>& p) {
                            std::string s = (p.param.scene.empty() ? std::string("cornell") : p.param.scene) + "_" +
                                            strategy_name(p.param.strategy) + (p.param.min_pdf > 0 ? "_min_pdf" : "") +
-                                           (p.param.rr_depth >= 0 ? "_rr" + std::to_string(p.param.rr_depth) : "");
+                                           (p.param.rr_depth >= 0 ? "_rr" + std::to_string(p.param.rr_depth) : "") +
+                                           (p.param.tilted ? "_tilted" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;

@@ -47,10 +47,24 @@ struct Lights {
 struct Scene {
   Strategy strategy = Strategy::Mis;
   int rr_depth = 0;
+  int max_vertex = 0;  // paths end at a vertex beyond this (the depth cap)
   float min_pdf = 0.0f;
-  std::ptrdiff_t albedo_offset = 0;  // bytes from a Material to its albedo
   Lights lights;
+  // Per shape, 16 floats: its material's albedo, emission, 1 if it emits on
+  // both sides, 1 if it emits, 1 if it scatters; the bits of the int32 index
+  // of its first light entry (-1: not a light); then unused.
+  const float* shape = nullptr;
+  // Every triangle (CompiledScene::triangles(): 12 floats each, p0 p1 p2 n),
+  // null if a shape is not a triangle mesh or there are more than 2^27
+  // (resolve then stays scalar); per shape, the index of its first one and
+  // its material (for Surfel::material).
+  const float* triangles = nullptr;
+  const std::int32_t* first_triangle = nullptr;
+  const void* const* material = nullptr;
 };
+namespace shape_field {
+inline constexpr std::size_t kAlbedo = 0, kEmission = 3, kTwoSided = 6, kEmits = 7, kScatters = 8, kFirstLight = 9;
+}
 
 // A pinhole camera (Camera::generate_ray without an aperture).
 struct Camera {
@@ -74,7 +88,9 @@ struct WaveView {
   float* beta = nullptr;               // Spectrum per path
   void* prev = nullptr;                // PreviousVertex per path
   std::uint8_t* alive = nullptr;
-  const void* surfel = nullptr;        // Surfel per path
+  void* surfel = nullptr;              // Surfel per path
+  const void* hit = nullptr;           // RayHit per path
+  const std::uint8_t* found = nullptr;
   void* shadow = nullptr;              // two Rays per path: [2i + 1] is the area light's
   float* unoccluded = nullptr;         // two Spectrums per path
   float* light_weight = nullptr;       // two per path
@@ -85,7 +101,9 @@ struct WaveView {
 namespace layout {
 inline constexpr std::size_t kRaySize = 28, kRayOrigin = 0, kRayDir = 12, kRayTmax = 24;
 inline constexpr std::size_t kSurfelSize = 88, kSurfelP = 0, kSurfelPError = 12, kSurfelN = 24, kSurfelFrameS = 36,
-                             kSurfelFrameT = 48, kSurfelFrameN = 60, kSurfelMaterial = 72;
+                             kSurfelFrameT = 48, kSurfelFrameN = 60, kSurfelMaterial = 72, kSurfelShape = 80,
+                             kSurfelPrim = 84;
+inline constexpr std::size_t kHitSize = 20, kHitT = 0, kHitShape = 4, kHitPrim = 8, kHitUv = 12;
 inline constexpr std::size_t kPrevSize = 20, kPrevP = 0, kPrevPdf = 12, kPrevImpulse = 16, kPrevBsdfTechnique = 17;
 }  // namespace layout
 
@@ -94,10 +112,19 @@ bool cpu_supported();
 
 // generate_camera_rays: every path's camera ray, and its state reset.
 void generate_camera_rays(const Camera& camera, const WaveView& wave);
+// resolve: the Surfel of every path whose ray found a surface, and one more
+// ray per path (needs Scene::triangles).
+void resolve(const Scene& scene, const WaveView& wave);
+// add_emission: the emission each path's ray found, as the strategy weighs
+// it, and the end of paths that escaped, passed the depth cap or cannot
+// scatter (the scene has no environment light).
+void add_emission(const Scene& scene, const WaveView& wave);
 // sample_lights: for every live path, next-event estimation towards one
 // area light (the scalar stage's slot [2i + 1]; slot [2i] is cleared, as
 // the scene has no point lights).
 void sample_lights(const Scene& scene, const WaveView& wave);
+// add_light: the light of every visible area-light sample.
+void add_light(const WaveView& wave);
 // scatter: a cosine-weighted continuation, Russian roulette and the next ray.
 void scatter(const Scene& scene, const WaveView& wave);
 

@@ -157,22 +157,25 @@ M alive_lanes(const WaveView& w, std::size_t i0, M in) {
   return _mm512_test_epi32_mask(a, a);
 }
 
-// Each surfel's material's albedo (Material::albedo through Surfel::material).
-V3 albedo(M m, const Scene& sc, const void* surfels, I surfel_idx) {
-  const I half_idx[2] = {surfel_idx, _mm512_shuffle_i64x2(surfel_idx, surfel_idx, 0x4e)};
-  F c[3];
-  __m256 part[3][2];
-  for (int h = 0; h < 2; ++h) {
-    const auto mh = static_cast<__mmask8>(h == 0 ? (m & 0xff) : (m >> 8));
-    const I ptr = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), mh, _mm512_castsi512_si256(half_idx[h]),
-                                              advance(surfels, layout::kSurfelMaterial), 1);
-    const I at = _mm512_add_epi64(ptr, _mm512_set1_epi64(static_cast<long long>(sc.albedo_offset)));
-    for (int j = 0; j < 3; ++j)
-      part[j][h] = _mm512_mask_i64gather_ps(_mm256_setzero_ps(), mh, _mm512_add_epi64(at, _mm512_set1_epi64(4 * j)),
-                                            nullptr, 1);
-  }
-  for (int j = 0; j < 3; ++j) c[j] = _mm512_insertf32x8(_mm512_castps256_ps512(part[j][0]), part[j][1], 1);
-  return {c[0], c[1], c[2]};
+// Byte offsets into Scene::shape of each lane's surfel's shape.
+I shape_offsets(M m, const void* surfels, I surfel_idx) {
+  const I shape = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), m, surfel_idx,
+                                              advance(surfels, layout::kSurfelShape), 1);
+  return _mm512_slli_epi32(shape, 6);  // 16 floats per shape
+}
+F shape_value(M m, const Scene& sc, I shape_offset, std::size_t index) {
+  return gather(m, shape_offset, sc.shape, 4 * index);
+}
+V3 shape_value3(M m, const Scene& sc, I shape_offset, std::size_t index) {
+  return gather3(m, shape_offset, sc.shape, 4 * index);
+}
+
+// power_heuristic (core/sampling.h).
+F power_heuristic(F a, F b) {
+  const F r = div(b, a);
+  F w = div(k(1.0f), add(k(1.0f), mul(r, r)));
+  w = _mm512_mask_mov_ps(w, _mm512_cmp_ps_mask(a, k(0.0f), _CMP_NGT_UQ), k(0.0f));
+  return _mm512_mask_mov_ps(w, _mm512_fpclass_ps_mask(a, 0x18), k(1.0f));
 }
 
 // LightSampler::pick: the first entry whose cdf exceeds u (the last entry if
@@ -233,6 +236,143 @@ void generate_camera_rays(const Camera& c, const WaveView& w) {
   }
 }
 
+void resolve(const Scene& sc, const WaveView& w) {
+  using namespace layout;
+  const I hit_idx = strided(kHitSize), surfel_idx = strided(kSurfelSize);
+  for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
+    const M in = lanes(w.n, i0);
+    const I rays = _mm512_maskz_loadu_epi32(in, w.rays + i0);
+    _mm512_mask_storeu_epi32(w.rays + i0, in, _mm512_add_epi32(rays, _mm512_set1_epi32(1)));
+    const I found_bytes = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(in, w.found + i0));
+    const M found = _mm512_test_epi32_mask(found_bytes, found_bytes);
+    if (found == 0) continue;
+    const void* hits = advance(w.hit, i0 * kHitSize);
+    const I shape = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), found, hit_idx, advance(hits, kHitShape), 1);
+    const I prim = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), found, hit_idx, advance(hits, kHitPrim), 1);
+    const F b1 = gather(found, hit_idx, hits, kHitUv), b2 = gather(found, hit_idx, hits, kHitUv + 4);
+    // triangle_point (core/geometry.cpp) of triangle first_triangle[shape] + prim.
+    const I tri = _mm512_add_epi32(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), found, shape, sc.first_triangle, 4), prim);
+    const I t = _mm512_mullo_epi32(tri, _mm512_set1_epi32(12));  // in floats
+    auto vertex3 = [&](int first) {
+      return V3{_mm512_mask_i32gather_ps(_mm512_setzero_ps(), found, _mm512_add_epi32(t, _mm512_set1_epi32(first)),
+                                         sc.triangles, 4),
+                _mm512_mask_i32gather_ps(_mm512_setzero_ps(), found, _mm512_add_epi32(t, _mm512_set1_epi32(first + 1)),
+                                         sc.triangles, 4),
+                _mm512_mask_i32gather_ps(_mm512_setzero_ps(), found, _mm512_add_epi32(t, _mm512_set1_epi32(first + 2)),
+                                         sc.triangles, 4)};
+    };
+    const V3 p0 = vertex3(0), p1 = vertex3(3), p2 = vertex3(6), n = vertex3(9);
+    const F b0 = sub(sub(k(1.0f), b1), b2);
+    const V3 p = add(add(mul(b0, p0), mul(b1, p1)), mul(b2, p2));
+    const V3 error = mul(k(kGamma7), add(add(abs(mul(b0, p0)), abs(mul(b1, p1))), abs(mul(b2, p2))));
+    // Frame(n) (core/math.h).
+    const F sign = _mm512_castsi512_ps(_mm512_or_si512(
+        _mm512_and_si512(_mm512_castps_si512(n.z), _mm512_set1_epi32(INT32_MIN)), _mm512_castps_si512(k(1.0f))));
+    const F a = div(k(-1.0f), add(sign, n.z));
+    const F b = mul(mul(n.x, n.y), a);
+    const V3 fs{add(k(1.0f), mul(mul(mul(sign, n.x), n.x), a)), mul(sign, b), mul(neg(sign), n.x)};
+    const V3 ft{b, add(sign, mul(mul(n.y, n.y), a)), neg(n.y)};
+    void* surfels = advance(w.surfel, i0 * kSurfelSize);
+    scatter3(found, surfel_idx, surfels, kSurfelP, p);
+    scatter3(found, surfel_idx, surfels, kSurfelPError, error);
+    scatter3(found, surfel_idx, surfels, kSurfelN, n);
+    scatter3(found, surfel_idx, surfels, kSurfelFrameS, fs);
+    scatter3(found, surfel_idx, surfels, kSurfelFrameT, ft);
+    scatter3(found, surfel_idx, surfels, kSurfelFrameN, n);
+    _mm512_mask_i32scatter_epi32(advance(surfels, kSurfelShape), found, surfel_idx, shape, 1);
+    _mm512_mask_i32scatter_epi32(advance(surfels, kSurfelPrim), found, surfel_idx, prim, 1);
+    // Surfel::material: the shape's material, 64-bit pointers in two halves.
+    const I shape_hi = _mm512_shuffle_i64x2(shape, shape, 0x4e), idx_hi = _mm512_shuffle_i64x2(surfel_idx, surfel_idx, 0x4e);
+    const auto m_lo = static_cast<__mmask8>(found & 0xff), m_hi = static_cast<__mmask8>(found >> 8);
+    const I mat_lo = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), m_lo, _mm512_castsi512_si256(shape), sc.material, 8);
+    const I mat_hi = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), m_hi, _mm512_castsi512_si256(shape_hi), sc.material, 8);
+    _mm512_mask_i32scatter_epi64(advance(surfels, kSurfelMaterial), m_lo, _mm512_castsi512_si256(surfel_idx), mat_lo, 1);
+    _mm512_mask_i32scatter_epi64(advance(surfels, kSurfelMaterial), m_hi, _mm512_castsi512_si256(idx_hi), mat_hi, 1);
+  }
+}
+
+void add_emission(const Scene& sc, const WaveView& w) {
+  using namespace layout;
+  const I surfel_idx = strided(kSurfelSize), ray_idx = strided(kRaySize), spectrum_idx = strided(12),
+          prev_idx = strided(kPrevSize);
+  const V3 zero{k(0.0f), k(0.0f), k(0.0f)};
+  for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
+    const M in = lanes(w.n, i0);
+    const I found_bytes = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(in, w.found + i0));
+    const M found = _mm512_test_epi32_mask(found_bytes, found_bytes);
+    const V3 beta = gather3(in, spectrum_idx, w.beta + 3 * i0, 0);
+    V3 L = gather3(in, spectrum_idx, w.L + 3 * i0, 0);
+    // Escaped: no environment, so Le = 0 and its weight 0; L += beta * (0 * 0).
+    const V3 L_escaped = add(L, mul(beta, mul(k(0.0f), zero)));
+    M alive = 0;
+    if (found != 0) {
+      // Surfel::emitted.
+      const void* surfels = advance(w.surfel, i0 * kSurfelSize);
+      const I shape = shape_offsets(found, surfels, surfel_idx);
+      const V3 wo = neg(gather3(found, ray_idx, advance(w.ray, i0 * kRaySize), kRayDir));
+      const V3 n = gather3(found, surfel_idx, surfels, kSurfelN);
+      const M emits = found & ~eq(shape_value(found, sc, shape, shape_field::kEmits), k(0.0f));
+      const M facing = ~eq(shape_value(found, sc, shape, shape_field::kTwoSided), k(0.0f)) | gt(dot(n, wo), k(0.0f));
+      const V3 Le = select(emits & facing, shape_value3(found, sc, shape, shape_field::kEmission), zero);
+      const M lit = found & ~is_black(Le);
+      // LightSampler::pdf(prev.p, s) for the lit lanes.
+      void* prev = advance(w.prev, i0 * kPrevSize);
+      const I flags = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), lit, prev_idx, advance(prev, kPrevImpulse), 1);
+      const M impulse = _mm512_test_epi32_mask(flags, _mm512_set1_epi32(0xff));
+      const M bsdf_technique = _mm512_test_epi32_mask(flags, _mm512_set1_epi32(0xff00));
+      const F prev_pdf = gather(lit, prev_idx, prev, kPrevPdf);
+      const I first = _mm512_castps_si512(shape_value(lit, sc, shape, shape_field::kFirstLight));
+      const M light = lit & _mm512_cmpge_epi32_mask(first, _mm512_setzero_si512());
+      const I prim = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), light, surfel_idx,
+                                                 advance(surfels, kSurfelPrim), 1);
+      const I entry = _mm512_add_epi32(first, prim);
+      const V3 d = sub(gather3(light, surfel_idx, surfels, kSurfelP), gather3(light, prev_idx, prev, kPrevP));
+      const F dist = _mm512_sqrt_ps(dot(d, d));
+      const F c = _mm512_abs_ps(div(dot(n, d), dist));
+      const F inv_area = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), light, entry, sc.lights.inv_area, 4);
+      const F pmf = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), light, entry, sc.lights.pmf, 4);
+      const F to_solid_angle = select(gt(c, k(0.0f)), div(mul(mul(inv_area, dist), dist), c), k(0.0f));
+      const F light_pdf = _mm512_maskz_mov_ps(light, mul(pmf, to_solid_angle));
+      // emission_weight (core/strategy_weights.h).
+      F weight = k(1.0f);
+      if (sc.strategy == Strategy::Light) weight = select(gt(light_pdf, k(0.0f)), k(0.0f), k(1.0f));
+      if (sc.strategy == Strategy::Mis) weight = power_heuristic(prev_pdf, light_pdf);
+      if (sc.strategy == Strategy::LightBsdf)
+        weight = _mm512_maskz_mov_ps(bsdf_technique, div(mul(k(2.0f), prev_pdf), add(prev_pdf, light_pdf)));
+      weight = _mm512_mask_mov_ps(weight, impulse, k(1.0f));
+      weight = _mm512_maskz_mov_ps(lit, weight);
+      const V3 L_hit = add(L, mul(beta, mul(weight, Le)));
+      L = select(found, L_hit, L_escaped);
+      // The path goes on if it may take another vertex and the surface scatters.
+      const I vertex = _mm512_maskz_loadu_epi32(in, w.vertex + i0);
+      alive = found & _mm512_cmple_epi32_mask(vertex, _mm512_set1_epi32(sc.max_vertex)) &
+              ~eq(shape_value(found, sc, shape, shape_field::kScatters), k(0.0f));
+    } else {
+      L = L_escaped;
+    }
+    scatter3(in, spectrum_idx, w.L + 3 * i0, 0, L);
+    _mm512_mask_cvtepi32_storeu_epi8(w.alive + i0, in, _mm512_maskz_mov_epi32(alive, _mm512_set1_epi32(1)));
+  }
+}
+
+void add_light(const WaveView& w) {
+  const I spectrum_idx = strided(12), pair_spectrum_idx = strided(2 * 12);
+  for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
+    const M in = lanes(w.n, i0);
+    // Slot [2i + 1]'s state (slot [2i], for point lights, is always empty here).
+    const I pairs = _mm512_cvtepu16_epi32(_mm256_maskz_loadu_epi16(in, w.shadow_state + 2 * i0));
+    const I state = _mm512_srli_epi32(pairs, 8);
+    const M traced = in & _mm512_test_epi32_mask(state, state);
+    if (traced == 0) continue;
+    const M visible = traced & _mm512_cmpeq_epi32_mask(state, _mm512_set1_epi32(2));
+    const V3 beta = gather3(traced, spectrum_idx, w.beta + 3 * i0, 0);
+    const V3 L = gather3(traced, spectrum_idx, w.L + 3 * i0, 0);
+    const V3 unoccluded = gather3(visible, pair_spectrum_idx, w.unoccluded + 3 * (2 * i0 + 1), 0);
+    const V3 zero{k(0.0f), k(0.0f), k(0.0f)};
+    scatter3(traced, spectrum_idx, w.L + 3 * i0, 0, add(L, select(visible, mul(beta, unoccluded), zero)));
+  }
+}
+
 void sample_lights(const Scene& sc, const WaveView& w) {
   using namespace layout;
   const I surfel_idx = strided(kSurfelSize), ray_idx = strided(kRaySize), shadow_idx = strided(2 * kRaySize);
@@ -287,7 +427,7 @@ void sample_lights(const Scene& sc, const WaveView& w) {
       wi_z = select(lt(wo_z, k(0.0f)), neg(wi_z), wi_z);
       const M upper = gt(wi_z, k(0.0f));
       const F cos_pi = mul(wi_z, k(kInvPi));
-      const V3 rho = albedo(ok, sc, surfels, surfel_idx);
+      const V3 rho = shape_value3(ok, sc, shape_offsets(ok, surfels, surfel_idx), shape_field::kAlbedo);
       const V3 zero{k(0.0f), k(0.0f), k(0.0f)};
       const V3 f = select(upper, mul(cos_pi, rho), zero);
       ok &= ~is_black(f);
@@ -296,8 +436,7 @@ void sample_lights(const Scene& sc, const WaveView& w) {
       // light_sample_weight (core/strategy_weights.h); pdf_light is finite and > 0 here.
       F weight = k(1.0f);
       if (sc.strategy == Strategy::Mis) {
-        const F r = div(pdf_bsdf, pdf_light);
-        weight = div(k(1.0f), add(k(1.0f), mul(r, r)));
+        weight = power_heuristic(pdf_light, pdf_bsdf);
       } else if (sc.strategy == Strategy::LightBsdf) {
         weight = div(mul(k(2.0f), pdf_light), add(pdf_light, pdf_bsdf));
       }
@@ -350,7 +489,7 @@ void scatter(const Scene& sc, const WaveView& w) {
     const F side = select(lt(dot(wo, fn), k(0.0f)), k(-1.0f), k(1.0f));
     const F wz = mul(z, side);
     const V3 wi = add(add(mul(x, fs), mul(y, ft)), mul(wz, fn));  // Frame::to_world
-    V3 weight = albedo(ok, sc, surfels, surfel_idx);
+    V3 weight = shape_value3(ok, sc, shape_offsets(ok, surfels, surfel_idx), shape_field::kAlbedo);
     ok &= ~is_black(weight);
 
     // Russian roulette (the scatter stage).

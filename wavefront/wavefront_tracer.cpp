@@ -6,6 +6,7 @@
 #include "core/strategy_weights.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <optional>
 #include <cstddef>
@@ -95,7 +96,9 @@ std::size_t WavefrontTracer::bytes_per_path() {
 struct WavefrontTracer::VectorStages {
   std::optional<vector_stages::Camera> camera;  // a pinhole camera
   std::optional<vector_stages::Scene> lambert;  // Lambert surfaces and triangle lights
-  std::vector<float> inv_area, triangle;
+  std::vector<float> inv_area, triangle, shape_table;
+  std::vector<std::int32_t> first_triangle;
+  std::vector<const void*> material;
 
   static std::unique_ptr<const VectorStages> make(const CompiledScene& compiled, const RenderSettings& settings,
                                                   std::string* why_not) {
@@ -130,6 +133,7 @@ struct WavefrontTracer::VectorStages {
       case Strategy::LightBsdf: sc.strategy = vs::Strategy::LightBsdf; break;
     }
     sc.rr_depth = settings.rr_depth;
+    sc.max_vertex = settings.max_depth >= 0 ? settings.max_depth : kMaxVerticesUncapped;
     // Every material Lambert (shaded by the Lambert-only code) or an
     // emitter that does not scatter, with one min_pdf.
     const Scene& scene = compiled.scene();
@@ -142,10 +146,7 @@ struct WavefrontTracer::VectorStages {
       if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return "materials with different min_pdf";
       diffuse = &m;
     }
-    if (diffuse) {
-      sc.min_pdf = diffuse->shading.min_pdf;
-      sc.albedo_offset = reinterpret_cast<const char*>(&diffuse->albedo) - reinterpret_cast<const char*>(diffuse);
-    }
+    if (diffuse) sc.min_pdf = diffuse->shading.min_pdf;
     // Only triangle area lights: no point light, sphere or environment.
     const LightSampler& lights = compiled.lights();
     if (lights.has_delta_lights()) return "point lights";
@@ -160,6 +161,30 @@ struct WavefrontTracer::VectorStages {
       inv_area.push_back(1.0f / e.area);
     }
     sc.lights = {lights.entries().size(), lights.cdf().data(), lights.pmf().data(), inv_area.data(), triangle.data()};
+    // Per shape: its material's parameters, and where its triangles start.
+    bool all_triangles = compiled.triangles().size() < (std::size_t{1} << 27);  // 12 * index fits an int32
+    for (std::uint32_t i = 0; i < scene.shapes.size(); ++i) {
+      const Shape& sh = scene.shapes[i];
+      const Material& m = scene.materials[sh.material];
+      namespace f = vs::shape_field;
+      float fields[16] = {};
+      for (int c = 0; c < 3; ++c) fields[f::kAlbedo + c] = m.albedo[c], fields[f::kEmission + c] = m.emission[c];
+      fields[f::kTwoSided] = m.two_sided_emission ? 1.0f : 0.0f;
+      fields[f::kEmits] = m.emits() ? 1.0f : 0.0f;
+      fields[f::kScatters] = m.scatters() ? 1.0f : 0.0f;
+      fields[f::kFirstLight] = std::bit_cast<float>(static_cast<std::int32_t>(lights.first_entry(i)));
+      shape_table.insert(shape_table.end(), std::begin(fields), std::end(fields));
+      first_triangle.push_back(static_cast<std::int32_t>(compiled.first_triangle(i)));
+      material.push_back(&m);
+      all_triangles = all_triangles && sh.kind == Shape::Kind::Triangles;
+    }
+    sc.shape = shape_table.data();
+    if (all_triangles) {
+      static_assert(sizeof(Triangle) == 12 * sizeof(float));
+      sc.triangles = &compiled.triangles().data()->p0.x;
+      sc.first_triangle = first_triangle.data();
+      sc.material = material.data();
+    }
     lambert = sc;
     return "";
   }
@@ -190,6 +215,9 @@ WavefrontTracer::~WavefrontTracer() = default;
 namespace {
 // The layouts vector_stages.h hard-codes.
 using namespace vector_stages::layout;
+static_assert(sizeof(RayHit) == kHitSize && offsetof(RayHit, t) == kHitT && offsetof(RayHit, shape) == kHitShape &&
+              offsetof(RayHit, prim) == kHitPrim && offsetof(RayHit, uv) == kHitUv);
+static_assert(offsetof(Surfel, shape) == kSurfelShape && offsetof(Surfel, prim) == kSurfelPrim);
 static_assert(sizeof(Ray) == kRaySize && offsetof(Ray, origin) == kRayOrigin && offsetof(Ray, dir) == kRayDir &&
               offsetof(Ray, tmax) == kRayTmax);
 static_assert(sizeof(Surfel) == kSurfelSize && offsetof(Surfel, p) == kSurfelP &&
@@ -220,6 +248,8 @@ vector_stages::WaveView WavefrontTracer::view(Wave& w) {
   v.prev = w.prev.data();
   v.alive = w.alive.data();
   v.surfel = w.surfel.data();
+  v.hit = w.hit.data();
+  v.found = w.found.data();
   v.shadow = w.shadow.data();
   v.unoccluded = &w.unoccluded.data()->x;
   v.light_weight = w.light_weight.data();
@@ -246,6 +276,7 @@ void WavefrontTracer::intersect(Wave& w) const {
   w.queries[kind] += n;
   for (std::size_t i = 0; i < n; ++i)
     if (found[i]) scene_.prefetch(hits[i]);
+  if (vectorised() && vector_->lambert->triangles) return vector_stages::resolve(*vector_->lambert, view(w));
   for (std::size_t i = 0; i < n; ++i) {
     ++w.rays[i];
     if (found[i]) scene_.resolve(rays[i], hits[i], &w.surfel[i]);
@@ -256,6 +287,7 @@ void WavefrontTracer::intersect(Wave& w) const {
 // the end of paths that escape, pass the depth cap or reach a surface that
 // does not scatter.
 void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
+  if (vectorised() && !obs) return vector_stages::add_emission(*vector_->lambert, view(w));
   const int cap = settings_.max_depth >= 0 ? settings_.max_depth : kMaxVerticesUncapped;
   const Strategy strategy = settings_.strategy;
   for (std::size_t i = 0; i < w.n; ++i) {
@@ -347,6 +379,7 @@ void WavefrontTracer::trace_shadow_rays(Wave& w) const {
 
 // Stage: the light of visible samples, point light first (the reference's order).
 void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
+  if (vectorised() && !obs) return vector_stages::add_light(view(w));
   for (std::size_t i = 0; i < w.n; ++i) {
     for (std::size_t k = 2 * i; k < 2 * i + 2; ++k) {
       if (w.shadow_state[k] == 0) continue;
