@@ -51,6 +51,14 @@ class CompiledScene {
                       bool coherent = false) const {
     accel_->occluded_batch(rays, occluded, mode, coherent);
   }
+  void intersect_arrays(const RayArrays& rays, std::size_t n, const HitArrays& hits, RayBatchMode mode,
+                        bool coherent = false) const {
+    accel_->intersect_arrays(rays, n, hits, mode, coherent);
+  }
+  void occluded_arrays(const RayArrays& rays, std::size_t n, std::uint8_t* occluded, RayBatchMode mode,
+                       bool coherent = false) const {
+    accel_->occluded_arrays(rays, n, occluded, mode, coherent);
+  }
   // The Surfel of a hit `ray` found.
   void resolve(const Ray& ray, const RayHit& hit, Surfel* surfel) const;
   // Every shape's triangles as resolve() reads them, one shape after the

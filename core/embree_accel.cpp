@@ -257,6 +257,130 @@ void EmbreeAccel::occluded_batch(std::span<const Ray> rays, std::span<std::uint8
   }
 }
 
+namespace {
+
+// Ray i of `rays` in the one-ray form.
+Ray ray_at(const RayArrays& r, std::size_t i) {
+  return Ray{vec3(r.ox[i], r.oy[i], r.oz[i]), vec3(r.dx[i], r.dy[i], r.dz[i]), r.tmax[i]};
+}
+
+// Lanes [b, b + n) of `rays` as a 16-wide packet.
+template <typename Packet>
+void fill_packet(Packet& p, const RayArrays& rays, std::size_t b, std::size_t n) {
+  const std::size_t bytes = n * sizeof(float);
+  std::memcpy(p.org_x, rays.ox + b, bytes);
+  std::memcpy(p.org_y, rays.oy + b, bytes);
+  std::memcpy(p.org_z, rays.oz + b, bytes);
+  std::memcpy(p.dir_x, rays.dx + b, bytes);
+  std::memcpy(p.dir_y, rays.dy + b, bytes);
+  std::memcpy(p.dir_z, rays.dz + b, bytes);
+  std::memcpy(p.tfar, rays.tmax + b, bytes);
+  for (std::size_t k = 0; k < n; ++k) {
+    p.tnear[k] = 0.0f;
+    p.time[k] = 0.0f;
+    p.mask[k] = 0xffffffffu;
+    p.id[k] = 0;
+    p.flags[k] = 0;
+  }
+}
+
+// The per-ray inputs of a pointer-SoA stream that the arrays do not hold:
+// tnear 0, time 0, every mask bit, id and flags 0; and tfar to be written.
+struct StreamScratch {
+  std::vector<float> zeros, tfar, ng, u, v;
+  std::vector<unsigned> mask, zero_ids, geom, prim, inst;
+  void resize(std::size_t n) {
+    if (zeros.size() >= n) return;
+    zeros.assign(n, 0.0f), mask.assign(n, 0xffffffffu), zero_ids.assign(n, 0u);
+    tfar.resize(n), ng.resize(n), u.resize(n), v.resize(n), geom.resize(n), prim.resize(n), inst.resize(n);
+  }
+  RTCRayNp ray(const RayArrays& r) {
+    return RTCRayNp{const_cast<float*>(r.ox), const_cast<float*>(r.oy), const_cast<float*>(r.oz), zeros.data(),
+                    const_cast<float*>(r.dx), const_cast<float*>(r.dy), const_cast<float*>(r.dz), zeros.data(),
+                    tfar.data(), mask.data(), zero_ids.data(), zero_ids.data()};
+  }
+};
+
+}  // namespace
+
+void EmbreeAccel::intersect_arrays(const RayArrays& rays, std::size_t n, const HitArrays& hits, RayBatchMode mode,
+                                   bool coherent) const {
+  RTCIntersectContext context = make_context(coherent);
+  auto record = [&](std::size_t i, float tfar, unsigned geom, unsigned prim, float u, float v) {
+    hits.found[i] = geom != RTC_INVALID_GEOMETRY_ID;
+    if (!hits.found[i]) return;
+    hits.t[i] = tfar, hits.shape[i] = geom, hits.prim[i] = prim, hits.u[i] = u, hits.v[i] = v;
+  };
+  switch (mode) {
+    case RayBatchMode::Single:
+      for (std::size_t i = 0; i < n; ++i) {
+        RTCRayHit rh;
+        fill(rh, ray_at(rays, i));
+        rtcIntersect1(impl_->scene, &context, &rh);
+        record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v);
+      }
+      return;
+    case RayBatchMode::Packet16:
+      for (std::size_t b = 0; b < n; b += kPacket) {
+        const std::size_t m = std::min<std::size_t>(kPacket, n - b);
+        const ValidMask valid(m);
+        RTCRayHit16 rh;
+        fill_packet(rh.ray, rays, b, m);
+        for (std::size_t k = 0; k < m; ++k) rh.hit.geomID[k] = rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        rtcIntersect16(valid.lane, impl_->scene, &context, &rh);
+        for (std::size_t k = 0; k < m; ++k)
+          record(b + k, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]);
+      }
+      return;
+    case RayBatchMode::Stream: {
+      thread_local StreamScratch s;
+      s.resize(n);
+      std::memcpy(s.tfar.data(), rays.tmax, n * sizeof(float));
+      std::fill_n(s.geom.begin(), n, RTC_INVALID_GEOMETRY_ID);
+      std::fill_n(s.inst.begin(), n, RTC_INVALID_GEOMETRY_ID);
+      const RTCRayHitNp rh{s.ray(rays), RTCHitNp{s.ng.data(), s.ng.data(), s.ng.data(), s.u.data(), s.v.data(),
+                                                 s.prim.data(), s.geom.data(), {s.inst.data()}}};
+      rtcIntersectNp(impl_->scene, &context, &rh, static_cast<unsigned>(n));
+      for (std::size_t i = 0; i < n; ++i) record(i, s.tfar[i], s.geom[i], s.prim[i], s.u[i], s.v[i]);
+      return;
+    }
+  }
+}
+
+void EmbreeAccel::occluded_arrays(const RayArrays& rays, std::size_t n, std::uint8_t* occluded, RayBatchMode mode,
+                                  bool coherent) const {
+  RTCIntersectContext context = make_context(coherent);
+  switch (mode) {
+    case RayBatchMode::Single:
+      for (std::size_t i = 0; i < n; ++i) {
+        RTCRay r;
+        fill(r, ray_at(rays, i));
+        rtcOccluded1(impl_->scene, &context, &r);
+        occluded[i] = r.tfar < 0.0f;
+      }
+      return;
+    case RayBatchMode::Packet16:
+      for (std::size_t b = 0; b < n; b += kPacket) {
+        const std::size_t m = std::min<std::size_t>(kPacket, n - b);
+        const ValidMask valid(m);
+        RTCRay16 r;
+        fill_packet(r, rays, b, m);
+        rtcOccluded16(valid.lane, impl_->scene, &context, &r);
+        for (std::size_t k = 0; k < m; ++k) occluded[b + k] = r.tfar[k] < 0.0f;
+      }
+      return;
+    case RayBatchMode::Stream: {
+      thread_local StreamScratch s;
+      s.resize(n);
+      std::memcpy(s.tfar.data(), rays.tmax, n * sizeof(float));
+      const RTCRayNp r = s.ray(rays);
+      rtcOccludedNp(impl_->scene, &context, &r, static_cast<unsigned>(n));
+      for (std::size_t i = 0; i < n; ++i) occluded[i] = s.tfar[i] < 0.0f;
+      return;
+    }
+  }
+}
+
 bool EmbreeAccel::occluded(const Ray& ray) const {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);

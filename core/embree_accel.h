@@ -30,6 +30,17 @@ const char* ray_batch_mode_name(RayBatchMode mode);
 inline constexpr RayBatchMode kAllRayBatchModes[] = {RayBatchMode::Single, RayBatchMode::Packet16,
                                                      RayBatchMode::Stream};
 
+// Rays and hits as one array per scalar (structure of arrays), the layout
+// the wavefront's vectorised stages keep their paths in.
+struct RayArrays {
+  const float *ox, *oy, *oz, *dx, *dy, *dz, *tmax;
+};
+struct HitArrays {
+  float *t, *u, *v;               // distance; Embree's barycentrics (b1, b2) for a triangle
+  std::uint32_t *shape, *prim;
+  std::uint8_t* found;
+};
+
 class EmbreeAccel {
  public:
   // Builds the BVH. Throws SystemError with Embree's message if the device
@@ -54,6 +65,13 @@ class EmbreeAccel {
                        RayBatchMode mode, bool coherent = false) const;
   void occluded_batch(std::span<const Ray> rays, std::span<std::uint8_t> occluded, RayBatchMode mode,
                       bool coherent = false) const;
+  // The same again for n rays in arrays; a hit's fields are written only
+  // where found[i] is 1. Streams go to Embree without a copy
+  // (rtcIntersectNp / rtcOccludedNp), packets as 16 consecutive lanes.
+  void intersect_arrays(const RayArrays& rays, std::size_t n, const HitArrays& hits, RayBatchMode mode,
+                        bool coherent = false) const;
+  void occluded_arrays(const RayArrays& rays, std::size_t n, std::uint8_t* occluded, RayBatchMode mode,
+                       bool coherent = false) const;
 
  private:
   struct Impl;

@@ -1,9 +1,8 @@
-// Wavefront stages that run 16 paths at a time in AVX-512 registers:
-// - making camera rays, for any scene seen through a pinhole camera;
-// - sampling lights and scattering, for scenes that need nothing more than
-//   Lambert surfaces and triangle area lights (the dragon benchmark, the
-//   Cornell box).
-// Other scenes, and machines without AVX-512, run the scalar stages of
+// The wavefront's stages run 16 paths at a time in AVX-512 registers, over
+// paths kept as one array per scalar (structure of arrays), for scenes that
+// need nothing more than Lambert surfaces and triangle area lights (the
+// dragon benchmark, the Cornell box; meshes and spheres, any camera). Other
+// scenes, and machines without AVX-512, run the scalar stages of
 // wavefront_tracer.cpp.
 //
 // Same paths: every lane computes what the scalar code computes, operation
@@ -11,9 +10,9 @@
 // root round the same in a vector lane as in a scalar register), nothing is
 // contracted into FMAs (-ffp-contract=off, project-wide), and the one
 // transcendental step, the concentric disk's sine and cosine, is
-// core/sampling.h's sin_cos_quarter polynomial rather than libm's.
-// tests/test_wavefront.cpp checks every sample of several scenes bit for
-// bit against the scalar stages.
+// core/sampling.h's sin_cos_quarter polynomial rather than libm's. Embree
+// sees the same batches in the same order. tests/test_wavefront.cpp checks
+// every sample of several scenes bit for bit against the scalar stages.
 //
 // This header is plain data on purpose: vector_stages_avx512.cpp is compiled
 // for AVX-512 and must not instantiate any inline function (GLM, the standard
@@ -50,82 +49,101 @@ struct Scene {
   int max_vertex = 0;  // paths end at a vertex beyond this (the depth cap)
   float min_pdf = 0.0f;
   Lights lights;
-  // Per shape, 16 floats: its material's albedo, emission, 1 if it emits on
-  // both sides, 1 if it emits, 1 if it scatters; the bits of the int32 index
-  // of its first light entry (-1: not a light); then unused.
+  // Per shape, 32 floats (ShapeField): its material's albedo, emission and
+  // flags, its first light entry, and its geometry.
   const float* shape = nullptr;
-  // Every triangle (CompiledScene::triangles(): 12 floats each, p0 p1 p2 n),
-  // null if a shape is not a triangle mesh or there are more than 2^27
-  // (resolve then stays scalar); per shape, the index of its first one and
-  // its material (for Surfel::material).
+  // Every triangle (CompiledScene::triangles(): 12 floats each, p0 p1 p2 n).
   const float* triangles = nullptr;
-  const std::int32_t* first_triangle = nullptr;
-  const void* const* material = nullptr;
 };
-namespace shape_field {
-inline constexpr std::size_t kAlbedo = 0, kEmission = 3, kTwoSided = 6, kEmits = 7, kScatters = 8, kFirstLight = 9;
-}
+enum ShapeField : int {
+  kAlbedo = 0,         // 3 floats
+  kEmission = 3,       // 3 floats
+  kTwoSided = 6,       // 1 if it emits on both sides, else 0
+  kEmits = 7,          // 1 if it emits
+  kScatters = 8,       // 1 if it scatters
+  kFirstLight = 9,     // bits of an int32: its triangle 0's light entry, -1 if not a light
+  kFirstTriangle = 10, // bits of an int32: its triangle 0 in Scene::triangles (a mesh)
+  kIsSphere = 11,      // 1 for a sphere, 0 for a mesh
+  kCenter = 12,        // 3 floats (a sphere)
+  kRadius = 15,        // a sphere's radius
+  kFlipped = 16,       // 1 if a sphere's normals point inwards
+  kShapeFields = 32,
+};
 
-// A pinhole camera (Camera::generate_ray without an aperture).
+// A camera (Camera::generate_ray).
 struct Camera {
   float position[3], forward[3], right[3], up[3];
   float tan_half_fov, aspect, inv_width, inv_height;
+  float aperture_radius, focus_distance;  // a pinhole if aperture_radius <= 0
 };
 
-// The wave's arrays (wavefront_tracer.cpp's Wave), as raw memory. The record
-// layouts (Ray, Surfel, PreviousVertex) are fixed below and checked with
-// static_asserts where the real types are visible.
-struct WaveView {
-  std::size_t n = 0;                   // paths in slots [0, n)
-  const std::uint64_t* rng = nullptr;  // SampleStream::key() per path
-  const std::uint32_t* x = nullptr;    // pixel per path
-  const std::uint32_t* y = nullptr;
-  float* film = nullptr;               // vec2 per path
-  float* L = nullptr;                  // Spectrum per path
-  std::uint32_t* rays = nullptr;
-  std::int32_t* vertex = nullptr;
-  void* ray = nullptr;                 // Ray per path
-  float* beta = nullptr;               // Spectrum per path
-  void* prev = nullptr;                // PreviousVertex per path
-  std::uint8_t* alive = nullptr;
-  void* surfel = nullptr;              // Surfel per path
-  const void* hit = nullptr;           // RayHit per path
-  const std::uint8_t* found = nullptr;
-  void* shadow = nullptr;              // two Rays per path: [2i + 1] is the area light's
-  float* unoccluded = nullptr;         // two Spectrums per path
-  float* light_weight = nullptr;       // two per path
-  std::uint8_t* shadow_state = nullptr;  // two per path
+// The state of a wave's paths, one array per scalar, each with room for a
+// whole wave. Slots [0, n) hold the live paths.
+enum FloatArray : int {
+  kOx, kOy, kOz, kDx, kDy, kDz, kTmax,  // the ray to trace next
+  kBetaR, kBetaG, kBetaB,               // throughput
+  kLR, kLG, kLB,                        // radiance so far
+  kPrevX, kPrevY, kPrevZ, kPrevPdf,     // PreviousVertex
+  kFilmX, kFilmY,
+  // This bounce only: the hit and the Surfel made of it.
+  kHitT, kHitU, kHitV,
+  kPx, kPy, kPz, kErrX, kErrY, kErrZ, kNx, kNy, kNz, kSx, kSy, kSz, kTx, kTy, kTz,
+  // What the area-light sample brings if nothing blocks its shadow ray.
+  kUnR, kUnG, kUnB,
+  // The shadow rays to trace, packed in path order for Embree.
+  kQOx, kQOy, kQOz, kQDx, kQDy, kQDz, kQTmax,
+  kFloatArrays
+};
+enum UintArray : int {
+  kOutIndex, kRays, kVertex, kPixelX, kPixelY, kSample,
+  kShape, kPrim,  // the hit's
+  kQSlot,         // each packed shadow ray's path
+  kUintArrays
+};
+enum ByteArray : int {
+  kAlive, kFound, kPrevImpulse, kPrevBsdfTechnique,
+  kQOccluded,  // per packed shadow ray
+  kByteArrays
+};
+struct Wave {
+  std::size_t n = 0;
+  float* f[kFloatArrays] = {};
+  std::uint32_t* u[kUintArrays] = {};
+  std::uint8_t* b[kByteArrays] = {};
+  std::uint64_t* rng = nullptr;  // SampleStream::key() per path
 };
 
-// Byte layouts of the records the stages read and write.
-namespace layout {
-inline constexpr std::size_t kRaySize = 28, kRayOrigin = 0, kRayDir = 12, kRayTmax = 24;
-inline constexpr std::size_t kSurfelSize = 88, kSurfelP = 0, kSurfelPError = 12, kSurfelN = 24, kSurfelFrameS = 36,
-                             kSurfelFrameT = 48, kSurfelFrameN = 60, kSurfelMaterial = 72, kSurfelShape = 80,
-                             kSurfelPrim = 84;
-inline constexpr std::size_t kHitSize = 20, kHitT = 0, kHitShape = 4, kHitPrim = 8, kHitUv = 12;
-inline constexpr std::size_t kPrevSize = 20, kPrevP = 0, kPrevPdf = 12, kPrevImpulse = 16, kPrevBsdfTechnique = 17;
-}  // namespace layout
+// What compact() returns for each path that ended (FilmSample's fields).
+struct Finished {
+  std::uint32_t out_index;
+  float film_x, film_y, L[3];
+  std::uint32_t rays, hits;
+};
 
 // Whether this processor runs the vectorised stages.
 bool cpu_supported();
 
-// generate_camera_rays: every path's camera ray, and its state reset.
-void generate_camera_rays(const Camera& camera, const WaveView& wave);
-// resolve: the Surfel of every path whose ray found a surface, and one more
-// ray per path (needs Scene::triangles).
-void resolve(const Scene& scene, const WaveView& wave);
-// add_emission: the emission each path's ray found, as the strategy weighs
-// it, and the end of paths that escaped, passed the depth cap or cannot
-// scatter (the scene has no environment light).
-void add_emission(const Scene& scene, const WaveView& wave);
-// sample_lights: for every live path, next-event estimation towards one
-// area light (the scalar stage's slot [2i + 1]; slot [2i] is cleared, as
-// the scene has no point lights).
-void sample_lights(const Scene& scene, const WaveView& wave);
-// add_light: the light of every visible area-light sample.
-void add_light(const WaveView& wave);
-// scatter: a cosine-weighted continuation, Russian roulette and the next ray.
-void scatter(const Scene& scene, const WaveView& wave);
+// The stages, in the order a bounce runs them (wavefront_tracer.cpp has the
+// scalar twin of each). Tracing the rays themselves is Embree's.
+// Each path's random stream, pixel and sample are set; make its camera ray
+// and reset its state.
+void generate_camera_rays(const Camera& camera, const Wave& wave);
+// The Surfel of each path whose ray found a surface, and one more ray per path.
+void resolve(const Scene& scene, const Wave& wave);
+// The emission each ray found, as the strategy weighs it, and the end of
+// paths that escaped, passed the depth cap or cannot scatter (the scene has
+// no environment light).
+void add_emission(const Scene& scene, const Wave& wave);
+// Next-event estimation towards one area light for every live path (the
+// scene has no point lights); packs the shadow rays to trace into the kQ
+// arrays and returns how many.
+std::size_t sample_lights(const Scene& scene, const Wave& wave);
+// The light of every visible sample, once Embree has filled kQOccluded.
+void add_light(const Wave& wave, std::size_t queries);
+// A cosine-weighted continuation, Russian roulette and the next ray.
+void scatter(const Scene& scene, const Wave& wave);
+// Packs the survivors into slots [0, m) in order and returns m; each path
+// that ended is written to finished[0, n - m) in slot order.
+std::size_t compact(const Wave& wave, Finished* finished);
 
 }  // namespace pathlab::vector_stages

@@ -50,29 +50,6 @@ V3 select(M m, const V3& a, const V3& b) { return {select(m, a.x, b.x), select(m
 F dot(const V3& a, const V3& b) { return add(add(mul(a.x, b.x), mul(a.y, b.y)), mul(a.z, b.z)); }
 M is_black(const V3& a) { return eq(a.x, k(0.0f)) & eq(a.y, k(0.0f)) & eq(a.z, k(0.0f)); }
 
-// Lane k's float at base + offset + idx[k] bytes (0 in lanes outside m).
-F gather(M m, I idx, const void* base, std::size_t offset) {
-  return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, idx, static_cast<const char*>(base) + offset, 1);
-}
-V3 gather3(M m, I idx, const void* base, std::size_t offset) {
-  return {gather(m, idx, base, offset), gather(m, idx, base, offset + 4), gather(m, idx, base, offset + 8)};
-}
-void scatter(M m, I idx, void* base, std::size_t offset, F v) {
-  _mm512_mask_i32scatter_ps(static_cast<char*>(base) + offset, m, idx, v, 1);
-}
-void scatter3(M m, I idx, void* base, std::size_t offset, const V3& v) {
-  scatter(m, idx, base, offset, v.x);
-  scatter(m, idx, base, offset + 4, v.y);
-  scatter(m, idx, base, offset + 8, v.z);
-}
-// Byte offsets of 16 consecutive records of `size` bytes.
-I strided(std::size_t size) {
-  return _mm512_mullo_epi32(_mm512_set_epi32(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0),
-                            _mm512_set1_epi32(static_cast<int>(size)));
-}
-void* advance(void* p, std::size_t bytes) { return static_cast<char*>(p) + bytes; }
-const void* advance(const void* p, std::size_t bytes) { return static_cast<const char*>(p) + bytes; }
-
 // next_float_up / next_float_down (core/ray.h), lane by lane.
 F next_float(F v, bool up) {
   const I bits = _mm512_castps_si512(v);
@@ -140,7 +117,7 @@ struct Streams {
     return mul(_mm512_insertf32x8(_mm512_castps256_ps512(a), b, 1), k(0x1p-24f));
   }
 };
-Streams streams(const WaveView& w, std::size_t i0, M m, I vertex) {
+Streams streams(const Wave& w, std::size_t i0, M m, I vertex) {
   const auto m_lo = static_cast<__mmask8>(m & 0xff), m_hi = static_cast<__mmask8>(m >> 8);
   const I key_lo = _mm512_maskz_loadu_epi64(m_lo, w.rng + i0), key_hi = _mm512_maskz_loadu_epi64(m_hi, w.rng + i0 + 8);
   const I v_lo = _mm512_slli_epi64(_mm512_cvtepu32_epi64(_mm512_castsi512_si256(vertex)), 32);
@@ -148,26 +125,56 @@ Streams streams(const WaveView& w, std::size_t i0, M m, I vertex) {
   return {_mm512_xor_si512(key_lo, v_lo), _mm512_xor_si512(key_hi, v_hi)};
 }
 
-// The lanes of slots [i0, i0 + 16) that exist, and which of them are alive.
+// The lanes of slots [i0, i0 + 16) that exist.
 M lanes(std::size_t n, std::size_t i0) {
   return n - i0 >= 16 ? M(0xffff) : static_cast<M>((1u << (n - i0)) - 1u);
 }
-M alive_lanes(const WaveView& w, std::size_t i0, M in) {
-  const I a = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(in, w.alive + i0));
-  return _mm512_test_epi32_mask(a, a);
+
+// Slots [i0, i0 + 16) of the wave's arrays (0 outside m; nothing stored outside m).
+F load(const Wave& w, FloatArray a, std::size_t i0, M m) { return _mm512_maskz_loadu_ps(m, w.f[a] + i0); }
+V3 load3(const Wave& w, FloatArray x, std::size_t i0, M m) {
+  return {load(w, x, i0, m), load(w, static_cast<FloatArray>(x + 1), i0, m), load(w, static_cast<FloatArray>(x + 2), i0, m)};
+}
+void store(const Wave& w, FloatArray a, std::size_t i0, M m, F v) { _mm512_mask_storeu_ps(w.f[a] + i0, m, v); }
+void store3(const Wave& w, FloatArray x, std::size_t i0, M m, const V3& v) {
+  store(w, x, i0, m, v.x);
+  store(w, static_cast<FloatArray>(x + 1), i0, m, v.y);
+  store(w, static_cast<FloatArray>(x + 2), i0, m, v.z);
+}
+I load(const Wave& w, UintArray a, std::size_t i0, M m) { return _mm512_maskz_loadu_epi32(m, w.u[a] + i0); }
+void store(const Wave& w, UintArray a, std::size_t i0, M m, I v) { _mm512_mask_storeu_epi32(w.u[a] + i0, m, v); }
+// A byte array as a mask of the lanes whose byte is not 0, and back.
+M load_mask(const Wave& w, ByteArray a, std::size_t i0, M m) {
+  const I v = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(m, w.b[a] + i0));
+  return _mm512_test_epi32_mask(v, v);
+}
+void store_mask(const Wave& w, ByteArray a, std::size_t i0, M m, M value) {
+  _mm512_mask_cvtepi32_storeu_epi8(w.b[a] + i0, m, _mm512_maskz_mov_epi32(value, _mm512_set1_epi32(1)));
 }
 
-// Byte offsets into Scene::shape of each lane's surfel's shape.
-I shape_offsets(M m, const void* surfels, I surfel_idx) {
-  const I shape = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), m, surfel_idx,
-                                              advance(surfels, layout::kSurfelShape), 1);
-  return _mm512_slli_epi32(shape, 6);  // 16 floats per shape
+// Fields of each lane's shape (Scene::shape); `shape` is the shape index.
+I shape_offsets(I shape) { return _mm512_slli_epi32(shape, 7); }  // 32 floats = 128 bytes per shape
+F shape_value(M m, const Scene& sc, I offsets, ShapeField field) {
+  return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, offsets, sc.shape + field, 1);
 }
-F shape_value(M m, const Scene& sc, I shape_offset, std::size_t index) {
-  return gather(m, shape_offset, sc.shape, 4 * index);
+V3 shape_value3(M m, const Scene& sc, I offsets, ShapeField field) {
+  return {shape_value(m, sc, offsets, field), shape_value(m, sc, offsets, static_cast<ShapeField>(field + 1)),
+          shape_value(m, sc, offsets, static_cast<ShapeField>(field + 2))};
 }
-V3 shape_value3(M m, const Scene& sc, I shape_offset, std::size_t index) {
-  return gather3(m, shape_offset, sc.shape, 4 * index);
+I shape_int(M m, const Scene& sc, I offsets, ShapeField field) {
+  return _mm512_castps_si512(shape_value(m, sc, offsets, field));
+}
+M shape_flag(M m, const Scene& sc, I offsets, ShapeField field) {
+  return m & ~eq(shape_value(m, sc, offsets, field), k(0.0f));
+}
+// Float `index` of a light table with `stride` floats per entry.
+F table(M m, const float* base, I entry, int stride, int index) {
+  const I at = _mm512_add_epi32(_mm512_mullo_epi32(entry, _mm512_set1_epi32(stride)), _mm512_set1_epi32(index));
+  return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, at, base, 4);
+}
+V3 table3(M m, const float* base, I entry, int stride, int index) {
+  return {table(m, base, entry, stride, index), table(m, base, entry, stride, index + 1),
+          table(m, base, entry, stride, index + 2)};
 }
 
 // power_heuristic (core/sampling.h).
@@ -177,6 +184,9 @@ F power_heuristic(F a, F b) {
   w = _mm512_mask_mov_ps(w, _mm512_cmp_ps_mask(a, k(0.0f), _CMP_NGT_UQ), k(0.0f));
   return _mm512_mask_mov_ps(w, _mm512_fpclass_ps_mask(a, 0x18), k(1.0f));
 }
+
+// glm::normalize: v * (1 / sqrt(v.v)).
+V3 normalize(const V3& v) { return mul(div(k(1.0f), _mm512_sqrt_ps(dot(v, v))), v); }
 
 // LightSampler::pick: the first entry whose cdf exceeds u (the last entry if
 // none does), as a branch-free binary search.
@@ -197,9 +207,7 @@ I pick(M m, const Lights& lights, F u) {
 
 }  // namespace
 
-void generate_camera_rays(const Camera& c, const WaveView& w) {
-  using namespace layout;
-  const I ray_idx = strided(kRaySize), film_idx = strided(8), spectrum_idx = strided(12), prev_idx = strided(kPrevSize);
+void generate_camera_rays(const Camera& c, const Wave& w) {
   const V3 position{k(c.position[0]), k(c.position[1]), k(c.position[2])};
   const V3 forward{k(c.forward[0]), k(c.forward[1]), k(c.forward[2])};
   const V3 right{k(c.right[0]), k(c.right[1]), k(c.right[2])};
@@ -209,124 +217,119 @@ void generate_camera_rays(const Camera& c, const WaveView& w) {
     const M in = lanes(w.n, i0);
     const Streams rng = streams(w, i0, in, _mm512_setzero_si512());  // the camera's numbers are vertex 0's
     // The film position: pixel + FilmX/Y (wavefront_tracer.cpp).
-    const F fx = add(_mm512_cvtepu32_ps(_mm512_maskz_loadu_epi32(in, w.x + i0)), rng.u(Dim::FilmX));
-    const F fy = add(_mm512_cvtepu32_ps(_mm512_maskz_loadu_epi32(in, w.y + i0)), rng.u(Dim::FilmY));
-    scatter(in, film_idx, w.film + 2 * i0, 0, fx);
-    scatter(in, film_idx, w.film + 2 * i0, 4, fy);
-    // Camera::generate_ray, pinhole.
+    const F fx = add(_mm512_cvtepu32_ps(load(w, kPixelX, i0, in)), rng.u(Dim::FilmX));
+    const F fy = add(_mm512_cvtepu32_ps(load(w, kPixelY, i0, in)), rng.u(Dim::FilmY));
+    store(w, kFilmX, i0, in, fx);
+    store(w, kFilmY, i0, in, fy);
+    // Camera::generate_ray.
     const F sx = mul(mul(sub(mul(mul(k(2.0f), fx), k(c.inv_width)), k(1.0f)), k(c.tan_half_fov)), k(c.aspect));
     const F sy = mul(sub(k(1.0f), mul(mul(k(2.0f), fy), k(c.inv_height))), k(c.tan_half_fov));
-    const V3 v = add(add(forward, mul(sx, right)), mul(sy, up));
-    const V3 d = mul(div(k(1.0f), _mm512_sqrt_ps(dot(v, v))), v);  // glm::normalize: v * (1 / sqrt(v.v))
-    void* rays = advance(w.ray, i0 * kRaySize);
-    scatter3(in, ray_idx, rays, kRayOrigin, position);
-    scatter3(in, ray_idx, rays, kRayDir, d);
-    scatter(in, ray_idx, rays, kRayTmax, k(__builtin_inff()));
-    // A fresh path: beta 1, L 0, PreviousVertex{} (at 0, pdf 0, impulse, BSDF
-    // technique), no rays yet, alive, about to reach vertex 1.
-    scatter3(in, spectrum_idx, w.beta + 3 * i0, 0, one);
-    scatter3(in, spectrum_idx, w.L + 3 * i0, 0, zero);
-    void* prev = advance(w.prev, i0 * kPrevSize);
-    scatter3(in, prev_idx, prev, kPrevP, zero);
-    scatter(in, prev_idx, prev, kPrevPdf, k(0.0f));
-    _mm512_mask_i32scatter_epi32(advance(prev, kPrevImpulse), in, prev_idx, _mm512_set1_epi32(0x0101), 1);
-    _mm512_mask_storeu_epi32(w.rays + i0, in, _mm512_setzero_si512());
-    _mm512_mask_storeu_epi32(w.vertex + i0, in, _mm512_set1_epi32(1));
-    _mm512_mask_cvtepi32_storeu_epi8(w.alive + i0, in, _mm512_set1_epi32(1));
+    const V3 d = normalize(add(add(forward, mul(sx, right)), mul(sy, up)));
+    if (c.aperture_radius <= 0.0f) {
+      store3(w, kOx, i0, in, position);
+      store3(w, kDx, i0, in, d);
+    } else {
+      // Thin lens: through the point of the plane in focus.
+      const V3 focus = add(position, mul(div(k(c.focus_distance), dot(d, forward)), d));
+      F lx, ly;
+      concentric_disk(rng.u(Dim::LensX), rng.u(Dim::LensY), &lx, &ly);
+      lx = mul(k(c.aperture_radius), lx);
+      ly = mul(k(c.aperture_radius), ly);
+      const V3 origin = add(add(position, mul(lx, right)), mul(ly, up));
+      store3(w, kOx, i0, in, origin);
+      store3(w, kDx, i0, in, normalize(sub(focus, origin)));
+    }
+    store(w, kTmax, i0, in, k(__builtin_inff()));
+    // A fresh path: beta 1, L 0, PreviousVertex{} (at 0, pdf 0, an impulse,
+    // the BSDF technique), no rays yet, alive, about to reach vertex 1.
+    store3(w, kBetaR, i0, in, one);
+    store3(w, kLR, i0, in, zero);
+    store3(w, kPrevX, i0, in, zero);
+    store(w, kPrevPdf, i0, in, k(0.0f));
+    store_mask(w, kPrevImpulse, i0, in, in);
+    store_mask(w, kPrevBsdfTechnique, i0, in, in);
+    store(w, kRays, i0, in, _mm512_setzero_si512());
+    store(w, kVertex, i0, in, _mm512_set1_epi32(1));
+    store_mask(w, kAlive, i0, in, in);
   }
 }
 
-void resolve(const Scene& sc, const WaveView& w) {
-  using namespace layout;
-  const I hit_idx = strided(kHitSize), surfel_idx = strided(kSurfelSize);
+void resolve(const Scene& sc, const Wave& w) {
+  constexpr float kGamma5 = (5.0f * 0x1p-24f) / (1.0f - 5.0f * 0x1p-24f);
+  constexpr float kGamma2 = (2.0f * 0x1p-24f) / (1.0f - 2.0f * 0x1p-24f);
   for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
     const M in = lanes(w.n, i0);
-    const I rays = _mm512_maskz_loadu_epi32(in, w.rays + i0);
-    _mm512_mask_storeu_epi32(w.rays + i0, in, _mm512_add_epi32(rays, _mm512_set1_epi32(1)));
-    const I found_bytes = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(in, w.found + i0));
-    const M found = _mm512_test_epi32_mask(found_bytes, found_bytes);
+    store(w, kRays, i0, in, _mm512_add_epi32(load(w, kRays, i0, in), _mm512_set1_epi32(1)));
+    const M found = load_mask(w, kFound, i0, in);
     if (found == 0) continue;
-    const void* hits = advance(w.hit, i0 * kHitSize);
-    const I shape = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), found, hit_idx, advance(hits, kHitShape), 1);
-    const I prim = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), found, hit_idx, advance(hits, kHitPrim), 1);
-    const F b1 = gather(found, hit_idx, hits, kHitUv), b2 = gather(found, hit_idx, hits, kHitUv + 4);
-    // triangle_point (core/geometry.cpp) of triangle first_triangle[shape] + prim.
-    const I tri = _mm512_add_epi32(_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), found, shape, sc.first_triangle, 4), prim);
-    const I t = _mm512_mullo_epi32(tri, _mm512_set1_epi32(12));  // in floats
-    auto vertex3 = [&](int first) {
-      return V3{_mm512_mask_i32gather_ps(_mm512_setzero_ps(), found, _mm512_add_epi32(t, _mm512_set1_epi32(first)),
-                                         sc.triangles, 4),
-                _mm512_mask_i32gather_ps(_mm512_setzero_ps(), found, _mm512_add_epi32(t, _mm512_set1_epi32(first + 1)),
-                                         sc.triangles, 4),
-                _mm512_mask_i32gather_ps(_mm512_setzero_ps(), found, _mm512_add_epi32(t, _mm512_set1_epi32(first + 2)),
-                                         sc.triangles, 4)};
-    };
-    const V3 p0 = vertex3(0), p1 = vertex3(3), p2 = vertex3(6), n = vertex3(9);
-    const F b0 = sub(sub(k(1.0f), b1), b2);
-    const V3 p = add(add(mul(b0, p0), mul(b1, p1)), mul(b2, p2));
-    const V3 error = mul(k(kGamma7), add(add(abs(mul(b0, p0)), abs(mul(b1, p1))), abs(mul(b2, p2))));
+    const I shape = shape_offsets(load(w, kShape, i0, found));
+    const M sphere = shape_flag(found, sc, shape, kIsSphere), mesh = found & ~sphere;
+    V3 p, error, n;
+    if (mesh != 0) {
+      // triangle_point (core/geometry.cpp) of the shape's triangle prim.
+      const I tri = _mm512_add_epi32(shape_int(mesh, sc, shape, kFirstTriangle), load(w, kPrim, i0, mesh));
+      const V3 p0 = table3(mesh, sc.triangles, tri, 12, 0), p1 = table3(mesh, sc.triangles, tri, 12, 3),
+               p2 = table3(mesh, sc.triangles, tri, 12, 6);
+      n = table3(mesh, sc.triangles, tri, 12, 9);
+      const F b1 = load(w, kHitU, i0, mesh), b2 = load(w, kHitV, i0, mesh);
+      const F b0 = sub(sub(k(1.0f), b1), b2);
+      p = add(add(mul(b0, p0), mul(b1, p1)), mul(b2, p2));
+      error = mul(k(kGamma7), add(add(abs(mul(b0, p0)), abs(mul(b1, p1))), abs(mul(b2, p2))));
+    }
+    if (sphere != 0) {
+      // sphere_point (core/geometry.cpp) of origin + t dir.
+      const F t = load(w, kHitT, i0, sphere);
+      const V3 o = load3(w, kOx, i0, sphere), d = load3(w, kDx, i0, sphere);
+      const V3 center = shape_value3(sphere, sc, shape, kCenter);
+      const F radius = shape_value(sphere, sc, shape, kRadius);
+      const V3 dir = normalize(sub(add(o, mul(t, d)), center));
+      const V3 rdir = mul(radius, dir);
+      const V3 sp = add(center, rdir);
+      const V3 serr = add(mul(k(kGamma5), abs(rdir)), mul(k(kGamma2), abs(sp)));
+      const V3 sn = select(shape_flag(sphere, sc, shape, kFlipped), neg(dir), dir);
+      p = select(sphere, sp, p);
+      error = select(sphere, serr, error);
+      n = select(sphere, sn, n);
+    }
     // Frame(n) (core/math.h).
     const F sign = _mm512_castsi512_ps(_mm512_or_si512(
         _mm512_and_si512(_mm512_castps_si512(n.z), _mm512_set1_epi32(INT32_MIN)), _mm512_castps_si512(k(1.0f))));
     const F a = div(k(-1.0f), add(sign, n.z));
     const F b = mul(mul(n.x, n.y), a);
-    const V3 fs{add(k(1.0f), mul(mul(mul(sign, n.x), n.x), a)), mul(sign, b), mul(neg(sign), n.x)};
-    const V3 ft{b, add(sign, mul(mul(n.y, n.y), a)), neg(n.y)};
-    void* surfels = advance(w.surfel, i0 * kSurfelSize);
-    scatter3(found, surfel_idx, surfels, kSurfelP, p);
-    scatter3(found, surfel_idx, surfels, kSurfelPError, error);
-    scatter3(found, surfel_idx, surfels, kSurfelN, n);
-    scatter3(found, surfel_idx, surfels, kSurfelFrameS, fs);
-    scatter3(found, surfel_idx, surfels, kSurfelFrameT, ft);
-    scatter3(found, surfel_idx, surfels, kSurfelFrameN, n);
-    _mm512_mask_i32scatter_epi32(advance(surfels, kSurfelShape), found, surfel_idx, shape, 1);
-    _mm512_mask_i32scatter_epi32(advance(surfels, kSurfelPrim), found, surfel_idx, prim, 1);
-    // Surfel::material: the shape's material, 64-bit pointers in two halves.
-    const I shape_hi = _mm512_shuffle_i64x2(shape, shape, 0x4e), idx_hi = _mm512_shuffle_i64x2(surfel_idx, surfel_idx, 0x4e);
-    const auto m_lo = static_cast<__mmask8>(found & 0xff), m_hi = static_cast<__mmask8>(found >> 8);
-    const I mat_lo = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), m_lo, _mm512_castsi512_si256(shape), sc.material, 8);
-    const I mat_hi = _mm512_mask_i32gather_epi64(_mm512_setzero_si512(), m_hi, _mm512_castsi512_si256(shape_hi), sc.material, 8);
-    _mm512_mask_i32scatter_epi64(advance(surfels, kSurfelMaterial), m_lo, _mm512_castsi512_si256(surfel_idx), mat_lo, 1);
-    _mm512_mask_i32scatter_epi64(advance(surfels, kSurfelMaterial), m_hi, _mm512_castsi512_si256(idx_hi), mat_hi, 1);
+    store3(w, kPx, i0, found, p);
+    store3(w, kErrX, i0, found, error);
+    store3(w, kNx, i0, found, n);
+    store3(w, kSx, i0, found, V3{add(k(1.0f), mul(mul(mul(sign, n.x), n.x), a)), mul(sign, b), mul(neg(sign), n.x)});
+    store3(w, kTx, i0, found, V3{b, add(sign, mul(mul(n.y, n.y), a)), neg(n.y)});
   }
 }
 
-void add_emission(const Scene& sc, const WaveView& w) {
-  using namespace layout;
-  const I surfel_idx = strided(kSurfelSize), ray_idx = strided(kRaySize), spectrum_idx = strided(12),
-          prev_idx = strided(kPrevSize);
+void add_emission(const Scene& sc, const Wave& w) {
   const V3 zero{k(0.0f), k(0.0f), k(0.0f)};
   for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
     const M in = lanes(w.n, i0);
-    const I found_bytes = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(in, w.found + i0));
-    const M found = _mm512_test_epi32_mask(found_bytes, found_bytes);
-    const V3 beta = gather3(in, spectrum_idx, w.beta + 3 * i0, 0);
-    V3 L = gather3(in, spectrum_idx, w.L + 3 * i0, 0);
+    const M found = load_mask(w, kFound, i0, in);
+    const V3 beta = load3(w, kBetaR, i0, in);
+    const V3 L = load3(w, kLR, i0, in);
     // Escaped: no environment, so Le = 0 and its weight 0; L += beta * (0 * 0).
-    const V3 L_escaped = add(L, mul(beta, mul(k(0.0f), zero)));
+    V3 L_new = add(L, mul(beta, mul(k(0.0f), zero)));
     M alive = 0;
     if (found != 0) {
       // Surfel::emitted.
-      const void* surfels = advance(w.surfel, i0 * kSurfelSize);
-      const I shape = shape_offsets(found, surfels, surfel_idx);
-      const V3 wo = neg(gather3(found, ray_idx, advance(w.ray, i0 * kRaySize), kRayDir));
-      const V3 n = gather3(found, surfel_idx, surfels, kSurfelN);
-      const M emits = found & ~eq(shape_value(found, sc, shape, shape_field::kEmits), k(0.0f));
-      const M facing = ~eq(shape_value(found, sc, shape, shape_field::kTwoSided), k(0.0f)) | gt(dot(n, wo), k(0.0f));
-      const V3 Le = select(emits & facing, shape_value3(found, sc, shape, shape_field::kEmission), zero);
+      const I shape = shape_offsets(load(w, kShape, i0, found));
+      const V3 wo = neg(load3(w, kDx, i0, found));
+      const V3 n = load3(w, kNx, i0, found);
+      const M facing = shape_flag(found, sc, shape, kTwoSided) | gt(dot(n, wo), k(0.0f));
+      const V3 Le = select(shape_flag(found, sc, shape, kEmits) & facing, shape_value3(found, sc, shape, kEmission), zero);
       const M lit = found & ~is_black(Le);
-      // LightSampler::pdf(prev.p, s) for the lit lanes.
-      void* prev = advance(w.prev, i0 * kPrevSize);
-      const I flags = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), lit, prev_idx, advance(prev, kPrevImpulse), 1);
-      const M impulse = _mm512_test_epi32_mask(flags, _mm512_set1_epi32(0xff));
-      const M bsdf_technique = _mm512_test_epi32_mask(flags, _mm512_set1_epi32(0xff00));
-      const F prev_pdf = gather(lit, prev_idx, prev, kPrevPdf);
-      const I first = _mm512_castps_si512(shape_value(lit, sc, shape, shape_field::kFirstLight));
+      // LightSampler::pdf(prev.p, s).
+      const M impulse = load_mask(w, kPrevImpulse, i0, lit);
+      const M bsdf_technique = load_mask(w, kPrevBsdfTechnique, i0, lit);
+      const F prev_pdf = load(w, kPrevPdf, i0, lit);
+      const I first = shape_int(lit, sc, shape, kFirstLight);
       const M light = lit & _mm512_cmpge_epi32_mask(first, _mm512_setzero_si512());
-      const I prim = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), light, surfel_idx,
-                                                 advance(surfels, kSurfelPrim), 1);
-      const I entry = _mm512_add_epi32(first, prim);
-      const V3 d = sub(gather3(light, surfel_idx, surfels, kSurfelP), gather3(light, prev_idx, prev, kPrevP));
+      const I entry = _mm512_add_epi32(first, load(w, kPrim, i0, light));
+      const V3 d = sub(load3(w, kPx, i0, light), load3(w, kPrevX, i0, light));
       const F dist = _mm512_sqrt_ps(dot(d, d));
       const F c = _mm512_abs_ps(div(dot(n, d), dist));
       const F inv_area = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), light, entry, sc.lights.inv_area, 4);
@@ -339,140 +342,120 @@ void add_emission(const Scene& sc, const WaveView& w) {
       if (sc.strategy == Strategy::Mis) weight = power_heuristic(prev_pdf, light_pdf);
       if (sc.strategy == Strategy::LightBsdf)
         weight = _mm512_maskz_mov_ps(bsdf_technique, div(mul(k(2.0f), prev_pdf), add(prev_pdf, light_pdf)));
-      weight = _mm512_mask_mov_ps(weight, impulse, k(1.0f));
-      weight = _mm512_maskz_mov_ps(lit, weight);
-      const V3 L_hit = add(L, mul(beta, mul(weight, Le)));
-      L = select(found, L_hit, L_escaped);
+      weight = _mm512_maskz_mov_ps(lit, _mm512_mask_mov_ps(weight, impulse, k(1.0f)));
+      L_new = select(found, add(L, mul(beta, mul(weight, Le))), L_new);
       // The path goes on if it may take another vertex and the surface scatters.
-      const I vertex = _mm512_maskz_loadu_epi32(in, w.vertex + i0);
-      alive = found & _mm512_cmple_epi32_mask(vertex, _mm512_set1_epi32(sc.max_vertex)) &
-              ~eq(shape_value(found, sc, shape, shape_field::kScatters), k(0.0f));
-    } else {
-      L = L_escaped;
+      alive = _mm512_cmple_epi32_mask(load(w, kVertex, i0, found), _mm512_set1_epi32(sc.max_vertex)) &
+              shape_flag(found, sc, shape, kScatters);
     }
-    scatter3(in, spectrum_idx, w.L + 3 * i0, 0, L);
-    _mm512_mask_cvtepi32_storeu_epi8(w.alive + i0, in, _mm512_maskz_mov_epi32(alive, _mm512_set1_epi32(1)));
+    store3(w, kLR, i0, in, L_new);
+    store_mask(w, kAlive, i0, in, alive);
   }
 }
 
-void add_light(const WaveView& w) {
-  const I spectrum_idx = strided(12), pair_spectrum_idx = strided(2 * 12);
+std::size_t sample_lights(const Scene& sc, const Wave& w) {
+  std::size_t queries = 0;
+  const I iota = _mm512_set_epi32(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
   for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
     const M in = lanes(w.n, i0);
-    // Slot [2i + 1]'s state (slot [2i], for point lights, is always empty here).
-    const I pairs = _mm512_cvtepu16_epi32(_mm256_maskz_loadu_epi16(in, w.shadow_state + 2 * i0));
-    const I state = _mm512_srli_epi32(pairs, 8);
-    const M traced = in & _mm512_test_epi32_mask(state, state);
-    if (traced == 0) continue;
-    const M visible = traced & _mm512_cmpeq_epi32_mask(state, _mm512_set1_epi32(2));
-    const V3 beta = gather3(traced, spectrum_idx, w.beta + 3 * i0, 0);
-    const V3 L = gather3(traced, spectrum_idx, w.L + 3 * i0, 0);
-    const V3 unoccluded = gather3(visible, pair_spectrum_idx, w.unoccluded + 3 * (2 * i0 + 1), 0);
-    const V3 zero{k(0.0f), k(0.0f), k(0.0f)};
-    scatter3(traced, spectrum_idx, w.L + 3 * i0, 0, add(L, select(visible, mul(beta, unoccluded), zero)));
-  }
-}
-
-void sample_lights(const Scene& sc, const WaveView& w) {
-  using namespace layout;
-  const I surfel_idx = strided(kSurfelSize), ray_idx = strided(kRaySize), shadow_idx = strided(2 * kRaySize);
-  const I pair_spectrum_idx = strided(2 * 12), pair_float_idx = strided(2 * 4);
-  for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
-    const M in = lanes(w.n, i0);
-    const void* surfels = advance(w.surfel, i0 * kSurfelSize);
-    const I vertex = _mm512_maskz_loadu_epi32(in, w.vertex + i0);
+    const I vertex = load(w, kVertex, i0, in);
     const Streams rng = streams(w, i0, in, vertex);
     // samples_area_lights (core/strategy_weights.h).
-    M ok = alive_lanes(w, i0, in);
+    M ok = load_mask(w, kAlive, i0, in);
     if (sc.strategy == Strategy::Bsdf || sc.lights.count == 0) ok = 0;
     if (sc.strategy == Strategy::LightBsdf) ok &= lt(rng.u(Dim::Technique), k(0.5f));
+    if (ok == 0) continue;
 
-    if (ok != 0) {
-      // LightSampler::sample: pick a triangle, then a point uniformly on it
-      // (square_to_uniform_triangle, triangle_point).
-      const I light = pick(ok, sc.lights, rng.u(Dim::LightChoice));
-      const F ux = rng.u(Dim::LightX), uy = rng.u(Dim::LightY);
-      const F s = _mm512_sqrt_ps(ux);
-      const F b1 = mul(uy, s), b2 = sub(k(1.0f), s);
-      const F b0 = sub(sub(k(1.0f), b1), b2);
-      const I tri = _mm512_slli_epi32(light, 6);  // 16 floats per light
-      const V3 p0 = gather3(ok, tri, sc.lights.triangle, 0), p1 = gather3(ok, tri, sc.lights.triangle, 12),
-               p2 = gather3(ok, tri, sc.lights.triangle, 24), ln = gather3(ok, tri, sc.lights.triangle, 36),
-               Le = gather3(ok, tri, sc.lights.triangle, 48);
-      const F two_sided = gather(ok, tri, sc.lights.triangle, 60);
-      const V3 lp = add(add(mul(b0, p0), mul(b1, p1)), mul(b2, p2));
-      const V3 lerr = mul(k(kGamma7), add(add(abs(mul(b0, p0)), abs(mul(b1, p1))), abs(mul(b2, p2))));
+    // LightSampler::sample: pick a triangle, then a point uniformly on it
+    // (square_to_uniform_triangle, triangle_point).
+    const I light = pick(ok, sc.lights, rng.u(Dim::LightChoice));
+    const F ux = rng.u(Dim::LightX), uy = rng.u(Dim::LightY);
+    const F s = _mm512_sqrt_ps(ux);
+    const F b1 = mul(uy, s), b2 = sub(k(1.0f), s);
+    const F b0 = sub(sub(k(1.0f), b1), b2);
+    const V3 p0 = table3(ok, sc.lights.triangle, light, 16, 0), p1 = table3(ok, sc.lights.triangle, light, 16, 3),
+             p2 = table3(ok, sc.lights.triangle, light, 16, 6), ln = table3(ok, sc.lights.triangle, light, 16, 9),
+             Le = table3(ok, sc.lights.triangle, light, 16, 12);
+    const F two_sided = table(ok, sc.lights.triangle, light, 16, 15);
+    const V3 lp = add(add(mul(b0, p0), mul(b1, p1)), mul(b2, p2));
+    const V3 lerr = mul(k(kGamma7), add(add(abs(mul(b0, p0)), abs(mul(b1, p1))), abs(mul(b2, p2))));
 
-      const V3 sp = gather3(ok, surfel_idx, surfels, kSurfelP);
-      const V3 d = sub(lp, sp);
-      const F dist = _mm512_sqrt_ps(dot(d, d));
-      ok &= gt(dist, k(0.0f));
-      const V3 wi = div(d, dist);
-      const F cos_light = dot(ln, neg(wi));
-      ok &= ~eq(two_sided, k(0.0f)) | _mm512_cmp_ps_mask(cos_light, k(0.0f), _CMP_NLE_UQ);  // back of a one-sided emitter
-      // pmf * area_to_solid_angle(1 / area, dist, cos_light) (core/sampling.h).
-      const F c = _mm512_abs_ps(cos_light);
-      const F inv_area = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), ok, light, sc.lights.inv_area, 4);
-      const F pmf = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), ok, light, sc.lights.pmf, 4);
-      const F to_solid_angle = select(gt(c, k(0.0f)), div(mul(mul(inv_area, dist), dist), c), k(0.0f));
-      const F pdf_light = mul(pmf, to_solid_angle);
-      ok &= gt(pdf_light, k(0.0f)) & ~_mm512_fpclass_ps_mask(pdf_light, 0x18);  // seen edge-on
+    const V3 sp = load3(w, kPx, i0, ok);
+    const V3 d = sub(lp, sp);
+    const F dist = _mm512_sqrt_ps(dot(d, d));
+    ok &= gt(dist, k(0.0f));
+    const V3 wi = div(d, dist);
+    const F cos_light = dot(ln, neg(wi));
+    ok &= ~eq(two_sided, k(0.0f)) | _mm512_cmp_ps_mask(cos_light, k(0.0f), _CMP_NLE_UQ);  // back of a one-sided emitter
+    // pmf * area_to_solid_angle(1 / area, dist, cos_light) (core/sampling.h).
+    const F c = _mm512_abs_ps(cos_light);
+    const F inv_area = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), ok, light, sc.lights.inv_area, 4);
+    const F pmf = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), ok, light, sc.lights.pmf, 4);
+    const F to_solid_angle = select(gt(c, k(0.0f)), div(mul(mul(inv_area, dist), dist), c), k(0.0f));
+    const F pdf_light = mul(pmf, to_solid_angle);
+    ok &= gt(pdf_light, k(0.0f)) & ~_mm512_fpclass_ps_mask(pdf_light, 0x18);  // seen edge-on
 
-      // Surfel::eval and Surfel::pdf of the Lambert lobe (core/surfel.cpp,
-      // bsdf/lambert.h): only the local z of wo and wi matters.
-      const V3 wo = neg(gather3(ok, ray_idx, advance(w.ray, i0 * kRaySize), kRayDir));
-      const V3 fn = gather3(ok, surfel_idx, surfels, kSurfelFrameN);
-      const F wo_z = dot(wo, fn);
-      F wi_z = dot(wi, fn);
-      wi_z = select(lt(wo_z, k(0.0f)), neg(wi_z), wi_z);
-      const M upper = gt(wi_z, k(0.0f));
-      const F cos_pi = mul(wi_z, k(kInvPi));
-      const V3 rho = shape_value3(ok, sc, shape_offsets(ok, surfels, surfel_idx), shape_field::kAlbedo);
-      const V3 zero{k(0.0f), k(0.0f), k(0.0f)};
-      const V3 f = select(upper, mul(cos_pi, rho), zero);
-      ok &= ~is_black(f);
-      const F pdf_bsdf = select(upper, cos_pi, k(0.0f));
+    // Surfel::eval and Surfel::pdf of the Lambert lobe (core/surfel.cpp,
+    // bsdf/lambert.h): only the local z of wo and wi matters.
+    const V3 wo = neg(load3(w, kDx, i0, ok));
+    const V3 n = load3(w, kNx, i0, ok);  // the frame's normal is the surface's
+    const F wo_z = dot(wo, n);
+    F wi_z = dot(wi, n);
+    wi_z = select(lt(wo_z, k(0.0f)), neg(wi_z), wi_z);
+    const M upper = gt(wi_z, k(0.0f));
+    const F cos_pi = mul(wi_z, k(kInvPi));
+    const V3 rho = shape_value3(ok, sc, shape_offsets(load(w, kShape, i0, ok)), kAlbedo);
+    const V3 f = select(upper, mul(cos_pi, rho), V3{k(0.0f), k(0.0f), k(0.0f)});
+    ok &= ~is_black(f);
+    const F pdf_bsdf = select(upper, cos_pi, k(0.0f));
 
-      // light_sample_weight (core/strategy_weights.h); pdf_light is finite and > 0 here.
-      F weight = k(1.0f);
-      if (sc.strategy == Strategy::Mis) {
-        weight = power_heuristic(pdf_light, pdf_bsdf);
-      } else if (sc.strategy == Strategy::LightBsdf) {
-        weight = div(mul(k(2.0f), pdf_light), add(pdf_light, pdf_bsdf));
-      }
-      const V3 unoccluded = mul(div(weight, pdf_light), mul(f, Le));
+    // light_sample_weight (core/strategy_weights.h).
+    F weight = k(1.0f);
+    if (sc.strategy == Strategy::Mis) weight = power_heuristic(pdf_light, pdf_bsdf);
+    if (sc.strategy == Strategy::LightBsdf) weight = div(mul(k(2.0f), pdf_light), add(pdf_light, pdf_bsdf));
+    store3(w, kUnR, i0, ok, mul(div(weight, pdf_light), mul(f, Le)));
 
-      // Surfel::spawn_to(lp, lerr, ln).
-      const V3 sn = gather3(ok, surfel_idx, surfels, kSurfelN), serr = gather3(ok, surfel_idx, surfels, kSurfelPError);
-      const V3 origin = offset_ray_origin(sp, serr, select(ge(dot(d, sn), k(0.0f)), sn, neg(sn)));
-      const V3 end = offset_ray_origin(lp, lerr, select(ge(dot(sub(origin, lp), ln), k(0.0f)), ln, neg(ln)));
-      const V3 dd = sub(end, origin);
-      const F len = _mm512_sqrt_ps(dot(dd, dd));
+    // Surfel::spawn_to(lp, lerr, ln), packed behind the previous ones.
+    const V3 err = load3(w, kErrX, i0, ok);
+    const V3 origin = offset_ray_origin(sp, err, select(ge(dot(d, n), k(0.0f)), n, neg(n)));
+    const V3 end = offset_ray_origin(lp, lerr, select(ge(dot(sub(origin, lp), ln), k(0.0f)), ln, neg(ln)));
+    const V3 dd = sub(end, origin);
+    const F len = _mm512_sqrt_ps(dot(dd, dd));
+    const V3 dir = div(dd, len);
+    const F q[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
+    for (int a = 0; a < 7; ++a) _mm512_mask_compressstoreu_ps(w.f[kQOx + a] + queries, ok, q[a]);
+    _mm512_mask_compressstoreu_epi32(w.u[kQSlot] + queries, ok,
+                                     _mm512_add_epi32(iota, _mm512_set1_epi32(static_cast<int>(i0))));
+    // The shadow ray counts as one of the path's rays.
+    store(w, kRays, i0, ok, _mm512_add_epi32(load(w, kRays, i0, ok), _mm512_set1_epi32(1)));
+    queries += static_cast<std::size_t>(__builtin_popcount(ok));
+  }
+  return queries;
+}
 
-      void* shadow = advance(w.shadow, (2 * i0 + 1) * kRaySize);
-      scatter3(ok, shadow_idx, shadow, kRayOrigin, origin);
-      scatter3(ok, shadow_idx, shadow, kRayDir, div(dd, len));
-      scatter(ok, shadow_idx, shadow, kRayTmax, len);
-      scatter3(ok, pair_spectrum_idx, w.unoccluded + 3 * (2 * i0 + 1), 0, unoccluded);
-      scatter(ok, pair_float_idx, w.light_weight + 2 * i0 + 1, 0, weight);
+void add_light(const Wave& w, std::size_t queries) {
+  for (std::size_t r0 = 0; r0 < queries; r0 += 16) {
+    const M in = lanes(queries, r0);
+    const I slot = _mm512_maskz_loadu_epi32(in, w.u[kQSlot] + r0);
+    const I blocked = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(in, w.b[kQOccluded] + r0));
+    const M visible = in & ~_mm512_test_epi32_mask(blocked, blocked);
+    auto at = [&](FloatArray a, M m) { return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, slot, w.f[a], 4); };
+    // Each path has at most one shadow ray: the slots are distinct.
+    for (int c = 0; c < 3; ++c) {
+      const auto l = static_cast<FloatArray>(kLR + c);
+      const F added = _mm512_maskz_mov_ps(visible, mul(at(static_cast<FloatArray>(kBetaR + c), visible),
+                                                      at(static_cast<FloatArray>(kUnR + c), visible)));
+      _mm512_mask_i32scatter_ps(w.f[l], in, slot, add(at(l, in), added), 4);
     }
-    // Slot [2i] (point lights) is empty; slot [2i + 1] is to be traced or empty.
-    const I state = _mm512_maskz_mov_epi32(ok, _mm512_set1_epi32(0x0100));
-    _mm512_mask_cvtepi32_storeu_epi16(w.shadow_state + 2 * i0, in, state);
   }
 }
 
-void scatter(const Scene& sc, const WaveView& w) {
-  using namespace layout;
-  const I surfel_idx = strided(kSurfelSize), ray_idx = strided(kRaySize), spectrum_idx = strided(12),
-          prev_idx = strided(kPrevSize);
+void scatter(const Scene& sc, const Wave& w) {
   for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
     const M in = lanes(w.n, i0);
-    M ok = alive_lanes(w, i0, in);
+    M ok = load_mask(w, kAlive, i0, in);
     if (ok == 0) continue;
-    const void* surfels = advance(w.surfel, i0 * kSurfelSize);
-    void* rays = advance(w.ray, i0 * kRaySize);
-    I vertex = _mm512_maskz_loadu_epi32(in, w.vertex + i0);
+    I vertex = load(w, kVertex, i0, in);
     const Streams rng = streams(w, i0, in, vertex);
 
     // square_to_cosine_hemisphere (core/sampling.cpp).
@@ -483,17 +466,15 @@ void scatter(const Scene& sc, const WaveView& w) {
     // Surfel::scatter, Lambert: no sample on the disk's rim, or below min_pdf.
     const F pdf = select(gt(z, k(0.0f)), mul(z, k(kInvPi)), k(0.0f));
     ok &= _mm512_cmp_ps_mask(pdf, k(0.0f), _CMP_NLE_UQ) & _mm512_cmp_ps_mask(pdf, k(sc.min_pdf), _CMP_NLT_UQ);
-    const V3 wo = neg(gather3(ok, ray_idx, rays, kRayDir));
-    const V3 fs = gather3(ok, surfel_idx, surfels, kSurfelFrameS), ft = gather3(ok, surfel_idx, surfels, kSurfelFrameT),
-             fn = gather3(ok, surfel_idx, surfels, kSurfelFrameN);
-    const F side = select(lt(dot(wo, fn), k(0.0f)), k(-1.0f), k(1.0f));
-    const F wz = mul(z, side);
-    const V3 wi = add(add(mul(x, fs), mul(y, ft)), mul(wz, fn));  // Frame::to_world
-    V3 weight = shape_value3(ok, sc, shape_offsets(ok, surfels, surfel_idx), shape_field::kAlbedo);
+    const V3 wo = neg(load3(w, kDx, i0, ok));
+    const V3 fs = load3(w, kSx, i0, ok), ft = load3(w, kTx, i0, ok), n = load3(w, kNx, i0, ok);
+    const F side = select(lt(dot(wo, n), k(0.0f)), k(-1.0f), k(1.0f));
+    const V3 wi = add(add(mul(x, fs), mul(y, ft)), mul(mul(z, side), n));  // Frame::to_world
+    V3 weight = shape_value3(ok, sc, shape_offsets(load(w, kShape, i0, ok)), kAlbedo);
     ok &= ~is_black(weight);
 
     // Russian roulette (the scatter stage).
-    V3 beta = gather3(ok, spectrum_idx, w.beta + 3 * i0, 0);
+    V3 beta = load3(w, kBetaR, i0, ok);
     const M rr = ok & _mm512_cmpgt_epi32_mask(vertex, _mm512_set1_epi32(sc.rr_depth));
     if (rr != 0) {
       const V3 bw = mul(beta, weight);
@@ -501,30 +482,69 @@ void scatter(const Scene& sc, const WaveView& w) {
       ok &= ~(rr & ~lt(rng.u(Dim::Roulette), survival));
       weight = select(rr, div(weight, survival), weight);
     }
-    beta = mul(beta, weight);
-    scatter3(ok, spectrum_idx, w.beta + 3 * i0, 0, beta);
+    store3(w, kBetaR, i0, ok, mul(beta, weight));
 
     // PreviousVertex{s.p, pdf, impulse = false, bsdf_technique}.
-    const V3 sp = gather3(ok, surfel_idx, surfels, kSurfelP);
-    void* prev = advance(w.prev, i0 * kPrevSize);
-    scatter3(ok, prev_idx, prev, kPrevP, sp);
-    scatter(ok, prev_idx, prev, kPrevPdf, pdf);
+    const V3 sp = load3(w, kPx, i0, ok);
+    store3(w, kPrevX, i0, ok, sp);
+    store(w, kPrevPdf, i0, ok, pdf);
+    store_mask(w, kPrevImpulse, i0, ok, 0);
     M bsdf_technique = 0xffff;
     if (sc.strategy == Strategy::LightBsdf) bsdf_technique = ~lt(rng.u(Dim::Technique), k(0.5f));
-    static_assert(layout::kPrevBsdfTechnique == layout::kPrevImpulse + 1);
-    const I flags = _mm512_maskz_mov_epi32(bsdf_technique, _mm512_set1_epi32(0x0100));  // impulse 0, bsdf_technique
-    _mm512_mask_i32scatter_epi32(advance(prev, kPrevImpulse), ok, prev_idx, flags, 1);
+    store_mask(w, kPrevBsdfTechnique, i0, ok, bsdf_technique);
 
     // Surfel::spawn(wi).
-    const V3 sn = gather3(ok, surfel_idx, surfels, kSurfelN), serr = gather3(ok, surfel_idx, surfels, kSurfelPError);
-    const V3 origin = offset_ray_origin(sp, serr, select(ge(dot(wi, sn), k(0.0f)), sn, neg(sn)));
-    scatter3(ok, ray_idx, rays, kRayOrigin, origin);
-    scatter3(ok, ray_idx, rays, kRayDir, wi);
-    scatter(ok, ray_idx, rays, kRayTmax, k(__builtin_inff()));
-    vertex = _mm512_mask_add_epi32(vertex, ok, vertex, _mm512_set1_epi32(1));
-    _mm512_mask_storeu_epi32(w.vertex + i0, ok, vertex);
-    _mm512_mask_cvtepi32_storeu_epi8(w.alive + i0, in, _mm512_maskz_mov_epi32(ok, _mm512_set1_epi32(1)));
+    const V3 err = load3(w, kErrX, i0, ok);
+    store3(w, kOx, i0, ok, offset_ray_origin(sp, err, select(ge(dot(wi, n), k(0.0f)), n, neg(n))));
+    store3(w, kDx, i0, ok, wi);
+    store(w, kTmax, i0, ok, k(__builtin_inff()));
+    vertex = _mm512_add_epi32(vertex, _mm512_set1_epi32(1));
+    store(w, kVertex, i0, ok, vertex);
+    store_mask(w, kAlive, i0, in, ok);
   }
+}
+
+std::size_t compact(const Wave& w, Finished* finished) {
+  static constexpr FloatArray kMovedFloats[] = {kOx,   kOy,   kOz,   kDx,   kDy,   kDz,      kTmax,  kBetaR, kBetaG,
+                                                kBetaB, kLR,  kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX,
+                                                kFilmY};
+  static constexpr UintArray kMovedUints[] = {kOutIndex, kRays, kVertex};
+  static constexpr ByteArray kMovedBytes[] = {kPrevImpulse, kPrevBsdfTechnique};
+  std::size_t m = 0, ended = 0;
+  for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
+    const M in = lanes(w.n, i0);
+    const M alive = load_mask(w, kAlive, i0, in);
+    // The paths that ended, in slot order: FilmSample{film, L, rays, hits}.
+    for (M dead = in & ~alive; dead != 0; dead &= static_cast<M>(dead - 1)) {
+      const std::size_t i = i0 + static_cast<std::size_t>(__builtin_ctz(dead));
+      const std::uint32_t vertex = w.u[kVertex][i];
+      finished[ended++] = Finished{w.u[kOutIndex][i], w.f[kFilmX][i], w.f[kFilmY][i],
+                                   {w.f[kLR][i], w.f[kLG][i], w.f[kLB][i]}, w.u[kRays][i],
+                                   vertex - (w.b[kFound][i] ? 0u : 1u)};
+    }
+    // The survivors, packed behind the previous ones (m <= i0: a block is
+    // read before anything is written over it).
+    if (alive == in && m == i0) {
+      m += static_cast<std::size_t>(__builtin_popcount(in));
+      continue;
+    }
+    for (FloatArray a : kMovedFloats) _mm512_mask_compressstoreu_ps(w.f[a] + m, alive, load(w, a, i0, in));
+    for (UintArray a : kMovedUints) _mm512_mask_compressstoreu_epi32(w.u[a] + m, alive, load(w, a, i0, in));
+    const auto count = static_cast<std::size_t>(__builtin_popcount(alive));
+    const auto packed = static_cast<M>((1u << count) - 1u);
+    for (ByteArray a : kMovedBytes) {
+      const I v = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(in, w.b[a] + i0));
+      _mm512_mask_cvtepi32_storeu_epi8(w.b[a] + m, packed, _mm512_maskz_compress_epi32(alive, v));
+    }
+    const auto lo = static_cast<__mmask8>(alive & 0xff), hi = static_cast<__mmask8>(alive >> 8);
+    const I key_lo = _mm512_maskz_loadu_epi64(static_cast<__mmask8>(in & 0xff), w.rng + i0);
+    const I key_hi = _mm512_maskz_loadu_epi64(static_cast<__mmask8>(in >> 8), w.rng + i0 + 8);
+    _mm512_mask_compressstoreu_epi64(w.rng + m, lo, key_lo);
+    _mm512_mask_compressstoreu_epi64(w.rng + m + static_cast<std::size_t>(__builtin_popcount(lo)), hi, key_hi);
+    _mm512_mask_cvtepi32_storeu_epi8(w.b[kAlive] + m, packed, _mm512_set1_epi32(1));
+    m += count;
+  }
+  return m;
 }
 
 }  // namespace pathlab::vector_stages

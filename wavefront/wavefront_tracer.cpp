@@ -84,7 +84,7 @@ std::uint64_t clock_ns() {
 }
 }  // namespace
 
-std::size_t WavefrontTracer::bytes_per_path() {
+std::size_t WavefrontTracer::scalar_bytes_per_path() {
   return 4 * sizeof(std::uint32_t) + sizeof(SampleStream) + sizeof(vec2) + sizeof(Ray) + 2 * sizeof(Spectrum) +
          sizeof(PreviousVertex) + sizeof(std::int32_t) + sizeof(std::uint32_t) + 1 + sizeof(Surfel) + sizeof(RayHit) +
          1 + 2 * (sizeof(Ray) + sizeof(LightSample) + sizeof(Spectrum) + sizeof(float) + 1) +
@@ -92,41 +92,28 @@ std::size_t WavefrontTracer::bytes_per_path() {
 }
 
 // What the vectorised stages read of the scene (vector_stages.h), and the
-// storage of its light table. Exists when the processor has AVX-512.
+// storage of its tables. Exists when the processor and the scene allow
+// them.
 struct WavefrontTracer::VectorStages {
-  std::optional<vector_stages::Camera> camera;  // a pinhole camera
-  std::optional<vector_stages::Scene> lambert;  // Lambert surfaces and triangle lights
-  std::vector<float> inv_area, triangle, shape_table;
-  std::vector<std::int32_t> first_triangle;
-  std::vector<const void*> material;
+  vector_stages::Scene scene;
+  vector_stages::Camera camera;
+  std::vector<float> inv_area, light_triangle, shape;
 
+  // Null, with *why_not saying what stops it, unless the processor has
+  // AVX-512 and the scene needs nothing more than Lambert surfaces and
+  // triangle area lights.
   static std::unique_ptr<const VectorStages> make(const CompiledScene& compiled, const RenderSettings& settings,
                                                   std::string* why_not) {
-    if (!vector_stages::cpu_supported()) {
-      *why_not = "the processor has no AVX-512";
-      return nullptr;
-    }
-    auto v = std::make_unique<VectorStages>();
-    const Camera& camera = compiled.camera();
-    if (camera.desc().aperture_radius <= 0.0f) {
-      const Camera::Plane p = camera.plane();
-      const vec3 o = camera.desc().position;
-      v->camera = vector_stages::Camera{{o.x, o.y, o.z},
-                                        {p.forward.x, p.forward.y, p.forward.z},
-                                        {p.right.x, p.right.y, p.right.z},
-                                        {p.up.x, p.up.y, p.up.z},
-                                        p.tan_half_fov, p.aspect, p.inv_width, p.inv_height};
-    }
-    *why_not = v->make_lambert(compiled, settings);
-    return v;
-  }
-
-  // Fills `lambert`, or says why the scene needs more than it models.
-  std::string make_lambert(const CompiledScene& compiled, const RenderSettings& settings) {
     namespace vs = vector_stages;
-    vs::Scene sc;
+    auto no = [&](std::string why) {
+      *why_not = std::move(why);
+      return nullptr;
+    };
+    if (!vs::cpu_supported()) return no("the processor has no AVX-512");
+    auto v = std::make_unique<VectorStages>();
+    vs::Scene& sc = v->scene;
     switch (settings.strategy) {
-      case Strategy::Cosine: return "strategy cosine";
+      case Strategy::Cosine: return no("strategy cosine");
       case Strategy::Bsdf: sc.strategy = vs::Strategy::Bsdf; break;
       case Strategy::Light: sc.strategy = vs::Strategy::Light; break;
       case Strategy::Mis: sc.strategy = vs::Strategy::Mis; break;
@@ -141,52 +128,91 @@ struct WavefrontTracer::VectorStages {
     for (const Material& m : scene.materials) {
       if (m.type == MaterialType::Emissive && !m.scatters()) continue;
       if (m.type != MaterialType::Diffuse)
-        return "material '" + m.name + "' is " + material_type_name(m.type) + ", not diffuse";
-      if (m.shading.path != ShadingPath::LambertOnly) return std::string("shading path ") + shading_path_name(m.shading.path);
-      if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return "materials with different min_pdf";
+        return no("material '" + m.name + "' is " + material_type_name(m.type) + ", not diffuse");
+      if (m.shading.path != ShadingPath::LambertOnly)
+        return no(std::string("shading path ") + shading_path_name(m.shading.path));
+      if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return no("materials with different min_pdf");
       diffuse = &m;
     }
     if (diffuse) sc.min_pdf = diffuse->shading.min_pdf;
-    // Only triangle area lights: no point light, sphere or environment.
+    // Only triangle area lights: no point light, sphere light or environment.
     const LightSampler& lights = compiled.lights();
-    if (lights.has_delta_lights()) return "point lights";
-    if (lights.samples_environment()) return "an environment light";
+    if (lights.has_delta_lights()) return no("point lights");
+    if (lights.samples_environment()) return no("an environment light");
     for (const LightSampler::Entry& e : lights.entries()) {
       const Shape& shape = scene.shapes[e.shape];
-      if (shape.kind != Shape::Kind::Triangles) return "a sphere light (" + shape.description + ")";
+      if (shape.kind != Shape::Kind::Triangles) return no("a sphere light (" + shape.description + ")");
       const Material& m = scene.materials[shape.material];
       const Triangle& t = e.triangle;
-      for (const vec3& c : {t.p0, t.p1, t.p2, t.n, m.emission}) triangle.insert(triangle.end(), {c.x, c.y, c.z});
-      triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
-      inv_area.push_back(1.0f / e.area);
+      for (const vec3& c : {t.p0, t.p1, t.p2, t.n, m.emission})
+        v->light_triangle.insert(v->light_triangle.end(), {c.x, c.y, c.z});
+      v->light_triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
+      v->inv_area.push_back(1.0f / e.area);
     }
-    sc.lights = {lights.entries().size(), lights.cdf().data(), lights.pmf().data(), inv_area.data(), triangle.data()};
-    // Per shape: its material's parameters, and where its triangles start.
-    bool all_triangles = compiled.triangles().size() < (std::size_t{1} << 27);  // 12 * index fits an int32
+    sc.lights = {lights.entries().size(), lights.cdf().data(), lights.pmf().data(), v->inv_area.data(),
+                 v->light_triangle.data()};
+    // Per shape: its material's parameters and its geometry.
+    if (compiled.triangles().size() >= (std::size_t{1} << 27)) return no("more than 2^27 triangles");
     for (std::uint32_t i = 0; i < scene.shapes.size(); ++i) {
       const Shape& sh = scene.shapes[i];
       const Material& m = scene.materials[sh.material];
-      namespace f = vs::shape_field;
-      float fields[16] = {};
-      for (int c = 0; c < 3; ++c) fields[f::kAlbedo + c] = m.albedo[c], fields[f::kEmission + c] = m.emission[c];
-      fields[f::kTwoSided] = m.two_sided_emission ? 1.0f : 0.0f;
-      fields[f::kEmits] = m.emits() ? 1.0f : 0.0f;
-      fields[f::kScatters] = m.scatters() ? 1.0f : 0.0f;
-      fields[f::kFirstLight] = std::bit_cast<float>(static_cast<std::int32_t>(lights.first_entry(i)));
-      shape_table.insert(shape_table.end(), std::begin(fields), std::end(fields));
-      first_triangle.push_back(static_cast<std::int32_t>(compiled.first_triangle(i)));
-      material.push_back(&m);
-      all_triangles = all_triangles && sh.kind == Shape::Kind::Triangles;
+      float f[vs::kShapeFields] = {};
+      for (int c = 0; c < 3; ++c) {
+        f[vs::kAlbedo + c] = m.albedo[c];
+        f[vs::kEmission + c] = m.emission[c];
+        f[vs::kCenter + c] = sh.center[c];
+      }
+      f[vs::kTwoSided] = m.two_sided_emission ? 1.0f : 0.0f;
+      f[vs::kEmits] = m.emits() ? 1.0f : 0.0f;
+      f[vs::kScatters] = m.scatters() ? 1.0f : 0.0f;
+      f[vs::kFirstLight] = std::bit_cast<float>(static_cast<std::int32_t>(lights.first_entry(i)));
+      f[vs::kFirstTriangle] = std::bit_cast<float>(static_cast<std::int32_t>(compiled.first_triangle(i)));
+      f[vs::kIsSphere] = sh.kind == Shape::Kind::Sphere ? 1.0f : 0.0f;
+      f[vs::kRadius] = sh.radius;
+      f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
+      v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
     }
-    sc.shape = shape_table.data();
-    if (all_triangles) {
-      static_assert(sizeof(Triangle) == 12 * sizeof(float));
-      sc.triangles = &compiled.triangles().data()->p0.x;
-      sc.first_triangle = first_triangle.data();
-      sc.material = material.data();
-    }
-    lambert = sc;
-    return "";
+    sc.shape = v->shape.data();
+    static_assert(sizeof(Triangle) == 12 * sizeof(float));
+    sc.triangles = compiled.triangles().empty() ? nullptr : &compiled.triangles().data()->p0.x;
+    // The camera.
+    const Camera& camera = compiled.camera();
+    const Camera::Plane p = camera.plane();
+    const CameraDesc& d = camera.desc();
+    v->camera = vs::Camera{{d.position.x, d.position.y, d.position.z},
+                           {p.forward.x, p.forward.y, p.forward.z},
+                           {p.right.x, p.right.y, p.right.z},
+                           {p.up.x, p.up.y, p.up.z},
+                           p.tan_half_fov, p.aspect, p.inv_width, p.inv_height, d.aperture_radius, d.focus_distance};
+    return v;
+  }
+};
+
+// A wave's paths for the vectorised stages: one array per scalar
+// (vector_stages::Wave names them).
+struct WavefrontTracer::Lanes {
+  std::vector<float> f[vector_stages::kFloatArrays];
+  std::vector<std::uint32_t> u[vector_stages::kUintArrays];
+  std::vector<std::uint8_t> b[vector_stages::kByteArrays];
+  std::vector<std::uint64_t> rng;
+  std::vector<vector_stages::Finished> finished;
+  vector_stages::Wave view;  // pointers into the arrays; view.n live paths
+
+  void resize(std::size_t size) {
+    for (auto& a : f) a.resize(size);
+    for (auto& a : u) a.resize(size);
+    for (auto& a : b) a.resize(size);
+    rng.resize(size);
+    finished.resize(size);
+    for (int a = 0; a < vector_stages::kFloatArrays; ++a) view.f[a] = f[a].data();
+    for (int a = 0; a < vector_stages::kUintArrays; ++a) view.u[a] = u[a].data();
+    for (int a = 0; a < vector_stages::kByteArrays; ++a) view.b[a] = b[a].data();
+    view.rng = rng.data();
+  }
+  std::size_t capacity() const { return rng.size(); }
+  static constexpr std::size_t bytes_per_path() {
+    return vector_stages::kFloatArrays * sizeof(float) + vector_stages::kUintArrays * sizeof(std::uint32_t) +
+           vector_stages::kByteArrays + sizeof(std::uint64_t) + sizeof(vector_stages::Finished);
   }
 };
 
@@ -199,62 +225,17 @@ WavefrontTracer::WavefrontTracer(const CompiledScene& scene, const RenderSetting
   if (stages == WavefrontStages::Scalar) scalar_reason_ = "asked for";
 }
 
-bool WavefrontTracer::vectorised() const { return vector_ && vector_->lambert; }
-bool WavefrontTracer::camera_vectorised() const { return vector_ && vector_->camera; }
-
-std::string WavefrontTracer::stages_description() const {
-  if (!vector_) return "scalar stages (" + scalar_reason_ + ")";
-  std::string d = "vectorised stages (AVX-512, 16 paths at a time): ";
-  d += camera_vectorised() ? "camera rays" : "camera rays no (a thin lens)";
-  d += vectorised() ? ", light sampling and scattering" : ", light sampling and scattering no (" + scalar_reason_ + ")";
-  return d;
-}
-
 WavefrontTracer::~WavefrontTracer() = default;
 
-namespace {
-// The layouts vector_stages.h hard-codes.
-using namespace vector_stages::layout;
-static_assert(sizeof(RayHit) == kHitSize && offsetof(RayHit, t) == kHitT && offsetof(RayHit, shape) == kHitShape &&
-              offsetof(RayHit, prim) == kHitPrim && offsetof(RayHit, uv) == kHitUv);
-static_assert(offsetof(Surfel, shape) == kSurfelShape && offsetof(Surfel, prim) == kSurfelPrim);
-static_assert(sizeof(Ray) == kRaySize && offsetof(Ray, origin) == kRayOrigin && offsetof(Ray, dir) == kRayDir &&
-              offsetof(Ray, tmax) == kRayTmax);
-static_assert(sizeof(Surfel) == kSurfelSize && offsetof(Surfel, p) == kSurfelP &&
-              offsetof(Surfel, p_error) == kSurfelPError && offsetof(Surfel, n) == kSurfelN &&
-              offsetof(Surfel, frame) + offsetof(Frame, s) == kSurfelFrameS &&
-              offsetof(Surfel, frame) + offsetof(Frame, t) == kSurfelFrameT &&
-              offsetof(Surfel, frame) + offsetof(Frame, n) == kSurfelFrameN &&
-              offsetof(Surfel, material) == kSurfelMaterial);
-static_assert(sizeof(PreviousVertex) == kPrevSize && offsetof(PreviousVertex, p) == kPrevP &&
-              offsetof(PreviousVertex, pdf) == kPrevPdf && offsetof(PreviousVertex, impulse) == kPrevImpulse &&
-              offsetof(PreviousVertex, bsdf_technique) == kPrevBsdfTechnique && sizeof(bool) == 1);
-static_assert(sizeof(Spectrum) == 3 * sizeof(float) && sizeof(SampleStream) == sizeof(std::uint64_t) &&
-              std::is_trivially_copyable_v<SampleStream>);
-}  // namespace
+bool WavefrontTracer::vectorised() const { return vector_ != nullptr; }
 
-vector_stages::WaveView WavefrontTracer::view(Wave& w) {
-  vector_stages::WaveView v;
-  v.n = w.n;
-  v.rng = reinterpret_cast<const std::uint64_t*>(w.rng.data());
-  v.x = w.x.data();
-  v.y = w.y.data();
-  v.film = &w.film.data()->x;
-  v.L = &w.L.data()->x;
-  v.rays = w.rays.data();
-  v.vertex = w.vertex.data();
-  v.ray = w.ray.data();
-  v.beta = &w.beta.data()->x;
-  v.prev = w.prev.data();
-  v.alive = w.alive.data();
-  v.surfel = w.surfel.data();
-  v.hit = w.hit.data();
-  v.found = w.found.data();
-  v.shadow = w.shadow.data();
-  v.unoccluded = &w.unoccluded.data()->x;
-  v.light_weight = w.light_weight.data();
-  v.shadow_state = w.shadow_state.data();
-  return v;
+std::string WavefrontTracer::stages_description() const {
+  return vector_ ? "every stage vectorised (AVX-512, 16 paths at a time, paths as structure of arrays)"
+                 : "scalar stages (" + scalar_reason_ + ")";
+}
+
+std::size_t WavefrontTracer::bytes_per_path() const {
+  return vector_ ? Lanes::bytes_per_path() : scalar_bytes_per_path();
 }
 
 // Stage: the first surface along each live path's ray. The rays go to
@@ -276,7 +257,6 @@ void WavefrontTracer::intersect(Wave& w) const {
   w.queries[kind] += n;
   for (std::size_t i = 0; i < n; ++i)
     if (found[i]) scene_.prefetch(hits[i]);
-  if (vectorised() && vector_->lambert->triangles) return vector_stages::resolve(*vector_->lambert, view(w));
   for (std::size_t i = 0; i < n; ++i) {
     ++w.rays[i];
     if (found[i]) scene_.resolve(rays[i], hits[i], &w.surfel[i]);
@@ -287,7 +267,6 @@ void WavefrontTracer::intersect(Wave& w) const {
 // the end of paths that escape, pass the depth cap or reach a surface that
 // does not scatter.
 void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
-  if (vectorised() && !obs) return vector_stages::add_emission(*vector_->lambert, view(w));
   const int cap = settings_.max_depth >= 0 ? settings_.max_depth : kMaxVerticesUncapped;
   const Strategy strategy = settings_.strategy;
   for (std::size_t i = 0; i < w.n; ++i) {
@@ -323,7 +302,6 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
 // light in every strategy; an area light as the strategy says), each with
 // the contribution it brings if nothing blocks its shadow ray.
 void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
-  if (vectorised() && !obs) return vector_stages::sample_lights(*vector_->lambert, view(w));
   const LightSampler& lights = scene_.lights();
   const Strategy strategy = settings_.strategy;
   for (std::size_t i = 0; i < w.n; ++i) {
@@ -379,7 +357,6 @@ void WavefrontTracer::trace_shadow_rays(Wave& w) const {
 
 // Stage: the light of visible samples, point light first (the reference's order).
 void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
-  if (vectorised() && !obs) return vector_stages::add_light(view(w));
   for (std::size_t i = 0; i < w.n; ++i) {
     for (std::size_t k = 2 * i; k < 2 * i + 2; ++k) {
       if (w.shadow_state[k] == 0) continue;
@@ -397,7 +374,6 @@ void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
 
 // Stage: sample the continuation, apply Russian roulette, spawn the next ray.
 void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
-  if (vectorised() && !obs) return vector_stages::scatter(*vector_->lambert, view(w));
   const Strategy strategy = settings_.strategy;
   for (std::size_t i = 0; i < w.n; ++i) {
     if (!w.alive[i]) continue;
@@ -457,7 +433,6 @@ void WavefrontTracer::compact(Wave& w, std::span<FilmSample> out) {
 
 // Stage: one camera ray per path.
 void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
-  if (camera_vectorised() && !obs) return vector_stages::generate_camera_rays(*vector_->camera, view(w));
   const Camera& camera = scene_.camera();
   for (std::size_t i = 0; i < w.n; ++i) {
     w.vertex[i] = 0;  // the camera's random numbers are those of vertex 0
@@ -492,6 +467,49 @@ void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver*
   for (int k = 0; k < kWave; ++k) rays_[k].fetch_add(w.queries[k], std::memory_order_relaxed);
 }
 
+// The vectorised twin of run_wave: the same stages and the same Embree
+// batches, over Lanes.
+void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out) const {
+  namespace vs = vector_stages;
+  const vs::Scene& sc = vector_->scene;
+  const vs::Wave& w = lanes.view;
+  std::uint64_t nanoseconds[kClocked] = {}, queries[kWave] = {};
+  const std::uint64_t t0 = clock_ns();
+  vs::generate_camera_rays(vector_->camera, w);
+  for (bool camera_rays = true; lanes.view.n > 0; camera_rays = false) {
+    const std::size_t n = w.n;
+    const RayArrays rays{w.f[vs::kOx], w.f[vs::kOy], w.f[vs::kOz], w.f[vs::kDx], w.f[vs::kDy], w.f[vs::kDz], w.f[vs::kTmax]};
+    const HitArrays hits{w.f[vs::kHitT], w.f[vs::kHitU], w.f[vs::kHitV], w.u[vs::kShape], w.u[vs::kPrim], w.b[vs::kFound]};
+    const Clocked kind = camera_rays ? kCameraQueries : kBounceQueries;
+    std::uint64_t t = clock_ns();
+    scene_.intersect_arrays(rays, n, hits, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
+    nanoseconds[kind] += clock_ns() - t;
+    queries[kind] += n;
+    vs::resolve(sc, w);
+    vs::add_emission(sc, w);
+    const std::size_t q = vs::sample_lights(sc, w);
+    if (q > 0) {
+      const RayArrays shadow{w.f[vs::kQOx], w.f[vs::kQOy], w.f[vs::kQOz], w.f[vs::kQDx],
+                             w.f[vs::kQDy], w.f[vs::kQDz], w.f[vs::kQTmax]};
+      t = clock_ns();
+      scene_.occluded_arrays(shadow, q, w.b[vs::kQOccluded], modes_.shadow);
+      nanoseconds[kShadowQueries] += clock_ns() - t;
+      queries[kShadowQueries] += q;
+      vs::add_light(w, q);
+    }
+    vs::scatter(sc, w);
+    const std::size_t survivors = vs::compact(w, lanes.finished.data());
+    for (std::size_t k = 0; k < n - survivors; ++k) {
+      const vs::Finished& f = lanes.finished[k];
+      out[f.out_index] = FilmSample{vec2(f.film_x, f.film_y), Spectrum(f.L[0], f.L[1], f.L[2]), f.rays, f.hits};
+    }
+    lanes.view.n = survivors;
+  }
+  nanoseconds[kWave] = clock_ns() - t0;
+  for (int k = 0; k < kClocked; ++k) nanoseconds_[k].fetch_add(nanoseconds[k], std::memory_order_relaxed);
+  for (int k = 0; k < kWave; ++k) rays_[k].fetch_add(queries[k], std::memory_order_relaxed);
+}
+
 WavefrontTimes WavefrontTracer::times() const {
   auto seconds = [&](int k) { return 1e-9 * static_cast<double>(nanoseconds_[k].load(std::memory_order_relaxed)); };
   auto queries = [&](int k) { return WavefrontTimes::Queries{rays_[k].load(std::memory_order_relaxed), seconds(k)}; };
@@ -508,32 +526,64 @@ void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std
   const std::size_t waves = (out.size() + wave_size - 1) / wave_size;
   // Wave k always holds the same samples, whichever thread runs it, so the
   // batches Embree sees - and hence the image - do not depend on threads.
+  // Path i of wave k: its output slot, pixel, sample and random stream.
+  // Sample j of pixel p is entry p * count + j of the batch; step through
+  // them without a division per path.
+  auto fill = [&](std::size_t begin, std::size_t n, auto&& set) {
+    auto pixel = static_cast<std::uint32_t>(begin / count);
+    auto j = static_cast<std::uint32_t>(begin % count);
+    std::uint32_t x = pixel % width, y = pixel / width;
+    for (std::size_t i = 0; i < n; ++i) {
+      set(i, static_cast<std::uint32_t>(begin + i), x, y, first + j, SampleStream(settings_.seed, pixel, first + j));
+      if (++j == count) {
+        j = 0;
+        ++pixel;
+        if (++x == width) x = 0, ++y;
+      }
+    }
+  };
+  // Wave k always holds the same samples, whichever thread runs it, so the
+  // batches Embree sees - and hence the image - do not depend on threads.
+  // Each thread keeps its wave's arrays from one batch to the next
+  // (allocating and page-faulting them in per wave cost more than tracing).
+  const std::size_t n_max = std::min(wave_size, out.size());
+  if (vector_) {
+    parallel_for(0, waves, 1, [&](std::size_t k0, std::size_t k1) {
+      thread_local Lanes lanes;
+      if (lanes.capacity() < n_max) lanes.resize(n_max);
+      namespace vs = vector_stages;
+      for (std::size_t k = k0; k < k1; ++k) {
+        const std::size_t begin = k * wave_size;
+        lanes.view.n = std::min(wave_size, out.size() - begin);
+        fill(begin, lanes.view.n,
+             [&](std::size_t i, std::uint32_t slot, std::uint32_t x, std::uint32_t y, std::uint32_t sample,
+                 SampleStream rng) {
+               lanes.u[vs::kOutIndex][i] = slot;
+               lanes.u[vs::kPixelX][i] = x;
+               lanes.u[vs::kPixelY][i] = y;
+               lanes.u[vs::kSample][i] = sample;
+               lanes.rng[i] = rng.key();
+             });
+        run_wave_vector(lanes, out);
+      }
+    });
+    return;
+  }
   parallel_for(0, waves, 1, [&](std::size_t k0, std::size_t k1) {
-    // Each thread keeps its wave's arrays from one batch to the next
-    // (allocating and page-faulting them in per wave cost more than tracing).
     thread_local Wave w;
-    const std::size_t n_max = std::min(wave_size, out.size());
     if (w.capacity() < n_max) w.resize(n_max);
     for (std::size_t k = k0; k < k1; ++k) {
       const std::size_t begin = k * wave_size;
       w.n = std::min(wave_size, out.size() - begin);
-      // Sample j of pixel p is entry p * count + j of the batch; step through
-      // them without a division per path.
-      auto pixel = static_cast<std::uint32_t>(begin / count);
-      auto j = static_cast<std::uint32_t>(begin % count);
-      std::uint32_t x = pixel % width, y = pixel / width;
-      for (std::size_t i = 0; i < w.n; ++i) {
-        w.out_index[i] = static_cast<std::uint32_t>(begin + i);
-        w.x[i] = x;
-        w.y[i] = y;
-        w.sample[i] = first + j;
-        w.rng[i] = SampleStream(settings_.seed, pixel, w.sample[i]);
-        if (++j == count) {
-          j = 0;
-          ++pixel;
-          if (++x == width) x = 0, ++y;
-        }
-      }
+      fill(begin, w.n,
+           [&](std::size_t i, std::uint32_t slot, std::uint32_t x, std::uint32_t y, std::uint32_t sample,
+               SampleStream rng) {
+             w.out_index[i] = slot;
+             w.x[i] = x;
+             w.y[i] = y;
+             w.sample[i] = sample;
+             w.rng[i] = rng;
+           });
       run_wave(w, out, nullptr);
     }
   });

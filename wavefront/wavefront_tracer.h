@@ -21,10 +21,6 @@
 
 namespace pathlab {
 
-namespace vector_stages {
-struct WaveView;
-}
-
 // How each kind of ray reaches Embree (core/embree_accel.h). The defaults
 // are the fastest on the dragon benchmark on a 2-core AVX-512 machine
 // (bench/bench_tracers.cpp measures every mode; docs/performance.md).
@@ -74,19 +70,17 @@ class WavefrontTracer final : public Tracer {
                           PathObserver* observer) const override;
 
   // Memory the path state of one wave takes per path, in bytes.
-  static std::size_t bytes_per_path();
+  std::size_t bytes_per_path() const;
   std::size_t wave_size() const { return wave_size_; }
   const RayModes& ray_modes() const { return modes_; }
-  // Whether light sampling and scattering run vectorised (16 paths per
-  // AVX-512 register): the scene needs only Lambert surfaces and triangle
-  // area lights, the strategy is not "cosine", and the processor has
-  // AVX-512. Tracing one sample with an observer always runs the scalar
-  // stages (they report every event); the paths are the same either way.
+  // Whether the stages run vectorised (vector_stages.h: 16 paths per
+  // AVX-512 register, paths as one array per scalar): the scene needs only
+  // Lambert surfaces and triangle area lights, the strategy is not
+  // "cosine", and the processor has AVX-512. Tracing one sample with an
+  // observer always runs the scalar stages (they report every event); the
+  // paths are the same bits either way.
   bool vectorised() const;
-  // Whether camera rays are made vectorised: a pinhole camera and AVX-512.
-  bool camera_vectorised() const;
-  // Why light sampling and scattering run scalar ("" when vectorised),
-  // e.g. "strategy cosine".
+  // Why the stages run scalar ("" when vectorised), e.g. "strategy cosine".
   const std::string& scalar_reason() const { return scalar_reason_; }
   // Which stages run vectorised, in a line for people.
   std::string stages_description() const;
@@ -95,6 +89,7 @@ class WavefrontTracer final : public Tracer {
 
  private:
   struct Wave;
+  struct Lanes;
   // Traces the wave's paths to their ends, writing each one's sample to
   // out[its out_index] as it ends.
   void run_wave(Wave& wave, std::span<FilmSample> out, PathObserver* observer) const;
@@ -106,7 +101,8 @@ class WavefrontTracer final : public Tracer {
   void add_light(Wave& w, PathObserver* obs) const;
   void scatter(Wave& w, PathObserver* obs) const;
   static void compact(Wave& w, std::span<FilmSample> out);
-  static vector_stages::WaveView view(Wave& w);
+  void run_wave_vector(Lanes& lanes, std::span<FilmSample> out) const;
+  static std::size_t scalar_bytes_per_path();
 
   struct VectorStages;
   std::size_t wave_size_;

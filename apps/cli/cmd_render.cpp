@@ -137,8 +137,8 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
         << strategy_name(settings.strategy) << "): " << line << "\n";
     if (const auto* wf = dynamic_cast<const WavefrontTracer*>(tracer.get())) {
       err << "pathlab: wavefront: one wave of up to " << wf->wave_size() << " paths per thread, "
-          << WavefrontTracer::bytes_per_path() << " bytes of path state per path ("
-          << (wf->wave_size() * WavefrontTracer::bytes_per_path() * static_cast<std::size_t>(max_threads()) + 512 * 1024) /
+          << wf->bytes_per_path() << " bytes of path state per path ("
+          << (wf->wave_size() * wf->bytes_per_path() * static_cast<std::size_t>(max_threads()) + 512 * 1024) /
                  (1024 * 1024)
           << " MiB in flight on " << max_threads() << " threads); "
           << wf->stages_description()
