@@ -66,11 +66,15 @@ class CompiledScene {
   // (a sphere has none).
   std::span<const Triangle> triangles() const { return triangles_; }
   std::size_t first_triangle(std::uint32_t shape) const { return first_triangle_[shape]; }
-  // Starts loading what resolve() will read for `hit` into the cache.
-  void prefetch(const RayHit& hit) const {
-    const std::size_t t = first_triangle_[hit.shape] + hit.prim;
-    if (t < first_triangle_[hit.shape + 1]) __builtin_prefetch(&triangles_[t]);
+  // Starts loading what resolve() will read for a hit on triangle `prim`
+  // of shape `shape` into the cache (both lines a Triangle may straddle).
+  void prefetch(std::uint32_t shape, std::uint32_t prim) const {
+    const std::size_t t = first_triangle_[shape] + prim;
+    if (t >= first_triangle_[shape + 1]) return;
+    __builtin_prefetch(&triangles_[t].p0);
+    __builtin_prefetch(&triangles_[t].n);
   }
+  void prefetch(const RayHit& hit) const { prefetch(hit.shape, hit.prim); }
 
  private:
   Scene scene_;
