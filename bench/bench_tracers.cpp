@@ -9,7 +9,10 @@
 // At the end it prints the ratios the wavefront issue asks for (medians over
 // --benchmark_repetitions): wavefront / reference samples per second, and
 // each tracer's rays per second as a fraction of Embree's raw rate for the
-// same mix of rays.
+// same mix of rays. Each wavefront repetition is paired with a reference
+// render and a raw cast of the captured rays in its own modes, taken beside
+// it, so that both ratios compare measurements seconds apart (x_reference,
+// x_raw).
 //
 //   build/bench/pathlab_bench_tracers [--scene=bench/scenes/dragon.json] [--spp=4]
 //                                      [--resolution=WxH] [--raw-min-time=SECONDS] [--cpu-time]
@@ -114,11 +117,22 @@ void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes mode
   static std::uint64_t pairs = 0;
   RenderStats stats;
   double reference_seconds = 0.0, wavefront_seconds = 0.0;
+  // Beside the reference, Embree alone casts the captured rays in the modes
+  // this run uses: the raw rate for the same mix, taken at the same moment.
+  const CapturedRays& captured = setup().rays;
+  double raw_seconds = 0.0, raw_rays = 0.0;
   auto time_reference = [&] {
     state.PauseTiming();
     const double t0 = now_seconds();
     render_frame(reference_tracer);
     reference_seconds += now_seconds() - t0;
+    for (RayKind kind : kAllRayKinds) {
+      const RayBatchMode mode = kind == RayKind::Camera ? modes.camera : kind == RayKind::Bounce ? modes.bounce : modes.shadow;
+      const double t1 = now_seconds();
+      cast(*setup().scene, captured.of(kind), kind, mode);
+      raw_seconds += now_seconds() - t1;
+      raw_rays += static_cast<double>(captured.of(kind).size());
+    }
     state.ResumeTiming();
   };
   for (auto _ : state) {
@@ -131,6 +145,8 @@ void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes mode
   }
   set_rates(state, stats);
   state.counters["x_reference"] = wavefront_seconds > 0.0 ? reference_seconds / wavefront_seconds : 0.0;
+  const double tracer_rate = static_cast<double>(state.iterations() * stats.rays) / wavefront_seconds;
+  state.counters["x_raw"] = raw_seconds > 0.0 && wavefront_seconds > 0.0 ? tracer_rate / (raw_rays / raw_seconds) : 0.0;
   state.counters["vectorised"] = tracer.vectorised() ? 1.0 : 0.0;
   // Embree as the wavefront meets it, between its stages: the share of the
   // waves' time it takes, and its rates on all threads, to set beside Raw/.
@@ -245,10 +261,11 @@ class RatioReporter : public benchmark::ConsoleReporter {
       const WavefrontRayModes modes = parse_modes(run);
       const double sps = median(run, "samples/s"), rps = median(run, "rays/s");
       const double raw_rate = raw_mix_rate(modes);
-      std::printf("%s: %.4g samples/s = %.2fx reference (paired, sd %.2f); %.4g rays/s = %.2f of raw (%.4g rays/s); "
-                  "%s stages\n",
-                  run.c_str(), sps, median(run, "x_reference"), stddev(run, "x_reference"), rps,
-                  raw_rate > 0 ? rps / raw_rate : 0.0, raw_rate, median(run, "vectorised") > 0.5 ? "vectorised" : "scalar");
+      std::printf("%s: %.4g samples/s = %.2fx reference (paired, sd %.2f); %.4g rays/s = %.2f of raw (paired, sd "
+                  "%.2f; %.2f of the Raw/ medians' %.4g rays/s); %s stages\n",
+                  run.c_str(), sps, median(run, "x_reference"), stddev(run, "x_reference"), rps, median(run, "x_raw"),
+                  stddev(run, "x_raw"), raw_rate > 0 ? rps / raw_rate : 0.0, raw_rate,
+                  median(run, "vectorised") > 0.5 ? "vectorised" : "scalar");
       // Embree's rate inside the tracer against its raw rate in the same mode.
       auto in_context = [&](const char* counter, RayKind kind, RayBatchMode mode) {
         const double raw_kind = median(raw_name(kind, mode), "rays/s");

@@ -1,16 +1,14 @@
 #include "wavefront/wavefront_tracer.h"
 
 #include "core/parallel.h"
-#include "wavefront/vector_stages.h"
 #include "core/rng.h"
 #include "core/strategy_weights.h"
+#include "wavefront/vector_stages.h"
 
 #include <algorithm>
 #include <bit>
 #include <chrono>
 #include <optional>
-#include <cstddef>
-#include <type_traits>
 
 namespace pathlab {
 

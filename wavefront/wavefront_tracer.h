@@ -44,10 +44,10 @@ struct WavefrontTimes {
   double query_seconds() const { return camera.seconds + bounce.seconds + shadow.seconds; }
 };
 
-// Which implementation runs the stages that have two (vector_stages.h).
+// Which implementation runs the stages (vector_stages.h).
 enum class WavefrontStages : std::uint8_t {
-  Auto,    // the AVX-512 stages when the scene and the processor allow them
-  Scalar,  // the scalar stages everywhere
+  Auto,    // the vectorised stages when the scene and the processor allow them
+  Scalar,  // the scalar stages always (the baseline they are measured and tested against)
 };
 
 class WavefrontTracer final : public Tracer {
