@@ -12,6 +12,10 @@
 namespace pathlab {
 namespace {
 
+// Hits set instID[0] only: scenes have no instances, and Embree is built
+// with one instance level.
+static_assert(RTC_MAX_INSTANCE_LEVEL_COUNT == 1);
+
 // Embree reports errors through a callback registered when the device is
 // created; we keep the first one and turn it into an exception after the
 // call that caused it (library code never exits).

@@ -119,8 +119,10 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
 // The vectorised stages (wavefront/vector_stages.h) give every sample the
 // bits the scalar stages give it, on every scene and strategy they take:
 // several lights (the pick's binary search), a two-sided emitting box, a
-// min_pdf cut-off, roulette from the first bounce, and waves whose size is
-// not a multiple of 16 lanes.
+// min_pdf cut-off, roulette from the first bounce, waves whose size is not
+// a multiple of 16 lanes, and every way rays reach Embree (single rays,
+// packets, streams: the vectorised stages hand Embree arrays, the scalar
+// ones records).
 struct VectorCase {
   std::string scene;  // as SameSeedCase
   Strategy strategy;
@@ -159,9 +161,16 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   const CompiledScene compiled(std::move(scene));
   const std::size_t pixels = static_cast<std::size_t>(compiled.scene().film.width) * compiled.scene().film.height;
   const auto count = static_cast<std::uint32_t>(settings.spp);
-  for (std::size_t wave : {std::size_t{997}, std::size_t{4096}}) {
-    const WavefrontTracer vectorised(compiled, settings, wave, {}, WavefrontStages::Auto);
-    const WavefrontTracer scalar(compiled, settings, wave, {}, WavefrontStages::Scalar);
+  // The default ray modes at two wave sizes, and each mode for every kind of ray.
+  struct Run {
+    std::size_t wave;
+    WavefrontRayModes modes;
+  };
+  std::vector<Run> runs{{997, {}}, {4096, {}}};
+  for (RayBatchMode m : kAllRayBatchModes) runs.push_back({997, {m, m, m}});
+  for (const auto& [wave, modes] : runs) {
+    const WavefrontTracer vectorised(compiled, settings, wave, modes, WavefrontStages::Auto);
+    const WavefrontTracer scalar(compiled, settings, wave, modes, WavefrontStages::Scalar);
     ASSERT_TRUE(vectorised.vectorised()) << vectorised.scalar_reason();
     ASSERT_FALSE(scalar.vectorised());
     std::vector<FilmSample> a(pixels * count), b(pixels * count);
@@ -171,7 +180,8 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
     for (std::size_t i = 0; i < a.size(); ++i)
       differ += std::memcmp(&a[i].L, &b[i].L, sizeof(Spectrum)) != 0 || a[i].film != b[i].film ||
                 a[i].rays != b[i].rays || a[i].hits != b[i].hits;
-    EXPECT_EQ(differ, 0u) << "of " << a.size() << " samples, wave size " << wave;
+    EXPECT_EQ(differ, 0u) << "of " << a.size() << " samples, wave size " << wave << ", camera rays "
+                          << ray_batch_mode_name(modes.camera);
   }
 }
 

@@ -1,9 +1,10 @@
 // The vectorised stages of vector_stages.h, 16 paths per AVX-512 register.
 //
-// Compiled with -mavx512f/dq/bw/vl -ffp-contract=off (wavefront/CMakeLists.txt)
-// and called only when vector_stages::cpu_supported(). Every function here
-// has internal linkage except the two stages, and nothing is included but the
-// plain-data header and <immintrin.h>: see vector_stages.h for why.
+// Compiled with -mavx512f/dq/bw/vl (wavefront/CMakeLists.txt; -ffp-contract=off
+// project-wide) and called only when vector_stages::cpu_supported(). Every
+// function here has internal linkage except the stages vector_stages.h
+// declares, and nothing is included but that plain-data header and
+// <immintrin.h>: see vector_stages.h for why.
 //
 // Each step names the scalar code it mirrors. The order of every sum and
 // product follows that code (GLM's dot is (x + y) + z; a vec3 divided by a
@@ -264,7 +265,8 @@ void resolve(const Scene& sc, const Wave& w) {
     if (found == 0) continue;
     const I shape = shape_offsets(load(w, kShape, i0, found));
     const M sphere = shape_flag(found, sc, shape, kIsSphere), mesh = found & ~sphere;
-    V3 p, error, n;
+    const V3 zero{k(0.0f), k(0.0f), k(0.0f)};
+    V3 p = zero, error = zero, n = zero;
     if (mesh != 0) {
       // triangle_point (core/geometry.cpp) of the shape's triangle prim.
       const I tri = _mm512_add_epi32(shape_int(mesh, sc, shape, kFirstTriangle), load(w, kPrim, i0, mesh));
