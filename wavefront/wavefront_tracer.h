@@ -1,10 +1,13 @@
 // The wavefront tracer: the reference's estimator refactored the way
 // production tracers are. One path per work item; recursion turned into a
 // loop that carries the throughput forward; every stage run over arrays of
-// paths (structure of arrays): generate camera rays -> intersect -> add
-// emission -> sample lights -> trace shadow rays -> add light -> scatter ->
-// compact the survivors. Paths are processed in waves of a bounded size,
-// whatever the resolution and sample count.
+// paths: generate camera rays -> intersect -> add emission -> sample lights
+// -> trace shadow rays -> add light -> scatter -> compact the survivors.
+// Paths are processed in waves of a bounded size, whatever the resolution
+// and sample count. Two implementations of the stages: scalar ones over
+// arrays of records (Ray, Surfel, ...), which run every scene, and
+// vectorised ones over one array per scalar (vector_stages.h), which run the
+// scenes they model on processors with AVX-512.
 //
 // Same sample contract as the reference (rng.h, sample_dims.h) and the same
 // strategy weights (strategy_weights.h): the same seed gives the same path,
