@@ -76,6 +76,11 @@ void raw(benchmark::State& state, RayKind kind, RayBatchMode mode) {
 
 // --- tracers --------------------------------------------------------------------
 
+// The mode a wavefront run casts rays of `kind` in.
+RayBatchMode mode_of(const WavefrontRayModes& modes, RayKind kind) {
+  return kind == RayKind::Camera ? modes.camera : kind == RayKind::Bounce ? modes.bounce : modes.shadow;
+}
+
 // Seconds on the clock the run is measured by: wall time, or the process's
 // CPU time (all threads) with --cpu-time.
 double now_seconds() {
@@ -106,28 +111,28 @@ void reference(benchmark::State& state) {
   set_rates(state, stats);
 }
 
-// The wavefront, paired with the reference: each iteration also renders the
-// frame with the reference, just before or just after (alternating), outside
-// the timed region. Its counter x_reference = reference time / wavefront time
-// compares two renders taken seconds apart, so a machine whose speed drifts
-// by 10 % between repetitions (as this shared one does) moves both alike.
+// The wavefront, paired with its baselines: each iteration also renders the
+// frame with the reference and casts the captured rays with Embree alone in
+// the run's modes, just before or just after (alternating), outside the
+// timed region. Its counters x_reference = reference time / wavefront time
+// and x_raw = wavefront rays/s / raw rays/s compare measurements taken
+// seconds apart, so a machine whose speed drifts by 10 % between
+// repetitions (as this shared one does) moves both sides alike.
 void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes modes, WavefrontStages stages) {
   const ReferenceTracer reference_tracer(*setup().scene, setup().settings);
   const WavefrontTracer tracer(*setup().scene, setup().settings, wave, modes, stages);
   static std::uint64_t pairs = 0;
   RenderStats stats;
   double reference_seconds = 0.0, wavefront_seconds = 0.0;
-  // Beside the reference, Embree alone casts the captured rays in the modes
-  // this run uses: the raw rate for the same mix, taken at the same moment.
   const CapturedRays& captured = setup().rays;
   double raw_seconds = 0.0, raw_rays = 0.0;
-  auto time_reference = [&] {
+  auto time_baselines = [&] {
     state.PauseTiming();
     const double t0 = now_seconds();
     render_frame(reference_tracer);
     reference_seconds += now_seconds() - t0;
     for (RayKind kind : kAllRayKinds) {
-      const RayBatchMode mode = kind == RayKind::Camera ? modes.camera : kind == RayKind::Bounce ? modes.bounce : modes.shadow;
+      const RayBatchMode mode = mode_of(modes, kind);
       const double t1 = now_seconds();
       cast(*setup().scene, captured.of(kind), kind, mode);
       raw_seconds += now_seconds() - t1;
@@ -137,11 +142,11 @@ void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes mode
   };
   for (auto _ : state) {
     const bool reference_first = (pairs++ % 2) == 0;
-    if (reference_first) time_reference();
+    if (reference_first) time_baselines();
     const double t0 = now_seconds();
     stats = render_frame(tracer);
     wavefront_seconds += now_seconds() - t0;
-    if (!reference_first) time_reference();
+    if (!reference_first) time_baselines();
   }
   set_rates(state, stats);
   state.counters["x_reference"] = wavefront_seconds > 0.0 ? reference_seconds / wavefront_seconds : 0.0;
@@ -201,7 +206,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
     const double total = static_cast<double>(c.total());
     double seconds_per_ray = 0.0;
     for (RayKind kind : kAllRayKinds) {
-      const RayBatchMode mode = kind == RayKind::Camera ? modes.camera : kind == RayKind::Bounce ? modes.bounce : modes.shadow;
+      const RayBatchMode mode = mode_of(modes, kind);
       const double rate = median(raw_name(kind, mode), "rays/s");
       if (rate <= 0.0) return 0.0;
       seconds_per_ray += static_cast<double>(c.of(kind).size()) / total / rate;

@@ -298,6 +298,8 @@ struct StreamScratch {
     zeros.assign(n, 0.0f), mask.assign(n, 0xffffffffu), zero_ids.assign(n, 0u);
     tfar.resize(n), ng.resize(n), u.resize(n), v.resize(n), geom.resize(n), prim.resize(n), inst.resize(n);
   }
+  // Embree's pointer-SoA ray is not const, but it writes only tfar (kept
+  // here) and, for intersections, the hit arrays.
   RTCRayNp ray(const RayArrays& r) {
     return RTCRayNp{const_cast<float*>(r.ox), const_cast<float*>(r.oy), const_cast<float*>(r.oz), zeros.data(),
                     const_cast<float*>(r.dx), const_cast<float*>(r.dy), const_cast<float*>(r.dz), zeros.data(),

@@ -95,7 +95,7 @@ enum FloatArray : int {
   kFloatArrays
 };
 enum UintArray : int {
-  kOutIndex, kRays, kVertex, kPixelX, kPixelY, kSample,
+  kOutIndex, kRays, kVertex, kPixelX, kPixelY,
   kShape, kPrim,  // the hit's
   kQSlot,         // each packed shadow ray's path
   kUintArrays

@@ -12,6 +12,15 @@
 
 namespace pathlab {
 
+// One wave's clock: the time of its queries of each kind and of the whole
+// wave, in nanoseconds (indexed by Clocked), and the rays of each kind. A
+// clock read per batch of rays, not per ray.
+struct WavefrontTracer::Clock {
+  std::uint64_t nanoseconds[kClocked] = {}, queries[kWave] = {};
+  // A batch of n queries of `kind` that started at clock_ns() == t0.
+  void batch(Clocked kind, std::uint64_t t0, std::size_t n);
+};
+
 // The state of every path of a wave, one array per field. The paths still
 // being traced occupy slots [0, n), in the order they were created: after
 // each bounce compact() writes out the finished ones and moves the
@@ -20,9 +29,7 @@ namespace pathlab {
 // through all its stages; threads run different waves.
 struct WavefrontTracer::Wave {
   std::size_t n = 0;  // live paths
-  // Clock time of this wave's queries of each kind and of the whole wave, in
-  // nanoseconds (indexed by Clocked), and the rays of each kind.
-  std::uint64_t nanoseconds[kClocked] = {}, queries[kWave] = {};
+  Clock clock;
   // Identity and output. x, y and sample are read only when the camera ray
   // is made; the rest is moved with the path.
   std::vector<std::uint32_t> out_index, x, y, sample;
@@ -82,6 +89,16 @@ std::uint64_t clock_ns() {
 }
 }  // namespace
 
+void WavefrontTracer::Clock::batch(Clocked kind, std::uint64_t t0, std::size_t n) {
+  nanoseconds[kind] += clock_ns() - t0;
+  queries[kind] += n;
+}
+
+void WavefrontTracer::publish(const Clock& clock) const {
+  for (int k = 0; k < kClocked; ++k) nanoseconds_[k].fetch_add(clock.nanoseconds[k], std::memory_order_relaxed);
+  for (int k = 0; k < kWave; ++k) rays_[k].fetch_add(clock.queries[k], std::memory_order_relaxed);
+}
+
 std::size_t WavefrontTracer::scalar_bytes_per_path() {
   return 4 * sizeof(std::uint32_t) + sizeof(SampleStream) + sizeof(vec2) + sizeof(Ray) + 2 * sizeof(Spectrum) +
          sizeof(PreviousVertex) + sizeof(std::int32_t) + sizeof(std::uint32_t) + 1 + sizeof(Surfel) + sizeof(RayHit) +
@@ -124,7 +141,7 @@ struct WavefrontTracer::VectorStages {
     const Scene& scene = compiled.scene();
     const Material* diffuse = nullptr;
     for (const Material& m : scene.materials) {
-      if (m.type == MaterialType::Emissive && !m.scatters()) continue;
+      if (m.type == MaterialType::Emissive) continue;  // never scatters
       if (m.type != MaterialType::Diffuse)
         return no("material '" + m.name + "' is " + material_type_name(m.type) + ", not diffuse");
       if (m.shading.path != ShadingPath::LambertOnly)
@@ -252,9 +269,7 @@ void WavefrontTracer::intersect(Wave& w) const {
   const std::span<std::uint8_t> found(w.found.data(), n);
   const std::uint64_t t0 = clock_ns();
   scene_.intersect_batch(rays, hits, found, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
-  const Clocked kind = camera_rays ? kCameraQueries : kBounceQueries;
-  w.nanoseconds[kind] += clock_ns() - t0;
-  w.queries[kind] += n;
+  w.clock.batch(camera_rays ? kCameraQueries : kBounceQueries, t0, n);
   for (std::size_t i = 0; i < n; ++i)
     if (found[i]) scene_.prefetch(hits[i]);
   for (std::size_t i = 0; i < n; ++i) {
@@ -350,8 +365,7 @@ void WavefrontTracer::trace_shadow_rays(Wave& w) const {
   const std::span<std::uint8_t> occluded(w.query_result.data(), n);
   const std::uint64_t t0 = clock_ns();
   scene_.occluded_batch(std::span<const Ray>(w.query.data(), n), occluded, modes_.shadow);
-  w.nanoseconds[kShadowQueries] += clock_ns() - t0;
-  w.queries[kShadowQueries] += n;
+  w.clock.batch(kShadowQueries, t0, n);
   for (std::size_t r = 0; r < n; ++r) w.shadow_state[w.query_slot[r]] = occluded[r] ? 3 : 2;
 }
 
@@ -449,8 +463,7 @@ void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
 }
 
 void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver* obs) const {
-  std::fill(std::begin(w.nanoseconds), std::end(w.nanoseconds), 0);
-  std::fill(std::begin(w.queries), std::end(w.queries), 0);
+  w.clock = Clock{};
   const std::uint64_t t0 = clock_ns();
   generate_camera_rays(w, obs);
   while (w.n > 0) {
@@ -462,9 +475,8 @@ void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver*
     scatter(w, obs);
     compact(w, out);
   }
-  w.nanoseconds[kWave] = clock_ns() - t0;
-  for (int k = 0; k < kClocked; ++k) nanoseconds_[k].fetch_add(w.nanoseconds[k], std::memory_order_relaxed);
-  for (int k = 0; k < kWave; ++k) rays_[k].fetch_add(w.queries[k], std::memory_order_relaxed);
+  w.clock.nanoseconds[kWave] = clock_ns() - t0;
+  publish(w.clock);
 }
 
 // The vectorised twin of run_wave: the same stages and the same Embree
@@ -473,18 +485,16 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out) c
   namespace vs = vector_stages;
   const vs::Scene& sc = vector_->scene;
   const vs::Wave& w = lanes.view;
-  std::uint64_t nanoseconds[kClocked] = {}, queries[kWave] = {};
+  Clock clock;
   const std::uint64_t t0 = clock_ns();
   vs::generate_camera_rays(vector_->camera, w);
   for (bool camera_rays = true; lanes.view.n > 0; camera_rays = false) {
     const std::size_t n = w.n;
     const RayArrays rays{w.f[vs::kOx], w.f[vs::kOy], w.f[vs::kOz], w.f[vs::kDx], w.f[vs::kDy], w.f[vs::kDz], w.f[vs::kTmax]};
     const HitArrays hits{w.f[vs::kHitT], w.f[vs::kHitU], w.f[vs::kHitV], w.u[vs::kShape], w.u[vs::kPrim], w.b[vs::kFound]};
-    const Clocked kind = camera_rays ? kCameraQueries : kBounceQueries;
-    std::uint64_t t = clock_ns();
+    const std::uint64_t t = clock_ns();
     scene_.intersect_arrays(rays, n, hits, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
-    nanoseconds[kind] += clock_ns() - t;
-    queries[kind] += n;
+    clock.batch(camera_rays ? kCameraQueries : kBounceQueries, t, n);
     for (std::size_t i = 0; i < n; ++i)  // overlap the hits' cache misses (as intersect() does)
       if (w.b[vs::kFound][i]) scene_.prefetch(w.u[vs::kShape][i], w.u[vs::kPrim][i]);
     vs::resolve(sc, w);
@@ -493,10 +503,9 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out) c
     if (q > 0) {
       const RayArrays shadow{w.f[vs::kQOx], w.f[vs::kQOy], w.f[vs::kQOz], w.f[vs::kQDx],
                              w.f[vs::kQDy], w.f[vs::kQDz], w.f[vs::kQTmax]};
-      t = clock_ns();
+      const std::uint64_t ts = clock_ns();
       scene_.occluded_arrays(shadow, q, w.b[vs::kQOccluded], modes_.shadow);
-      nanoseconds[kShadowQueries] += clock_ns() - t;
-      queries[kShadowQueries] += q;
+      clock.batch(kShadowQueries, ts, q);
       vs::add_light(w, q);
     }
     vs::scatter(sc, w);
@@ -507,9 +516,8 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out) c
     }
     lanes.view.n = survivors;
   }
-  nanoseconds[kWave] = clock_ns() - t0;
-  for (int k = 0; k < kClocked; ++k) nanoseconds_[k].fetch_add(nanoseconds[k], std::memory_order_relaxed);
-  for (int k = 0; k < kWave; ++k) rays_[k].fetch_add(queries[k], std::memory_order_relaxed);
+  clock.nanoseconds[kWave] = clock_ns() - t0;
+  publish(clock);
 }
 
 WavefrontTimes WavefrontTracer::times() const {
@@ -558,12 +566,11 @@ void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std
         const std::size_t begin = k * wave_size;
         lanes.view.n = std::min(wave_size, out.size() - begin);
         fill(begin, lanes.view.n,
-             [&](std::size_t i, std::uint32_t slot, std::uint32_t x, std::uint32_t y, std::uint32_t sample,
+             [&](std::size_t i, std::uint32_t slot, std::uint32_t x, std::uint32_t y, std::uint32_t /*sample: in rng*/,
                  SampleStream rng) {
                lanes.u[vs::kOutIndex][i] = slot;
                lanes.u[vs::kPixelX][i] = x;
                lanes.u[vs::kPixelY][i] = y;
-               lanes.u[vs::kSample][i] = sample;
                lanes.rng[i] = rng.key();
              });
         run_wave_vector(lanes, out);

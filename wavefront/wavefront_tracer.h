@@ -91,6 +91,7 @@ class WavefrontTracer final : public Tracer {
   WavefrontTimes times() const;
 
  private:
+  struct Clock;
   struct Wave;
   struct Lanes;
   // Traces the wave's paths to their ends, writing each one's sample to
@@ -105,6 +106,8 @@ class WavefrontTracer final : public Tracer {
   void scatter(Wave& w, PathObserver* obs) const;
   static void compact(Wave& w, std::span<FilmSample> out);
   void run_wave_vector(Lanes& lanes, std::span<FilmSample> out) const;
+  // Adds one wave's clock to what times() reports.
+  void publish(const Clock& clock) const;
   static std::size_t scalar_bytes_per_path();
 
   struct VectorStages;
