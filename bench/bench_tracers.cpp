@@ -16,6 +16,7 @@
 //
 //   build/bench/pathlab_bench_tracers [--scene=bench/scenes/dragon.json] [--spp=4]
 //                                      [--resolution=WxH] [--raw-min-time=SECONDS] [--cpu-time]
+//                                      [--waves=1024,4096,65536]
 //                                      [--benchmark_repetitions=5] [--benchmark_filter=...]
 #include "bench/ray_capture.h"
 #include "core/compiled_scene.h"
@@ -32,6 +33,7 @@
 #include <cmath>
 #include <ctime>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -52,6 +54,9 @@ struct Setup {
   bool cpu_time = false;
   double raw_min_seconds = 0.5;  // per Raw/ benchmark
   int width = 0, height = 0;     // 0: the scene's own resolution
+  // The wave sizes measured in the default ray modes (the other
+  // configurations use the default wave size).
+  std::vector<std::size_t> waves{std::size_t{1} << 10, WavefrontTracer::kDefaultWaveSize, std::size_t{1} << 16};
   std::unique_ptr<CompiledScene> scene;
   RenderSettings settings;
   CapturedRays rays;
@@ -156,7 +161,10 @@ void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes mode
   // Embree as the wavefront meets it, between its stages: the share of the
   // waves' time it takes, and its rates on all threads, to set beside Raw/.
   const WavefrontTimes t = tracer.times();
-  const double threads = static_cast<double>(max_threads());
+  // Raw/ rates are per second of the clock the run uses: wall time (all
+  // threads casting) or, with --cpu-time, CPU time summed over threads,
+  // which is a single thread's rate.
+  const double threads = setup().cpu_time ? 1.0 : static_cast<double>(max_threads());
   state.counters["embree_share"] = t.waves_seconds > 0.0 ? t.query_seconds() / t.waves_seconds : 0.0;
   state.counters["camera_in_context"] = threads * t.camera.rays_per_second();
   state.counters["bounce_in_context"] = threads * t.bounce.rays_per_second();
@@ -338,7 +346,7 @@ void register_benchmarks() {
   std::vector<Config> configs;
   const WavefrontRayModes defaults;
   const std::size_t wave = WavefrontTracer::kDefaultWaveSize;
-  for (std::size_t w : {std::size_t{1} << 10, wave, std::size_t{1} << 16}) configs.push_back({w, defaults});
+  for (std::size_t w : setup().waves) configs.push_back({w, defaults});
   for (RayBatchMode mode : kAllRayBatchModes) configs.push_back({wave, {mode, mode, mode}});
   // The scalar stages, the baseline of the vectorised ones.
   configs.push_back({wave, defaults, WavefrontStages::Scalar});
@@ -369,6 +377,20 @@ int main(int argc, char** argv) {
       s.cpu_time = true;
     else if (std::strncmp(argv[i], "--spp=", 6) == 0)
       s.spp = std::max(1, std::atoi(argv[i] + 6));
+    else if (std::strncmp(argv[i], "--waves=", 8) == 0) {
+      s.waves.clear();
+      for (const char* p = argv[i] + 8; *p != '\0';) {
+        char* end = nullptr;
+        const long w = std::strtol(p, &end, 10);
+        if (end == p || w <= 0) {
+          std::fprintf(stderr, "pathlab bench: --waves: expected positive wave sizes separated by commas, got '%s'\n",
+                       argv[i] + 8);
+          return 1;
+        }
+        s.waves.push_back(static_cast<std::size_t>(w));
+        p = *end == ',' ? end + 1 : end;
+      }
+    }
     else
       rest.push_back(argv[i]);
   }

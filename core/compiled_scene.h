@@ -6,6 +6,7 @@
 #include "core/camera.h"
 #include "core/embree_accel.h"
 #include "core/geometry.h"
+#include "core/huge_pages.h"
 #include "core/light_sampler.h"
 #include "core/scene.h"
 #include "core/surfel.h"
@@ -81,7 +82,7 @@ class CompiledScene {
   Camera camera_;
   std::unique_ptr<EmbreeAccel> accel_;
   std::unique_ptr<LightSampler> lights_;
-  std::vector<Triangle> triangles_;           // every shape's, in shape order
+  HugePageVector<Triangle> triangles_;        // every shape's, in shape order (read at random: huge pages)
   std::vector<std::size_t> first_triangle_;  // per shape, and one past the last
   LobeMask lobes_ = 0;
   vec3 bounds_center_{0.0f};

@@ -15,6 +15,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstring>
 #include <filesystem>
 
@@ -130,6 +131,7 @@ struct VectorCase {
   int rr_depth = -1;  // -1: the scene's
   bool thin_lens = false;
   bool tilted = false;  // the whole scene turned off the axes, so that no normal is axis-aligned
+  bool crowded = false;  // more than 16 shapes and lights (tables gathered, not permuted)
 };
 
 // The scene and its camera turned by 37 degrees about (1, 2, 3).
@@ -144,6 +146,46 @@ void tilt(Scene& scene) {
   scene.camera.up = r * scene.camera.up;
 }
 
+// The same scene as one shape per triangle, each emitting triangle first cut
+// into 16: more than 16 shapes and light entries, so that the vectorised stages
+// gather from their tables instead of permuting registers.
+void crowd(Scene& scene) {
+  std::vector<Shape> shapes;
+  for (const Shape& shape : scene.shapes) {
+    if (shape.kind != Shape::Kind::Triangles) {
+      shapes.push_back(shape);
+      continue;
+    }
+    const bool emits = scene.materials[shape.material].emits();
+    for (const glm::uvec3& t : shape.mesh.triangles) {
+      Shape one = shape;
+      one.mesh.positions = {shape.mesh.positions[t.x], shape.mesh.positions[t.y], shape.mesh.positions[t.z]};
+      one.mesh.triangles = {glm::uvec3(0, 1, 2)};
+      for (int split = 0; emits && split < 2; ++split) {  // each triangle into 4, twice
+        TriangleMesh finer;
+        for (const glm::uvec3& f : one.mesh.triangles) {
+          const vec3 a = one.mesh.positions[f.x], b = one.mesh.positions[f.y], c = one.mesh.positions[f.z];
+          const vec3 ab = 0.5f * (a + b), bc = 0.5f * (b + c), ca = 0.5f * (c + a);
+          for (const std::array<vec3, 3>& g : {std::array<vec3, 3>{a, ab, ca}, std::array<vec3, 3>{ab, b, bc},
+                                                std::array<vec3, 3>{ca, bc, c}, std::array<vec3, 3>{ab, bc, ca}}) {
+            const auto i = static_cast<std::uint32_t>(finer.positions.size());
+            finer.positions.insert(finer.positions.end(), g.begin(), g.end());
+            finer.triangles.emplace_back(i, i + 1, i + 2);
+          }
+        }
+        one.mesh = std::move(finer);
+      }
+      for (const glm::uvec3& f : one.mesh.triangles) {
+        Shape piece = one;
+        piece.mesh.positions = {one.mesh.positions[f.x], one.mesh.positions[f.y], one.mesh.positions[f.z]};
+        piece.mesh.triangles = {glm::uvec3(0, 1, 2)};
+        shapes.push_back(std::move(piece));
+      }
+    }
+  }
+  scene.shapes = std::move(shapes);
+}
+
 class VectorStages : public testing::TestWithParam<VectorCase> {};
 
 TEST_P(VectorStages, GiveTheScalarStagesBits) {
@@ -153,12 +195,17 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   scene.render.min_pdf = c.min_pdf;
   if (c.rr_depth >= 0) scene.render.rr_depth = c.rr_depth;
   if (c.tilted) tilt(scene);
+  if (c.crowded) crowd(scene);
   if (c.thin_lens) {
     scene.camera.aperture_radius = 0.1f;
     scene.camera.focus_distance = 3.0f;
   }
   const RenderSettings settings = scene.render;
   const CompiledScene compiled(std::move(scene));
+  if (c.crowded) {
+    ASSERT_GT(compiled.scene().shapes.size(), 16u);
+    ASSERT_GT(compiled.lights().entries().size(), 16u);
+  }
   const std::size_t pixels = static_cast<std::size_t>(compiled.scene().film.width) * compiled.scene().film.height;
   const auto count = static_cast<std::uint32_t>(settings.spp);
   // The default ray modes at two wave sizes, and each mode for every kind of ray.
@@ -197,6 +244,9 @@ std::vector<VectorCase> vector_cases() {
     cases.push_back({"white-sphere-emissive-room.json", st, 0.0f, -1, false, true});
   }
   cases.push_back({"", Strategy::Mis, 0.0f, -1, true});  // thin lens
+  for (Strategy st : {Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"", st, 0.0f, -1, false, false, true});
+  cases.push_back({"white-sphere-emissive-room.json", Strategy::Mis, 0.0f, -1, false, false, true});
   return cases;
 }
 
@@ -205,7 +255,8 @@ INSTANTIATE_TEST_SUITE_P(LambertScenes, VectorStages, testing::ValuesIn(vector_c
                            std::string s = (p.param.scene.empty() ? std::string("cornell") : p.param.scene) + "_" +
                                            strategy_name(p.param.strategy) + (p.param.min_pdf > 0 ? "_min_pdf" : "") +
                                            (p.param.rr_depth >= 0 ? "_rr" + std::to_string(p.param.rr_depth) : "") +
-                                           (p.param.tilted ? "_tilted" : "") + (p.param.thin_lens ? "_thin_lens" : "");
+                                           (p.param.tilted ? "_tilted" : "") + (p.param.thin_lens ? "_thin_lens" : "") +
+                                           (p.param.crowded ? "_crowded" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;

@@ -37,9 +37,19 @@ struct Lights {
   const float* cdf = nullptr;       // LightSampler::cdf()
   const float* pmf = nullptr;       // LightSampler::pmf()
   const float* inv_area = nullptr;  // 1 / area, as LightSampler computes it
-  // Per light, 16 floats: p0, p1, p2, front normal, emitted radiance, and
-  // 1 if it emits on both sides (else 0).
+  // Per light, 16 floats (LightField): p0, p1, p2, front normal, emitted
+  // radiance, and 1 if it emits on both sides (else 0).
   const float* triangle = nullptr;
+  // The same values by column when there are 1 to 16 lights (else null):
+  // LightField f of light l at [16 f + l], then the cdf, pmf and 1 / area
+  // rows (kLightCdf...). A lookup is then one permute of a register
+  // instead of a gather from memory.
+  const float* columns = nullptr;
+};
+enum LightField : int {
+  kLightP0 = 0, kLightP1 = 3, kLightP2 = 6, kLightNormal = 9, kLightLe = 12, kLightTwoSided = 15,
+  kLightCdf = 16, kLightPmf = 17, kLightInvArea = 18,  // rows of Lights::columns only
+  kLightColumns = 19,
 };
 
 // What the stages read of the scene and the render settings.
@@ -52,6 +62,9 @@ struct Scene {
   // Per shape, 32 floats (ShapeField): its material's albedo, emission and
   // flags, its first light entry, and its geometry.
   const float* shape = nullptr;
+  // The same by column when there are at most 16 shapes (else null): field
+  // f of shape s at [16 f + s].
+  const float* shape_columns = nullptr;
   // Every triangle (CompiledScene::triangles(): 12 floats each, p0 p1 p2 n).
   const float* triangles = nullptr;
 };
@@ -97,11 +110,11 @@ enum FloatArray : int {
 enum UintArray : int {
   kOutIndex, kRays, kVertex, kPixelX, kPixelY,
   kShape, kPrim,  // the hit's
-  kQSlot,         // each packed shadow ray's path
   kUintArrays
 };
 enum ByteArray : int {
   kAlive, kFound, kPrevImpulse, kPrevBsdfTechnique,
+  kHasQuery,   // whether the path has a shadow ray among the packed ones
   kQOccluded,  // per packed shadow ray
   kByteArrays
 };
@@ -113,9 +126,9 @@ struct Wave {
   std::uint64_t* rng = nullptr;  // SampleStream::key() per path
 };
 
-// What compact() returns for each path that ended (FilmSample's fields).
-struct Finished {
-  std::uint32_t out_index;
+// What compact() writes for each path that ended: FilmSample's fields, in
+// its layout (wavefront_tracer.cpp checks that they agree).
+struct Sample {
   float film_x, film_y, L[3];
   std::uint32_t rays, hits;
 };
@@ -143,7 +156,8 @@ void add_light(const Wave& wave, std::size_t queries);
 // A cosine-weighted continuation, Russian roulette and the next ray.
 void scatter(const Scene& scene, const Wave& wave);
 // Packs the survivors into slots [0, m) in order and returns m; each path
-// that ended is written to finished[0, n - m) in slot order.
-std::size_t compact(const Wave& wave, Finished* finished);
+// that ended is written to samples[its kOutIndex] (an array of Sample's
+// layout, copied in bytes).
+std::size_t compact(const Wave& wave, void* samples);
 
 }  // namespace pathlab::vector_stages

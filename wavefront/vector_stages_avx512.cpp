@@ -153,29 +153,62 @@ void store_mask(const Wave& w, ByteArray a, std::size_t i0, M m, M value) {
   _mm512_mask_cvtepi32_storeu_epi8(w.b[a] + i0, m, _mm512_maskz_mov_epi32(value, _mm512_set1_epi32(1)));
 }
 
-// Fields of each lane's shape (Scene::shape); `shape` is the shape index.
-I shape_offsets(I shape) { return _mm512_slli_epi32(shape, 7); }  // 32 floats = 128 bytes per shape
-F shape_value(M m, const Scene& sc, I offsets, ShapeField field) {
-  return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, offsets, sc.shape + field, 1);
-}
-V3 shape_value3(M m, const Scene& sc, I offsets, ShapeField field) {
-  return {shape_value(m, sc, offsets, field), shape_value(m, sc, offsets, static_cast<ShapeField>(field + 1)),
-          shape_value(m, sc, offsets, static_cast<ShapeField>(field + 2))};
-}
-I shape_int(M m, const Scene& sc, I offsets, ShapeField field) {
-  return _mm512_castps_si512(shape_value(m, sc, offsets, field));
-}
-M shape_flag(M m, const Scene& sc, I offsets, ShapeField field) {
-  return m & ~eq(shape_value(m, sc, offsets, field), k(0.0f));
-}
-// Float `index` of a light table with `stride` floats per entry.
-F table(M m, const float* base, I entry, int stride, int index) {
+// Float `index` of entry `entry` of a table with `stride` floats per entry
+// (0 outside m).
+F gather(M m, const float* base, I entry, int stride, int index) {
   const I at = _mm512_add_epi32(_mm512_mullo_epi32(entry, _mm512_set1_epi32(stride)), _mm512_set1_epi32(index));
   return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, at, base, 4);
 }
-V3 table3(M m, const float* base, I entry, int stride, int index) {
-  return {table(m, base, entry, stride, index), table(m, base, entry, stride, index + 1),
-          table(m, base, entry, stride, index + 2)};
+V3 gather3(M m, const float* base, I entry, int stride, int index) {
+  return {gather(m, base, entry, stride, index), gather(m, base, entry, stride, index + 1),
+          gather(m, base, entry, stride, index + 2)};
+}
+// Entry `entry` of a table of at most 16 entries kept by column (`row`
+// holds one field of every entry): a permute, not a gather (0 outside m).
+F permute(M m, const float* row, I entry) { return _mm512_maskz_permutexvar_ps(m, entry, _mm512_loadu_ps(row)); }
+
+// Field `field` of each lane's shape (Scene::shape); `shape` is the shape
+// index. 0 outside m.
+F shape_value(M m, const Scene& sc, I shape, ShapeField field) {
+  if (sc.shape_columns) return permute(m, sc.shape_columns + 16 * field, shape);
+  return gather(m, sc.shape, shape, kShapeFields, field);
+}
+V3 shape_value3(M m, const Scene& sc, I shape, ShapeField field) {
+  return {shape_value(m, sc, shape, field), shape_value(m, sc, shape, static_cast<ShapeField>(field + 1)),
+          shape_value(m, sc, shape, static_cast<ShapeField>(field + 2))};
+}
+I shape_int(M m, const Scene& sc, I shape, ShapeField field) {
+  return _mm512_castps_si512(shape_value(m, sc, shape, field));
+}
+M shape_flag(M m, const Scene& sc, I shape, ShapeField field) {
+  return m & ~eq(shape_value(m, sc, shape, field), k(0.0f));
+}
+// Field `field` of each lane's light entry (Lights). 0 outside m.
+F light_value(M m, const Lights& lights, I entry, LightField field) {
+  if (lights.columns) return permute(m, lights.columns + 16 * field, entry);
+  switch (field) {
+    case kLightCdf: return gather(m, lights.cdf, entry, 1, 0);
+    case kLightPmf: return gather(m, lights.pmf, entry, 1, 0);
+    case kLightInvArea: return gather(m, lights.inv_area, entry, 1, 0);
+    default: return gather(m, lights.triangle, entry, 16, field);
+  }
+}
+V3 light_value3(M m, const Lights& lights, I entry, LightField field) {
+  return {light_value(m, lights, entry, field), light_value(m, lights, entry, static_cast<LightField>(field + 1)),
+          light_value(m, lights, entry, static_cast<LightField>(field + 2))};
+}
+
+// The lanes of m packed to the front of `to` (to[0, popcount(m))). A
+// compress into a register and a masked store: on Intel cores a compress
+// straight to memory is several times slower.
+M packed_lanes(M m) { return static_cast<M>((1u << __builtin_popcount(m)) - 1u); }
+void compress_store(float* to, M m, F v) { _mm512_mask_storeu_ps(to, packed_lanes(m), _mm512_maskz_compress_ps(m, v)); }
+void compress_store(std::uint32_t* to, M m, I v) {
+  _mm512_mask_storeu_epi32(to, packed_lanes(m), _mm512_maskz_compress_epi32(m, v));
+}
+void compress_store(std::uint64_t* to, __mmask8 m, I v) {
+  const auto packed = static_cast<__mmask8>((1u << __builtin_popcount(m)) - 1u);
+  _mm512_mask_storeu_epi64(to, packed, _mm512_maskz_compress_epi64(m, v));
 }
 
 // power_heuristic (core/sampling.h).
@@ -199,8 +232,7 @@ I pick(M m, const Lights& lights, F u) {
   for (; step > 0; step /= 2) {
     const I cand = _mm512_add_epi32(idx, _mm512_set1_epi32(static_cast<int>(step)));
     const M valid = m & _mm512_cmple_epu32_mask(cand, _mm512_set1_epi32(static_cast<int>(count)));
-    const F c = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), valid, _mm512_sub_epi32(cand, _mm512_set1_epi32(1)),
-                                         lights.cdf, 4);
+    const F c = light_value(valid, lights, _mm512_sub_epi32(cand, _mm512_set1_epi32(1)), kLightCdf);
     idx = _mm512_mask_mov_epi32(idx, valid & le(c, u), cand);
   }
   return _mm512_min_epu32(idx, _mm512_set1_epi32(static_cast<int>(count - 1)));
@@ -263,16 +295,16 @@ void resolve(const Scene& sc, const Wave& w) {
     store(w, kRays, i0, in, _mm512_add_epi32(load(w, kRays, i0, in), _mm512_set1_epi32(1)));
     const M found = load_mask(w, kFound, i0, in);
     if (found == 0) continue;
-    const I shape = shape_offsets(load(w, kShape, i0, found));
+    const I shape = load(w, kShape, i0, found);
     const M sphere = shape_flag(found, sc, shape, kIsSphere), mesh = found & ~sphere;
     const V3 zero{k(0.0f), k(0.0f), k(0.0f)};
     V3 p = zero, error = zero, n = zero;
     if (mesh != 0) {
       // triangle_point (core/geometry.cpp) of the shape's triangle prim.
       const I tri = _mm512_add_epi32(shape_int(mesh, sc, shape, kFirstTriangle), load(w, kPrim, i0, mesh));
-      const V3 p0 = table3(mesh, sc.triangles, tri, 12, 0), p1 = table3(mesh, sc.triangles, tri, 12, 3),
-               p2 = table3(mesh, sc.triangles, tri, 12, 6);
-      n = table3(mesh, sc.triangles, tri, 12, 9);
+      const V3 p0 = gather3(mesh, sc.triangles, tri, 12, 0), p1 = gather3(mesh, sc.triangles, tri, 12, 3),
+               p2 = gather3(mesh, sc.triangles, tri, 12, 6);
+      n = gather3(mesh, sc.triangles, tri, 12, 9);
       const F b1 = load(w, kHitU, i0, mesh), b2 = load(w, kHitV, i0, mesh);
       const F b0 = sub(sub(k(1.0f), b1), b2);
       p = add(add(mul(b0, p0), mul(b1, p1)), mul(b2, p2));
@@ -318,7 +350,7 @@ void add_emission(const Scene& sc, const Wave& w) {
     M alive = 0;
     if (found != 0) {
       // Surfel::emitted.
-      const I shape = shape_offsets(load(w, kShape, i0, found));
+      const I shape = load(w, kShape, i0, found);
       const V3 wo = neg(load3(w, kDx, i0, found));
       const V3 n = load3(w, kNx, i0, found);
       const M facing = shape_flag(found, sc, shape, kTwoSided) | gt(dot(n, wo), k(0.0f));
@@ -334,8 +366,8 @@ void add_emission(const Scene& sc, const Wave& w) {
       const V3 d = sub(load3(w, kPx, i0, light), load3(w, kPrevX, i0, light));
       const F dist = _mm512_sqrt_ps(dot(d, d));
       const F c = _mm512_abs_ps(div(dot(n, d), dist));
-      const F inv_area = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), light, entry, sc.lights.inv_area, 4);
-      const F pmf = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), light, entry, sc.lights.pmf, 4);
+      const F inv_area = light_value(light, sc.lights, entry, kLightInvArea);
+      const F pmf = light_value(light, sc.lights, entry, kLightPmf);
       const F to_solid_angle = select(gt(c, k(0.0f)), div(mul(mul(inv_area, dist), dist), c), k(0.0f));
       const F light_pdf = _mm512_maskz_mov_ps(light, mul(pmf, to_solid_angle));
       // emission_weight (core/strategy_weights.h).
@@ -357,7 +389,6 @@ void add_emission(const Scene& sc, const Wave& w) {
 
 std::size_t sample_lights(const Scene& sc, const Wave& w) {
   std::size_t queries = 0;
-  const I iota = _mm512_set_epi32(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
   for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
     const M in = lanes(w.n, i0);
     const I vertex = load(w, kVertex, i0, in);
@@ -366,7 +397,10 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     M ok = load_mask(w, kAlive, i0, in);
     if (sc.strategy == Strategy::Bsdf || sc.lights.count == 0) ok = 0;
     if (sc.strategy == Strategy::LightBsdf) ok &= lt(rng.u(Dim::Technique), k(0.5f));
-    if (ok == 0) continue;
+    if (ok == 0) {
+      store_mask(w, kHasQuery, i0, in, 0);
+      continue;
+    }
 
     // LightSampler::sample: pick a triangle, then a point uniformly on it
     // (square_to_uniform_triangle, triangle_point).
@@ -375,10 +409,10 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     const F s = _mm512_sqrt_ps(ux);
     const F b1 = mul(uy, s), b2 = sub(k(1.0f), s);
     const F b0 = sub(sub(k(1.0f), b1), b2);
-    const V3 p0 = table3(ok, sc.lights.triangle, light, 16, 0), p1 = table3(ok, sc.lights.triangle, light, 16, 3),
-             p2 = table3(ok, sc.lights.triangle, light, 16, 6), ln = table3(ok, sc.lights.triangle, light, 16, 9),
-             Le = table3(ok, sc.lights.triangle, light, 16, 12);
-    const F two_sided = table(ok, sc.lights.triangle, light, 16, 15);
+    const V3 p0 = light_value3(ok, sc.lights, light, kLightP0), p1 = light_value3(ok, sc.lights, light, kLightP1),
+             p2 = light_value3(ok, sc.lights, light, kLightP2), ln = light_value3(ok, sc.lights, light, kLightNormal),
+             Le = light_value3(ok, sc.lights, light, kLightLe);
+    const F two_sided = light_value(ok, sc.lights, light, kLightTwoSided);
     const V3 lp = add(add(mul(b0, p0), mul(b1, p1)), mul(b2, p2));
     const V3 lerr = mul(k(kGamma7), add(add(abs(mul(b0, p0)), abs(mul(b1, p1))), abs(mul(b2, p2))));
 
@@ -391,8 +425,8 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     ok &= ~eq(two_sided, k(0.0f)) | _mm512_cmp_ps_mask(cos_light, k(0.0f), _CMP_NLE_UQ);  // back of a one-sided emitter
     // pmf * area_to_solid_angle(1 / area, dist, cos_light) (core/sampling.h).
     const F c = _mm512_abs_ps(cos_light);
-    const F inv_area = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), ok, light, sc.lights.inv_area, 4);
-    const F pmf = _mm512_mask_i32gather_ps(_mm512_setzero_ps(), ok, light, sc.lights.pmf, 4);
+    const F inv_area = light_value(ok, sc.lights, light, kLightInvArea);
+    const F pmf = light_value(ok, sc.lights, light, kLightPmf);
     const F to_solid_angle = select(gt(c, k(0.0f)), div(mul(mul(inv_area, dist), dist), c), k(0.0f));
     const F pdf_light = mul(pmf, to_solid_angle);
     ok &= gt(pdf_light, k(0.0f)) & ~_mm512_fpclass_ps_mask(pdf_light, 0x18);  // seen edge-on
@@ -406,7 +440,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     wi_z = select(lt(wo_z, k(0.0f)), neg(wi_z), wi_z);
     const M upper = gt(wi_z, k(0.0f));
     const F cos_pi = mul(wi_z, k(kInvPi));
-    const V3 rho = shape_value3(ok, sc, shape_offsets(load(w, kShape, i0, ok)), kAlbedo);
+    const V3 rho = shape_value3(ok, sc, load(w, kShape, i0, ok), kAlbedo);
     const V3 f = select(upper, mul(cos_pi, rho), V3{k(0.0f), k(0.0f), k(0.0f)});
     ok &= ~is_black(f);
     const F pdf_bsdf = select(upper, cos_pi, k(0.0f));
@@ -417,7 +451,8 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     if (sc.strategy == Strategy::LightBsdf) weight = div(mul(k(2.0f), pdf_light), add(pdf_light, pdf_bsdf));
     store3(w, kUnR, i0, ok, mul(div(weight, pdf_light), mul(f, Le)));
 
-    // Surfel::spawn_to(lp, lerr, ln), packed behind the previous ones.
+    // Surfel::spawn_to(lp, lerr, ln), packed behind the previous ones in
+    // path order (add_light() finds them again by kHasQuery).
     const V3 err = load3(w, kErrX, i0, ok);
     const V3 origin = offset_ray_origin(sp, err, select(ge(dot(d, n), k(0.0f)), n, neg(n)));
     const V3 end = offset_ray_origin(lp, lerr, select(ge(dot(sub(origin, lp), ln), k(0.0f)), ln, neg(ln)));
@@ -425,9 +460,8 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     const F len = _mm512_sqrt_ps(dot(dd, dd));
     const V3 dir = div(dd, len);
     const F q[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
-    for (int a = 0; a < 7; ++a) _mm512_mask_compressstoreu_ps(w.f[kQOx + a] + queries, ok, q[a]);
-    _mm512_mask_compressstoreu_epi32(w.u[kQSlot] + queries, ok,
-                                     _mm512_add_epi32(iota, _mm512_set1_epi32(static_cast<int>(i0))));
+    for (int a = 0; a < 7; ++a) compress_store(w.f[kQOx + a] + queries, ok, q[a]);
+    store_mask(w, kHasQuery, i0, in, ok);
     // The shadow ray counts as one of the path's rays.
     store(w, kRays, i0, ok, _mm512_add_epi32(load(w, kRays, i0, ok), _mm512_set1_epi32(1)));
     queries += static_cast<std::size_t>(__builtin_popcount(ok));
@@ -436,19 +470,23 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
 }
 
 void add_light(const Wave& w, std::size_t queries) {
-  for (std::size_t r0 = 0; r0 < queries; r0 += 16) {
-    const M in = lanes(queries, r0);
-    const I slot = _mm512_maskz_loadu_epi32(in, w.u[kQSlot] + r0);
-    const I blocked = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(in, w.b[kQOccluded] + r0));
-    const M visible = in & ~_mm512_test_epi32_mask(blocked, blocked);
-    auto at = [&](FloatArray a, M m) { return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), m, slot, w.f[a], 4); };
-    // Each path has at most one shadow ray: the slots are distinct.
+  // The packed shadow rays are in path order, at most one per path: block
+  // i0's are the next popcount(has) of them.
+  std::size_t r = 0;
+  for (std::size_t i0 = 0; i0 < w.n && r < queries; i0 += 16) {
+    const M in = lanes(w.n, i0);
+    const M has = load_mask(w, kHasQuery, i0, in);
+    if (has == 0) continue;
+    const I packed = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(packed_lanes(has), w.b[kQOccluded] + r));
+    const I blocked = _mm512_maskz_expand_epi32(has, packed);
+    const M visible = has & ~_mm512_test_epi32_mask(blocked, blocked);
     for (int c = 0; c < 3; ++c) {
       const auto l = static_cast<FloatArray>(kLR + c);
-      const F added = _mm512_maskz_mov_ps(visible, mul(at(static_cast<FloatArray>(kBetaR + c), visible),
-                                                      at(static_cast<FloatArray>(kUnR + c), visible)));
-      _mm512_mask_i32scatter_ps(w.f[l], in, slot, add(at(l, in), added), 4);
+      const F added = _mm512_maskz_mov_ps(visible, mul(load(w, static_cast<FloatArray>(kBetaR + c), i0, visible),
+                                                      load(w, static_cast<FloatArray>(kUnR + c), i0, visible)));
+      store(w, l, i0, has, add(load(w, l, i0, has), added));
     }
+    r += static_cast<std::size_t>(__builtin_popcount(has));
   }
 }
 
@@ -472,7 +510,7 @@ void scatter(const Scene& sc, const Wave& w) {
     const V3 fs = load3(w, kSx, i0, ok), ft = load3(w, kTx, i0, ok), n = load3(w, kNx, i0, ok);
     const F side = select(lt(dot(wo, n), k(0.0f)), k(-1.0f), k(1.0f));
     const V3 wi = add(add(mul(x, fs), mul(y, ft)), mul(mul(z, side), n));  // Frame::to_world
-    V3 weight = shape_value3(ok, sc, shape_offsets(load(w, kShape, i0, ok)), kAlbedo);
+    V3 weight = shape_value3(ok, sc, load(w, kShape, i0, ok), kAlbedo);
     ok &= ~is_black(weight);
 
     // Russian roulette (the scatter stage).
@@ -506,23 +544,22 @@ void scatter(const Scene& sc, const Wave& w) {
   }
 }
 
-std::size_t compact(const Wave& w, Finished* finished) {
+std::size_t compact(const Wave& w, void* samples) {
   static constexpr FloatArray kMovedFloats[] = {kOx,   kOy,   kOz,   kDx,   kDy,   kDz,      kTmax,  kBetaR, kBetaG,
                                                 kBetaB, kLR,  kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX,
                                                 kFilmY};
   static constexpr UintArray kMovedUints[] = {kOutIndex, kRays, kVertex};
   static constexpr ByteArray kMovedBytes[] = {kPrevImpulse, kPrevBsdfTechnique};
-  std::size_t m = 0, ended = 0;
+  std::size_t m = 0;
   for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
     const M in = lanes(w.n, i0);
     const M alive = load_mask(w, kAlive, i0, in);
-    // The paths that ended, in slot order: FilmSample{film, L, rays, hits}.
+    // The paths that ended: FilmSample{film, L, rays, hits}.
     for (M dead = in & ~alive; dead != 0; dead &= static_cast<M>(dead - 1)) {
       const std::size_t i = i0 + static_cast<std::size_t>(__builtin_ctz(dead));
-      const std::uint32_t vertex = w.u[kVertex][i];
-      finished[ended++] = Finished{w.u[kOutIndex][i], w.f[kFilmX][i], w.f[kFilmY][i],
-                                   {w.f[kLR][i], w.f[kLG][i], w.f[kLB][i]}, w.u[kRays][i],
-                                   vertex - (w.b[kFound][i] ? 0u : 1u)};
+      const Sample sample{w.f[kFilmX][i], w.f[kFilmY][i], {w.f[kLR][i], w.f[kLG][i], w.f[kLB][i]}, w.u[kRays][i],
+                          w.u[kVertex][i] - (w.b[kFound][i] ? 0u : 1u)};
+      __builtin_memcpy(static_cast<char*>(samples) + sizeof(Sample) * w.u[kOutIndex][i], &sample, sizeof(Sample));
     }
     // The survivors, packed behind the previous ones (m <= i0: a block is
     // read before anything is written over it).
@@ -530,10 +567,10 @@ std::size_t compact(const Wave& w, Finished* finished) {
       m += static_cast<std::size_t>(__builtin_popcount(in));
       continue;
     }
-    for (FloatArray a : kMovedFloats) _mm512_mask_compressstoreu_ps(w.f[a] + m, alive, load(w, a, i0, in));
-    for (UintArray a : kMovedUints) _mm512_mask_compressstoreu_epi32(w.u[a] + m, alive, load(w, a, i0, in));
+    for (FloatArray a : kMovedFloats) compress_store(w.f[a] + m, alive, load(w, a, i0, in));
+    for (UintArray a : kMovedUints) compress_store(w.u[a] + m, alive, load(w, a, i0, in));
     const auto count = static_cast<std::size_t>(__builtin_popcount(alive));
-    const auto packed = static_cast<M>((1u << count) - 1u);
+    const M packed = packed_lanes(alive);
     for (ByteArray a : kMovedBytes) {
       const I v = _mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(in, w.b[a] + i0));
       _mm512_mask_cvtepi32_storeu_epi8(w.b[a] + m, packed, _mm512_maskz_compress_epi32(alive, v));
@@ -541,8 +578,8 @@ std::size_t compact(const Wave& w, Finished* finished) {
     const auto lo = static_cast<__mmask8>(alive & 0xff), hi = static_cast<__mmask8>(alive >> 8);
     const I key_lo = _mm512_maskz_loadu_epi64(static_cast<__mmask8>(in & 0xff), w.rng + i0);
     const I key_hi = _mm512_maskz_loadu_epi64(static_cast<__mmask8>(in >> 8), w.rng + i0 + 8);
-    _mm512_mask_compressstoreu_epi64(w.rng + m, lo, key_lo);
-    _mm512_mask_compressstoreu_epi64(w.rng + m + static_cast<std::size_t>(__builtin_popcount(lo)), hi, key_hi);
+    compress_store(w.rng + m, lo, key_lo);
+    compress_store(w.rng + m + static_cast<std::size_t>(__builtin_popcount(lo)), hi, key_hi);
     _mm512_mask_cvtepi32_storeu_epi8(w.b[kAlive] + m, packed, _mm512_set1_epi32(1));
     m += count;
   }

@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cstddef>
 #include <optional>
+#include <type_traits>
 
 namespace pathlab {
 
@@ -112,7 +114,7 @@ std::size_t WavefrontTracer::scalar_bytes_per_path() {
 struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
-  std::vector<float> inv_area, light_triangle, shape;
+  std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns;
 
   // Null, with *why_not saying what stops it, unless the processor has
   // AVX-512 and the scene needs nothing more than Lambert surfaces and
@@ -164,8 +166,18 @@ struct WavefrontTracer::VectorStages {
       v->light_triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
       v->inv_area.push_back(1.0f / e.area);
     }
-    sc.lights = {lights.entries().size(), lights.cdf().data(), lights.pmf().data(), v->inv_area.data(),
-                 v->light_triangle.data()};
+    const std::size_t n_lights = lights.entries().size();
+    if (n_lights >= 1 && n_lights <= 16) {  // small enough to keep by column
+      v->light_columns.assign(16 * vs::kLightColumns, 0.0f);
+      for (std::size_t l = 0; l < n_lights; ++l) {
+        for (int f = 0; f < 16; ++f) v->light_columns[16 * f + l] = v->light_triangle[16 * l + f];
+        v->light_columns[16 * vs::kLightCdf + l] = lights.cdf()[l];
+        v->light_columns[16 * vs::kLightPmf + l] = lights.pmf()[l];
+        v->light_columns[16 * vs::kLightInvArea + l] = v->inv_area[l];
+      }
+    }
+    sc.lights = {n_lights, lights.cdf().data(), lights.pmf().data(), v->inv_area.data(), v->light_triangle.data(),
+                 v->light_columns.empty() ? nullptr : v->light_columns.data()};
     // Per shape: its material's parameters and its geometry.
     // 32-bit byte offsets: 128 bytes per shape, 48 per triangle, 64 per light.
     if (compiled.triangles().size() >= (std::size_t{1} << 27)) return no("more than 2^27 triangles");
@@ -190,6 +202,12 @@ struct WavefrontTracer::VectorStages {
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
     }
     sc.shape = v->shape.data();
+    if (scene.shapes.size() <= 16) {
+      v->shape_columns.assign(16 * vs::kShapeFields, 0.0f);
+      for (std::size_t i = 0; i < scene.shapes.size(); ++i)
+        for (int f = 0; f < vs::kShapeFields; ++f) v->shape_columns[16 * f + i] = v->shape[vs::kShapeFields * i + f];
+      sc.shape_columns = v->shape_columns.data();
+    }
     static_assert(sizeof(Triangle) == 12 * sizeof(float));
     sc.triangles = compiled.triangles().empty() ? nullptr : &compiled.triangles().data()->p0.x;
     // The camera.
@@ -205,6 +223,14 @@ struct WavefrontTracer::VectorStages {
   }
 };
 
+// vector_stages::compact() writes finished paths as FilmSamples, byte for byte.
+static_assert(std::is_trivially_copyable_v<FilmSample> && sizeof(FilmSample) == sizeof(vector_stages::Sample));
+static_assert(offsetof(FilmSample, film) == offsetof(vector_stages::Sample, film_x) &&
+              offsetof(FilmSample, L) == offsetof(vector_stages::Sample, L) &&
+              offsetof(FilmSample, rays) == offsetof(vector_stages::Sample, rays) &&
+              offsetof(FilmSample, hits) == offsetof(vector_stages::Sample, hits));
+static_assert(sizeof(vec2) == 2 * sizeof(float) && sizeof(Spectrum) == 3 * sizeof(float));
+
 // A wave's paths for the vectorised stages: one array per scalar
 // (vector_stages::Wave names them).
 struct WavefrontTracer::Lanes {
@@ -212,7 +238,6 @@ struct WavefrontTracer::Lanes {
   std::vector<std::uint32_t> u[vector_stages::kUintArrays];
   std::vector<std::uint8_t> b[vector_stages::kByteArrays];
   std::vector<std::uint64_t> rng;
-  std::vector<vector_stages::Finished> finished;
   vector_stages::Wave view;  // pointers into the arrays; view.n live paths
 
   void resize(std::size_t size) {
@@ -220,7 +245,6 @@ struct WavefrontTracer::Lanes {
     for (auto& a : u) a.resize(size);
     for (auto& a : b) a.resize(size);
     rng.resize(size);
-    finished.resize(size);
     for (int a = 0; a < vector_stages::kFloatArrays; ++a) view.f[a] = f[a].data();
     for (int a = 0; a < vector_stages::kUintArrays; ++a) view.u[a] = u[a].data();
     for (int a = 0; a < vector_stages::kByteArrays; ++a) view.b[a] = b[a].data();
@@ -229,7 +253,7 @@ struct WavefrontTracer::Lanes {
   std::size_t capacity() const { return rng.size(); }
   static constexpr std::size_t bytes_per_path() {
     return vector_stages::kFloatArrays * sizeof(float) + vector_stages::kUintArrays * sizeof(std::uint32_t) +
-           vector_stages::kByteArrays + sizeof(std::uint64_t) + sizeof(vector_stages::Finished);
+           vector_stages::kByteArrays + sizeof(std::uint64_t);
   }
 };
 
@@ -509,12 +533,7 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out) c
       vs::add_light(w, q);
     }
     vs::scatter(sc, w);
-    const std::size_t survivors = vs::compact(w, lanes.finished.data());
-    for (std::size_t k = 0; k < n - survivors; ++k) {
-      const vs::Finished& f = lanes.finished[k];
-      out[f.out_index] = FilmSample{vec2(f.film_x, f.film_y), Spectrum(f.L[0], f.L[1], f.L[2]), f.rays, f.hits};
-    }
-    lanes.view.n = survivors;
+    lanes.view.n = vs::compact(w, out.data());
   }
   clock.nanoseconds[kWave] = clock_ns() - t0;
   publish(clock);
