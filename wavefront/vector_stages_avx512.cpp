@@ -92,7 +92,8 @@ void concentric_disk(F ux, F uy, F* dx, F* dy) {
   const M wide = gt(_mm512_abs_ps(ox), _mm512_abs_ps(oy));  // the left and right wedges
   const F r = select(wide, ox, oy);
   F s, c;
-  sin_cos_quarter(mul(k(3.14159265358979323846f / 4.0f), select(wide, div(oy, ox), div(ox, oy))), &s, &c);
+  // One division per lane, of whichever ratio the lane's wedge takes.
+  sin_cos_quarter(mul(k(3.14159265358979323846f / 4.0f), div(select(wide, oy, ox), select(wide, ox, oy))), &s, &c);
   const M centre = eq(ox, k(0.0f)) & eq(oy, k(0.0f));
   *dx = _mm512_maskz_mov_ps(~centre, mul(r, select(wide, c, s)));
   *dy = _mm512_maskz_mov_ps(~centre, mul(r, select(wide, s, c)));
