@@ -6,6 +6,11 @@
 //   Tracer/reference      the recursive tracer rendering the frame
 //   Tracer/wavefront/...  the wavefront tracer, for several wave sizes and
 //                         ray modes
+//   After/<kind>/<work>   Embree on one thread casting the captured rays in
+//                         chunks of 4,096, each right after a burst of other
+//                         work (none, 512-bit, 256-bit or scalar arithmetic):
+//                         what the wavefront's vectorised stages cost Embree
+//                         through the core's clock (the AVX-512 licence)
 // At the end it prints the ratios the wavefront issue asks for (medians over
 // --benchmark_repetitions): wavefront / reference samples per second, and
 // each tracer's rays per second as a fraction of Embree's raw rate for the
@@ -27,6 +32,7 @@
 #include "wavefront/wavefront_tracer.h"
 
 #include <benchmark/benchmark.h>
+#include <immintrin.h>
 
 #include <algorithm>
 #include <chrono>
@@ -79,12 +85,96 @@ void raw(benchmark::State& state, RayKind kind, RayBatchMode mode) {
   state.counters["hit_fraction"] = rays.empty() ? 0.0 : static_cast<double>(hits) / static_cast<double>(rays.size());
 }
 
-// --- tracers --------------------------------------------------------------------
-
 // The mode a wavefront run casts rays of `kind` in.
 RayBatchMode mode_of(const WavefrontRayModes& modes, RayKind kind) {
   return kind == RayKind::Camera ? modes.camera : kind == RayKind::Bounce ? modes.bounce : modes.shadow;
 }
+
+// --- Embree after other work ----------------------------------------------------
+// Dense 512-bit floating-point work lowers the clock of a Skylake-SP or
+// Cascade Lake core (its "AVX-512 licence") for about two milliseconds after
+// the work ends, and 256-bit work does so less. Between two Embree batches
+// of a wave the vectorised stages do such work, so Embree then runs slower
+// than in Raw/, which casts batch after batch. After/ measures that on one
+// core: each chunk of rays right after a burst of about as many operations
+// as the stages spend on it, Embree's time alone on the clock.
+
+enum class Burst { None, Zmm, Ymm, Scalar };
+const char* burst_name(Burst b) {
+  switch (b) {
+    case Burst::None: return "none";
+    case Burst::Zmm: return "zmm";
+    case Burst::Ymm: return "ymm";
+    case Burst::Scalar: return "scalar";
+  }
+  return "?";
+}
+constexpr int kBurstSteps = 20000;  // three dependent chains of multiplies and adds: ~60 us
+
+__attribute__((target("avx512f"), noinline)) float burst_zmm(float x) {
+  __m512 a = _mm512_set1_ps(x), b = _mm512_set1_ps(1.0001f), c = _mm512_set1_ps(0.9999f), d = a, e = b;
+  for (int i = 0; i < kBurstSteps; ++i) a = _mm512_mul_ps(a, b), d = _mm512_mul_ps(d, c), e = _mm512_add_ps(e, a);
+  alignas(64) float out[16];  // (not _mm512_reduce_add_ps: GCC 12 warns inside it, PR 105593)
+  _mm512_store_ps(out, _mm512_add_ps(_mm512_add_ps(a, d), e));
+  return out[0] + out[15];
+}
+__attribute__((target("avx2"), noinline)) float burst_ymm(float x) {
+  __m256 a = _mm256_set1_ps(x), b = _mm256_set1_ps(1.0001f), c = _mm256_set1_ps(0.9999f), d = a, e = b;
+  for (int i = 0; i < kBurstSteps; ++i) a = _mm256_mul_ps(a, b), d = _mm256_mul_ps(d, c), e = _mm256_add_ps(e, a);
+  alignas(32) float out[8];
+  _mm256_store_ps(out, _mm256_add_ps(_mm256_add_ps(a, d), e));
+  return out[0] + out[7];
+}
+__attribute__((noinline)) float burst_scalar(float x) {
+  float a = x, d = x, e = 1.0f;
+  for (int i = 0; i < kBurstSteps; ++i) {
+    a *= 1.0001f, d *= 0.9999f, e += a;
+    benchmark::DoNotOptimize(e);
+  }
+  return a + d + e;
+}
+
+void after_burst(benchmark::State& state, RayKind kind, Burst burst) {
+  if ((burst == Burst::Zmm && !__builtin_cpu_supports("avx512f")) ||
+      (burst == Burst::Ymm && !__builtin_cpu_supports("avx2"))) {
+    state.SkipWithError("the processor lacks the instructions of this burst");
+    return;
+  }
+  const Setup& s = setup();
+  const std::vector<Ray>& rays = s.rays.of(kind);
+  const RayBatchMode mode = mode_of(WavefrontRayModes{}, kind);  // as the wavefront casts them
+  constexpr std::size_t kChunk = 4096;
+  std::vector<RayHit> hits(kChunk);
+  std::vector<std::uint8_t> found(kChunk);
+  float sink = 1.0f;
+  for (auto _ : state) {
+    double embree_seconds = 0.0;
+    for (std::size_t b = 0; b < rays.size(); b += kChunk) {
+      if (burst == Burst::Zmm) sink += burst_zmm(sink);
+      if (burst == Burst::Ymm) sink += burst_ymm(sink);
+      if (burst == Burst::Scalar) sink += burst_scalar(sink);
+      const std::size_t n = std::min(kChunk, rays.size() - b);
+      const std::span<const Ray> chunk(rays.data() + b, n);
+      const auto t0 = std::chrono::steady_clock::now();
+      if (kind == RayKind::Shadow)
+        s.scene->occluded_batch(chunk, std::span<std::uint8_t>(found.data(), n), mode);
+      else
+        s.scene->intersect_batch(chunk, std::span<RayHit>(hits.data(), n), std::span<std::uint8_t>(found.data(), n),
+                                 mode, kind == RayKind::Camera);
+      embree_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+    state.SetIterationTime(embree_seconds);
+  }
+  benchmark::DoNotOptimize(sink);
+  state.counters["rays/s"] = benchmark::Counter(static_cast<double>(state.iterations() * rays.size()),
+                                                benchmark::Counter::kIsIterationInvariantRate);
+}
+
+std::string after_name(RayKind kind, Burst burst) {
+  return std::string("After/") + ray_kind_name(kind) + "/" + burst_name(burst);
+}
+
+// --- tracers --------------------------------------------------------------------
 
 // Seconds on the clock the run is measured by: wall time, or the process's
 // CPU time (all threads) with --cpu-time.
@@ -264,6 +354,15 @@ class RatioReporter : public benchmark::ConsoleReporter {
                   rest_ref > 0 ? (t_ref / 1.3 - embree_best) / rest_ref : 0.0,
                   rest_ref > 0 ? (embree_best / 0.75 - embree_best) / rest_ref : 0.0);
     }
+    // Embree after the bursts, against after none (one core).
+    for (RayKind kind : kAllRayKinds) {
+      const double none = median(after_name(kind, Burst::None), "rays/s");
+      if (none <= 0.0) continue;
+      std::printf("Embree on one core, %s rays, right after a burst of work, of its rate after none:", ray_kind_name(kind));
+      for (Burst b : {Burst::Zmm, Burst::Ymm, Burst::Scalar})
+        std::printf(" %s %.2f", burst_name(b), median(after_name(kind, b), "rays/s") / none);
+      std::printf("\n");
+    }
     std::vector<std::string> runs;
     for (const auto* source : {&values_, &medians_})
       for (const auto& entry : *source)
@@ -337,6 +436,12 @@ void register_benchmarks() {
   for (RayKind kind : kAllRayKinds)
     for (RayBatchMode mode : kAllRayBatchModes)
       timed(benchmark::RegisterBenchmark(raw_name(kind, mode).c_str(), raw, kind, mode))->MinTime(setup().raw_min_seconds);
+  for (RayKind kind : kAllRayKinds)
+    for (Burst b : {Burst::None, Burst::Zmm, Burst::Ymm, Burst::Scalar})
+      benchmark::RegisterBenchmark(after_name(kind, b).c_str(), after_burst, kind, b)
+          ->Unit(benchmark::kMillisecond)
+          ->UseManualTime()
+          ->Iterations(2);
   timed(benchmark::RegisterBenchmark("Tracer/reference", reference))->Iterations(1);
   struct Config {
     std::size_t wave;
