@@ -52,16 +52,8 @@ class CompiledScene {
                       bool coherent = false) const {
     accel_->occluded_batch(rays, occluded, mode, coherent);
   }
-  // The triangle of each hit is prefetched as soon as Embree finds it (as
-  // prefetch() does), unless `hits` asks for something else to be done.
-  void intersect_arrays(const RayArrays& rays, std::size_t n, HitArrays hits, RayBatchMode mode,
+  void intersect_arrays(const RayArrays& rays, std::size_t n, const HitArrays& hits, RayBatchMode mode,
                         bool coherent = false) const {
-    if (!hits.on_hit) {
-      hits.on_hit = [](const void* scene, std::uint32_t shape, std::uint32_t prim) {
-        static_cast<const CompiledScene*>(scene)->prefetch(shape, prim);
-      };
-      hits.on_hit_context = this;
-    }
     accel_->intersect_arrays(rays, n, hits, mode, coherent);
   }
   void occluded_arrays(const RayArrays& rays, std::size_t n, std::uint8_t* occluded, RayBatchMode mode,

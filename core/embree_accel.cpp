@@ -316,7 +316,6 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays, std::size_t n, const H
     hits.found[i] = geom != RTC_INVALID_GEOMETRY_ID;
     if (!hits.found[i]) return;
     hits.t[i] = tfar, hits.shape[i] = geom, hits.prim[i] = prim, hits.u[i] = u, hits.v[i] = v;
-    if (hits.on_hit) hits.on_hit(hits.on_hit_context, geom, prim);
   };
   switch (mode) {
     case RayBatchMode::Single:

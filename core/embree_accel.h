@@ -39,11 +39,6 @@ struct HitArrays {
   float *t, *u, *v;               // distance; Embree's barycentrics (b1, b2) for a triangle
   std::uint32_t *shape, *prim;
   std::uint8_t* found;
-  // Optional: called with each hit as soon as Embree has found it (after its
-  // ray, packet or stream), e.g. to start loading what the caller will read
-  // about the hit while Embree traces the next rays.
-  void (*on_hit)(const void* context, std::uint32_t shape, std::uint32_t prim) = nullptr;
-  const void* on_hit_context = nullptr;
 };
 
 class EmbreeAccel {

@@ -517,9 +517,10 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out) c
     const RayArrays rays{w.f[vs::kOx], w.f[vs::kOy], w.f[vs::kOz], w.f[vs::kDx], w.f[vs::kDy], w.f[vs::kDz], w.f[vs::kTmax]};
     const HitArrays hits{w.f[vs::kHitT], w.f[vs::kHitU], w.f[vs::kHitV], w.u[vs::kShape], w.u[vs::kPrim], w.b[vs::kFound]};
     const std::uint64_t t = clock_ns();
-    // (each hit's triangle prefetched as Embree finds it, while it traces the next rays)
     scene_.intersect_arrays(rays, n, hits, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
     clock.batch(camera_rays ? kCameraQueries : kBounceQueries, t, n);
+    for (std::size_t i = 0; i < n; ++i)  // overlap the hits' cache misses (as intersect() does)
+      if (w.b[vs::kFound][i]) scene_.prefetch(w.u[vs::kShape][i], w.u[vs::kPrim][i]);
     vs::resolve(sc, w);
     vs::add_emission(sc, w);
     const std::size_t q = vs::sample_lights(sc, w);
