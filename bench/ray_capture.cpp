@@ -9,9 +9,9 @@
 namespace pathlab::bench {
 namespace {
 
-// Rebuilds the rays of one path from its events. Ray origins are offset off
-// their surfaces as the tracers do (a small absolute bound stands in for the
-// position error the events do not carry).
+// Keeps the rays of one path as the tracer cast them: camera rays, the
+// shadow rays (offset off the surface and short of the light, as traced) and
+// the continuation rays.
 class RayRecorder final : public PathObserver {
  public:
   struct Tagged {
@@ -21,25 +21,10 @@ class RayRecorder final : public PathObserver {
   std::vector<Tagged> camera, bounce, shadow;
 
   void on_camera(const CameraEvent& e) override { camera.push_back({0, Ray{e.origin, e.dir, kInfinity}}); }
-  void on_hit(const HitEvent& e) override {
-    p_ = e.p;
-    n_ = e.n;
-  }
-  void on_light(const LightEvent& e) override {
-    const vec3 origin = leave(e.wi);
-    const float tmax = e.infinite ? kInfinity : glm::length(e.point - origin) * (1.0f - 1e-4f);
-    shadow.push_back({e.vertex, Ray{origin, e.wi, tmax}});
-  }
+  void on_light(const LightEvent& e) override { shadow.push_back({e.vertex, e.ray}); }
   void on_scatter(const ScatterEvent& e) override {
-    if (!is_black(e.throughput)) bounce.push_back({e.vertex, Ray{leave(e.wi), e.wi, kInfinity}});
+    if (!is_black(e.throughput)) bounce.push_back({e.vertex, e.next});
   }
-
- private:
-  vec3 leave(const vec3& dir) const {
-    const vec3 side = glm::dot(dir, n_) >= 0.0f ? n_ : -n_;
-    return offset_ray_origin(p_, vec3(1e-6f * (1.0f + max_component(glm::abs(p_)))), side);
-  }
-  vec3 p_{0.0f}, n_{0.0f};
 };
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include "core/material.h"
 #include "core/math.h"
+#include "core/ray.h"
 
 #include <cstdint>
 
@@ -59,6 +60,7 @@ struct LightEvent {
   bool visible = false;
   float mis_weight = 1.0f;
   Spectrum added{0.0f};
+  Ray ray{vec3(0.0f), vec3(0.0f), 0.0f};  // the shadow ray as traced (offset off both surfaces)
 };
 
 struct ScatterEvent {
@@ -71,6 +73,7 @@ struct ScatterEvent {
   Spectrum weight{0.0f};    // f |cos| / pdf, divided by `survival` if the path survived roulette
   float survival = 1.0f;    // Russian roulette probability (1 = not applied)
   Spectrum throughput{0.0f};  // after this scattering
+  Ray next{vec3(0.0f), vec3(0.0f), 0.0f};  // the ray the path goes on with (tmax 0 if it ends here)
 };
 
 struct EndEvent {

@@ -30,8 +30,10 @@ constexpr float to_unit_float(std::uint64_t h) {
 class SampleStream {
  public:
   constexpr SampleStream(std::uint64_t seed, std::uint32_t pixel, std::uint32_t sample)
-      : key_(mix64(mix64(seed + 0x9e3779b97f4a7c15ull) ^
-                   ((static_cast<std::uint64_t>(pixel) << 32) | sample))) {}
+      : key_(mix64(seed_key(seed) ^ ((static_cast<std::uint64_t>(pixel) << 32) | sample))) {}
+
+  // key() is mix64(seed_key(seed) ^ (pixel << 32 | sample)).
+  static constexpr std::uint64_t seed_key(std::uint64_t seed) { return mix64(seed + 0x9e3779b97f4a7c15ull); }
 
   constexpr float get(std::uint32_t bounce, Dim dim) const {
     return to_unit_float(

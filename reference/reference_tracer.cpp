@@ -85,11 +85,13 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
     if (!PATHLAB_FAULT(RouletteNotReweighted)) weight /= survival;
   }
   const Spectrum beta_next = beta * weight;
+  const Ray next_ray = s.spawn(bs->wi);
   if (path.observer)
-    path.observer->on_scatter({vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, beta_next});
+    path.observer->on_scatter(
+        {vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, beta_next, next_ray});
 
   const PreviousVertex next{s.p, bs->pdf, bs->impulse, !(strategy == Strategy::LightBsdf && u_technique < 0.5f)};
-  return L + weight * Li(s.spawn(bs->wi), vertex + 1, next, beta_next, path);
+  return L + weight * Li(next_ray, vertex + 1, next, beta_next, path);
 }
 
 Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vertex, const Spectrum& beta,
@@ -101,10 +103,12 @@ Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vert
   const Spectrum f = s.eval(ls->wi, wo);
   if (is_black(f)) return Spectrum(0.0f);
   ++path.rays;
-  const bool visible = !scene_.occluded(s.spawn_to(ls->p, vec3(0.0f), -ls->wi));
+  const Ray shadow = s.spawn_to(ls->p, vec3(0.0f), -ls->wi);
+  const bool visible = !scene_.occluded(shadow);
   const Spectrum L = visible ? f * ls->Le / ls->pdf : Spectrum(0.0f);
   if (path.observer)
-    path.observer->on_light({vertex, true, false, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, 1.0f, beta * L});
+    path.observer->on_light(
+        {vertex, true, false, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, 1.0f, beta * L, shadow});
   return L;
 }
 
@@ -121,7 +125,8 @@ Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int verte
   const bool visible = !scene_.occluded(shadow);
   const Spectrum L = visible ? f * ls->Le * (w / ls->pdf) : Spectrum(0.0f);
   if (path.observer)
-    path.observer->on_light({vertex, false, ls->infinite, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, w, beta * L});
+    path.observer->on_light(
+        {vertex, false, ls->infinite, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, w, beta * L, shadow});
   return L;
 }
 

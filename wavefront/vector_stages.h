@@ -136,6 +136,10 @@ struct Sample {
 // Whether this processor runs the vectorised stages.
 bool cpu_supported();
 
+// SampleStream keys for a wave: each of keys[0, n) holds pixel << 32 |
+// sample and becomes mix64(seed_key ^ that), SampleStream::key().
+void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key);
+
 // The stages, in the order a bounce runs them (wavefront_tracer.cpp has the
 // scalar twin of each). Tracing the rays themselves is Embree's.
 // Each path's random stream, pixel and sample are set; make its camera ray
@@ -156,8 +160,8 @@ void add_light(const Wave& wave, std::size_t queries);
 // A cosine-weighted continuation, Russian roulette and the next ray.
 void scatter(const Scene& scene, const Wave& wave);
 // Packs the survivors into slots [0, m) in order and returns m; each path
-// that ended is written to samples[its kOutIndex] (an array of Sample's
-// layout, copied in bytes).
-std::size_t compact(const Wave& wave, void* samples);
+// that ended is written to samples[its kOutIndex - first] (an array of
+// Sample's layout, copied in bytes).
+std::size_t compact(const Wave& wave, void* samples, std::uint32_t first);
 
 }  // namespace pathlab::vector_stages

@@ -545,7 +545,15 @@ void scatter(const Scene& sc, const Wave& w) {
   }
 }
 
-std::size_t compact(const Wave& w, void* samples) {
+void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
+  const I seed = _mm512_set1_epi64(static_cast<long long>(seed_key));
+  for (std::size_t i0 = 0; i0 < n; i0 += 8) {
+    const auto m = static_cast<__mmask8>(n - i0 >= 8 ? 0xff : (1u << (n - i0)) - 1u);
+    _mm512_mask_storeu_epi64(keys + i0, m, mix64(_mm512_xor_si512(seed, _mm512_maskz_loadu_epi64(m, keys + i0))));
+  }
+}
+
+std::size_t compact(const Wave& w, void* samples, std::uint32_t first) {
   static constexpr FloatArray kMovedFloats[] = {kOx,   kOy,   kOz,   kDx,   kDy,   kDz,      kTmax,  kBetaR, kBetaG,
                                                 kBetaB, kLR,  kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX,
                                                 kFilmY};
@@ -560,7 +568,8 @@ std::size_t compact(const Wave& w, void* samples) {
       const std::size_t i = i0 + static_cast<std::size_t>(__builtin_ctz(dead));
       const Sample sample{w.f[kFilmX][i], w.f[kFilmY][i], {w.f[kLR][i], w.f[kLG][i], w.f[kLB][i]}, w.u[kRays][i],
                           w.u[kVertex][i] - (w.b[kFound][i] ? 0u : 1u)};
-      __builtin_memcpy(static_cast<char*>(samples) + sizeof(Sample) * w.u[kOutIndex][i], &sample, sizeof(Sample));
+      __builtin_memcpy(static_cast<char*>(samples) + sizeof(Sample) * (w.u[kOutIndex][i] - first), &sample,
+                       sizeof(Sample));
     }
     // The survivors, packed behind the previous ones (m <= i0: a block is
     // read before anything is written over it).

@@ -238,6 +238,11 @@ struct WavefrontTracer::Lanes {
   std::vector<std::uint32_t> u[vector_stages::kUintArrays];
   std::vector<std::uint8_t> b[vector_stages::kByteArrays];
   std::vector<std::uint64_t> rng;
+  // The wave's finished samples, in its own order: compact() writes them
+  // here (a region the caches hold) and the wave copies them out at its end
+  // in one sequential pass, instead of scattering them over the render's
+  // sample buffer.
+  std::vector<FilmSample> samples;
   vector_stages::Wave view;  // pointers into the arrays; view.n live paths
 
   void resize(std::size_t size) {
@@ -245,6 +250,7 @@ struct WavefrontTracer::Lanes {
     for (auto& a : u) a.resize(size);
     for (auto& a : b) a.resize(size);
     rng.resize(size);
+    samples.resize(size);
     for (int a = 0; a < vector_stages::kFloatArrays; ++a) view.f[a] = f[a].data();
     for (int a = 0; a < vector_stages::kUintArrays; ++a) view.u[a] = u[a].data();
     for (int a = 0; a < vector_stages::kByteArrays; ++a) view.b[a] = b[a].data();
@@ -253,7 +259,7 @@ struct WavefrontTracer::Lanes {
   std::size_t capacity() const { return rng.size(); }
   static constexpr std::size_t bytes_per_path() {
     return vector_stages::kFloatArrays * sizeof(float) + vector_stages::kUintArrays * sizeof(std::uint32_t) +
-           vector_stages::kByteArrays + sizeof(std::uint64_t);
+           vector_stages::kByteArrays + sizeof(std::uint64_t) + sizeof(FilmSample);
   }
 };
 
@@ -404,7 +410,7 @@ void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
       if (obs) {
         const LightSample& ls = w.light[k];
         obs->on_light({w.vertex[i], k == 2 * i, ls.infinite, ls.light, ls.p, ls.wi, ls.dist, ls.pdf, ls.Le, visible,
-                       w.light_weight[k], added});
+                       w.light_weight[k], added, w.shadow[k]});
       }
     }
   }
@@ -441,10 +447,11 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
       weight /= survival;
     }
     w.beta[i] *= weight;
-    if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i]});
+    const Ray next = s.spawn(bs->wi);
+    if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i], next});
     w.prev[i] = PreviousVertex{s.p, bs->pdf, bs->impulse,
                                !(strategy == Strategy::LightBsdf && w.u(i, Dim::Technique) < 0.5f)};
-    w.ray[i] = s.spawn(bs->wi);
+    w.ray[i] = next;
     w.vertex[i] = v + 1;
   }
 }
@@ -505,12 +512,13 @@ void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver*
 
 // The vectorised twin of run_wave: the same stages and the same Embree
 // batches, over Lanes.
-void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out) const {
+void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, std::uint32_t first) const {
   namespace vs = vector_stages;
   const vs::Scene& sc = vector_->scene;
   const vs::Wave& w = lanes.view;
   Clock clock;
   const std::uint64_t t0 = clock_ns();
+  const std::size_t paths = w.n;
   vs::generate_camera_rays(vector_->camera, w);
   for (bool camera_rays = true; lanes.view.n > 0; camera_rays = false) {
     const std::size_t n = w.n;
@@ -533,8 +541,9 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out) c
       vs::add_light(w, q);
     }
     vs::scatter(sc, w);
-    lanes.view.n = vs::compact(w, out.data());
+    lanes.view.n = vs::compact(w, lanes.samples.data(), first);
   }
+  std::copy_n(lanes.samples.begin(), paths, out.begin());
   clock.nanoseconds[kWave] = clock_ns() - t0;
   publish(clock);
 }
@@ -563,7 +572,7 @@ void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std
     auto j = static_cast<std::uint32_t>(begin % count);
     std::uint32_t x = pixel % width, y = pixel / width;
     for (std::size_t i = 0; i < n; ++i) {
-      set(i, static_cast<std::uint32_t>(begin + i), x, y, first + j, SampleStream(settings_.seed, pixel, first + j));
+      set(i, static_cast<std::uint32_t>(begin + i), x, y, pixel, first + j);
       if (++j == count) {
         j = 0;
         ++pixel;
@@ -585,14 +594,15 @@ void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std
         const std::size_t begin = k * wave_size;
         lanes.view.n = std::min(wave_size, out.size() - begin);
         fill(begin, lanes.view.n,
-             [&](std::size_t i, std::uint32_t slot, std::uint32_t x, std::uint32_t y, std::uint32_t /*sample: in rng*/,
-                 SampleStream rng) {
+             [&](std::size_t i, std::uint32_t slot, std::uint32_t x, std::uint32_t y, std::uint32_t pixel,
+                 std::uint32_t sample) {
                lanes.u[vs::kOutIndex][i] = slot;
                lanes.u[vs::kPixelX][i] = x;
                lanes.u[vs::kPixelY][i] = y;
-               lanes.rng[i] = rng.key();
+               lanes.rng[i] = (std::uint64_t{pixel} << 32) | sample;  // hashed into the key below
              });
-        run_wave_vector(lanes, out);
+        vs::hash_keys(lanes.rng.data(), lanes.view.n, SampleStream::seed_key(settings_.seed));
+        run_wave_vector(lanes, out.subspan(begin, lanes.view.n), static_cast<std::uint32_t>(begin));
       }
     });
     return;
@@ -604,13 +614,13 @@ void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std
       const std::size_t begin = k * wave_size;
       w.n = std::min(wave_size, out.size() - begin);
       fill(begin, w.n,
-           [&](std::size_t i, std::uint32_t slot, std::uint32_t x, std::uint32_t y, std::uint32_t sample,
-               SampleStream rng) {
+           [&](std::size_t i, std::uint32_t slot, std::uint32_t x, std::uint32_t y, std::uint32_t pixel,
+               std::uint32_t sample) {
              w.out_index[i] = slot;
              w.x[i] = x;
              w.y[i] = y;
              w.sample[i] = sample;
-             w.rng[i] = rng;
+             w.rng[i] = SampleStream(settings_.seed, pixel, sample);
            });
       run_wave(w, out, nullptr);
     }
