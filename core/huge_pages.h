@@ -26,7 +26,7 @@ struct HugePageAllocator {
   using value_type = T;
   HugePageAllocator() = default;
   template <class U>
-  HugePageAllocator(const HugePageAllocator<U>&) noexcept {}  // NOLINT: converting, as allocators are
+  HugePageAllocator(const HugePageAllocator<U>&) noexcept {}  // converting, as allocators must
   T* allocate(std::size_t n) {
     if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_array_new_length();
     return static_cast<T*>(detail::allocate_huge_page_backed(n * sizeof(T)));

@@ -13,6 +13,9 @@ bool near(const vec3& a, const vec3& b, float tol) {
   return near(a.x, b.x, tol) && near(a.y, b.y, tol) && near(a.z, b.z, tol);
 }
 bool near(const vec2& a, const vec2& b, float tol) { return near(a.x, b.x, tol) && near(a.y, b.y, tol); }
+bool near(const Ray& a, const Ray& b, float tol) {
+  return near(a.origin, b.origin, tol) && near(a.dir, b.dir, tol) && near(a.tmax, b.tmax, tol);
+}
 
 int vertex_of(const PathEvent& e) {
   return std::visit(
@@ -56,12 +59,14 @@ Difference compare(const PathEvent& ea, const PathEvent& eb, float tol) {
         } else if constexpr (std::is_same_v<T, LightEvent>) {
           check(a.delta == b.delta && a.light == b.light, "light chosen");
           check(near(a.wi, b.wi, tol) && near(a.pdf, b.pdf, tol), "light direction or pdf");
+          check(near(a.ray, b.ray, tol), "shadow ray");
           outcome(a.visible == b.visible, "light visibility");
           check(near(a.added, b.added, tol), "light added");
         } else if constexpr (std::is_same_v<T, ScatterEvent>) {
           check(a.lobe == b.lobe && a.impulse == b.impulse, "lobe");
           check(near(a.wi, b.wi, tol) && near(a.pdf, b.pdf, tol), "scattered direction or pdf");
           check(near(a.throughput, b.throughput, tol), "throughput");
+          check(near(a.next, b.next, tol), "continuation ray");
         } else if constexpr (std::is_same_v<T, EndEvent>) {
           outcome(a.reason == b.reason, "why the path ended");
         }

@@ -117,6 +117,47 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
   EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
 }
 
+// Both tracers report the rays they cast (LightEvent::ray,
+// ScatterEvent::next; the raw-rate benchmark casts exactly these): each
+// leaves the surface it starts on, the shadow ray ends at the light sample's
+// point and the continuation goes along the sampled direction - and the two
+// tracers' rays agree.
+TEST(Wavefront, EventsCarryTheRaysAsCast) {
+  Scene scene = test::small_cornell(12, 1, FilterKind::Box);
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const ReferenceTracer reference(compiled, settings);
+  const WavefrontTracer wavefront(compiled, settings);
+  std::size_t shadow_rays = 0, continuations = 0;
+  for (std::uint32_t y = 0; y < 12; ++y)
+    for (std::uint32_t x = 0; x < 12; ++x) {
+      PathRecorder ra, rb;
+      reference.trace_sample(x, y, 0, &ra);
+      wavefront.trace_sample(x, y, 0, &rb);
+      const PathDivergence d = first_divergence(ra.events(), rb.events(), 1e-4f);
+      EXPECT_TRUE(d.identical || d.rounding) << x << "," << y << ": " << d.reason;
+      vec3 p(0.0f);
+      for (const PathEvent& e : ra.events()) {
+        if (const auto* h = std::get_if<HitEvent>(&e)) p = h->p;
+        if (const auto* l = std::get_if<LightEvent>(&e)) {
+          ++shadow_rays;
+          EXPECT_LT(glm::length(l->ray.origin - p), 1e-3f);
+          EXPECT_GT(glm::dot(l->ray.dir, l->wi), 0.9999f);
+          ASSERT_TRUE(std::isfinite(l->ray.tmax));
+          EXPECT_LT(glm::length(l->ray.origin + l->ray.tmax * l->ray.dir - l->point), 1e-3f);
+        }
+        if (const auto* sc = std::get_if<ScatterEvent>(&e); sc && !is_black(sc->throughput)) {
+          ++continuations;
+          EXPECT_LT(glm::length(sc->next.origin - p), 1e-3f);
+          EXPECT_EQ(sc->next.dir, sc->wi);
+          EXPECT_EQ(sc->next.tmax, kInfinity);
+        }
+      }
+    }
+  EXPECT_GT(shadow_rays, 100u);
+  EXPECT_GT(continuations, 100u);
+}
+
 // The vectorised stages (wavefront/vector_stages.h) give every sample the
 // bits the scalar stages give it, on every scene and strategy they take:
 // several lights (the pick's binary search), a two-sided emitting box, a
