@@ -170,7 +170,7 @@ struct WavefrontTracer::VectorStages {
     if (n_lights >= 1 && n_lights <= 16) {  // small enough to keep by column
       v->light_columns.assign(16 * vs::kLightColumns, 0.0f);
       for (std::size_t l = 0; l < n_lights; ++l) {
-        for (int f = 0; f < 16; ++f) v->light_columns[16 * f + l] = v->light_triangle[16 * l + f];
+        for (int f = 0; f < vs::kLightCdf; ++f) v->light_columns[16 * f + l] = v->light_triangle[16 * l + f];
         v->light_columns[16 * vs::kLightCdf + l] = lights.cdf()[l];
         v->light_columns[16 * vs::kLightPmf + l] = lights.pmf()[l];
         v->light_columns[16 * vs::kLightInvArea + l] = v->inv_area[l];
@@ -179,7 +179,7 @@ struct WavefrontTracer::VectorStages {
     sc.lights = {n_lights, lights.cdf().data(), lights.pmf().data(), v->inv_area.data(), v->light_triangle.data(),
                  v->light_columns.empty() ? nullptr : v->light_columns.data()};
     // Per shape: its material's parameters and its geometry.
-    // 32-bit byte offsets: 128 bytes per shape, 48 per triangle, 64 per light.
+    // Gathers index these tables with 32-bit float indices: 32 per shape, 12 per triangle, 16 per light.
     if (compiled.triangles().size() >= (std::size_t{1} << 27)) return no("more than 2^27 triangles");
     if (scene.shapes.size() >= (std::size_t{1} << 24)) return no("more than 2^24 shapes");
     for (std::uint32_t i = 0; i < scene.shapes.size(); ++i) {
