@@ -181,6 +181,17 @@ struct alignas(64) ValidMask {
   }
 };
 
+// Calls packet(b, m, valid) for rays [b, b + m) of n, 16 at a time (the
+// last group may be shorter), valid being the lane mask Embree takes.
+template <typename Packet>
+void for_each_packet(std::size_t n, Packet&& packet) {
+  for (std::size_t b = 0; b < n; b += kPacket) {
+    const std::size_t m = std::min<std::size_t>(kPacket, n - b);
+    const ValidMask valid(m);
+    packet(b, m, valid.lane);
+  }
+}
+
 }  // namespace
 
 void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found,
@@ -200,19 +211,17 @@ void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> h
       }
       return;
     case RayBatchMode::Packet16:
-      for (std::size_t b = 0; b < rays.size(); b += kPacket) {
-        const std::size_t n = std::min<std::size_t>(kPacket, rays.size() - b);
-        const ValidMask valid(n);
+      for_each_packet(rays.size(), [&](std::size_t b, std::size_t n, const int* valid) {
         RTCRayHit16 rh;
         for (std::size_t k = 0; k < n; ++k) {
           fill_lane(rh.ray, static_cast<int>(k), rays[b + k]);
           rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
           rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
         }
-        rtcIntersect16(valid.lane, impl_->scene, &context, &rh);
+        rtcIntersect16(valid, impl_->scene, &context, &rh);
         for (std::size_t k = 0; k < n; ++k)
           record(b + k, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]);
-      }
+      });
       return;
     case RayBatchMode::Stream: {
       thread_local std::vector<RTCRayHit> buffer;
@@ -241,14 +250,12 @@ void EmbreeAccel::occluded_batch(std::span<const Ray> rays, std::span<std::uint8
       }
       return;
     case RayBatchMode::Packet16:
-      for (std::size_t b = 0; b < rays.size(); b += kPacket) {
-        const std::size_t n = std::min<std::size_t>(kPacket, rays.size() - b);
-        const ValidMask valid(n);
+      for_each_packet(rays.size(), [&](std::size_t b, std::size_t n, const int* valid) {
         RTCRay16 r;
         for (std::size_t k = 0; k < n; ++k) fill_lane(r, static_cast<int>(k), rays[b + k]);
-        rtcOccluded16(valid.lane, impl_->scene, &context, &r);
+        rtcOccluded16(valid, impl_->scene, &context, &r);
         for (std::size_t k = 0; k < n; ++k) occluded[b + k] = r.tfar[k] < 0.0f;
-      }
+      });
       return;
     case RayBatchMode::Stream: {
       thread_local std::vector<RTCRay> buffer;
@@ -293,10 +300,16 @@ void fill_packet(Packet& p, const RayArrays& rays, std::size_t b, std::size_t n)
 struct StreamScratch {
   std::vector<float> zeros, tfar, ng, u, v;
   std::vector<unsigned> mask, zero_ids, geom, prim, inst;
-  void resize(std::size_t n) {
-    if (zeros.size() >= n) return;
-    zeros.assign(n, 0.0f), mask.assign(n, 0xffffffffu), zero_ids.assign(n, 0u);
-    tfar.resize(n), ng.resize(n), u.resize(n), v.resize(n), geom.resize(n), prim.resize(n), inst.resize(n);
+  // This thread's scratch, with room for n rays and tfar set from `rays`.
+  static StreamScratch& for_rays(const RayArrays& rays, std::size_t n) {
+    thread_local StreamScratch s;
+    if (s.zeros.size() < n) {
+      s.zeros.assign(n, 0.0f), s.mask.assign(n, 0xffffffffu), s.zero_ids.assign(n, 0u);
+      s.tfar.resize(n), s.ng.resize(n), s.u.resize(n), s.v.resize(n), s.geom.resize(n), s.prim.resize(n),
+          s.inst.resize(n);
+    }
+    std::memcpy(s.tfar.data(), rays.tmax, n * sizeof(float));
+    return s;
   }
   // Embree's pointer-SoA ray is not const, but it writes only tfar (kept
   // here) and, for intersections, the hit arrays.
@@ -327,21 +340,17 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays, std::size_t n, const H
       }
       return;
     case RayBatchMode::Packet16:
-      for (std::size_t b = 0; b < n; b += kPacket) {
-        const std::size_t m = std::min<std::size_t>(kPacket, n - b);
-        const ValidMask valid(m);
+      for_each_packet(n, [&](std::size_t b, std::size_t m, const int* valid) {
         RTCRayHit16 rh;
         fill_packet(rh.ray, rays, b, m);
         for (std::size_t k = 0; k < m; ++k) rh.hit.geomID[k] = rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
-        rtcIntersect16(valid.lane, impl_->scene, &context, &rh);
+        rtcIntersect16(valid, impl_->scene, &context, &rh);
         for (std::size_t k = 0; k < m; ++k)
           record(b + k, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]);
-      }
+      });
       return;
     case RayBatchMode::Stream: {
-      thread_local StreamScratch s;
-      s.resize(n);
-      std::memcpy(s.tfar.data(), rays.tmax, n * sizeof(float));
+      StreamScratch& s = StreamScratch::for_rays(rays, n);
       std::fill_n(s.geom.begin(), n, RTC_INVALID_GEOMETRY_ID);
       std::fill_n(s.inst.begin(), n, RTC_INVALID_GEOMETRY_ID);
       const RTCRayHitNp rh{s.ray(rays), RTCHitNp{s.ng.data(), s.ng.data(), s.ng.data(), s.u.data(), s.v.data(),
@@ -366,19 +375,15 @@ void EmbreeAccel::occluded_arrays(const RayArrays& rays, std::size_t n, std::uin
       }
       return;
     case RayBatchMode::Packet16:
-      for (std::size_t b = 0; b < n; b += kPacket) {
-        const std::size_t m = std::min<std::size_t>(kPacket, n - b);
-        const ValidMask valid(m);
+      for_each_packet(n, [&](std::size_t b, std::size_t m, const int* valid) {
         RTCRay16 r;
         fill_packet(r, rays, b, m);
-        rtcOccluded16(valid.lane, impl_->scene, &context, &r);
+        rtcOccluded16(valid, impl_->scene, &context, &r);
         for (std::size_t k = 0; k < m; ++k) occluded[b + k] = r.tfar[k] < 0.0f;
-      }
+      });
       return;
     case RayBatchMode::Stream: {
-      thread_local StreamScratch s;
-      s.resize(n);
-      std::memcpy(s.tfar.data(), rays.tmax, n * sizeof(float));
+      StreamScratch& s = StreamScratch::for_rays(rays, n);
       const RTCRayNp r = s.ray(rays);
       rtcOccludedNp(impl_->scene, &context, &r, static_cast<unsigned>(n));
       for (std::size_t i = 0; i < n; ++i) occluded[i] = s.tfar[i] < 0.0f;

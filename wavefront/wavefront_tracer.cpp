@@ -580,8 +580,6 @@ void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std
       }
     }
   };
-  // Wave k always holds the same samples, whichever thread runs it, so the
-  // batches Embree sees - and hence the image - do not depend on threads.
   // Each thread keeps its wave's arrays from one batch to the next
   // (allocating and page-faulting them in per wave cost more than tracing).
   const std::size_t n_max = std::min(wave_size, out.size());
