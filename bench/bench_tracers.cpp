@@ -256,6 +256,9 @@ void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes mode
   // which is a single thread's rate.
   const double threads = setup().cpu_time ? 1.0 : static_cast<double>(max_threads());
   state.counters["embree_share"] = t.waves_seconds > 0.0 ? t.query_seconds() / t.waves_seconds : 0.0;
+  // The share of the render's time (on all threads) spent inside the waves;
+  // the rest is the film, the sample buffer and the threads' idle tails.
+  state.counters["waves_share"] = wavefront_seconds > 0.0 ? t.waves_seconds / (threads * wavefront_seconds) : 0.0;
   state.counters["camera_in_context"] = threads * t.camera.rays_per_second();
   state.counters["bounce_in_context"] = threads * t.bounce.rays_per_second();
   state.counters["shadow_in_context"] = threads * t.shadow.rays_per_second();
@@ -383,9 +386,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
         const double raw_kind = median(raw_name(kind, mode), "rays/s");
         return raw_kind > 0 ? median(run, counter) / raw_kind : 0.0;
       };
-      std::printf("  Embree %.0f%% of the waves' time; in context at %.2f (camera), %.2f (bounce), %.2f (shadow) of "
+      std::printf("  waves %.0f%% of the render's time; Embree %.0f%% of the waves' time; in context at %.2f (camera), %.2f (bounce), %.2f (shadow) of "
                   "its raw rates\n",
-                  100.0 * median(run, "embree_share"), in_context("camera_in_context", RayKind::Camera, modes.camera),
+                  100.0 * median(run, "waves_share"), 100.0 * median(run, "embree_share"), in_context("camera_in_context", RayKind::Camera, modes.camera),
                   in_context("bounce_in_context", RayKind::Bounce, modes.bounce),
                   in_context("shadow_in_context", RayKind::Shadow, modes.shadow));
     }

@@ -5,70 +5,100 @@
 namespace pathlab {
 
 Film::Film(int width, int height, FilterKind filter)
-    : width_(width), height_(height), filter_(filter), pixels_(static_cast<std::size_t>(width) * height) {}
-
-void Film::accumulate(Pixel& px, double w, const Spectrum& L) {
-  const dvec3 l(L);
-  const double w2 = w * w;
-  px.sum_w += w;
-  px.sum_w2 += w2;
-  px.sum_wL += w * l;
-  px.sum_w2L += w2 * l;
-  px.sum_w2L2 += w2 * l * l;
-}
+    : width_(width),
+      height_(height),
+      filter_(filter),
+      pixels_(static_cast<std::size_t>(width) * height),
+      splat_(filter == FilterKind::Box ? 0 : static_cast<std::size_t>(width) * height) {}
 
 void Film::add_batch(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples) {
-  const std::size_t n = samples.size();
-  // Serial scan for bad samples: cheap, and it keeps the report in a fixed order.
-  bad_mask_.assign(n, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (is_finite(samples[i].L)) continue;
-    bad_mask_[i] = 1;
-    ++bad_count_;
-    if (bad_kept_.size() < kMaxBadSamplesKept) {
-      const std::size_t pixel = i / count;
-      bad_kept_.push_back({static_cast<std::uint32_t>(pixel % width_), static_cast<std::uint32_t>(pixel / width_),
-                           first + static_cast<std::uint32_t>(i % count), samples[i].L});
-    }
-  }
-
+  // One parallel pass over the rows; each pixel gathers its samples in a
+  // fixed order. NaN / Inf samples are left out and counted per row; a batch
+  // that had any is scanned again, serially, to report them in order.
+  std::vector<std::uint64_t> bad_in_row(static_cast<std::size_t>(height_), 0);
   parallel_for(0, static_cast<std::size_t>(height_), 1, [&](std::size_t y0, std::size_t y1) {
     for (int y = static_cast<int>(y0); y < static_cast<int>(y1); ++y) {
+      std::uint64_t bad = 0;
       for (int x = 0; x < width_; ++x) {
-        Pixel& px = pixels_[static_cast<std::size_t>(y) * width_ + x];
-        const std::size_t own = static_cast<std::size_t>(y) * width_ + x;
-        for (std::uint32_t j = 0; j < count; ++j) {
-          if (!bad_mask_[own * count + j]) ++px.count;
-          if (filter_ == FilterKind::Box) {
-            if (!bad_mask_[own * count + j]) accumulate(px, 1.0, samples[own * count + j].L);
-            continue;
+        Pixel& px = pixels_[index(x, y)];
+        const std::size_t own = index(x, y) * count;
+        if (filter_ == FilterKind::Box) {
+          for (std::uint32_t j = 0; j < count; ++j) {
+            const Spectrum& L = samples[own + j].L;
+            if (!is_finite(L)) {
+              ++bad;
+              continue;
+            }
+            const dvec3 l(L);
+            ++px.count;
+            px.sum_wL += l;
+            px.sum_w2L2 += l * l;
           }
-          // Bilinear splat: gather sample j of the 3x3 source pixels around
-          // (x, y), weighting each by the tent centred on this pixel's centre.
-          const float cx = static_cast<float>(x) + 0.5f, cy = static_cast<float>(y) + 0.5f;
+          continue;
+        }
+        // Bilinear splat: gather sample j of the 3x3 source pixels around
+        // (x, y), weighting each by the tent centred on this pixel's centre.
+        SplatSums& sp = splat_[index(x, y)];
+        const float cx = static_cast<float>(x) + 0.5f, cy = static_cast<float>(y) + 0.5f;
+        for (std::uint32_t j = 0; j < count; ++j) {
+          if (is_finite(samples[own + j].L))
+            ++px.count;
+          else
+            ++bad;
           for (int sy = std::max(0, y - 1); sy <= std::min(height_ - 1, y + 1); ++sy) {
             for (int sx = std::max(0, x - 1); sx <= std::min(width_ - 1, x + 1); ++sx) {
-              const std::size_t i = (static_cast<std::size_t>(sy) * width_ + sx) * count + j;
-              if (bad_mask_[i]) continue;
-              const FilmSample& s = samples[i];
+              const FilmSample& s = samples[index(sx, sy) * count + j];
+              if (!is_finite(s.L)) continue;
               const float wx = 1.0f - std::abs(s.film.x - cx), wy = 1.0f - std::abs(s.film.y - cy);
               if (wx <= 0.0f || wy <= 0.0f) continue;
-              accumulate(px, static_cast<double>(wx) * wy, s.L);
+              const double w = static_cast<double>(wx) * wy, w2 = w * w;
+              const dvec3 l(s.L);
+              sp.sum_w += w;
+              sp.sum_w2 += w2;
+              px.sum_wL += w * l;
+              sp.sum_w2L += w2 * l;
+              px.sum_w2L2 += w2 * l * l;
             }
           }
         }
       }
+      bad_in_row[static_cast<std::size_t>(y)] = bad;
     }
   });
+  std::uint64_t bad = 0;
+  for (std::uint64_t b : bad_in_row) bad += b;
+  if (bad > 0) {
+    bad_count_ += bad;
+    record_bad(first, count, samples);
+  }
+}
+
+void Film::record_bad(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples) {
+  for (std::size_t i = 0; i < samples.size() && bad_kept_.size() < kMaxBadSamplesKept; ++i) {
+    if (is_finite(samples[i].L)) continue;
+    const std::size_t pixel = i / count;
+    bad_kept_.push_back({static_cast<std::uint32_t>(pixel % width_), static_cast<std::uint32_t>(pixel / width_),
+                         first + static_cast<std::uint32_t>(i % count), samples[i].L});
+  }
+}
+
+Film::Sums Film::sums(int x, int y) const {
+  const Pixel& p = pixels_[index(x, y)];
+  if (splat_.empty()) {
+    const auto n = static_cast<double>(p.count);
+    return {n, n, p.sum_wL, p.sum_wL, p.sum_w2L2};
+  }
+  const SplatSums& s = splat_[index(x, y)];
+  return {s.sum_w, s.sum_w2, p.sum_wL, s.sum_w2L, p.sum_w2L2};
 }
 
 Spectrum Film::mean(int x, int y) const {
-  const Pixel& p = at(x, y);
+  const Sums p = sums(x, y);
   return p.sum_w > 0.0 ? Spectrum(p.sum_wL / p.sum_w) : Spectrum(0.0f);
 }
 
 Spectrum Film::variance_of_mean(int x, int y) const {
-  const Pixel& p = at(x, y);
+  const Sums p = sums(x, y);
   if (p.sum_w <= 0.0) return Spectrum(0.0f);
   const dvec3 m = p.sum_wL / p.sum_w;
   // sum w^2 (L - m)^2 = sum w^2 L^2 - 2 m sum w^2 L + m^2 sum w^2
@@ -82,15 +112,19 @@ Spectrum Film::variance_of_mean(int x, int y) const {
 
 Image Film::image() const {
   Image img(width_, height_);
-  for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) img.at(x, y) = mean(x, y);
+  parallel_for(0, static_cast<std::size_t>(height_), 16, [&](std::size_t y0, std::size_t y1) {
+    for (int y = static_cast<int>(y0); y < static_cast<int>(y1); ++y)
+      for (int x = 0; x < width_; ++x) img.at(x, y) = mean(x, y);
+  });
   return img;
 }
 
 Image Film::variance_of_mean() const {
   Image img(width_, height_);
-  for (int y = 0; y < height_; ++y)
-    for (int x = 0; x < width_; ++x) img.at(x, y) = variance_of_mean(x, y);
+  parallel_for(0, static_cast<std::size_t>(height_), 16, [&](std::size_t y0, std::size_t y1) {
+    for (int y = static_cast<int>(y0); y < static_cast<int>(y1); ++y)
+      for (int x = 0; x < width_; ++x) img.at(x, y) = variance_of_mean(x, y);
+  });
   return img;
 }
 

@@ -11,6 +11,7 @@
 // to the usual  s^2 / n  for the box filter (w = 1).
 #pragma once
 
+#include "core/huge_pages.h"
 #include "core/image_io.h"
 #include "core/math.h"
 #include "core/scene.h"
@@ -52,30 +53,44 @@ class Film {
   Spectrum mean(int x, int y) const;
   Spectrum variance_of_mean(int x, int y) const;
   // Samples that fell in pixel (x, y) (its own samples, not splat neighbours).
-  std::uint64_t sample_count(int x, int y) const { return at(x, y).count; }
+  std::uint64_t sample_count(int x, int y) const { return pixels_[index(x, y)].count; }
 
   std::uint64_t bad_sample_count() const { return bad_count_; }
   const std::vector<BadSample>& bad_samples() const { return bad_kept_; }
   static constexpr std::size_t kMaxBadSamplesKept = 16;
 
  private:
+  // What every filter needs per pixel: sum(w L), sum(w^2 L^2) and the count
+  // of its own samples. With the box filter every weight is 1, so sum(w) and
+  // sum(w^2) are the count and sum(w^2 L) is sum(w L): a box film keeps
+  // these 56 bytes per pixel and nothing else.
   struct Pixel {
-    double sum_w = 0.0;
-    double sum_w2 = 0.0;
     dvec3 sum_wL{0.0};
-    dvec3 sum_w2L{0.0};
     dvec3 sum_w2L2{0.0};
     std::uint64_t count = 0;
   };
-  const Pixel& at(int x, int y) const { return pixels_[static_cast<std::size_t>(y) * width_ + x]; }
-  void accumulate(Pixel& px, double w, const Spectrum& L);
+  // What a splatting filter (w != 1) adds: sum(w), sum(w^2), sum(w^2 L).
+  struct SplatSums {
+    double sum_w = 0.0;
+    double sum_w2 = 0.0;
+    dvec3 sum_w2L{0.0};
+  };
+  // A pixel's sums whatever the filter.
+  struct Sums {
+    double sum_w, sum_w2;
+    dvec3 sum_wL, sum_w2L, sum_w2L2;
+  };
+  Sums sums(int x, int y) const;
+  std::size_t index(int x, int y) const { return static_cast<std::size_t>(y) * width_ + x; }
+  // Records the batch's NaN / Inf samples in order (the rare path).
+  void record_bad(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples);
 
   int width_, height_;
   FilterKind filter_;
-  std::vector<Pixel> pixels_;
+  HugePageVector<Pixel> pixels_;
+  HugePageVector<SplatSums> splat_;  // empty for the box filter
   std::uint64_t bad_count_ = 0;
   std::vector<BadSample> bad_kept_;
-  std::vector<std::uint8_t> bad_mask_;  // scratch for one batch
 };
 
 }  // namespace pathlab

@@ -1,5 +1,7 @@
 #include "core/render.h"
 
+#include "core/parallel.h"
+
 #include <algorithm>
 #include <chrono>
 #include <vector>
@@ -22,6 +24,24 @@ void clamp_samples(std::span<FilmSample> out, float limit, RenderStats& stats) {
       stats.energy_clamped += before - average(s.L);
     }
   }
+}
+
+// The rays a batch's samples cast, summed in parallel (a serial pass over
+// a frame's samples costs as much as half the film's).
+std::uint64_t rays_cast(std::span<const FilmSample> samples) {
+  constexpr std::size_t kChunk = std::size_t{1} << 16;
+  std::vector<std::uint64_t> partial((samples.size() + kChunk - 1) / kChunk, 0);
+  parallel_for(0, partial.size(), 1, [&](std::size_t c0, std::size_t c1) {
+    for (std::size_t c = c0; c < c1; ++c) {
+      std::uint64_t rays = 0;
+      for (const FilmSample& s : samples.subspan(c * kChunk, std::min(kChunk, samples.size() - c * kChunk)))
+        rays += s.rays;
+      partial[c] = rays;
+    }
+  });
+  std::uint64_t rays = 0;
+  for (std::uint64_t r : partial) rays += r;
+  return rays;
 }
 
 }  // namespace
@@ -51,7 +71,7 @@ RenderStats render_samples(const Tracer& tracer, Film& film, std::uint32_t first
       tracer.render_batch(begin, count, out);
       if (clamp > 0.0f) clamp_samples(out, clamp, stats);
       film.add_batch(begin, count, out);
-      for (const FilmSample& s : out) stats.rays += s.rays;
+      stats.rays += rays_cast(out);
       stats.samples += out.size();
       if (progress) progress(static_cast<double>(begin + count - first) / (last - first));
     }

@@ -88,6 +88,21 @@ TEST(Film, NanAndInfSamplesAreLeftOutCountedAndLocated) {
   EXPECT_EQ(film.sample_count(1, 1), 1u);
 }
 
+TEST(Film, BilinearLeavesANanOutOfItsNeighboursToo) {
+  // Pixel 1's NaN sample lies 0.3 px from pixel 0's centre line, inside its
+  // tent: pixel 0 must neither take it in nor count it.
+  Film film(2, 1, FilterKind::Bilinear);
+  std::vector<FilmSample> s = {{vec2(0.5f, 0.5f), Spectrum(2.0f), 1},
+                               {vec2(1.2f, 0.5f), Spectrum(std::nanf(""), 1.0f, 1.0f), 1}};
+  film.add_batch(0, 1, s);
+  EXPECT_EQ(film.bad_sample_count(), 1u);
+  EXPECT_EQ(film.mean(0, 0), Spectrum(2.0f));
+  EXPECT_EQ(film.mean(1, 0), Spectrum(0.0f));  // its only sample was bad; pixel 0's lies outside its tent
+  EXPECT_EQ(film.sample_count(0, 0), 1u);
+  EXPECT_EQ(film.sample_count(1, 0), 0u);
+  EXPECT_EQ(film.variance_of_mean(0, 0), Spectrum(0.0f));
+}
+
 Image render_with_threads(const Scene& scene_in, int threads) {
   const ThreadLimit limit(threads);
   Scene scene = scene_in;
