@@ -322,12 +322,16 @@ struct StreamScratch {
 
 }  // namespace
 
-void EmbreeAccel::intersect_arrays(const RayArrays& rays, std::size_t n, const HitArrays& hits, RayBatchMode mode,
-                                   bool coherent) const {
+void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, const HitArrays& hits_in,
+                                   RayBatchMode mode, bool coherent) const {
   RTCIntersectContext context = make_context(coherent);
+  // Copies whose address Embree never sees, so that its opaque calls do not
+  // force the array pointers to be reloaded for every ray.
+  const RayArrays rays = rays_in;
+  const HitArrays hits = hits_in;
+  // Every field written, hit or miss: no branch on a coin flip per ray.
   auto record = [&](std::size_t i, float tfar, unsigned geom, unsigned prim, float u, float v) {
     hits.found[i] = geom != RTC_INVALID_GEOMETRY_ID;
-    if (!hits.found[i]) return;
     hits.t[i] = tfar, hits.shape[i] = geom, hits.prim[i] = prim, hits.u[i] = u, hits.v[i] = v;
   };
   switch (mode) {
