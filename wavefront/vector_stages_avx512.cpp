@@ -564,12 +564,20 @@ std::size_t compact(const Wave& w, void* samples, std::uint32_t first) {
     const M in = lanes(w.n, i0);
     const M alive = load_mask(w, kAlive, i0, in);
     // The paths that ended: FilmSample{film, L, rays, hits}.
+    // Field by field: a Sample built on the stack and copied whole would be
+    // read back before its parts' stores retire (a store-forwarding stall
+    // per path).
     for (M dead = in & ~alive; dead != 0; dead &= static_cast<M>(dead - 1)) {
       const std::size_t i = i0 + static_cast<std::size_t>(__builtin_ctz(dead));
-      const Sample sample{w.f[kFilmX][i], w.f[kFilmY][i], {w.f[kLR][i], w.f[kLG][i], w.f[kLB][i]}, w.u[kRays][i],
-                          w.u[kVertex][i] - (w.b[kFound][i] ? 0u : 1u)};
-      __builtin_memcpy(static_cast<char*>(samples) + sizeof(Sample) * (w.u[kOutIndex][i] - first), &sample,
-                       sizeof(Sample));
+      char* out = static_cast<char*>(samples) + sizeof(Sample) * (w.u[kOutIndex][i] - first);
+      const std::uint32_t hits = w.u[kVertex][i] - (w.b[kFound][i] ? 0u : 1u);
+      __builtin_memcpy(out + offsetof(Sample, film_x), &w.f[kFilmX][i], sizeof(float));
+      __builtin_memcpy(out + offsetof(Sample, film_y), &w.f[kFilmY][i], sizeof(float));
+      __builtin_memcpy(out + offsetof(Sample, L) + 0 * sizeof(float), &w.f[kLR][i], sizeof(float));
+      __builtin_memcpy(out + offsetof(Sample, L) + 1 * sizeof(float), &w.f[kLG][i], sizeof(float));
+      __builtin_memcpy(out + offsetof(Sample, L) + 2 * sizeof(float), &w.f[kLB][i], sizeof(float));
+      __builtin_memcpy(out + offsetof(Sample, rays), &w.u[kRays][i], sizeof(std::uint32_t));
+      __builtin_memcpy(out + offsetof(Sample, hits), &hits, sizeof(std::uint32_t));
     }
     // The survivors, packed behind the previous ones (m <= i0: a block is
     // read before anything is written over it).
