@@ -145,6 +145,9 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key);
 // Each path's random stream, pixel and sample are set; make its camera ray
 // and reset its state.
 void generate_camera_rays(const Camera& camera, const Wave& wave);
+// Prefetches the triangle each mesh hit landed on, for resolve(): one pass
+// first lets the hits' cache misses overlap.
+void prefetch_hits(const Scene& scene, const Wave& wave);
 // The Surfel of each path whose ray found a surface, and one more ray per path.
 void resolve(const Scene& scene, const Wave& wave);
 // The emission each ray found, as the strategy weighs it, and the end of

@@ -288,6 +288,23 @@ void generate_camera_rays(const Camera& c, const Wave& w) {
   }
 }
 
+void prefetch_hits(const Scene& sc, const Wave& w) {
+  for (std::size_t i0 = 0; i0 < w.n; i0 += 16) {
+    const M found = load_mask(w, kFound, i0, lanes(w.n, i0));
+    if (found == 0) continue;
+    const I shape = load(w, kShape, i0, found);
+    const M mesh = found & ~shape_flag(found, sc, shape, kIsSphere);
+    if (mesh == 0) continue;
+    alignas(64) std::uint32_t tri[16];
+    _mm512_store_si512(tri, _mm512_add_epi32(shape_int(mesh, sc, shape, kFirstTriangle), load(w, kPrim, i0, mesh)));
+    for (M m = mesh; m != 0; m &= static_cast<M>(m - 1)) {
+      const float* t = sc.triangles + 12 * static_cast<std::size_t>(tri[__builtin_ctz(m)]);
+      __builtin_prefetch(t);       // p0 ...
+      __builtin_prefetch(t + 11);  // ... n: a triangle may straddle two lines
+    }
+  }
+}
+
 void resolve(const Scene& sc, const Wave& w) {
   constexpr float kGamma5 = (5.0f * 0x1p-24f) / (1.0f - 5.0f * 0x1p-24f);
   constexpr float kGamma2 = (2.0f * 0x1p-24f) / (1.0f - 2.0f * 0x1p-24f);

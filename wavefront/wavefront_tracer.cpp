@@ -527,8 +527,7 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
     const std::uint64_t t = clock_ns();
     scene_.intersect_arrays(rays, n, hits, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
     clock.batch(camera_rays ? kCameraQueries : kBounceQueries, t, n);
-    for (std::size_t i = 0; i < n; ++i)  // overlap the hits' cache misses (as intersect() does)
-      if (w.b[vs::kFound][i]) scene_.prefetch(w.u[vs::kShape][i], w.u[vs::kPrim][i]);
+    vs::prefetch_hits(sc, w);  // overlap the hits' cache misses (as intersect() does)
     vs::resolve(sc, w);
     vs::add_emission(sc, w);
     const std::size_t q = vs::sample_lights(sc, w);
