@@ -64,16 +64,17 @@ class Film {
   // of its own samples. With the box filter every weight is 1, so sum(w) and
   // sum(w^2) are the count and sum(w^2 L) is sum(w L): a box film keeps
   // these 56 bytes per pixel and nothing else.
+  // (No member initialisers: the film zeroes its pixels in parallel.)
   struct Pixel {
-    dvec3 sum_wL{0.0};
-    dvec3 sum_w2L2{0.0};
-    std::uint64_t count = 0;
+    dvec3 sum_wL;
+    dvec3 sum_w2L2;
+    std::uint64_t count;
   };
   // What a splatting filter (w != 1) adds: sum(w), sum(w^2), sum(w^2 L).
   struct SplatSums {
-    double sum_w = 0.0;
-    double sum_w2 = 0.0;
-    dvec3 sum_w2L{0.0};
+    double sum_w;
+    double sum_w2;
+    dvec3 sum_w2L;
   };
   // A pixel's sums whatever the filter.
   struct Sums {

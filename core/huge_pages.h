@@ -5,11 +5,14 @@
 // "madvise", does). One TLB entry then covers 2 MiB instead of 4 KiB: a
 // 40 MiB triangle array needs 20 entries instead of 10,000, and a hit's
 // triangle no longer costs a page walk as well as a cache miss. Elsewhere,
-// or if the kernel declines, the memory is ordinary memory.
+// or if the kernel declines, the memory is ordinary memory. The vector does
+// not zero what it allocates (see HugePageAllocator::construct).
 #pragma once
 
 #include <cstddef>
 #include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace pathlab {
@@ -32,6 +35,18 @@ struct HugePageAllocator {
     return static_cast<T*>(detail::allocate_huge_page_backed(n * sizeof(T)));
   }
   void deallocate(T* p, std::size_t) noexcept { detail::free_huge_page_backed(p); }
+  // Elements are default-initialised, not value-initialised: resizing to n
+  // trivially constructible elements leaves the new pages untouched, for
+  // the owner to fill in parallel (each page then faults in, and is zeroed
+  // by the kernel, on the thread that fills it).
+  template <class U>
+  void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
   template <class U>
   bool operator==(const HugePageAllocator<U>&) const noexcept {
     return true;
