@@ -258,6 +258,8 @@ void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes mode
   state.counters["embree_share"] = t.waves_seconds > 0.0 ? t.query_seconds() / t.waves_seconds : 0.0;
   // The share of the render's time (on all threads) spent inside the waves;
   // the rest is the film, the sample buffer and the threads' idle tails.
+  // Under --cpu-time this is approximate: the waves are timed on the steady
+  // clock, the render in process CPU time (which also counts TBB spinning).
   state.counters["waves_share"] = wavefront_seconds > 0.0 ? t.waves_seconds / (threads * wavefront_seconds) : 0.0;
   state.counters["camera_in_context"] = threads * t.camera.rays_per_second();
   state.counters["bounce_in_context"] = threads * t.bounce.rays_per_second();

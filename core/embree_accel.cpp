@@ -118,6 +118,9 @@ void fill(RTCRayHit& rh, const Ray& ray) {
   fill(rh.ray, ray);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  // Embree leaves these alone on a miss; intersect_arrays copies them anyway.
+  rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.u = rh.hit.v = 0.0f;
 }
 
 }  // namespace
@@ -347,7 +350,10 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, cons
       for_each_packet(n, [&](std::size_t b, std::size_t m, const int* valid) {
         RTCRayHit16 rh;
         fill_packet(rh.ray, rays, b, m);
-        for (std::size_t k = 0; k < m; ++k) rh.hit.geomID[k] = rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        for (std::size_t k = 0; k < m; ++k) {
+          rh.hit.geomID[k] = rh.hit.instID[0][k] = rh.hit.primID[k] = RTC_INVALID_GEOMETRY_ID;
+          rh.hit.u[k] = rh.hit.v[k] = 0.0f;  // copied on a miss too (record)
+        }
         rtcIntersect16(valid, impl_->scene, &context, &rh);
         for (std::size_t k = 0; k < m; ++k)
           record(b + k, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]);

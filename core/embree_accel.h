@@ -66,7 +66,8 @@ class EmbreeAccel {
   void occluded_batch(std::span<const Ray> rays, std::span<std::uint8_t> occluded, RayBatchMode mode,
                       bool coherent = false) const;
   // The same again for n rays in arrays; a hit's fields mean something only
-  // where found[i] is 1 (elsewhere they are overwritten with Embree's miss). Streams go to Embree without a copy
+  // where found[i] is 1 (elsewhere they are overwritten with unspecified
+  // values). Streams go to Embree without a copy
   // (rtcIntersectNp / rtcOccludedNp), packets as 16 consecutive lanes.
   void intersect_arrays(const RayArrays& rays, std::size_t n, const HitArrays& hits, RayBatchMode mode,
                         bool coherent = false) const;

@@ -36,9 +36,9 @@ struct HugePageAllocator {
   }
   void deallocate(T* p, std::size_t) noexcept { detail::free_huge_page_backed(p); }
   // Elements are default-initialised, not value-initialised: resizing to n
-  // trivially constructible elements leaves the new pages untouched, for
-  // the owner to fill in parallel (each page then faults in, and is zeroed
-  // by the kernel, on the thread that fills it).
+  // trivially constructible elements leaves the new memory untouched, for
+  // the owner to fill in parallel (fresh pages then fault in on the thread
+  // that fills them; recycled memory holds whatever it held).
   template <class U>
   void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
     ::new (static_cast<void*>(p)) U;
@@ -53,6 +53,8 @@ struct HugePageAllocator {
   }
 };
 
+// Note: resize(n) and vector(n) leave trivially constructible elements
+// uninitialised (HugePageAllocator::construct); the owner must write them.
 template <class T>
 using HugePageVector = std::vector<T, HugePageAllocator<T>>;
 
