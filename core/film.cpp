@@ -16,7 +16,7 @@ Film::Film(int width, int height, FilterKind filter)
   // against 14 ms for the vector zeroing them on one.
   parallel_for(0, pixels_.size(), std::size_t{1} << 16, [&](std::size_t b, std::size_t e) {
     std::fill(pixels_.begin() + static_cast<std::ptrdiff_t>(b), pixels_.begin() + static_cast<std::ptrdiff_t>(e), Pixel{});
-    if (!splat_.empty())
+    if (filter_ != FilterKind::Box)
       std::fill(splat_.begin() + static_cast<std::ptrdiff_t>(b), splat_.begin() + static_cast<std::ptrdiff_t>(e),
                 SplatSums{});
   });
@@ -95,7 +95,7 @@ void Film::record_bad(std::uint32_t first, std::uint32_t count, std::span<const 
 
 Film::Sums Film::sums(int x, int y) const {
   const Pixel& p = pixels_[index(x, y)];
-  if (splat_.empty()) {
+  if (filter_ == FilterKind::Box) {
     const auto n = static_cast<double>(p.count);
     return {n, n, p.sum_wL, p.sum_wL, p.sum_w2L2};
   }
