@@ -153,14 +153,9 @@ void after_burst(benchmark::State& state, RayKind kind, Burst burst) {
       if (burst == Burst::Zmm) sink += burst_zmm(sink);
       if (burst == Burst::Ymm) sink += burst_ymm(sink);
       if (burst == Burst::Scalar) sink += burst_scalar(sink);
-      const std::size_t n = std::min(kChunk, rays.size() - b);
-      const std::span<const Ray> chunk(rays.data() + b, n);
+      const std::span<const Ray> chunk(rays.data() + b, std::min(kChunk, rays.size() - b));
       const auto t0 = std::chrono::steady_clock::now();
-      if (kind == RayKind::Shadow)
-        s.scene->occluded_batch(chunk, std::span<std::uint8_t>(found.data(), n), mode);
-      else
-        s.scene->intersect_batch(chunk, std::span<RayHit>(hits.data(), n), std::span<std::uint8_t>(found.data(), n),
-                                 mode, kind == RayKind::Camera);
+      cast_batch(*s.scene, chunk, kind, mode, hits, found);
       embree_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     state.SetIterationTime(embree_seconds);
@@ -388,9 +383,10 @@ class RatioReporter : public benchmark::ConsoleReporter {
         const double raw_kind = median(raw_name(kind, mode), "rays/s");
         return raw_kind > 0 ? median(run, counter) / raw_kind : 0.0;
       };
-      std::printf("  waves %.0f%% of the render's time; Embree %.0f%% of the waves' time; in context at %.2f (camera), %.2f (bounce), %.2f (shadow) of "
-                  "its raw rates\n",
-                  100.0 * median(run, "waves_share"), 100.0 * median(run, "embree_share"), in_context("camera_in_context", RayKind::Camera, modes.camera),
+      std::printf("  waves %.0f%% of the render's time; Embree %.0f%% of the waves' time; in context at %.2f "
+                  "(camera), %.2f (bounce), %.2f (shadow) of its raw rates\n",
+                  100.0 * median(run, "waves_share"), 100.0 * median(run, "embree_share"),
+                  in_context("camera_in_context", RayKind::Camera, modes.camera),
                   in_context("bounce_in_context", RayKind::Bounce, modes.bounce),
                   in_context("shadow_in_context", RayKind::Shadow, modes.shadow));
     }

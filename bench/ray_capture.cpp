@@ -68,20 +68,24 @@ CapturedRays capture_rays(const CompiledScene& scene, const RenderSettings& sett
   return c;
 }
 
+std::size_t cast_batch(const CompiledScene& scene, std::span<const Ray> rays, RayKind kind, RayBatchMode mode,
+                       std::span<RayHit> hits, std::span<std::uint8_t> found) {
+  if (kind == RayKind::Shadow)
+    scene.occluded_batch(rays, found.first(rays.size()), mode);
+  else
+    scene.intersect_batch(rays, hits.first(rays.size()), found.first(rays.size()), mode, kind == RayKind::Camera);
+  std::size_t n = 0;
+  for (std::uint8_t f : found.first(rays.size())) n += f;
+  return n;
+}
+
 std::size_t cast(const CompiledScene& scene, const std::vector<Ray>& rays, RayKind kind, RayBatchMode mode) {
   std::atomic<std::size_t> hits{0};
   parallel_for(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {
     thread_local std::vector<RayHit> hit;
     thread_local std::vector<std::uint8_t> found;
     hit.resize(e - b), found.resize(e - b);
-    const std::span<const Ray> batch(rays.data() + b, e - b);
-    if (kind == RayKind::Shadow)
-      scene.occluded_batch(batch, found, mode);
-    else
-      scene.intersect_batch(batch, hit, found, mode, kind == RayKind::Camera);
-    std::size_t n = 0;
-    for (std::uint8_t f : found) n += f;
-    hits += n;
+    hits += cast_batch(scene, std::span<const Ray>(rays.data() + b, e - b), kind, mode, hit, found);
   });
   return hits;
 }

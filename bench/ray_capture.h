@@ -8,6 +8,8 @@
 #include "core/compiled_scene.h"
 
 #include <cstddef>
+#include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,6 +29,12 @@ struct CapturedRays {
 };
 
 CapturedRays capture_rays(const CompiledScene& scene, const RenderSettings& settings);
+
+// Casts one batch of `kind` on the calling thread, as the wavefront hands it
+// to Embree (closest hit into hits/found, or occlusion into found for shadow
+// rays; camera rays marked coherent). Returns how many hit something.
+std::size_t cast_batch(const CompiledScene& scene, std::span<const Ray> rays, RayKind kind, RayBatchMode mode,
+                       std::span<RayHit> hits, std::span<std::uint8_t> found);
 
 // Casts `rays` (closest hit, or occlusion for shadow rays) over every worker
 // thread in tasks of 256 rays, as the wavefront tracer does. Returns how

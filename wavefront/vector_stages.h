@@ -163,8 +163,8 @@ void add_light(const Wave& wave, std::size_t queries);
 // A cosine-weighted continuation, Russian roulette and the next ray.
 void scatter(const Scene& scene, const Wave& wave);
 // Packs the survivors into slots [0, m) in order and returns m; each path
-// that ended is written to samples[its kOutIndex - first] (an array of
+// that ended is written to samples[its kOutIndex - first_slot] (an array of
 // Sample's layout, copied in bytes).
-std::size_t compact(const Wave& wave, void* samples, std::uint32_t first);
+std::size_t compact(const Wave& wave, void* samples, std::uint32_t first_slot);
 
 }  // namespace pathlab::vector_stages

@@ -570,7 +570,7 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
   }
 }
 
-std::size_t compact(const Wave& w, void* samples, std::uint32_t first) {
+std::size_t compact(const Wave& w, void* samples, std::uint32_t first_slot) {
   static constexpr FloatArray kMovedFloats[] = {kOx,   kOy,   kOz,   kDx,   kDy,   kDz,      kTmax,  kBetaR, kBetaG,
                                                 kBetaB, kLR,  kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX,
                                                 kFilmY};
@@ -586,7 +586,7 @@ std::size_t compact(const Wave& w, void* samples, std::uint32_t first) {
     // per path).
     for (M dead = in & ~alive; dead != 0; dead &= static_cast<M>(dead - 1)) {
       const std::size_t i = i0 + static_cast<std::size_t>(__builtin_ctz(dead));
-      char* out = static_cast<char*>(samples) + sizeof(Sample) * (w.u[kOutIndex][i] - first);
+      char* out = static_cast<char*>(samples) + sizeof(Sample) * (w.u[kOutIndex][i] - first_slot);
       const std::uint32_t hits = w.u[kVertex][i] - (w.b[kFound][i] ? 0u : 1u);
       __builtin_memcpy(out + offsetof(Sample, film_x), &w.f[kFilmX][i], sizeof(float));
       __builtin_memcpy(out + offsetof(Sample, film_y), &w.f[kFilmY][i], sizeof(float));

@@ -512,7 +512,7 @@ void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver*
 
 // The vectorised twin of run_wave: the same stages and the same Embree
 // batches, over Lanes.
-void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, std::uint32_t first) const {
+void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, std::uint32_t first_slot) const {
   namespace vs = vector_stages;
   const vs::Scene& sc = vector_->scene;
   const vs::Wave& w = lanes.view;
@@ -540,7 +540,7 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
       vs::add_light(w, q);
     }
     vs::scatter(sc, w);
-    lanes.view.n = vs::compact(w, lanes.samples.data(), first);
+    lanes.view.n = vs::compact(w, lanes.samples.data(), first_slot);
   }
   std::copy_n(lanes.samples.begin(), paths, out.begin());
   clock.nanoseconds[kWave] = clock_ns() - t0;

@@ -106,8 +106,8 @@ class WavefrontTracer final : public Tracer {
   void scatter(Wave& w, PathObserver* obs) const;
   static void compact(Wave& w, std::span<FilmSample> out);
   // The same over Lanes; `out` is the wave's own samples, the ones whose
-  // output slots are first, first + 1, ...
-  void run_wave_vector(Lanes& lanes, std::span<FilmSample> out, std::uint32_t first) const;
+  // output slots are first_slot, first_slot + 1, ...
+  void run_wave_vector(Lanes& lanes, std::span<FilmSample> out, std::uint32_t first_slot) const;
   // Adds one wave's clock to what times() reports.
   void publish(const Clock& clock) const;
   static std::size_t scalar_bytes_per_path();
