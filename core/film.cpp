@@ -25,14 +25,19 @@ Film::Film(int width, int height, FilterKind filter)
 void Film::add_batch(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples) {
   // One parallel pass over the rows; each pixel gathers its samples in a
   // fixed order. NaN / Inf samples are left out and counted per row; a batch
-  // that had any is scanned again, serially, to report them in order.
-  std::vector<std::uint64_t> bad_in_row(static_cast<std::size_t>(height_), 0);
+  // that had any is scanned again, serially, to report them in order. The
+  // rows' rays are summed on the way.
+  struct RowTally {
+    std::uint64_t bad, rays;
+  };
+  std::vector<RowTally> tally(static_cast<std::size_t>(height_));
   parallel_for(0, static_cast<std::size_t>(height_), 1, [&](std::size_t y0, std::size_t y1) {
     for (int y = static_cast<int>(y0); y < static_cast<int>(y1); ++y) {
-      std::uint64_t bad = 0;
+      std::uint64_t bad = 0, rays = 0;
       for (int x = 0; x < width_; ++x) {
         Pixel& px = pixels_[index(x, y)];
         const std::size_t own = index(x, y) * count;
+        for (std::uint32_t j = 0; j < count; ++j) rays += samples[own + j].rays;
         if (filter_ == FilterKind::Box) {
           for (std::uint32_t j = 0; j < count; ++j) {
             const Spectrum& L = samples[own + j].L;
@@ -73,11 +78,14 @@ void Film::add_batch(std::uint32_t first, std::uint32_t count, std::span<const F
           }
         }
       }
-      bad_in_row[static_cast<std::size_t>(y)] = bad;
+      tally[static_cast<std::size_t>(y)] = {bad, rays};
     }
   });
   std::uint64_t bad = 0;
-  for (std::uint64_t b : bad_in_row) bad += b;
+  for (const RowTally& t : tally) {
+    bad += t.bad;
+    rays_ += t.rays;
+  }
   if (bad > 0) {
     bad_count_ += bad;
     record_bad(first, count, samples);

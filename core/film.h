@@ -45,7 +45,8 @@ class Film {
   FilterKind filter() const { return filter_; }
 
   // Adds samples [first, first + count) of every pixel. NaN / Inf samples are
-  // left out, counted and remembered (the first kMaxBadSamplesKept).
+  // left out, counted and remembered (the first kMaxBadSamplesKept); the
+  // rays of every sample, bad or not, are summed into rays_cast().
   void add_batch(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples);
 
   Image image() const;                  // the per-pixel weighted mean
@@ -56,6 +57,9 @@ class Film {
   std::uint64_t sample_count(int x, int y) const { return pixels_[index(x, y)].count; }
 
   std::uint64_t bad_sample_count() const { return bad_count_; }
+  // FilmSample::rays summed over every sample added (the render's ray count,
+  // taken in the film's pass over the samples rather than in one more).
+  std::uint64_t rays_cast() const { return rays_; }
   const std::vector<BadSample>& bad_samples() const { return bad_kept_; }
   static constexpr std::size_t kMaxBadSamplesKept = 16;
 
@@ -91,6 +95,7 @@ class Film {
   HugePageVector<Pixel> pixels_;
   HugePageVector<SplatSums> splat_;  // empty for the box filter
   std::uint64_t bad_count_ = 0;
+  std::uint64_t rays_ = 0;
   std::vector<BadSample> bad_kept_;
 };
 

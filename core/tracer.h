@@ -22,7 +22,9 @@ class Tracer {
   virtual std::string_view name() const = 0;
 
   // Traces samples [first, first + count) of every pixel into
-  // out[pixel * count + j] (pixel = y * width + x). May run in parallel.
+  // out[pixel * count + j] (pixel = y * width + x), writing every field of
+  // every element: `out` may arrive unwritten (SampleBuffer). May run in
+  // parallel.
   virtual void render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const = 0;
 
   // Traces one sample of one pixel on the calling thread, reporting every

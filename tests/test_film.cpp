@@ -36,6 +36,24 @@ TEST(Film, BoxFilterMeanAndVarianceOfMean) {
   EXPECT_EQ(film.sample_count(0, 0), 4u);
 }
 
+TEST(Film, SumsTheRaysOfEverySampleItIsGiven) {
+  // A NaN sample is left out of the image, but its rays were cast all the
+  // same; with a splatting filter each sample counts once, not once per
+  // pixel it lands in.
+  for (FilterKind filter : {FilterKind::Box, FilterKind::Bilinear}) {
+    Film film(2, 2, filter);
+    std::vector<FilmSample> s(4 * 2);
+    for (std::uint32_t i = 0; i < s.size(); ++i)
+      s[i] = {vec2(float(i / 2 % 2) + 0.5f, float(i / 4) + 0.5f), Spectrum(1.0f), i + 1};
+    s[5].L = Spectrum(std::nanf(""));
+    film.add_batch(0, 2, s);
+    EXPECT_EQ(film.rays_cast(), 36u);  // 1 + 2 + ... + 8
+    film.add_batch(2, 2, s);
+    EXPECT_EQ(film.rays_cast(), 72u);
+    EXPECT_EQ(film.bad_sample_count(), 2u);
+  }
+}
+
 TEST(Film, BatchesAddUpToOneBigBatch) {
   // Two batches of 2 give the same bits as one batch of 4.
   auto make = [](std::uint32_t first, std::uint32_t count) {

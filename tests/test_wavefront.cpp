@@ -117,6 +117,27 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
   EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
 }
 
+// The render driver hands tracers a SampleBuffer nobody has written, so a
+// tracer must write every field of every sample: the same batch traced over
+// zeros and over a byte pattern must come out the same, bit for bit.
+TEST(Tracers, WriteEveryFieldOfEverySample) {
+  static_assert(sizeof(FilmSample) == 2 * sizeof(float) + 3 * sizeof(float) + 2 * sizeof(std::uint32_t),
+                "no padding, so memcmp compares fields only");
+  Scene scene = test::small_cornell(12, 3, FilterKind::Box);
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const ReferenceTracer reference(compiled, settings);
+  const WavefrontTracer vector(compiled, settings, 61), scalar(compiled, settings, 61, {}, WavefrontStages::Scalar);
+  for (const Tracer* tracer : std::initializer_list<const Tracer*>{&reference, &vector, &scalar}) {
+    std::vector<FilmSample> zeros(12 * 12 * 3), pattern(zeros.size());
+    std::memset(static_cast<void*>(zeros.data()), 0, zeros.size() * sizeof(FilmSample));
+    std::memset(static_cast<void*>(pattern.data()), 0xa5, pattern.size() * sizeof(FilmSample));
+    tracer->render_batch(0, 3, zeros);
+    tracer->render_batch(0, 3, pattern);
+    EXPECT_EQ(std::memcmp(zeros.data(), pattern.data(), zeros.size() * sizeof(FilmSample)), 0) << tracer->name();
+  }
+}
+
 // Both tracers report the rays they cast (LightEvent::ray,
 // ScatterEvent::next; the raw-rate benchmark casts exactly these): each
 // leaves the surface it starts on, the shadow ray ends at the light sample's

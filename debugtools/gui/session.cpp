@@ -97,7 +97,7 @@ void Session::worker(std::uint64_t /*generation*/) {
   Film film(w, h, sc.film.filter);
   AovAccumulator aovs(*compiled_, render_settings_);
   const std::uint32_t batch = batch_size(w, h, target);
-  std::vector<FilmSample> samples(pixels * batch);
+  SampleBuffer samples(pixels * batch);
   const auto start = std::chrono::steady_clock::now();
 
   const auto publish = [&](int done) {
@@ -131,7 +131,7 @@ void Session::worker(std::uint64_t /*generation*/) {
   publish(0);
   for (std::uint32_t first = 0; first < static_cast<std::uint32_t>(target) && !stop_; first += batch) {
     const std::uint32_t count = std::min<std::uint32_t>(batch, static_cast<std::uint32_t>(target) - first);
-    const std::span<FilmSample> out(samples.data(), pixels * count);
+    const std::span<FilmSample> out = samples.first(pixels * count);
     tracer_->render_batch(first, count, out);
     if (stop_) break;
     film.add_batch(first, count, out);
