@@ -30,7 +30,8 @@ struct Setup {
     tracer = std::make_unique<ReferenceTracer>(*compiled, settings);
   }
   double render_seconds() const {
-    Film film(compiled->scene().film.width, compiled->scene().film.height, compiled->scene().film.filter);
+    Film film(compiled->scene().film.width, compiled->scene().film.height, compiled->scene().film.filter,
+              FilmMoments::Mean);
     return render(*tracer, film).seconds;
   }
   RenderSettings settings;

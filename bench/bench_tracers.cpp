@@ -180,7 +180,8 @@ double now_seconds() {
 
 RenderStats render_frame(const Tracer& tracer) {
   const FilmDesc& fd = setup().scene->scene().film;
-  Film film(fd.width, fd.height, fd.filter);
+  // The film of a plain `pathlab render`, which writes the image alone.
+  Film film(fd.width, fd.height, fd.filter, FilmMoments::Mean);
   const RenderStats stats = render(tracer, film);
   benchmark::DoNotOptimize(film.image().pixels.data());
   return stats;

@@ -36,13 +36,25 @@ struct BadSample {
   Spectrum L{0.0f};
 };
 
+// What a film keeps beyond each pixel's weighted mean.
+enum class FilmMoments : std::uint8_t {
+  // Second moments too, for variance_of_mean() (the variance AOV, the
+  // analytic checks, progressive rendering to an error target).
+  MeanAndVariance,
+  // The image alone, for a render that writes nothing else: a box pixel is
+  // then 32 bytes instead of 56, which the film's pass over every batch
+  // reads and writes (at 720p a third less memory traffic).
+  Mean,
+};
+
 class Film {
  public:
-  Film(int width, int height, FilterKind filter);
+  Film(int width, int height, FilterKind filter, FilmMoments moments = FilmMoments::MeanAndVariance);
 
   int width() const { return width_; }
   int height() const { return height_; }
   FilterKind filter() const { return filter_; }
+  bool keeps_variance() const { return moments_ == FilmMoments::MeanAndVariance; }
 
   // Adds samples [first, first + count) of every pixel. NaN / Inf samples are
   // left out, counted and remembered (the first kMaxBadSamplesKept); the
@@ -50,8 +62,10 @@ class Film {
   void add_batch(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples);
 
   Image image() const;                  // the per-pixel weighted mean
-  Image variance_of_mean() const;       // estimated variance of that mean
   Spectrum mean(int x, int y) const;
+  // The estimated variance of that mean. Throws std::logic_error unless the
+  // film keeps_variance().
+  Image variance_of_mean() const;
   Spectrum variance_of_mean(int x, int y) const;
   // Samples that fell in pixel (x, y) (its own samples, not splat neighbours).
   std::uint64_t sample_count(int x, int y) const { return pixels_[index(x, y)].count; }
@@ -64,17 +78,16 @@ class Film {
   static constexpr std::size_t kMaxBadSamplesKept = 16;
 
  private:
-  // What every filter needs per pixel: sum(w L), sum(w^2 L^2) and the count
-  // of its own samples. With the box filter every weight is 1, so sum(w) and
-  // sum(w^2) are the count and sum(w^2 L) is sum(w L): a box film keeps
-  // these 56 bytes per pixel and nothing else.
-  // (No member initialisers: the film zeroes its pixels in parallel.)
+  // What every film keeps per pixel: sum(w L) and the count of its own
+  // samples. With the box filter every weight is 1, so sum(w) and sum(w^2)
+  // are the count and sum(w^2 L) is sum(w L).
+  // (No member initialisers: the film zeroes its arrays in parallel.)
   struct Pixel {
     dvec3 sum_wL;
-    dvec3 sum_w2L2;
     std::uint64_t count;
   };
-  // What a splatting filter (w != 1) adds: sum(w), sum(w^2), sum(w^2 L).
+  // What a splatting filter (w != 1) adds: sum(w), and for the variance
+  // sum(w^2) and sum(w^2 L).
   struct SplatSums {
     double sum_w;
     double sum_w2;
@@ -86,13 +99,16 @@ class Film {
     dvec3 sum_wL, sum_w2L, sum_w2L2;
   };
   Sums sums(int x, int y) const;
+  void require_variance() const;
   std::size_t index(int x, int y) const { return static_cast<std::size_t>(y) * width_ + x; }
   // Records the batch's NaN / Inf samples in order (the rare path).
   void record_bad(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples);
 
   int width_, height_;
   FilterKind filter_;
+  FilmMoments moments_;
   HugePageVector<Pixel> pixels_;
+  HugePageVector<dvec3> sum_w2L2_;   // sum(w^2 L^2) per pixel; empty for FilmMoments::Mean
   HugePageVector<SplatSums> splat_;  // empty for the box filter
   std::uint64_t bad_count_ = 0;
   std::uint64_t rays_ = 0;

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <sstream>
+#include <stdexcept>
 
 namespace pathlab {
 namespace {
@@ -51,6 +52,32 @@ TEST(Film, SumsTheRaysOfEverySampleItIsGiven) {
     film.add_batch(2, 2, s);
     EXPECT_EQ(film.rays_cast(), 72u);
     EXPECT_EQ(film.bad_sample_count(), 2u);
+  }
+}
+
+// A film that keeps only the mean gives the same image bits as one that
+// keeps the variance too, for either filter and with a NaN among the
+// samples; asked for a variance, it says it has none.
+TEST(Film, MeanOnlyFilmHasTheSameImage) {
+  for (FilterKind filter : {FilterKind::Box, FilterKind::Bilinear}) {
+    std::vector<FilmSample> s(9 * 3);
+    for (std::uint32_t i = 0; i < s.size(); ++i) {
+      const float k = static_cast<float>(i) * 0.77f;
+      s[i] = {vec2(float(i / 3 % 3) + std::fmod(k * 0.37f, 1.0f), float(i / 9) + std::fmod(k * 0.61f, 1.0f)),
+              Spectrum(k, 1.0f / (k + 1.0f), std::sqrt(k)), 2};
+    }
+    s[4].L.y = std::nanf("");
+    Film full(3, 3, filter), mean(3, 3, filter, FilmMoments::Mean);
+    full.add_batch(0, 3, s);
+    mean.add_batch(0, 3, s);
+    const Image a = full.image(), b = mean.image();
+    EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
+    EXPECT_EQ(mean.sample_count(1, 1), full.sample_count(1, 1));
+    EXPECT_EQ(mean.bad_sample_count(), 1u);
+    EXPECT_TRUE(full.keeps_variance());
+    EXPECT_FALSE(mean.keeps_variance());
+    EXPECT_THROW(mean.variance_of_mean(), std::logic_error);
+    EXPECT_THROW(mean.variance_of_mean(0, 0), std::logic_error);
   }
 }
 

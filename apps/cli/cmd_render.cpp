@@ -13,6 +13,7 @@
 #include "debugtools/aov.h"
 #include "wavefront/wavefront_tracer.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <optional>
@@ -70,11 +71,14 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   if (const std::size_t n = compiled.lights().unsampled_light_count())
     err << "pathlab: warning: " << n << " light(s) are too dim next to the others ever to be picked for light "
         << "sampling; only rays that hit them count their light\n";
-  Film film(sc.film.width, sc.film.height, sc.film.filter);
+  const bool progressive = time_budget || target_relmse;
+  // The second moments only if something reads them: progressive rendering
+  // estimates its error from them, and the variance AOV is them.
+  const bool variance = progressive || std::find(layers.begin(), layers.end(), Aov::Variance) != layers.end();
+  Film film(sc.film.width, sc.film.height, sc.film.filter, variance ? FilmMoments::MeanAndVariance : FilmMoments::Mean);
 
   ProgressBar bar(err, "rendering", !quiet && stderr_is_terminal());
   const Tracer& driven = aov_tracer ? static_cast<const Tracer&>(*aov_tracer) : *tracer;
-  const bool progressive = time_budget || target_relmse;
   std::optional<UntilResult> until;
   if (progressive) {
     // Without an explicit --spp the budget or target decides alone.
