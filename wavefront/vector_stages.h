@@ -100,7 +100,7 @@ enum FloatArray : int {
   kFilmX, kFilmY,
   // This bounce only: the hit and the Surfel made of it.
   kHitT, kHitU, kHitV,
-  kPx, kPy, kPz, kErrX, kErrY, kErrZ, kNx, kNy, kNz, kSx, kSy, kSz, kTx, kTy, kTz,
+  kPx, kPy, kPz, kErrX, kErrY, kErrZ, kNx, kNy, kNz,
   // What the area-light sample brings if nothing blocks its shadow ray.
   kUnR, kUnG, kUnB,
   // The shadow rays to trace, packed in path order for Embree.

@@ -220,6 +220,18 @@ F power_heuristic(F a, F b) {
   return _mm512_mask_mov_ps(w, _mm512_fpclass_ps_mask(a, 0x18), k(1.0f));
 }
 
+// Frame(n) (core/math.h): the shading frame's s and t. Only scatter needs
+// them, so it makes them from n rather than resolve() storing six more
+// arrays per path.
+void frame(const V3& n, V3* s, V3* t) {
+  const F sign = _mm512_castsi512_ps(_mm512_or_si512(
+      _mm512_and_si512(_mm512_castps_si512(n.z), _mm512_set1_epi32(INT32_MIN)), _mm512_castps_si512(k(1.0f))));
+  const F a = div(k(-1.0f), add(sign, n.z));
+  const F b = mul(mul(n.x, n.y), a);
+  *s = V3{add(k(1.0f), mul(mul(mul(sign, n.x), n.x), a)), mul(sign, b), mul(neg(sign), n.x)};
+  *t = V3{b, add(sign, mul(mul(n.y, n.y), a)), neg(n.y)};
+}
+
 // glm::normalize: v * (1 / sqrt(v.v)).
 V3 normalize(const V3& v) { return mul(div(k(1.0f), _mm512_sqrt_ps(dot(v, v))), v); }
 
@@ -343,16 +355,9 @@ void resolve(const Scene& sc, const Wave& w) {
       error = select(sphere, serr, error);
       n = select(sphere, sn, n);
     }
-    // Frame(n) (core/math.h).
-    const F sign = _mm512_castsi512_ps(_mm512_or_si512(
-        _mm512_and_si512(_mm512_castps_si512(n.z), _mm512_set1_epi32(INT32_MIN)), _mm512_castps_si512(k(1.0f))));
-    const F a = div(k(-1.0f), add(sign, n.z));
-    const F b = mul(mul(n.x, n.y), a);
     store3(w, kPx, i0, found, p);
     store3(w, kErrX, i0, found, error);
     store3(w, kNx, i0, found, n);
-    store3(w, kSx, i0, found, V3{add(k(1.0f), mul(mul(mul(sign, n.x), n.x), a)), mul(sign, b), mul(neg(sign), n.x)});
-    store3(w, kTx, i0, found, V3{b, add(sign, mul(mul(n.y, n.y), a)), neg(n.y)});
   }
 }
 
@@ -525,7 +530,9 @@ void scatter(const Scene& sc, const Wave& w) {
     const F pdf = select(gt(z, k(0.0f)), mul(z, k(kInvPi)), k(0.0f));
     ok &= _mm512_cmp_ps_mask(pdf, k(0.0f), _CMP_NLE_UQ) & _mm512_cmp_ps_mask(pdf, k(sc.min_pdf), _CMP_NLT_UQ);
     const V3 wo = neg(load3(w, kDx, i0, ok));
-    const V3 fs = load3(w, kSx, i0, ok), ft = load3(w, kTx, i0, ok), n = load3(w, kNx, i0, ok);
+    const V3 n = load3(w, kNx, i0, ok);
+    V3 fs, ft;
+    frame(n, &fs, &ft);
     const F side = select(lt(dot(wo, n), k(0.0f)), k(-1.0f), k(1.0f));
     const V3 wi = add(add(mul(x, fs), mul(y, ft)), mul(mul(z, side), n));  // Frame::to_world
     V3 weight = shape_value3(ok, sc, load(w, kShape, i0, ok), kAlbedo);
