@@ -39,7 +39,8 @@ struct BadSample {
 // What a film keeps beyond each pixel's weighted mean.
 enum class FilmMoments : std::uint8_t {
   // Second moments too, for variance_of_mean() (the variance AOV, the
-  // analytic checks, progressive rendering to an error target).
+  // analytic checks, progressive rendering, which estimates its error from
+  // them).
   MeanAndVariance,
   // The image alone, for a render that writes nothing else: a box pixel is
   // then 32 bytes instead of 56, which the film's pass over every batch

@@ -71,7 +71,9 @@ struct UntilResult {
 // Renders whole passes into an empty `film` until the rule says stop. Before
 // each pass after the first it predicts the pass's time as the mean of the
 // passes so far and does not start it if it would end past the time budget,
-// so the render ends at most about one pass before the budget.
+// so the render ends at most about one pass before the budget. It estimates
+// the film's error from its variance, so `film` must keep it
+// (FilmMoments::MeanAndVariance; a mean-only film throws std::logic_error).
 UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule, const ProgressFn& progress = {});
 
 // The relative error of the film's image estimated from its own per-pixel
