@@ -109,7 +109,7 @@ void Film::record_bad(std::uint32_t first, std::uint32_t count, std::span<const 
 
 Film::Sums Film::sums(int x, int y) const {
   const Pixel& p = pixels_[index(x, y)];
-  const dvec3 sum_w2L2 = sum_w2L2_.empty() ? dvec3(0.0) : sum_w2L2_[index(x, y)];
+  const dvec3 sum_w2L2 = keeps_variance() ? sum_w2L2_[index(x, y)] : dvec3(0.0);
   if (filter_ == FilterKind::Box) {
     const auto n = static_cast<double>(p.count);
     return {n, n, p.sum_wL, p.sum_wL, sum_w2L2};

@@ -53,8 +53,6 @@ struct HugePageAllocator {
   }
 };
 
-// Note: resize(n) and vector(n) leave trivially constructible elements
-// uninitialised (HugePageAllocator::construct); the owner must write them.
 template <class T>
 using HugePageVector = std::vector<T, HugePageAllocator<T>>;
 

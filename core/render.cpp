@@ -1,7 +1,5 @@
 #include "core/render.h"
 
-#include "core/parallel.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>

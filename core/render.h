@@ -90,9 +90,8 @@ double estimated_relmse(const Film& film);
 class SampleBuffer {
  public:
   explicit SampleBuffer(std::size_t size);
-  std::size_t size() const { return size_; }
-  // The first `n` (<= size()) samples.
-  std::span<FilmSample> first(std::size_t n) { return {data_.get(), n}; }
+  // The first `n` samples (n at most the size it was made with).
+  std::span<FilmSample> first(std::size_t n) { return std::span<FilmSample>(data_.get(), size_).first(n); }
 
  private:
   struct Free {
