@@ -22,6 +22,7 @@
 //   build/bench/pathlab_bench_tracers [--scene=bench/scenes/dragon.json] [--spp=4]
 //                                      [--resolution=WxH] [--raw-min-time=SECONDS] [--cpu-time]
 //                                      [--waves=1024,4096,65536]
+//                                      [--modes=CAMERA/BOUNCE/SHADOW,...]
 //                                      [--benchmark_repetitions=5] [--benchmark_filter=...]
 #include "bench/ray_capture.h"
 #include "core/compiled_scene.h"
@@ -32,6 +33,7 @@
 #include "wavefront/wavefront_tracer.h"
 
 #include <benchmark/benchmark.h>
+#include <cpuid.h>
 #include <immintrin.h>
 
 #include <algorithm>
@@ -63,6 +65,10 @@ struct Setup {
   // The wave sizes measured in the default ray modes (the other
   // configurations use the default wave size).
   std::vector<std::size_t> waves{std::size_t{1} << 10, WavefrontTracer::kDefaultWaveSize, std::size_t{1} << 16};
+  // More ray modes (camera/bounce/shadow) measured at the default wave size,
+  // beside the defaults and the all-one-mode configurations: to choose the
+  // defaults on another machine.
+  std::vector<WavefrontRayModes> modes;
   std::unique_ptr<CompiledScene> scene;
   RenderSettings settings;
   CapturedRays rays;
@@ -76,7 +82,7 @@ Setup& setup() {
 
 void raw(benchmark::State& state, RayKind kind, RayBatchMode mode) {
   const Setup& s = setup();
-  const std::vector<Ray>& rays = s.rays.of(kind);
+  const RayList& rays = s.rays.of(kind);
   std::size_t hits = 0;
   for (auto _ : state) hits = cast(*s.scene, rays, kind, mode);
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * rays.size()));
@@ -141,21 +147,18 @@ void after_burst(benchmark::State& state, RayKind kind, Burst burst) {
     return;
   }
   const Setup& s = setup();
-  const std::vector<Ray>& rays = s.rays.of(kind);
+  const RayList& rays = s.rays.of(kind);
   const RayBatchMode mode = mode_of(WavefrontRayModes{}, kind);  // as the wavefront casts them
-  constexpr std::size_t kChunk = 4096;
-  std::vector<RayHit> hits(kChunk);
-  std::vector<std::uint8_t> found(kChunk);
+  HitBuffers hits(kCastChunk);
   float sink = 1.0f;
   for (auto _ : state) {
     double embree_seconds = 0.0;
-    for (std::size_t b = 0; b < rays.size(); b += kChunk) {
+    for (std::size_t b = 0; b < rays.size(); b += kCastChunk) {
       if (burst == Burst::Zmm) sink += burst_zmm(sink);
       if (burst == Burst::Ymm) sink += burst_ymm(sink);
       if (burst == Burst::Scalar) sink += burst_scalar(sink);
-      const std::span<const Ray> chunk(rays.data() + b, std::min(kChunk, rays.size() - b));
       const auto t0 = std::chrono::steady_clock::now();
-      cast_batch(*s.scene, chunk, kind, mode, hits, found);
+      cast_batch(*s.scene, rays, b, std::min(kCastChunk, rays.size() - b), kind, mode, hits);
       embree_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     state.SetIterationTime(embree_seconds);
@@ -168,6 +171,8 @@ void after_burst(benchmark::State& state, RayKind kind, Burst burst) {
 std::string after_name(RayKind kind, Burst burst) {
   return std::string("After/") + ray_kind_name(kind) + "/" + burst_name(burst);
 }
+
+static_assert(kCastChunk == WavefrontTracer::kDefaultWaveSize, "raw casts hand Embree a default wave's rays at a time");
 
 // --- tracers --------------------------------------------------------------------
 
@@ -455,13 +460,57 @@ void register_benchmarks() {
   const std::size_t wave = WavefrontTracer::kDefaultWaveSize;
   for (std::size_t w : setup().waves) configs.push_back({w, defaults});
   for (RayBatchMode mode : kAllRayBatchModes) configs.push_back({wave, {mode, mode, mode}});
+  for (const WavefrontRayModes& m : setup().modes) configs.push_back({wave, m});
   // The scalar stages, the baseline of the vectorised ones.
   configs.push_back({wave, defaults, WavefrontStages::Scalar});
   configs.push_back({wave, {RayBatchMode::Single, RayBatchMode::Single, RayBatchMode::Single}, WavefrontStages::Scalar});
-  for (const Config& c : configs)
-    timed(benchmark::RegisterBenchmark(wavefront_name(c.wave, c.modes, c.stages).c_str(), wavefront, c.wave, c.modes,
-                                       c.stages))
-        ->Iterations(1);
+  std::vector<std::string> names;
+  for (const Config& c : configs) {
+    const std::string name = wavefront_name(c.wave, c.modes, c.stages);
+    if (std::find(names.begin(), names.end(), name) != names.end()) continue;  // --modes repeated one
+    names.push_back(name);
+    timed(benchmark::RegisterBenchmark(name.c_str(), wavefront, c.wave, c.modes, c.stages))->Iterations(1);
+  }
+}
+
+// "packet16/stream/stream": the camera, bounce and shadow modes; false if
+// that is not what `text` says.
+bool parse_modes_flag(const char* text, WavefrontRayModes* m) {
+  RayBatchMode parsed[3];
+  for (int k = 0; k < 3; ++k) {
+    const char* end = std::strchr(text, k < 2 ? '/' : '\0');
+    if (end == nullptr) return false;
+    const std::string name(text, end);
+    bool known = false;
+    for (RayBatchMode mode : kAllRayBatchModes)
+      if (name == ray_batch_mode_name(mode)) parsed[k] = mode, known = true;
+    if (!known) return false;
+    text = end + (k < 2 ? 1 : 0);
+  }
+  *m = WavefrontRayModes{parsed[0], parsed[1], parsed[2]};
+  return true;
+}
+
+// The processor, for the run's context: rates and ratios measured on one
+// core generation do not carry over to another (docs/performance.md). The
+// brand string of a virtual machine is often generic, hence the numbers.
+std::string processor() {
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  if (__get_cpuid(1, &eax, &ebx, &ecx, &edx) == 0) return "unknown";
+  const unsigned base_family = (eax >> 8) & 0xf;
+  const unsigned family = base_family == 0xf ? base_family + ((eax >> 20) & 0xff) : base_family;
+  const unsigned model =
+      base_family == 0x6 || base_family == 0xf ? ((eax >> 4) & 0xf) | (((eax >> 16) & 0xf) << 4) : (eax >> 4) & 0xf;
+  char brand[49] = {};
+  if (__get_cpuid_max(0x80000000u, nullptr) >= 0x80000004u)
+    for (unsigned leaf = 0; leaf < 3; ++leaf)
+      __get_cpuid(0x80000002u + leaf, reinterpret_cast<unsigned*>(brand + 16 * leaf),
+                  reinterpret_cast<unsigned*>(brand + 16 * leaf + 4), reinterpret_cast<unsigned*>(brand + 16 * leaf + 8),
+                  reinterpret_cast<unsigned*>(brand + 16 * leaf + 12));
+  std::string name(brand);
+  name.erase(0, name.find_first_not_of(' '));
+  return name + " (family " + std::to_string(family) + ", model " + std::to_string(model) + ", AVX-512 " +
+         (__builtin_cpu_supports("avx512f") ? "yes" : "no") + ")";
 }
 
 }  // namespace
@@ -498,6 +547,22 @@ int main(int argc, char** argv) {
         p = *end == ',' ? end + 1 : end;
       }
     }
+    else if (std::strncmp(argv[i], "--modes=", 8) == 0) {
+      std::string list = argv[i] + 8;
+      for (std::size_t begin = 0; begin <= list.size();) {
+        const std::size_t end = std::min(list.find(',', begin), list.size());
+        WavefrontRayModes m;
+        if (!parse_modes_flag(list.substr(begin, end - begin).c_str(), &m)) {
+          std::fprintf(stderr,
+                       "pathlab bench: --modes: expected CAMERA/BOUNCE/SHADOW triples of single, packet16 or stream "
+                       "separated by commas, got '%s'\n",
+                       argv[i] + 8);
+          return 1;
+        }
+        s.modes.push_back(m);
+        begin = end + 1;
+      }
+    }
     else
       rest.push_back(argv[i]);
   }
@@ -517,6 +582,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pathlab bench: %s\n", e.what());
     return 1;
   }
+  benchmark::AddCustomContext("processor", processor());
+  std::fprintf(stderr, "pathlab bench: processor %s\n", processor().c_str());
   register_benchmarks();
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);

@@ -42,6 +42,21 @@ std::string raw_name(RayKind kind, RayBatchMode mode) {
   return std::string("Raw/") + ray_kind_name(kind) + "/" + ray_batch_mode_name(mode);
 }
 
+void RayList::push_back(const Ray& r) {
+  ox.push_back(r.origin.x), oy.push_back(r.origin.y), oz.push_back(r.origin.z);
+  dx.push_back(r.dir.x), dy.push_back(r.dir.y), dz.push_back(r.dir.z);
+  tmax.push_back(r.tmax);
+}
+
+Ray RayList::operator[](std::size_t i) const {
+  return Ray{vec3(ox[i], oy[i], oz[i]), vec3(dx[i], dy[i], dz[i]), tmax[i]};
+}
+
+RayArrays RayList::from(std::size_t first) const {
+  return RayArrays{ox.data() + first, oy.data() + first, oz.data() + first, dx.data() + first,
+                   dy.data() + first, dz.data() + first, tmax.data() + first};
+}
+
 CapturedRays capture_rays(const CompiledScene& scene, const RenderSettings& settings) {
   const ReferenceTracer tracer(scene, settings);
   const int width = scene.scene().film.width, height = scene.scene().film.height;
@@ -55,8 +70,7 @@ CapturedRays capture_rays(const CompiledScene& scene, const RenderSettings& sett
     std::vector<RayRecorder::Tagged> all;
     for (RayRecorder& row : rows) all.insert(all.end(), (row.*list).begin(), (row.*list).end());
     std::stable_sort(all.begin(), all.end(), [](const auto& a, const auto& b) { return a.vertex < b.vertex; });
-    std::vector<Ray> rays;
-    rays.reserve(all.size());
+    RayList rays;
     for (const auto& t : all) rays.push_back(t.ray);
     return rays;
   };
@@ -68,24 +82,23 @@ CapturedRays capture_rays(const CompiledScene& scene, const RenderSettings& sett
   return c;
 }
 
-std::size_t cast_batch(const CompiledScene& scene, std::span<const Ray> rays, RayKind kind, RayBatchMode mode,
-                       std::span<RayHit> hits, std::span<std::uint8_t> found) {
+std::size_t cast_batch(const CompiledScene& scene, const RayList& rays, std::size_t first, std::size_t n,
+                       RayKind kind, RayBatchMode mode, HitBuffers& hits) {
+  const HitArrays out = hits.arrays();
   if (kind == RayKind::Shadow)
-    scene.occluded_batch(rays, found.first(rays.size()), mode);
+    scene.occluded_arrays(rays.from(first), n, out.found, mode);
   else
-    scene.intersect_batch(rays, hits.first(rays.size()), found.first(rays.size()), mode, kind == RayKind::Camera);
-  std::size_t n = 0;
-  for (std::uint8_t f : found.first(rays.size())) n += f;
-  return n;
+    scene.intersect_arrays(rays.from(first), n, out, mode, kind == RayKind::Camera);
+  std::size_t found = 0;
+  for (std::size_t i = 0; i < n; ++i) found += out.found[i];
+  return found;
 }
 
-std::size_t cast(const CompiledScene& scene, const std::vector<Ray>& rays, RayKind kind, RayBatchMode mode) {
+std::size_t cast(const CompiledScene& scene, const RayList& rays, RayKind kind, RayBatchMode mode) {
   std::atomic<std::size_t> hits{0};
-  parallel_for(0, rays.size(), 256, [&](std::size_t b, std::size_t e) {
-    thread_local std::vector<RayHit> hit;
-    thread_local std::vector<std::uint8_t> found;
-    hit.resize(e - b), found.resize(e - b);
-    hits += cast_batch(scene, std::span<const Ray>(rays.data() + b, e - b), kind, mode, hit, found);
+  parallel_for(0, rays.size(), kCastChunk, [&](std::size_t b, std::size_t e) {
+    thread_local HitBuffers buffers(kCastChunk);
+    hits += cast_batch(scene, rays, b, e - b, kind, mode, buffers);  // e - b <= kCastChunk
   });
   return hits;
 }

@@ -2,7 +2,8 @@
 // rate can be measured on exactly that mix. Captured from the reference
 // tracer's paths (every pixel, sample 0, through a PathObserver): camera
 // rays, continuation ("bounce") rays and shadow rays, each list in the order
-// the wavefront tracer would cast them (by vertex, then pixel).
+// the wavefront tracer would cast them (by vertex, then pixel), kept as
+// arrays and cast through the same calls as the wavefront's.
 #pragma once
 
 #include "core/compiled_scene.h"
@@ -19,10 +20,22 @@ enum class RayKind { Camera, Bounce, Shadow };
 inline constexpr RayKind kAllRayKinds[] = {RayKind::Camera, RayKind::Bounce, RayKind::Shadow};
 const char* ray_kind_name(RayKind kind);
 
+// Rays as one array per scalar, the layout the vectorised wavefront hands to
+// Embree (EmbreeAccel::intersect_arrays / occluded_arrays).
+struct RayList {
+  std::vector<float> ox, oy, oz, dx, dy, dz, tmax;
+  std::size_t size() const { return ox.size(); }
+  bool empty() const { return ox.empty(); }
+  void push_back(const Ray& r);
+  Ray operator[](std::size_t i) const;
+  // Rays [first, size()) as arrays.
+  RayArrays from(std::size_t first) const;
+};
+
 struct CapturedRays {
-  std::vector<Ray> camera, bounce, shadow;
+  RayList camera, bounce, shadow;
   std::size_t samples = 0;
-  const std::vector<Ray>& of(RayKind kind) const {
+  const RayList& of(RayKind kind) const {
     return kind == RayKind::Camera ? camera : kind == RayKind::Bounce ? bounce : shadow;
   }
   std::size_t total() const { return camera.size() + bounce.size() + shadow.size(); }
@@ -30,16 +43,30 @@ struct CapturedRays {
 
 CapturedRays capture_rays(const CompiledScene& scene, const RenderSettings& settings);
 
-// Casts one batch of `kind` on the calling thread, as the wavefront hands it
-// to Embree (closest hit into hits/found, or occlusion into found for shadow
-// rays; camera rays marked coherent). Returns how many hit something.
-std::size_t cast_batch(const CompiledScene& scene, std::span<const Ray> rays, RayKind kind, RayBatchMode mode,
-                       std::span<RayHit> hits, std::span<std::uint8_t> found);
+// Where a cast writes its hits: room for one chunk of rays.
+struct HitBuffers {
+  std::vector<float> t, u, v;
+  std::vector<std::uint32_t> shape, prim;
+  std::vector<std::uint8_t> found;
+  explicit HitBuffers(std::size_t n) : t(n), u(n), v(n), shape(n), prim(n), found(n) {}
+  HitArrays arrays() { return {t.data(), u.data(), v.data(), shape.data(), prim.data(), found.data()}; }
+};
 
-// Casts `rays` (closest hit, or occlusion for shadow rays) over every worker
-// thread in tasks of 256 rays, as the wavefront tracer does. Returns how
-// many hit something.
-std::size_t cast(const CompiledScene& scene, const std::vector<Ray>& rays, RayKind kind, RayBatchMode mode);
+// The rays the wavefront hands Embree in one call: at most a wave's worth
+// (WavefrontTracer::kDefaultWaveSize; bench_tracers.cpp checks they agree).
+inline constexpr std::size_t kCastChunk = 4096;
+
+// Casts rays [first, first + n) of `rays` (n <= kCastChunk) of `kind` on the
+// calling thread, as the wavefront's vectorised stages hand them to Embree:
+// from the arrays, closest hit into `hits`, or occlusion into hits.found for
+// shadow rays; camera rays marked coherent. Returns how many hit something.
+std::size_t cast_batch(const CompiledScene& scene, const RayList& rays, std::size_t first, std::size_t n,
+                       RayKind kind, RayBatchMode mode, HitBuffers& hits);
+
+// Casts every ray of `rays` over every worker thread, kCastChunk at a time
+// (as the wavefront casts a wave's rays at once). Returns how many hit
+// something.
+std::size_t cast(const CompiledScene& scene, const RayList& rays, RayKind kind, RayBatchMode mode);
 
 // "Raw/<kind>/<mode>", the benchmark's name.
 std::string raw_name(RayKind kind, RayBatchMode mode);

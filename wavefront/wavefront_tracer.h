@@ -25,11 +25,14 @@
 namespace pathlab {
 
 // How each kind of ray reaches Embree (core/embree_accel.h). The defaults
-// are the fastest on the dragon benchmark on a 2-core AVX-512 machine
-// (bench/bench_tracers.cpp measures every mode; docs/performance.md).
+// are the fastest on the dragon benchmark on this project's 2-core AVX-512
+// machine (bench/bench_tracers.cpp measures every mode, --modes= any other
+// mix; docs/performance.md): streams of every kind, which Embree reads
+// straight from the vectorised stages' arrays (camera streams marked
+// coherent).
 struct WavefrontRayModes {
-  RayBatchMode camera = RayBatchMode::Packet16;  // coherent: adjacent pixels
-  RayBatchMode bounce = RayBatchMode::Single;
+  RayBatchMode camera = RayBatchMode::Stream;
+  RayBatchMode bounce = RayBatchMode::Stream;
   RayBatchMode shadow = RayBatchMode::Stream;
 };
 
