@@ -145,8 +145,9 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
           << (wf->wave_size() * wf->bytes_per_path() * static_cast<std::size_t>(max_threads()) + 512 * 1024) /
                  (1024 * 1024)
           << " MiB in flight on " << max_threads() << " threads); "
-          << wf->stages_description()
-          << "\n";
+          << wf->stages_description() << "; rays to Embree: camera " << ray_batch_mode_name(wf->ray_modes().camera)
+          << ", bounce " << ray_batch_mode_name(wf->ray_modes().bounce) << ", shadow "
+          << ray_batch_mode_name(wf->ray_modes().shadow) << "\n";
       if (const WavefrontTimes t = wf->times(); t.waves_seconds > 0.0) {
         std::snprintf(line, sizeof line,
                       "%.0f%% of the waves' time in Embree; per thread, camera %.3g, bounce %.3g, shadow %.3g rays/s",
