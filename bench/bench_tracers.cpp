@@ -45,6 +45,7 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -473,22 +474,22 @@ void register_benchmarks() {
   }
 }
 
-// "packet16/stream/stream": the camera, bounce and shadow modes; false if
+// "packet16/stream/stream": the camera, bounce and shadow modes; nullopt if
 // that is not what `text` says.
-bool parse_modes_flag(const char* text, WavefrontRayModes* m) {
+std::optional<WavefrontRayModes> parse_mode_triple(const std::string& text) {
   RayBatchMode parsed[3];
+  std::size_t begin = 0;
   for (int k = 0; k < 3; ++k) {
-    const char* end = std::strchr(text, k < 2 ? '/' : '\0');
-    if (end == nullptr) return false;
-    const std::string name(text, end);
-    bool known = false;
-    for (RayBatchMode mode : kAllRayBatchModes)
-      if (name == ray_batch_mode_name(mode)) parsed[k] = mode, known = true;
-    if (!known) return false;
-    text = end + (k < 2 ? 1 : 0);
+    const std::size_t end = k < 2 ? text.find('/', begin) : text.size();
+    if (end == std::string::npos) return std::nullopt;
+    const std::string name = text.substr(begin, end - begin);
+    const auto* mode = std::find_if(std::begin(kAllRayBatchModes), std::end(kAllRayBatchModes),
+                                    [&](RayBatchMode m) { return name == ray_batch_mode_name(m); });
+    if (mode == std::end(kAllRayBatchModes)) return std::nullopt;
+    parsed[k] = *mode;
+    begin = end + 1;
   }
-  *m = WavefrontRayModes{parsed[0], parsed[1], parsed[2]};
-  return true;
+  return WavefrontRayModes{parsed[0], parsed[1], parsed[2]};
 }
 
 // The processor, for the run's context: rates and ratios measured on one
@@ -551,15 +552,15 @@ int main(int argc, char** argv) {
       std::string list = argv[i] + 8;
       for (std::size_t begin = 0; begin <= list.size();) {
         const std::size_t end = std::min(list.find(',', begin), list.size());
-        WavefrontRayModes m;
-        if (!parse_modes_flag(list.substr(begin, end - begin).c_str(), &m)) {
+        const std::optional<WavefrontRayModes> m = parse_mode_triple(list.substr(begin, end - begin));
+        if (!m) {
           std::fprintf(stderr,
                        "pathlab bench: --modes: expected CAMERA/BOUNCE/SHADOW triples of single, packet16 or stream "
                        "separated by commas, got '%s'\n",
                        argv[i] + 8);
           return 1;
         }
-        s.modes.push_back(m);
+        s.modes.push_back(*m);
         begin = end + 1;
       }
     }
