@@ -48,10 +48,6 @@ void RayList::push_back(const Ray& r) {
   tmax.push_back(r.tmax);
 }
 
-Ray RayList::operator[](std::size_t i) const {
-  return Ray{vec3(ox[i], oy[i], oz[i]), vec3(dx[i], dy[i], dz[i]), tmax[i]};
-}
-
 RayArrays RayList::from(std::size_t first) const {
   return RayArrays{ox.data() + first, oy.data() + first, oz.data() + first, dx.data() + first,
                    dy.data() + first, dz.data() + first, tmax.data() + first};

@@ -27,7 +27,6 @@ struct RayList {
   std::size_t size() const { return ox.size(); }
   bool empty() const { return ox.empty(); }
   void push_back(const Ray& r);
-  Ray operator[](std::size_t i) const;
   // Rays [first, size()) as arrays.
   RayArrays from(std::size_t first) const;
 };
