@@ -474,20 +474,28 @@ void register_benchmarks() {
   }
 }
 
+// `text` cut at every `sep` ("a,,b" gives "a", "", "b").
+std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> parts;
+  for (std::size_t begin = 0;;) {
+    const std::size_t end = text.find(sep, begin);
+    parts.push_back(text.substr(begin, end == std::string::npos ? std::string::npos : end - begin));
+    if (end == std::string::npos) return parts;
+    begin = end + 1;
+  }
+}
+
 // "packet16/stream/stream": the camera, bounce and shadow modes; nullopt if
 // that is not what `text` says.
 std::optional<WavefrontRayModes> parse_mode_triple(const std::string& text) {
+  const std::vector<std::string> names = split(text, '/');
+  if (names.size() != 3) return std::nullopt;
   RayBatchMode parsed[3];
-  std::size_t begin = 0;
   for (int k = 0; k < 3; ++k) {
-    const std::size_t end = k < 2 ? text.find('/', begin) : text.size();
-    if (end == std::string::npos) return std::nullopt;
-    const std::string name = text.substr(begin, end - begin);
     const auto* mode = std::find_if(std::begin(kAllRayBatchModes), std::end(kAllRayBatchModes),
-                                    [&](RayBatchMode m) { return name == ray_batch_mode_name(m); });
+                                    [&](RayBatchMode m) { return names[k] == ray_batch_mode_name(m); });
     if (mode == std::end(kAllRayBatchModes)) return std::nullopt;
     parsed[k] = *mode;
-    begin = end + 1;
   }
   return WavefrontRayModes{parsed[0], parsed[1], parsed[2]};
 }
@@ -549,10 +557,8 @@ int main(int argc, char** argv) {
       }
     }
     else if (std::strncmp(argv[i], "--modes=", 8) == 0) {
-      std::string list = argv[i] + 8;
-      for (std::size_t begin = 0; begin <= list.size();) {
-        const std::size_t end = std::min(list.find(',', begin), list.size());
-        const std::optional<WavefrontRayModes> m = parse_mode_triple(list.substr(begin, end - begin));
+      for (const std::string& triple : split(argv[i] + 8, ',')) {
+        const std::optional<WavefrontRayModes> m = parse_mode_triple(triple);
         if (!m) {
           std::fprintf(stderr,
                        "pathlab bench: --modes: expected CAMERA/BOUNCE/SHADOW triples of single, packet16 or stream "
@@ -561,7 +567,6 @@ int main(int argc, char** argv) {
           return 1;
         }
         s.modes.push_back(*m);
-        begin = end + 1;
       }
     }
     else
@@ -583,8 +588,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pathlab bench: %s\n", e.what());
     return 1;
   }
-  benchmark::AddCustomContext("processor", processor());
-  std::fprintf(stderr, "pathlab bench: processor %s\n", processor().c_str());
+  const std::string cpu = processor();
+  benchmark::AddCustomContext("processor", cpu);
+  std::fprintf(stderr, "pathlab bench: processor %s\n", cpu.c_str());
   register_benchmarks();
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
