@@ -176,6 +176,26 @@ void fill_lane(Packet& r, int k, const Ray& ray) {
   r.flags[k] = 0;
 }
 
+// Lanes [n, 16) of a packet as well-formed rays that are inactive by both of
+// Embree's conventions: masked off by the caller, and tnear > tfar. The valid
+// mask alone does not do: a build of Embree without native 16-wide kernels
+// (AVX2, no AVX-512) traces rtcIntersect16/rtcOccluded16 as a stream, which
+// decides activity from the ray data and asserts that it is finite.
+template <typename Packet>
+void disable_lanes(Packet& r, std::size_t n) {
+  for (auto k = n; k < static_cast<std::size_t>(16); ++k) {
+    r.org_x[k] = r.org_y[k] = r.org_z[k] = 0.0f;
+    r.dir_x[k] = r.dir_y[k] = 0.0f;
+    r.dir_z[k] = 1.0f;
+    r.tnear[k] = 1.0f;
+    r.tfar[k] = 0.0f;
+    r.time[k] = 0.0f;
+    r.mask[k] = 0u;
+    r.id[k] = 0;
+    r.flags[k] = 0;
+  }
+}
+
 // Lane masks for groups of up to 16 rays: -1 for a lane in use, 0 otherwise.
 struct alignas(64) ValidMask {
   int lane[kPacket];
@@ -221,6 +241,7 @@ void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> h
           rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
           rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
         }
+        disable_lanes(rh.ray, n);
         rtcIntersect16(valid, impl_->scene, &context, &rh);
         for (std::size_t k = 0; k < n; ++k)
           record(b + k, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]);
@@ -256,6 +277,7 @@ void EmbreeAccel::occluded_batch(std::span<const Ray> rays, std::span<std::uint8
       for_each_packet(rays.size(), [&](std::size_t b, std::size_t n, const int* valid) {
         RTCRay16 r;
         for (std::size_t k = 0; k < n; ++k) fill_lane(r, static_cast<int>(k), rays[b + k]);
+        disable_lanes(r, n);
         rtcOccluded16(valid, impl_->scene, &context, &r);
         for (std::size_t k = 0; k < n; ++k) occluded[b + k] = r.tfar[k] < 0.0f;
       });
@@ -296,6 +318,7 @@ void fill_packet(Packet& p, const RayArrays& rays, std::size_t b, std::size_t n)
     p.id[k] = 0;
     p.flags[k] = 0;
   }
+  disable_lanes(p, n);
 }
 
 // The per-ray inputs of a pointer-SoA stream that the arrays do not hold:

@@ -1,5 +1,6 @@
 #include "core/scene_loader.h"
 
+#include "core/data_dir.h"
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/json_document.h"
@@ -498,8 +499,10 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
   if (type == "mesh") {
     const Node file = node.required("file");
     if (file.string().empty()) file.fail("the mesh file name is empty");
-    const std::filesystem::path path = folder / file.string();
+    const std::filesystem::path path = resolve_scene_path(folder, file.string());
     shape.description = "shapes[" + std::to_string(index) + "] (mesh " + file.string() + ")";
+    if (names_data_file(file.string()) && !std::filesystem::exists(path))
+      file.fail(file.string() + ": " + path.string() + " does not exist; " + data_directory_hint());
     MeshLoadReport report;
     try {
       shape.mesh = load_mesh(path, &report);

@@ -1,5 +1,7 @@
 // Every scene shipped in scenes/ loads without a warning, compiles, and
-// traces a sample to a finite radiance.
+// traces a sample to a finite radiance; the benchmark scenes in bench/scenes/
+// load. Some read fetched data ("$data/..."), so these run after the
+// pathlab_data fixture.
 #include "core/compiled_scene.h"
 #include "core/scene_loader.h"
 #include "reference/reference_tracer.h"
@@ -11,9 +13,11 @@
 namespace pathlab {
 namespace {
 
+namespace fs = std::filesystem;
+
 TEST(ExampleScenes, LoadCompileAndTrace) {
   int count = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(PATHLAB_SOURCE_DIR) / "scenes")) {
+  for (const auto& entry : fs::directory_iterator(fs::path(PATHLAB_SOURCE_DIR) / "scenes")) {
     if (entry.path().extension() != ".json") continue;
     SCOPED_TRACE(entry.path().string());
     Scene scene = load_scene(entry.path());
@@ -26,13 +30,26 @@ TEST(ExampleScenes, LoadCompileAndTrace) {
     for (std::uint32_t s = 0; s < 16; ++s) EXPECT_TRUE(is_finite(tracer.trace_sample(w / 2, h / 2, s, nullptr).L));
     ++count;
   }
-  EXPECT_GE(count, 2);
+  EXPECT_GE(count, 3);
+}
+
+// The dragon scenes: the full dragon (871,414 triangles, 108 of them
+// degenerate and dropped with a warning) once and four times.
+TEST(ExampleScenes, BenchScenesLoad) {
+  for (const auto& [name, dragons] : {std::pair{"dragon.json", 1}, std::pair{"dragons-3m.json", 4}}) {
+    SCOPED_TRACE(name);
+    const Scene scene = load_scene(fs::path(PATHLAB_SOURCE_DIR) / "bench" / "scenes" / name);
+    std::size_t triangles = 0;
+    for (const Shape& shape : scene.shapes) triangles += shape.mesh.triangles.size();
+    EXPECT_GT(triangles, dragons * std::size_t{871'000});
+    EXPECT_EQ(scene.warnings.size(), static_cast<std::size_t>(dragons));
+  }
 }
 
 // The built-in default is scenes/cornell-box.json, compiled in.
 TEST(ExampleScenes, BuiltinIsTheCornellBoxFile) {
   const Scene a = builtin_cornell_box();
-  const Scene b = load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "scenes" / "cornell-box.json");
+  const Scene b = load_scene(fs::path(PATHLAB_SOURCE_DIR) / "scenes" / "cornell-box.json");
   ASSERT_EQ(a.shapes.size(), b.shapes.size());
   for (std::size_t i = 0; i < a.shapes.size(); ++i) EXPECT_EQ(a.shapes[i].mesh.positions, b.shapes[i].mesh.positions);
 }

@@ -19,10 +19,6 @@
 #include <string_view>
 #include <vector>
 
-#ifndef PATHLAB_SHARED_DATA_DIR
-#define PATHLAB_SHARED_DATA_DIR "/work/shared/data"
-#endif
-
 namespace pathlab {
 namespace {
 
@@ -481,33 +477,6 @@ TEST_F(MeshIoObj, VertexCheckAcceptsEveryNumberForm) {
   EXPECT_EQ(mesh.positions[2], vec3(0.0f, 1.0f, 0.0f));
   EXPECT_EQ(mesh.triangles.size(), 1u);
 }
-
-// ---------------------------------------------------------------- shared data
-
-void check_shared_mesh(const std::string& name, std::size_t faces, float min_extent, float max_extent) {
-  const fs::path path = fs::path(PATHLAB_SHARED_DATA_DIR) / "meshes" / name;
-  ASSERT_TRUE(fs::exists(path)) << path;
-  MeshLoadReport report;
-  const TriangleMesh mesh = load_mesh(path, &report);
-  EXPECT_EQ(report.faces_in_file, faces);
-  EXPECT_EQ(report.triangles_loaded + report.degenerate_dropped, report.faces_in_file);
-  EXPECT_EQ(report.triangles_loaded, mesh.triangles.size());
-  vec3 lo(kInfinity), hi(-kInfinity);
-  for (const vec3& p : mesh.positions) {
-    ASSERT_TRUE(is_finite(p));
-    lo = glm::min(lo, p);
-    hi = glm::max(hi, p);
-  }
-  for (const glm::uvec3& t : mesh.triangles)
-    for (int k = 0; k < 3; ++k) ASSERT_LT(t[k], mesh.positions.size());
-  const float extent = max_component(hi - lo);
-  EXPECT_GT(extent, min_extent);
-  EXPECT_LT(extent, max_extent);
-}
-
-TEST(MeshIoSharedData, BunnyRes4) { check_shared_mesh("bun_zipper_res4.ply.gz", 948, 0.1f, 0.2f); }
-
-TEST(MeshIoSharedData, DragonRes4) { check_shared_mesh("dragon_vrip_res4.ply.gz", 11102, 0.15f, 0.3f); }
 
 }  // namespace
 }  // namespace pathlab

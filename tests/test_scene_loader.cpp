@@ -19,10 +19,6 @@
 #include <string_view>
 #include <vector>
 
-#ifndef PATHLAB_SOURCE_DIR
-#define PATHLAB_SOURCE_DIR "/work/main"
-#endif
-
 namespace pathlab {
 namespace {
 

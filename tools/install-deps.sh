@@ -19,6 +19,7 @@ packages=(
   libvtk9-dev             # path polylines as VTK PolyData (debugtools/)
   libglfw3-dev libgl-dev libimgui-dev  # the pathlab-debug GUI
   xvfb xauth              # run the GUI headless in tests
+  curl ca-certificates    # tools/fetch-data.sh: test data from the npm registry
 )
 
 as_root=()
