@@ -2,6 +2,8 @@
 
 #include "core/sampling.h"
 
+#include <cmath>
+
 namespace pathlab {
 
 float triangle_area(const TriangleMesh& mesh, std::uint32_t tri) {
@@ -46,6 +48,15 @@ SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx) {
   sp.p_error = gamma_bound(5) * glm::abs(shape.radius * dir) + gamma_bound(2) * glm::abs(sp.p);
   sp.n = shape.flip_normals ? -dir : dir;
   return sp;
+}
+
+vec3 shading_normal(const vec3& ng, const vec3& sum) {
+  const float length = glm::length(sum);
+  if (!(length > 1e-20f) || !std::isfinite(length)) return ng;
+  vec3 ns = sum / length;
+  float c = glm::dot(ns, ng);
+  if (c < 0.0f) ns = -ns, c = -c;
+  return c > 1.0f - 1e-6f ? ng : ns;
 }
 
 SurfacePoint sample_triangle(const Triangle& t, vec2 u) { return triangle_point(t, square_to_uniform_triangle(u)); }

@@ -41,6 +41,15 @@ SurfacePoint triangle_point(const Shape& shape, std::uint32_t tri, vec2 b);
 // A point near `p_approx` projected back onto the sphere.
 SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx);
 
+// The shading normal at a point with geometric normal `ng` from the
+// interpolated vertex normals `sum` (not normalised): unit length, turned to
+// ng's side of the surface (so flip_normals and the file's winding decide the
+// front, not the file's normals). It is ng itself when `sum` vanishes or is
+// not finite (opposite vertex normals) and when it lies within about 0.08
+// degrees of ng (1 - cos < 1e-6), so that a mesh whose normals are its face
+// normals shades exactly as the flat mesh.
+vec3 shading_normal(const vec3& ng, const vec3& sum);
+
 SurfacePoint sample_triangle(const Triangle& t, vec2 u);
 SurfacePoint sample_triangle(const Shape& shape, std::uint32_t tri, vec2 u);
 SurfacePoint sample_sphere(const Shape& shape, vec2 u);

@@ -10,6 +10,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cctype>
 #include <cerrno>
@@ -20,6 +21,7 @@
 #include <cstring>
 #include <initializer_list>
 #include <iterator>
+#include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -59,9 +61,53 @@ struct RawMesh {
   std::vector<std::int64_t> indices;       // every face's vertex indices, concatenated
   std::vector<std::size_t> face_start{0};  // face f is indices[face_start[f], face_start[f + 1])
   int number_base = 0;  // messages number faces and vertices as the format does: PLY 0, OBJ 1
+  // Vertex attributes. PLY stores them per vertex (indexed like positions,
+  // the index arrays below empty); OBJ per corner, with indices of their own
+  // parallel to `indices` (-1: this corner has none).
+  std::vector<vec3> normals;
+  std::vector<vec2> uvs;
+  std::vector<std::int64_t> normal_indices, uv_indices;
+  std::vector<std::string> ignored;
 
   std::size_t face_count() const { return face_start.size() - 1; }
+  bool per_corner() const { return !normal_indices.empty() || !uv_indices.empty(); }
 };
+
+// The vertex attributes must be finite, and normals not of zero length;
+// normals come back unit length. `what` names them in messages ("normal").
+void check_attributes(const fs::path& file, RawMesh& raw) {
+  const auto name = [&](std::size_t i) { return std::to_string(i + static_cast<std::size_t>(raw.number_base)); };
+  // PLY: "vertex 7's normal"; OBJ: "normal 7 (vn)".
+  const bool obj = raw.number_base == 1;
+  for (std::size_t i = 0; i < raw.normals.size(); ++i) {
+    vec3& n = raw.normals[i];
+    const std::string where = obj ? "normal " + name(i) + " (vn)" : "vertex " + name(i) + "'s normal";
+    std::ostringstream value;
+    value << "(" << n.x << ", " << n.y << ", " << n.z << ")";
+    if (!is_finite(n)) fail(file, where + " is not finite " + value.str());
+    const double length = glm::length(dvec3(n));
+    if (!(length > 1e-30)) fail(file, where + " has zero length " + value.str());
+    n = vec3(dvec3(n) / length);
+  }
+  for (std::size_t i = 0; i < raw.uvs.size(); ++i) {
+    const vec2& t = raw.uvs[i];
+    if (!std::isfinite(t.x) || !std::isfinite(t.y)) {
+      std::ostringstream problem;
+      problem << (obj ? "texture coordinate " + name(i) + " (vt)" : "vertex " + name(i) + "'s texture coordinate")
+              << " is not finite (" << t.x << ", " << t.y << ")";
+      fail(file, problem.str());
+    }
+  }
+  const auto check_refs = [&](const std::vector<std::int64_t>& refs, std::size_t count, const char* what) {
+    for (std::size_t f = 0; f < raw.face_count(); ++f)
+      for (std::size_t k = raw.face_start[f]; k < raw.face_start[f + 1]; ++k)
+        if (refs[k] >= static_cast<std::int64_t>(count) || refs[k] < -1)
+          fail(file, "face " + name(f) + " refers to " + what + " " + std::to_string(refs[k] + raw.number_base) +
+                         " but the mesh has " + std::to_string(count));
+  };
+  if (!raw.normal_indices.empty()) check_refs(raw.normal_indices, raw.normals.size(), "normal");
+  if (!raw.uv_indices.empty()) check_refs(raw.uv_indices, raw.uvs.size(), "texture coordinate");
+}
 
 void check_indices(const fs::path& file, const RawMesh& raw) {
   const auto vertex_count = static_cast<std::int64_t>(raw.positions.size());
@@ -76,8 +122,9 @@ void check_indices(const fs::path& file, const RawMesh& raw) {
   }
 }
 
-// Validates `raw`, fan-triangulates its polygons and drops degenerate triangles.
-TriangleMesh finish(const fs::path& file, const RawMesh& raw, MeshLoadReport* report) {
+// Validates `raw` (normalising its normals), fan-triangulates its polygons and
+// drops degenerate triangles.
+TriangleMesh finish(const fs::path& file, RawMesh raw, MeshLoadReport* report) {
   for (std::size_t v = 0; v < raw.positions.size(); ++v) {
     const vec3& p = raw.positions[v];
     if (!is_finite(p)) {
@@ -91,23 +138,65 @@ TriangleMesh finish(const fs::path& file, const RawMesh& raw, MeshLoadReport* re
   if (raw.positions.size() > std::numeric_limits<std::uint32_t>::max())
     fail(file, "too many vertices (" + std::to_string(raw.positions.size()) + ")");
   check_indices(file, raw);
+  check_attributes(file, raw);
 
   TriangleMesh mesh;
   mesh.positions = raw.positions;
+  if (!raw.per_corner()) {
+    mesh.normals = raw.normals;
+    mesh.uvs = raw.uvs;
+  }
+  // OBJ corners: one vertex per distinct (position, normal, texture
+  // coordinate); a corner without a normal in a mesh with normals takes its
+  // face's, keyed by the normal's bits.
+  std::map<std::array<std::int64_t, 6>, std::uint32_t> welded;
+  const bool has_normals = !raw.normals.empty(), has_uvs = !raw.uvs.empty();
+  if (raw.per_corner()) {
+    mesh.positions.clear();
+    if (has_normals) mesh.normals.clear();
+  }
+  // The unit normal of face f, from its first three corners.
+  const auto face_normal = [&](std::size_t f) {
+    const std::size_t s = raw.face_start[f];
+    const dvec3 a(raw.positions[raw.indices[s]]), b(raw.positions[raw.indices[s + 1]]),
+        c(raw.positions[raw.indices[s + 2]]);
+    const dvec3 cr = glm::cross(b - a, c - a);
+    const double len = glm::length(cr);
+    return len > 0.0 ? vec3(cr / len) : vec3(0.0f, 0.0f, 1.0f);
+  };
+  const auto corner = [&](std::size_t k, std::size_t f) -> std::uint32_t {
+    if (!raw.per_corner()) return static_cast<std::uint32_t>(raw.indices[k]);
+    const std::int64_t ni = has_normals ? raw.normal_indices[k] : -1;
+    const std::int64_t ti = has_uvs ? raw.uv_indices[k] : -1;
+    const vec3 n = !has_normals ? vec3(0.0f) : ni >= 0 ? raw.normals[static_cast<std::size_t>(ni)] : face_normal(f);
+    const std::array<std::int64_t, 6> key{raw.indices[k], ni, std::bit_cast<std::int32_t>(n.x),
+                                          std::bit_cast<std::int32_t>(n.y), std::bit_cast<std::int32_t>(n.z), ti};
+    const auto [it, added] = welded.try_emplace(key, static_cast<std::uint32_t>(mesh.positions.size()));
+    if (added) {
+      mesh.positions.push_back(raw.positions[static_cast<std::size_t>(raw.indices[k])]);
+      if (has_normals) mesh.normals.push_back(n);
+      if (has_uvs) mesh.uvs.push_back(ti >= 0 ? raw.uvs[static_cast<std::size_t>(ti)] : vec2(0.0f));
+    }
+    return it->second;
+  };
   std::size_t dropped = 0;
   for (std::size_t f = 0; f < raw.face_count(); ++f) {
     // A fan around the polygon's first vertex: correct for convex polygons
     // (all that OBJ/PLY writers normally emit); concave ones may fold over.
     const std::size_t first = raw.face_start[f];
     for (std::size_t k = first + 1; k + 1 < raw.face_start[f + 1]; ++k) {
-      const glm::uvec3 tri(raw.indices[first], raw.indices[k], raw.indices[k + 1]);
-      const dvec3 a(mesh.positions[tri.x]), b(mesh.positions[tri.y]), c(mesh.positions[tri.z]);
-      const bool repeated = tri.x == tri.y || tri.y == tri.z || tri.x == tri.z;
+      const glm::u64vec3 pos(raw.indices[first], raw.indices[k], raw.indices[k + 1]);
+      const dvec3 a(raw.positions[pos.x]), b(raw.positions[pos.y]), c(raw.positions[pos.z]);
+      const bool repeated = pos.x == pos.y || pos.y == pos.z || pos.x == pos.z;
       if (repeated || glm::length(glm::cross(b - a, c - a)) == 0.0) {
         ++dropped;
         continue;
       }
-      mesh.triangles.push_back(tri);
+      // One corner after the other: the order numbers the welded vertices.
+      const std::uint32_t c0 = corner(first, f);
+      const std::uint32_t c1 = corner(k, f);
+      const std::uint32_t c2 = corner(k + 1, f);
+      mesh.triangles.emplace_back(c0, c1, c2);
     }
   }
   if (mesh.triangles.empty())
@@ -116,6 +205,7 @@ TriangleMesh finish(const fs::path& file, const RawMesh& raw, MeshLoadReport* re
     report->faces_in_file = raw.face_count();
     report->triangles_loaded = mesh.triangles.size();
     report->degenerate_dropped = dropped;
+    report->ignored = raw.ignored;
   }
   return mesh;
 }
@@ -124,38 +214,51 @@ TriangleMesh finish(const fs::path& file, const RawMesh& raw, MeshLoadReport* re
 
 // tinyobj turns a coordinate it cannot parse ("nan", "inf", "1,5", "abc")
 // into 0 without a warning, so a broken vertex would load silently at the
-// origin. Check the first three coordinates of every vertex line ("v" as
-// tinyobj recognises it) before handing the text over.
+// origin. Check the coordinates of every vertex, normal and texture
+// coordinate line ("v", "vn", "vt" as tinyobj recognises them) before handing
+// the text over.
 void check_obj_vertices(const fs::path& file, std::string_view text) {
   const auto is_blank = [](char c) { return c == ' ' || c == '\t'; };
-  int vertex = 0;
+  struct Kind {
+    std::string_view tag, name;
+    int needed, checked;  // coordinates required, and how many are read
+    int count = 0;
+  };
+  Kind kinds[] = {{"v", "vertex", 3, 3}, {"vn", "normal", 3, 3}, {"vt", "texture coordinate", 1, 2}};
   for (int line_no = 1; !text.empty(); ++line_no) {
     // Lines end like tinyobj's: at "\n", "\r\n" or a lone "\r".
     const std::size_t eol = std::min(text.find_first_of("\r\n"), text.size());
     std::string_view line = text.substr(0, eol);
     text.remove_prefix(std::min(eol + (text.substr(eol).starts_with("\r\n") ? 2 : 1), text.size()));
     line.remove_prefix(std::min(line.find_first_not_of(" \t"), line.size()));
-    if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
-    ++vertex;
+    Kind* kind = nullptr;
+    for (Kind& k : kinds)
+      if (line.size() > k.tag.size() && line.starts_with(k.tag) && is_blank(line[k.tag.size()])) kind = &k;
+    if (kind == nullptr) continue;
+    ++kind->count;
     const auto bad = [&](const std::string& problem) {
-      fail(file, "vertex " + std::to_string(vertex) + problem, line_no);
+      fail(file, std::string(kind->name) + " " + std::to_string(kind->count) + problem, line_no);
     };
     std::string_view coords[3];
     int n = 0;
-    for (std::size_t i = 1; n < 3;) {
+    for (std::size_t i = kind->tag.size(); n < kind->checked;) {
       while (i < line.size() && is_blank(line[i])) ++i;
       if (i == line.size()) break;
       const std::size_t start = i;
       while (i < line.size() && !is_blank(line[i])) ++i;
       coords[n++] = line.substr(start, i - start);
     }
-    if (n < 3) bad(" has " + std::to_string(n) + " coordinates (3 needed)");
+    if (n < kind->needed)
+      bad(" has " + std::to_string(n) + " coordinates (" + std::to_string(kind->needed) + " needed)");
     const auto cut = [](std::string_view c) { return std::string(c.substr(0, 40)); };
-    for (const std::string_view c : coords) {
+    for (int c = 0; c < n; ++c) {
       double value = 0.0;
-      if (parse_number(c, value) == Number::kMalformed) bad(": malformed number '" + cut(c) + "'");
-      if (!std::isfinite(value))
-        bad(" has a non-finite coordinate (" + cut(coords[0]) + ", " + cut(coords[1]) + ", " + cut(coords[2]) + ")");
+      if (parse_number(coords[c], value) == Number::kMalformed) bad(": malformed number '" + cut(coords[c]) + "'");
+      if (!std::isfinite(value)) {
+        std::string all;
+        for (int k = 0; k < n; ++k) all += (k ? ", " : "") + cut(coords[k]);
+        bad(" has a non-finite coordinate (" + all + ")");
+      }
     }
   }
 }
@@ -174,16 +277,39 @@ RawMesh parse_obj(const fs::path& file, std::string_view text) {
 
   RawMesh raw;
   raw.number_base = 1;
-  const std::vector<tinyobj::real_t>& v = reader.GetAttrib().vertices;
+  const tinyobj::attrib_t& attrib = reader.GetAttrib();
+  const std::vector<tinyobj::real_t>& v = attrib.vertices;
   for (std::size_t i = 0; i + 2 < v.size(); i += 3) raw.positions.emplace_back(v[i], v[i + 1], v[i + 2]);
-  // All shapes index the same vertex array, so concatenating them is trivial.
+  for (std::size_t i = 0; i + 2 < attrib.normals.size(); i += 3)
+    raw.normals.emplace_back(attrib.normals[i], attrib.normals[i + 1], attrib.normals[i + 2]);
+  for (std::size_t i = 0; i + 1 < attrib.texcoords.size(); i += 2)
+    raw.uvs.emplace_back(attrib.texcoords[i], attrib.texcoords[i + 1]);
+  // All shapes index the same vertex arrays, so concatenating them is trivial.
+  bool smoothing_groups = false;
+  std::vector<std::string> materials;
   for (const tinyobj::shape_t& shape : reader.GetShapes()) {
     std::size_t k = 0;
     for (const unsigned char n : shape.mesh.num_face_vertices) {
-      for (unsigned j = 0; j < n; ++j) raw.indices.push_back(shape.mesh.indices[k++].vertex_index);
+      for (unsigned j = 0; j < n; ++j, ++k) {
+        const tinyobj::index_t& index = shape.mesh.indices[k];
+        raw.indices.push_back(index.vertex_index);
+        if (!raw.normals.empty()) raw.normal_indices.push_back(index.normal_index);
+        if (!raw.uvs.empty()) raw.uv_indices.push_back(index.texcoord_index);
+      }
       raw.face_start.push_back(raw.indices.size());
     }
+    for (const unsigned id : shape.mesh.smoothing_group_ids) smoothing_groups |= id != 0;
   }
+  for (const tinyobj::material_t& m : reader.GetMaterials()) materials.push_back(m.name);
+  if (smoothing_groups && raw.normals.empty())
+    raw.ignored.push_back("smoothing groups ('s'; \"normals\": \"smooth\" computes vertex normals)");
+  if (!materials.empty()) {
+    std::string list;
+    for (const std::string& m : materials) list += (list.empty() ? "" : ", ") + m;
+    raw.ignored.push_back("OBJ materials (" + list + "; the scene's material applies)");
+  }
+  if (text.find("\nusemtl") != std::string_view::npos && materials.empty())
+    raw.ignored.push_back("'usemtl' (the scene's material applies)");
 
   // tinyobj does not fail on these; it warns and silently drops the face.
   const std::string& warning = reader.Warning();
@@ -362,7 +488,9 @@ RawMesh parse_ply(const fs::path& file, std::string_view text) {
   const PlyHeader header = parse_ply_header(file, text);
 
   // What each property of each element is for; everything else is skipped.
-  enum Role { kSkip = -1, kX = 0, kY = 1, kZ = 2, kFaceIndices = 3 };
+  enum Role { kSkip = -1, kX = 0, kY = 1, kZ = 2, kFaceIndices = 3, kNx = 4, kNy = 5, kNz = 6, kU = 7, kV = 8 };
+  bool has_normals = false, has_uvs = false;
+  std::vector<std::string> ignored;
   std::vector<std::vector<int>> roles;
   bool have_vertex = false, have_face = false;
   for (const PlyElement& element : header.elements) {
@@ -382,18 +510,44 @@ RawMesh parse_ply(const fs::path& file, std::string_view text) {
           fail(file, "PLY vertex element has no scalar '" + name + "' property");
         role[i] = axis;
       }
+      // Normals: all of nx ny nz, or none.
+      const int normal[3] = {find({"nx"}), find({"ny"}), find({"nz"})};
+      const int normal_count = (normal[0] >= 0) + (normal[1] >= 0) + (normal[2] >= 0);
+      if (normal_count != 0 && normal_count != 3) ignored.push_back("an incomplete vertex normal (not all of nx, ny, nz)");
+      if (normal_count == 3) {
+        has_normals = true;
+        for (int k = 0; k < 3; ++k) {
+          if (element.properties[normal[k]].is_list) fail(file, "PLY vertex normal property is a list");
+          role[normal[k]] = kNx + k;
+        }
+      }
+      // Texture coordinates, by the names writers use.
+      for (const auto& [u_name, v_name] : {std::pair{"u", "v"}, std::pair{"s", "t"},
+                                           std::pair{"texture_u", "texture_v"}, std::pair{"texture_s", "texture_t"}}) {
+        const int u = find({u_name}), v = find({v_name});
+        if (u < 0 || v < 0 || has_uvs) continue;
+        if (element.properties[u].is_list || element.properties[v].is_list)
+          fail(file, "PLY vertex texture coordinate property is a list");
+        has_uvs = true;
+        role[u] = kU;
+        role[v] = kV;
+      }
+      if (find({"red"}) >= 0 || find({"r"}) >= 0 || find({"diffuse_red"}) >= 0) ignored.push_back("per-vertex colours");
     } else if (element.name == "face" && !have_face) {
       have_face = true;
       const int i = find({"vertex_indices", "vertex_index"});
       if (i < 0 || !element.properties[i].is_list)
         fail(file, "PLY face element has no 'vertex_indices' list property");
       role[i] = kFaceIndices;
+      if (find({"red"}) >= 0 || find({"r"}) >= 0) ignored.push_back("per-face colours");
+      if (find({"texcoord"}) >= 0) ignored.push_back("per-face texture coordinates ('texcoord')");
     }
   }
   if (!have_vertex) fail(file, "PLY file has no 'vertex' element");
   if (!have_face) fail(file, "PLY file has no 'face' element");
 
   RawMesh raw;
+  raw.ignored = std::move(ignored);
   PlyBody body(file, text.substr(header.body_offset), header.encoding, header.line_count + 1);
   for (std::size_t e = 0; e < header.elements.size(); ++e) {
     const PlyElement& element = header.elements[e];
@@ -409,12 +563,16 @@ RawMesh parse_ply(const fs::path& file, std::string_view text) {
                          ", found " + std::to_string(i));
         return value;
       };
-      vec3 position(0.0f);
+      vec3 position(0.0f), normal(0.0f);
+      vec2 uv(0.0f);
       for (std::size_t p = 0; p < element.properties.size(); ++p) {
         const PlyProperty& prop = element.properties[p];
         if (!prop.is_list) {
-          const double value = read(prop.type);
-          if (role[p] >= kX && role[p] <= kZ) position[role[p]] = static_cast<float>(value);
+          const auto value = static_cast<float>(read(prop.type));
+          if (role[p] >= kX && role[p] <= kZ) position[role[p]] = value;
+          else if (role[p] >= kNx && role[p] <= kNz) normal[role[p] - kNx] = value;
+          else if (role[p] == kU) uv.x = value;
+          else if (role[p] == kV) uv.y = value;
           continue;
         }
         const double length = read(prop.count_type);
@@ -431,7 +589,11 @@ RawMesh parse_ply(const fs::path& file, std::string_view text) {
           raw.indices.push_back(static_cast<std::int64_t>(value));
         }
       }
-      if (is_vertex) raw.positions.push_back(position);
+      if (is_vertex) {
+        raw.positions.push_back(position);
+        if (has_normals) raw.normals.push_back(normal);
+        if (has_uvs) raw.uvs.push_back(uv);
+      }
       if (is_face) raw.face_start.push_back(raw.indices.size());
     }
   }
@@ -466,6 +628,28 @@ std::vector<char> read_file_maybe_gz(const std::filesystem::path& file) {
   return data;
 }
 
+std::vector<vec3> smooth_vertex_normals(const TriangleMesh& mesh) {
+  std::vector<dvec3> sum(mesh.positions.size(), dvec3(0.0));
+  for (const glm::uvec3& t : mesh.triangles) {
+    const dvec3 p[3] = {dvec3(mesh.positions[t.x]), dvec3(mesh.positions[t.y]), dvec3(mesh.positions[t.z])};
+    const dvec3 face = glm::cross(p[1] - p[0], p[2] - p[0]);
+    const double length = glm::length(face);
+    if (!(length > 0.0)) continue;
+    for (int k = 0; k < 3; ++k) {
+      const dvec3 a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
+      // The corner's angle, from atan2 (accurate for slivers, unlike acos).
+      const double angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+      sum[t[k]] += angle * (face / length);
+    }
+  }
+  std::vector<vec3> normals(sum.size());
+  for (std::size_t v = 0; v < sum.size(); ++v) {
+    const double length = glm::length(sum[v]);
+    normals[v] = length > 0.0 ? vec3(sum[v] / length) : vec3(0.0f, 0.0f, 1.0f);
+  }
+  return normals;
+}
+
 TriangleMesh load_mesh(const std::filesystem::path& file, MeshLoadReport* report) {
   std::string name = file.filename().string();
   std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -477,8 +661,8 @@ TriangleMesh load_mesh(const std::filesystem::path& file, MeshLoadReport* report
 
   const std::vector<char> data = read_file_maybe_gz(file);
   const std::string_view text(data.data(), data.size());
-  const RawMesh raw = extension == ".obj" ? parse_obj(file, text) : parse_ply(file, text);
-  return finish(file, raw, report);
+  RawMesh raw = extension == ".obj" ? parse_obj(file, text) : parse_ply(file, text);
+  return finish(file, std::move(raw), report);
 }
 
 }  // namespace pathlab

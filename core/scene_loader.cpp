@@ -405,7 +405,10 @@ mat4 read_transform(const Node& node) {
 }
 
 TriangleMesh unit_rectangle() {
-  return {{{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}}, {{0, 1, 2}, {0, 2, 3}}};
+  TriangleMesh m;
+  m.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return m;
 }
 
 TriangleMesh unit_box() {
@@ -428,6 +431,17 @@ TriangleMesh unit_box() {
 // Applies `xf` to a mesh and drops triangles that it made degenerate.
 std::size_t transform_mesh(TriangleMesh* mesh, const mat4& xf) {
   for (vec3& p : mesh->positions) p = vec3(xf * vec4(p, 1.0f));
+  // Normals by the inverse transpose, in double so that a strong
+  // non-uniform scale does not lose them; a normal the transform squashes to
+  // nothing (a singular matrix) is caught with the triangles it belongs to.
+  if (mesh->has_normals()) {
+    const glm::dmat3 to_normal = glm::transpose(glm::inverse(glm::dmat3(mat3(xf))));
+    for (vec3& n : mesh->normals) {
+      const dvec3 m = to_normal * dvec3(n);
+      const double length = glm::length(m);
+      n = length > 0.0 && std::isfinite(length) ? vec3(m / length) : vec3(0.0f, 0.0f, 1.0f);
+    }
+  }
   // A mirroring transform turns counter-clockwise into clockwise: swap two
   // indices so the front side stays the side the normal was on.
   if (glm::determinant(mat3(xf)) < 0.0f)
@@ -448,7 +462,7 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
   Shape shape;
   shape.description = "shapes[" + std::to_string(index) + "] (" + type + ")";
   if (type == "mesh") {
-    node.allow_only({"type", "file", "material", "transform", "flip_normals"});
+    node.allow_only({"type", "file", "material", "transform", "flip_normals", "normals"});
   } else if (type == "sphere") {
     node.allow_only({"type", "center", "radius", "material", "transform", "flip_normals"});
   } else if (type == "rectangle" || type == "box") {
@@ -503,11 +517,26 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
     shape.description = "shapes[" + std::to_string(index) + "] (mesh " + file.string() + ")";
     if (names_data_file(file.string()) && !std::filesystem::exists(path))
       file.fail(file.string() + ": " + path.string() + " does not exist; " + data_directory_hint());
+    const std::string normals = node.has("normals") ? node.child("normals").string() : "file";
+    if (normals != "file" && normals != "flat" && normals != "smooth")
+      node.child("normals").fail("unknown normals " + in_quotes(normals) + " (expected file, flat or smooth)");
     MeshLoadReport report;
     try {
       shape.mesh = load_mesh(path, &report);
     } catch (const InputError& e) {
       file.fail(e.what());
+    }
+    if (!report.ignored.empty()) {
+      std::string list;
+      for (const std::string& what : report.ignored) list += (list.empty() ? "" : "; ") + what;
+      scene.warnings.push_back(file.message(path.string() + ": ignored " + list));
+    }
+    // "file": the file's normals where it has them (flat otherwise);
+    // "flat": none; "smooth": angle-weighted vertex normals, computed.
+    if (normals == "flat") {
+      shape.mesh.normals.clear();
+    } else if (normals == "smooth") {
+      shape.mesh.normals = smooth_vertex_normals(shape.mesh);
     }
     if (report.degenerate_dropped > 0)
       scene.warnings.push_back(file.message(

@@ -97,9 +97,19 @@ Spectrum Surfel::emitted(const vec3& wo) const {
   return Spectrum(0.0f);
 }
 
+// The shading-normal policy (surfel.h): with a shading normal, a reflection
+// needs wi and wo on the same side of the geometric surface, a transmission
+// opposite sides. Without one the shading frame is the geometric frame and
+// the lobes' own hemisphere tests already say the same.
+bool geometric_side_ok(const vec3& n, const vec3& wi, const vec3& wo, bool transmission) {
+  const float a = glm::dot(wi, n), b = glm::dot(wo, n);
+  return transmission ? (a < 0.0f) != (b < 0.0f) && a != 0.0f && b != 0.0f : a * b > 0.0f;
+}
+
 Spectrum Surfel::eval(const vec3& wi, const vec3& wo) const {
   const Material& m = *material;
   if (m.is_pure_impulse() || m.type == MaterialType::Emissive) return Spectrum(0.0f);
+  if (shading_normal && !geometric_side_ok(n, wi, wo, false)) return Spectrum(0.0f);
   const LocalDirs d = to_local_upper(frame, wo, wi);
   switch (m.shading.path) {
     case ShadingPath::LambertOnly: return eval_as<0>(m, d);
@@ -124,6 +134,17 @@ float Surfel::pdf(const vec3& wi, const vec3& wo) const {
 }
 
 std::optional<BsdfSample> Surfel::scatter(const vec3& wo, float u_lobe, vec2 u) const {
+  if (!shading_normal) return scatter_in_frame(wo, u_lobe, u);
+  // The dielectric tells inside from outside by the side of wo: with a
+  // shading normal that must be the geometric side too.
+  if (material->type == MaterialType::Dielectric && (glm::dot(wo, n) < 0.0f) != (glm::dot(wo, frame.n) < 0.0f))
+    return std::nullopt;
+  std::optional<BsdfSample> s = scatter_in_frame(wo, u_lobe, u);
+  if (s && !geometric_side_ok(n, s->wi, wo, s->lobe == Lobe::DielectricTransmission)) return std::nullopt;
+  return s;
+}
+
+std::optional<BsdfSample> Surfel::scatter_in_frame(const vec3& wo, float u_lobe, vec2 u) const {
   const Material& m = *material;
   if (m.type == MaterialType::Dielectric) return scatter_dielectric(m, frame, wo, u_lobe);
   vec3 wo_local = frame.to_local(wo);
@@ -175,12 +196,13 @@ std::optional<BsdfSample> Surfel::scatter(const vec3& wo, float u_lobe, vec2 u) 
 
 std::optional<BsdfSample> Surfel::scatter_cosine(const vec3& wo, vec2 u) const {
   if (material->is_pure_impulse()) return std::nullopt;
-  const float side = glm::dot(wo, n) < 0.0f ? -1.0f : 1.0f;
+  const float side = glm::dot(wo, frame.n) < 0.0f ? -1.0f : 1.0f;
   vec3 wi_local = square_to_cosine_hemisphere(u);
   const float pdf = cosine_hemisphere_pdf(wi_local);
   if (pdf <= 0.0f) return std::nullopt;
   wi_local.z *= side;
   const vec3 wi = frame.to_world(wi_local);
+  if (shading_normal && !geometric_side_ok(n, wi, wo, false)) return std::nullopt;
   return BsdfSample{wi, eval(wi, wo) / pdf, pdf, Lobe::Lambert, false};
 }
 

@@ -28,7 +28,14 @@ struct Surfel {
   vec3 p;                       // position
   vec3 p_error{0.0f};           // bound on |computed p - true p|, per axis
   vec3 n;                       // unit geometric normal of the front (emitting) side
-  Frame frame;                  // shading frame about n
+  Frame frame;                  // shading frame: about n, or about the interpolated vertex normal
+  vec2 uv{0.0f};                // the mesh's texture coordinates where it has them, else the barycentrics (b1, b2)
+  // True when frame.n is a shading normal that differs from n. Then the
+  // shading-normal policy of docs/ARCHITECTURE.md applies: a reflection
+  // exists only between directions on the same side of the geometric
+  // surface, a transmission only across it; sampled directions on the wrong
+  // side are absorbed, and eval() is 0 there.
+  bool shading_normal = false;
   const Material* material = nullptr;
   std::uint32_t shape = 0;      // index into Scene::shapes
   std::uint32_t prim = 0;       // triangle index within the shape (0 for a sphere)
@@ -43,6 +50,8 @@ struct Surfel {
   // Cosine-weighted sampling of the hemisphere on wo's side, whatever the
   // material (strategy "cosine"); weight = eval / pdf.
   std::optional<BsdfSample> scatter_cosine(const vec3& wo, vec2 u) const;
+  // scatter() in the shading frame, before the shading-normal policy.
+  std::optional<BsdfSample> scatter_in_frame(const vec3& wo, float u_lobe, vec2 u) const;
 
   // A ray leaving this surface in direction `dir`, robustly offset.
   Ray spawn(const vec3& dir) const;

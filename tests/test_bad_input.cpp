@@ -312,6 +312,30 @@ TEST_F(BadInput, GarbledMesh) {
   expect_rejected(render(write("format.json", mesh_scene("mesh.stl"))), {"format.json:", "mesh.stl", "unknown mesh format '.stl'"});
 }
 
+// Vertex normals and texture coordinates: NaN, infinite, zero length, an
+// index beyond their list, an unknown "normals" choice.
+TEST_F(BadInput, BrokenNormalsAndTextureCoordinates) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  write("nan-normal.ply", header + "0 0 0 0 0 1 0 0\n1 0 0 0 nan 1 0 0\n0 1 0 0 0 1 0 0\n3 0 1 2\n");
+  expect_rejected(render(write("nan-normal.json", mesh_scene("nan-normal.ply"))),
+                  {"nan-normal.json:", "/shapes/0/file", "nan-normal.ply: vertex 1's normal is not finite"});
+  write("zero-normal.ply", header + "0 0 0 0 0 0 0 0\n1 0 0 0 0 1 0 0\n0 1 0 0 0 1 0 0\n3 0 1 2\n");
+  expect_rejected(render(write("zero-normal.json", mesh_scene("zero-normal.ply"))),
+                  {"zero-normal.json:", "zero-normal.ply: vertex 0's normal has zero length"});
+  write("inf-uv.ply", header + "0 0 0 0 0 1 0 0\n1 0 0 0 0 1 0 0\n0 1 0 0 0 1 0 -inf\n3 0 1 2\n");
+  expect_rejected(render(write("inf-uv.json", mesh_scene("inf-uv.ply"))),
+                  {"inf-uv.json:", "inf-uv.ply: vertex 2's texture coordinate is not finite"});
+  write("vn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//4\n");
+  expect_rejected(render(write("vn-index.json", mesh_scene("vn.obj"))), {"vn-index.json:", "vn.obj:", "normal"});
+  write("ok.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  std::string text = mesh_scene("ok.obj");
+  text.replace(text.find("\"file\""), 6, "\"normals\": \"soft\", \"file\"");
+  expect_rejected(render(write("normals-key.json", text)), {"normals-key.json:", "/shapes/0/normals", "unknown normals 'soft'"});
+}
+
 TEST_F(BadInput, NanAndInfiniteVerticesInPly) {
   for (const char* bad : {"nan", "-inf"}) {
     SCOPED_TRACE(bad);

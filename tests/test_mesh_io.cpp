@@ -460,8 +460,13 @@ TEST_F(MeshIoErrors, ObjNonFiniteAndMalformedCoordinates) {
   expect_error("comma.obj", "v 0 0 0\nv 1,5 0 0\nv 0 1 0\n" + face, {"comma.obj:2: vertex 2: malformed number '1,5'"});
   expect_error("short.obj", "v 0 0 0\nv 1 0\nv 0 1 0\n" + face, {"short.obj:2: vertex 2 has 2 coordinates (3 needed)"});
   // Only 'v' lines count as vertices; lines count from 1, indented or not.
-  expect_error("mixed.obj", "# comment\nvn 0 0 1\nv 0 0 0\n  v 1 0 0\nvt nan 0\n\tv 0 1 NaN\r\n" + face,
+  expect_error("mixed.obj", "# comment\nvn 0 0 1\nv 0 0 0\n  v 1 0 0\nvt 0.5 0\n\tv 0 1 NaN\r\n" + face,
                {"mixed.obj:6: vertex 3 has a non-finite coordinate (0, 1, NaN)"});
+  // Normals and texture coordinates are counted and checked as vertices are.
+  expect_error("vt.obj", "v 0 0 0\nv 1 0 0\nvt 0 0\nvt nan 0\nv 0 1 0\n" + face,
+               {"vt.obj:4: texture coordinate 2 has a non-finite coordinate (nan, 0)"});
+  expect_error("vn.obj", "vn 0 0 1\nv 0 0 0\nv 1 0 0\nvn 0 inf 1\nv 0 1 0\n" + face,
+               {"vn.obj:4: normal 2 has a non-finite coordinate (0, inf, 1)"});
   // A lone "\r" ends a line too (for tinyobj as well).
   expect_error("cr.obj", "v 0 0 0\r\rv 1 0 0\rv 0 1 x\r" + face, {"cr.obj:4: vertex 3: malformed number 'x'"});
 }

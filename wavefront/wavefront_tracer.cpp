@@ -152,6 +152,9 @@ struct WavefrontTracer::VectorStages {
       diffuse = &m;
     }
     if (diffuse) sc.min_pdf = diffuse->shading.min_pdf;
+    // Flat triangles only: the stages shade with the geometric normal.
+    for (const Shape& shape : scene.shapes)
+      if (shape.mesh.has_normals()) return no(shape.description + " has vertex normals (smooth shading)");
     // Only triangle area lights: no point light, sphere light or environment.
     const LightSampler& lights = compiled.lights();
     if (lights.has_delta_lights()) return no("point lights");
