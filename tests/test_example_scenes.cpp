@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <string_view>
 
 namespace pathlab {
 namespace {
@@ -34,15 +35,18 @@ TEST(ExampleScenes, LoadCompileAndTrace) {
 }
 
 // The dragon scenes: the full dragon (871,414 triangles, 108 of them
-// degenerate and dropped with a warning) once and four times.
+// degenerate and dropped with a warning) once, once smooth-shaded, and four
+// times.
 TEST(ExampleScenes, BenchScenesLoad) {
-  for (const auto& [name, dragons] : {std::pair{"dragon.json", 1}, std::pair{"dragons-3m.json", 4}}) {
+  for (const auto& [name, dragons] :
+       {std::pair{"dragon.json", 1}, std::pair{"dragon-smooth.json", 1}, std::pair{"dragons-3m.json", 4}}) {
     SCOPED_TRACE(name);
     const Scene scene = load_scene(fs::path(PATHLAB_SOURCE_DIR) / "bench" / "scenes" / name);
     std::size_t triangles = 0;
     for (const Shape& shape : scene.shapes) triangles += shape.mesh.triangles.size();
     EXPECT_GT(triangles, dragons * std::size_t{871'000});
     EXPECT_EQ(scene.warnings.size(), static_cast<std::size_t>(dragons));
+    EXPECT_EQ(scene.shapes[1].mesh.has_normals(), std::string_view(name) == "dragon-smooth.json");
   }
 }
 
