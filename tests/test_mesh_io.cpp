@@ -483,5 +483,36 @@ TEST_F(MeshIoObj, VertexCheckAcceptsEveryNumberForm) {
   EXPECT_EQ(mesh.triangles.size(), 1u);
 }
 
+// Binary PLY with normals (double, big-endian) and texture coordinates
+// (float, as texture_u / texture_v): read through the same decoder as the
+// positions.
+TEST_F(MeshIoPly, BinaryNormalsAndTextureCoordinates) {
+  for (const bool big : {false, true}) {
+    SCOPED_TRACE(big ? "big-endian" : "little-endian");
+    std::string out = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") + " 1.0\n";
+    out += "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+           "property double nx\nproperty double ny\nproperty double nz\n"
+           "property float texture_u\nproperty float texture_v\n"
+           "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    const float p[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const double n[3][3] = {{0, 0, 2}, {0, 0.6, 0.8}, {1, 0, 1}};
+    for (int v = 0; v < 3; ++v) {
+      for (int k = 0; k < 3; ++k) put<float>(out, p[v][k], big);
+      for (int k = 0; k < 3; ++k) put<double>(out, n[v][k], big);
+      put<float>(out, 0.25f * static_cast<float>(v), big);
+      put<float>(out, 1.0f - 0.25f * static_cast<float>(v), big);
+    }
+    put<std::uint8_t>(out, 3, big);
+    for (std::int32_t i : {0, 1, 2}) put<std::int32_t>(out, i, big);
+    const TriangleMesh mesh = load_mesh(write("bn.ply", out));
+    ASSERT_EQ(mesh.normals.size(), 3u);
+    ASSERT_EQ(mesh.uvs.size(), 3u);
+    EXPECT_EQ(mesh.normals[0], vec3(0, 0, 1));
+    EXPECT_NEAR(mesh.normals[1].y, 0.6f, 1e-7f);
+    EXPECT_NEAR(mesh.normals[2].x, std::sqrt(0.5f), 1e-7f);
+    EXPECT_EQ(mesh.uvs[2], vec2(0.5f, 0.5f));
+  }
+}
+
 }  // namespace
 }  // namespace pathlab
