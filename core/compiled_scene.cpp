@@ -59,26 +59,19 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const 
   s->p_error = sp.p_error;
   s->n = sp.n;
   s->uv = hit.uv;
-  s->shading_normal = false;
+  vec3 ns = sp.n;
   if (shape.kind == Shape::Kind::Triangles && (shape.mesh.has_normals() || shape.mesh.has_uvs())) {
     const glm::uvec3 v = shape.mesh.triangles[hit.prim];
     const float b0 = 1.0f - hit.uv.x - hit.uv.y;
     if (shape.mesh.has_uvs())
       s->uv = b0 * shape.mesh.uvs[v.x] + hit.uv.x * shape.mesh.uvs[v.y] + hit.uv.y * shape.mesh.uvs[v.z];
     if (shape.mesh.has_normals()) {
-      const vec3& n0 = shape.mesh.normals[v.x];
-      const vec3& n1 = shape.mesh.normals[v.y];
-      const vec3& n2 = shape.mesh.normals[v.z];
-      const vec3 ns = shading_normal(sp.n, b0 * n0 + hit.uv.x * n1 + hit.uv.y * n2);
-      s->shading_normal = ns != sp.n;
-      s->frame = Frame(ns);
-      s->material = &scene_.materials[shape.material];
-      s->shape = hit.shape;
-      s->prim = hit.prim;
-      return;
+      const std::vector<vec3>& n = shape.mesh.normals;
+      ns = shading_normal(sp.n, b0 * n[v.x] + hit.uv.x * n[v.y] + hit.uv.y * n[v.z]);
     }
   }
-  s->frame = Frame(sp.n);
+  s->shading_normal = ns != sp.n;
+  s->frame = Frame(ns);
   s->material = &scene_.materials[shape.material];
   s->shape = hit.shape;
   s->prim = hit.prim;

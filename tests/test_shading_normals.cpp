@@ -132,18 +132,27 @@ TEST_F(ShadingData, SceneNormalsKey) {
   }
 }
 
-// Normals go through the inverse transpose: a shear keeps them perpendicular.
-TEST(ShadingNormals, TransformKeepsNormalsPerpendicular) {
+// Normals go through the inverse transpose: under a shear and a non-uniform
+// scale, a plane's file normals stay perpendicular to the transformed plane
+// (the transformed normal itself would not).
+TEST_F(ShadingData, TransformKeepsNormalsPerpendicular) {
+  const float c = std::sqrt(1.0f / 3.0f);
+  write("plane.ply", ply_header(3, "property float nx\nproperty float ny\nproperty float nz\n") +
+                         "1 0 0 " + std::to_string(c) + " " + std::to_string(c) + " " + std::to_string(c) + "\n" +
+                         "0 1 0 " + std::to_string(c) + " " + std::to_string(c) + " " + std::to_string(c) + "\n" +
+                         "0 0 1 " + std::to_string(c) + " " + std::to_string(c) + " " + std::to_string(c) + "\n3 0 1 2\n");
   const std::string text = R"({"pathlab_scene": 1, "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0]},
     "materials": {"m": {"type": "diffuse", "albedo": 0.5}},
-    "shapes": [{"type": "box", "material": "m", "transform": {"matrix": [1, 0.7, 0, 0,  0, 1, 0, 0,  0, 0, 3, 0,  0, 0, 0, 1]}}]})";
-  Scene scene = parse_scene(text, "s.json");
-  TriangleMesh& m = scene.shapes[0].mesh;
-  ASSERT_FALSE(m.has_normals());  // a box has none of its own
-  m.normals = smooth_vertex_normals(m);
-  for (const glm::uvec3& t : m.triangles) {
-    const vec3 face = glm::normalize(glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]));
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(glm::dot(m.normals[t[k]], face), 1.0f, 1e-6f);  // box faces own their corners
+    "shapes": [{"type": "mesh", "file": "plane.ply", "material": "m",
+                "transform": {"matrix": [1, 0.7, 0, 0,  0, 1, 0, 0,  0, 0, 3, 0,  0, 0, 0, 1]}}]})";
+  const Scene scene = parse_scene(text, dir_ / "s.json");
+  const TriangleMesh& m = scene.shapes[0].mesh;
+  ASSERT_EQ(m.normals.size(), 3u);
+  const glm::uvec3 t = m.triangles[0];
+  const vec3 face = glm::normalize(glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]));
+  for (const vec3& n : m.normals) {
+    EXPECT_NEAR(glm::length(n), 1.0f, 1e-6f);
+    EXPECT_NEAR(glm::dot(n, face), 1.0f, 1e-6f);
   }
 }
 
