@@ -8,11 +8,19 @@
 #endif
 
 namespace pathlab {
+namespace {
+
+// $PATHLAB_DATA_DIR, or null when it is unset or empty.
+const char* data_directory_from_environment() {
+  const char* env = std::getenv("PATHLAB_DATA_DIR");
+  return env != nullptr && *env != '\0' ? env : nullptr;
+}
+
+}  // namespace
 
 std::filesystem::path data_directory() {
-  const char* env = std::getenv("PATHLAB_DATA_DIR");
-  if (env != nullptr && *env != '\0') return env;
-  return PATHLAB_DEFAULT_DATA_DIR;
+  const char* env = data_directory_from_environment();
+  return env != nullptr ? std::filesystem::path(env) : std::filesystem::path(PATHLAB_DEFAULT_DATA_DIR);
 }
 
 bool names_data_file(std::string_view name) { return name.starts_with(kDataPrefix); }
@@ -23,10 +31,8 @@ std::filesystem::path resolve_scene_path(const std::filesystem::path& folder, st
 }
 
 std::string data_directory_hint() {
-  const char* env = std::getenv("PATHLAB_DATA_DIR");
-  const bool from_env = env != nullptr && *env != '\0';
   return "the data directory is " + data_directory().string() +
-         (from_env ? " (from PATHLAB_DATA_DIR)" : " (set PATHLAB_DATA_DIR to use another)") +
+         (data_directory_from_environment() != nullptr ? " (from PATHLAB_DATA_DIR)" : " (set PATHLAB_DATA_DIR to use another)") +
          "; tools/fetch-data.sh fetches its files";
 }
 

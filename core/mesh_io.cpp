@@ -74,19 +74,20 @@ struct RawMesh {
 };
 
 // The vertex attributes must be finite, and normals not of zero length;
-// normals come back unit length. `what` names them in messages ("normal").
+// normals come back unit length.
 void check_attributes(const fs::path& file, RawMesh& raw) {
   const auto name = [&](std::size_t i) { return std::to_string(i + static_cast<std::size_t>(raw.number_base)); };
-  // PLY: "vertex 7's normal"; OBJ: "normal 7 (vn)".
   const bool obj = raw.number_base == 1;
   for (std::size_t i = 0; i < raw.normals.size(); ++i) {
     vec3& n = raw.normals[i];
-    const std::string where = obj ? "normal " + name(i) + " (vn)" : "vertex " + name(i) + "'s normal";
-    std::ostringstream value;
-    value << "(" << n.x << ", " << n.y << ", " << n.z << ")";
-    if (!is_finite(n)) fail(file, where + " is not finite " + value.str());
     const double length = glm::length(dvec3(n));
-    if (!(length > 1e-30)) fail(file, where + " has zero length " + value.str());
+    if (!is_finite(n) || !(length > 1e-30)) {
+      // PLY: "vertex 7's normal"; OBJ: "normal 7 (vn)".
+      std::ostringstream problem;
+      problem << (obj ? "normal " + name(i) + " (vn)" : "vertex " + name(i) + "'s normal")
+              << (is_finite(n) ? " has zero length (" : " is not finite (") << n.x << ", " << n.y << ", " << n.z << ")";
+      fail(file, problem.str());
+    }
     n = vec3(dvec3(n) / length);
   }
   for (std::size_t i = 0; i < raw.uvs.size(); ++i) {
@@ -140,21 +141,14 @@ TriangleMesh finish(const fs::path& file, RawMesh raw, MeshLoadReport* report) {
   check_indices(file, raw);
   check_attributes(file, raw);
 
+  // PLY's attributes are per vertex: the mesh takes raw's arrays as they
+  // are (at the end). OBJ corners: one vertex per distinct (position,
+  // normal, texture coordinate); a corner without a normal in a mesh with
+  // normals takes its face's, keyed by the normal's bits.
   TriangleMesh mesh;
-  mesh.positions = raw.positions;
-  if (!raw.per_corner()) {
-    mesh.normals = raw.normals;
-    mesh.uvs = raw.uvs;
-  }
-  // OBJ corners: one vertex per distinct (position, normal, texture
-  // coordinate); a corner without a normal in a mesh with normals takes its
-  // face's, keyed by the normal's bits.
+  const bool per_corner = raw.per_corner();
   std::map<std::array<std::int64_t, 6>, std::uint32_t> welded;
   const bool has_normals = !raw.normals.empty(), has_uvs = !raw.uvs.empty();
-  if (raw.per_corner()) {
-    mesh.positions.clear();
-    if (has_normals) mesh.normals.clear();
-  }
   // The unit normal of face f, from its first three corners.
   const auto face_normal = [&](std::size_t f) {
     const std::size_t s = raw.face_start[f];
@@ -165,7 +159,7 @@ TriangleMesh finish(const fs::path& file, RawMesh raw, MeshLoadReport* report) {
     return len > 0.0 ? vec3(cr / len) : vec3(0.0f, 0.0f, 1.0f);
   };
   const auto corner = [&](std::size_t k, std::size_t f) -> std::uint32_t {
-    if (!raw.per_corner()) return static_cast<std::uint32_t>(raw.indices[k]);
+    if (!per_corner) return static_cast<std::uint32_t>(raw.indices[k]);
     const std::int64_t ni = has_normals ? raw.normal_indices[k] : -1;
     const std::int64_t ti = has_uvs ? raw.uv_indices[k] : -1;
     const vec3 n = !has_normals ? vec3(0.0f) : ni >= 0 ? raw.normals[static_cast<std::size_t>(ni)] : face_normal(f);
@@ -201,11 +195,16 @@ TriangleMesh finish(const fs::path& file, RawMesh raw, MeshLoadReport* report) {
   }
   if (mesh.triangles.empty())
     fail(file, "no usable triangles (" + std::to_string(dropped) + " degenerate dropped)");
+  if (!per_corner) {
+    mesh.positions = std::move(raw.positions);
+    mesh.normals = std::move(raw.normals);
+    mesh.uvs = std::move(raw.uvs);
+  }
   if (report) {
     report->faces_in_file = raw.face_count();
     report->triangles_loaded = mesh.triangles.size();
     report->degenerate_dropped = dropped;
-    report->ignored = raw.ignored;
+    report->ignored = std::move(raw.ignored);
   }
   return mesh;
 }
@@ -300,7 +299,9 @@ RawMesh parse_obj(const fs::path& file, std::string_view text) {
     }
     for (const unsigned id : shape.mesh.smoothing_group_ids) smoothing_groups |= id != 0;
   }
-  for (const tinyobj::material_t& m : reader.GetMaterials()) materials.push_back(m.name);
+  // tinyobj adds an unnamed default material of its own: not the file's.
+  for (const tinyobj::material_t& m : reader.GetMaterials())
+    if (!m.name.empty()) materials.push_back(m.name);
   if (smoothing_groups && raw.normals.empty())
     raw.ignored.push_back("smoothing groups ('s'; \"normals\": \"smooth\" computes vertex normals)");
   if (!materials.empty()) {

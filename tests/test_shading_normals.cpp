@@ -104,7 +104,17 @@ TEST_F(ShadingData, ObjCornersAreWelded) {
   EXPECT_NEAR(m.normals[m.triangles[0][2]].y, std::sqrt(0.5f), 1e-6f);
   EXPECT_EQ(m.normals[m.triangles[2][1]], vec3(0, 0, 1));  // the face's own
   EXPECT_EQ(m.uvs[m.triangles[0][2]], vec2(1, 1));
-  EXPECT_TRUE(report.ignored.empty() || report.ignored[0].find("usemtl") == std::string::npos);
+  // "mtllib" names a file that does not exist and no face uses a material:
+  // nothing to warn about.
+  EXPECT_TRUE(report.ignored.empty()) << report.ignored.front();
+}
+
+// A face material the scene cannot use is named in the one warning.
+TEST_F(ShadingData, ObjMaterialsAreWarnedAbout) {
+  MeshLoadReport report;
+  (void)load_mesh(write("m.obj", "mtllib none.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"), &report);
+  ASSERT_EQ(report.ignored.size(), 1u);
+  EXPECT_NE(report.ignored[0].find("'usemtl'"), std::string::npos) << report.ignored[0];
 }
 
 TEST_F(ShadingData, SceneNormalsKey) {
