@@ -52,12 +52,16 @@ std::unique_ptr<AnalyticModel> make_furnace(const Scene& scene) {
     refuse(scene, kName, "the room's emission faces outwards: set \"flip_normals\": true or \"two_sided\": true");
   if (!scene.point_lights.empty()) refuse(scene, kName, "point lights break the uniform radiance; remove them");
   const int D = scene.render.max_depth;
-  if (D < 0 && max_component(m.albedo) >= 1.0f)
+  // Seen from inside, a one-sided room whose front faces out reflects nothing.
+  const Spectrum rho = reflectance_inside(room, m);
+  if (D < 0 && max_component(rho) >= 1.0f)
     refuse(scene, kName, "without a depth cap the albedo must be below 1 (the series diverges)");
   std::ostringstream d;
   d << "room '" << m.name << "' Le (" << m.emission.x << ", " << m.emission.y << ", " << m.emission.z << ") albedo ("
-    << m.albedo.x << ", " << m.albedo.y << ", " << m.albedo.z << "), depth cap " << D;
-  return std::make_unique<Furnace>(furnace_radiance(m.emission, m.albedo, D), d.str());
+    << m.albedo.x << ", " << m.albedo.y << ", " << m.albedo.z << ")"
+    << (m.one_sided ? (is_black(rho) ? ", one-sided and seen from its back (reflects nothing)" : ", one-sided") : "")
+    << ", depth cap " << D;
+  return std::make_unique<Furnace>(furnace_radiance(m.emission, rho, D), d.str());
 }
 
 }  // namespace pathlab::analytic

@@ -43,6 +43,8 @@ const Shape& lone_sphere(const Scene& scene, std::string_view model) {
   if (!scene.point_lights.empty()) refuse(scene, model, "point lights break the uniform surroundings; remove them");
   if (!scene.environment) refuse(scene, model, "needs a uniform environment light");
   if (scene.materials[scene.shapes[0].material].emits()) refuse(scene, model, "the sphere must not emit");
+  if (scene.materials[scene.shapes[0].material].one_sided && scene.shapes[0].flip_normals)
+    refuse(scene, model, "a one-sided sphere whose front faces in is black from outside: nothing to check");
   return scene.shapes[0];
 }
 

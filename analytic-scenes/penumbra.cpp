@@ -1,5 +1,6 @@
 // Model "penumbra": a planar convex emitter of radiance Le (one-sided unless
-// two_sided), a planar Lambert ground of albedo rho, and at most one black,
+// two_sided), a planar Lambert ground of albedo rho (black from behind if its
+// material is one_sided), and at most one black,
 // closed, convex occluder (a box) strictly between the emitter's plane and
 // the ground. Nothing else reflects, so a ground point x receives direct
 // light only:
@@ -91,7 +92,8 @@ class Penumbra final : public AnalyticModel {
   std::vector<glm::dvec2> emitter_2d;  // convex, counter-clockwise
   std::vector<dvec3> emitter_3d;
   Spectrum Le{0.0f}, rho{0.0f};
-  bool two_sided = false;
+  bool two_sided = false;         // the emitter's emission
+  bool ground_one_sided = false;  // the ground's reflection
   int max_depth = 0;
   std::string description;
 
@@ -133,8 +135,11 @@ class Penumbra final : public AnalyticModel {
     const dvec3 x = dvec3(ray.origin) + hit->second * d;
     if (hit->first == 0) return (two_sided || glm::dot(d, emitter_plane.normal) < 0.0) ? Le : Spectrum(0.0f);
     if (hit->first == 2 || max_depth == 0) return Spectrum(0.0f);
-    // The ground is two-sided Lambert: shade on the camera's side.
-    const dvec3 n = glm::dot(d, ground_plane.normal) < 0.0 ? ground_plane.normal : -ground_plane.normal;
+    // A two-sided Lambert ground shades on the camera's side; a one-sided
+    // one is black from behind.
+    const bool front = glm::dot(d, ground_plane.normal) < 0.0;
+    if (ground_one_sided && !front) return Spectrum(0.0f);
+    const dvec3 n = front ? ground_plane.normal : -ground_plane.normal;
     return rho * Le * static_cast<float>(visible_form_factor(x, n) / kPi);
   }
 };
@@ -201,11 +206,13 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
   model->Le = em.emission;
   model->rho = gm.albedo;
   model->two_sided = em.two_sided_emission;
+  model->ground_one_sided = gm.one_sided;
   model->max_depth = scene.render.max_depth;
   std::ostringstream d;
   d << "emitter '" << em.name << "' Le (" << em.emission.x << ", " << em.emission.y << ", " << em.emission.z << ")"
     << (em.sampled_as_light ? " as a light" : " not a light (BSDF sampling only)") << ", ground '" << gm.name
     << "' albedo (" << gm.albedo.x << ", " << gm.albedo.y << ", " << gm.albedo.z << ")"
+    << (gm.one_sided ? " one-sided" : "")
     << (model->occluder ? ", one occluder" : ", no occluder") << ", depth cap " << model->max_depth;
   model->description = d.str();
   return model;

@@ -71,11 +71,18 @@ bool contains(const Shape& shape, const vec3& p) {
   return crossings % 2 == 1;
 }
 
-bool emits_inwards(const Shape& shape, const Material& material) {
-  if (material.two_sided_emission) return true;
+bool front_faces_inwards(const Shape& shape) {
   if (shape.kind == Shape::Kind::Sphere) return shape.flip_normals;
   const bool outward_winding = signed_volume(shape.mesh) > 0.0;
   return outward_winding == shape.flip_normals;
+}
+
+bool emits_inwards(const Shape& shape, const Material& material) {
+  return material.two_sided_emission || front_faces_inwards(shape);
+}
+
+Spectrum reflectance_inside(const Shape& shape, const Material& material) {
+  return material.one_sided && !front_faces_inwards(shape) ? Spectrum(0.0f) : material.albedo;
 }
 
 std::optional<double> hit_sphere(const vec3& center, float radius, const Ray& ray) {

@@ -18,10 +18,15 @@ namespace pathlab::analytic {
 bool is_closed(const Shape& shape);
 // True if `p` is strictly inside the closed `shape` (ray parity for meshes).
 bool contains(const Shape& shape, const vec3& p);
+// True if the closed `shape`'s front side faces its inside (normals flipped
+// for a sphere; inward winding for a mesh).
+bool front_faces_inwards(const Shape& shape);
 // True if the closed `shape`'s emission reaches its inside: its front side
-// faces inwards (normals flipped for a sphere; inward winding for a mesh)
-// or the material emits from both sides.
+// faces inwards or the material emits from both sides.
 bool emits_inwards(const Shape& shape, const Material& material);
+// The Lambert albedo the closed `shape` reflects with towards its inside:
+// the material's, or black for a one-sided material whose front faces out.
+Spectrum reflectance_inside(const Shape& shape, const Material& material);
 
 // Distance t > 0 at which the ray from `o` along `d` crosses the triangle
 // (Möller-Trumbore in double precision), if it does.

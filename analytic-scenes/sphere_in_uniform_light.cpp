@@ -79,7 +79,7 @@ std::unique_ptr<AnalyticModel> make_sphere_in_uniform_light(const Scene& scene) 
     if (!contains(*room, sphere->center)) refuse(scene, kName, "the sphere must be inside the room");
     if (!emits_inwards(*room, rm))
       refuse(scene, kName, "the room's emission faces outwards: set \"flip_normals\": true or \"two_sided\": true");
-    if (rm.scatters()) {
+    if (!is_black(reflectance_inside(*room, rm))) {
       if (!(sm.type == MaterialType::Mirror && sm.albedo == Spectrum(1.0f) && D < 0 &&
             rm.type == MaterialType::Diffuse && max_component(rm.albedo) < 1.0f))
         refuse(scene, kName,
@@ -91,7 +91,10 @@ std::unique_ptr<AnalyticModel> make_sphere_in_uniform_light(const Scene& scene) 
     }
     what = "room '" + rm.name + "' radiance " + fmt(surround);
   }
-  const Spectrum on = D == 0 ? Spectrum(0.0f) : sm.albedo * surround;
+  // The camera and the light are outside the sphere: a one-sided sphere
+  // whose front faces in reflects nothing.
+  const Spectrum albedo = sm.one_sided && sphere->flip_normals ? Spectrum(0.0f) : sm.albedo;
+  const Spectrum on = D == 0 ? Spectrum(0.0f) : albedo * surround;
   const std::string description = std::string(material_type_name(sm.type)) + " sphere '" + sm.name + "' " + fmt(sm.albedo) +
                                   " in " + what + ", depth cap " + std::to_string(D) + ": sphere " + fmt(on);
   return std::make_unique<SphereInUniformLight>(*sphere, on, surround, description);

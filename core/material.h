@@ -13,10 +13,13 @@
 //     two_sided     bool               emit from both sides        default false
 //     light         bool               register the emission as a  default true
 //                                      light for light sampling; false leaves it to rays that hit it
+//     one_sided     bool               reflect on the front side   default false
+//                                      only; the back is black (Mitsuba 3's diffuse without
+//                                      "twosided", glTF's doubleSided false)
 //
 //   type "mirror"    perfect specular reflector (an impulse)
 //     reflectance   [r,g,b] in [0,1]                                default [1,1,1]
-//     emission, two_sided, light        as for "diffuse"
+//     emission, two_sided, light, one_sided  as for "diffuse"
 //
 //   type "disney"    Burley's principled BRDF (core/bsdf/disney.h); every
 //                    parameter but base_color is a number in [0, 1]
@@ -35,7 +38,7 @@
 //                     directional albedo never exceeds 1 (core/bsdf/energy.h);
 //                     false is Burley's published model, which reflects up
 //                     to 1.65x the incident light at grazing views
-//     emission, two_sided, light        as for "diffuse"
+//     emission, two_sided, light, one_sided  as for "diffuse"
 //
 //   type "dielectric" smooth glass: Fresnel reflection + Snell refraction
 //                    (two impulses, chosen by probability). The geometric
@@ -54,6 +57,9 @@
 //
 // Emission leaves the front side of a surface: the side its geometric normal
 // points to (see each shape's "flip_normals"), or both sides if two_sided.
+// Reflection happens on both sides unless one_sided: then a path that meets
+// the back (wo on the back of the geometric surface) ends there, and light
+// arriving from behind is not reflected (Surfel::eval and scatter).
 #pragma once
 
 #include "core/bsdf/closure.h"
@@ -100,6 +106,7 @@ struct Material {
   Spectrum emission{0.0f};     // emitted radiance
   bool two_sided_emission = false;
   bool sampled_as_light = true;  // false: only rays that hit it find its emission
+  bool one_sided = false;      // reflects on its front side only; the back is black
   DisneyParams disney{};       // type Disney
   DielectricParams glass{};    // type Dielectric
   // Derived from `disney` (or, for the general path, from `albedo`) by the

@@ -296,7 +296,7 @@ Material read_material(const Node& node, const std::string& name) {
                      {{type == "diffuse" ? "reflectance" : "albedo",
                        type == "diffuse" ? "its colour is 'albedo'" : "its colour is 'reflectance'"},
                       {"radiance", "emitted light is 'emission'"}});
-    node.allow_only({"type", refl, "emission", "two_sided", "light"});
+    node.allow_only({"type", refl, "emission", "two_sided", "light", "one_sided"});
     m.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
     m.albedo = node.has(refl) ? node.child(refl).color(true) : Spectrum(type == "diffuse" ? 0.5f : 1.0f);
     if (node.has("emission")) m.emission = node.child("emission").color(false);
@@ -304,7 +304,8 @@ Material read_material(const Node& node, const std::string& name) {
     reject_misplaced(node, type,
                      {{"emission", "its emitted light is 'radiance'"},
                       {"albedo", "it reflects nothing (use type diffuse with 'emission' for a surface that does both)"},
-                      {"reflectance", "it reflects nothing"}});
+                      {"reflectance", "it reflects nothing"},
+                      {"one_sided", "it reflects nothing; the sides it emits from are set by 'two_sided'"}});
     node.allow_only({"type", "radiance", "two_sided", "light"});
     m.type = MaterialType::Emissive;
     m.albedo = Spectrum(0.0f);
@@ -316,7 +317,7 @@ Material read_material(const Node& node, const std::string& name) {
                       {"radiance", "emitted light is 'emission'"}});
     node.allow_only({"type", "base_color", "metallic", "subsurface", "specular", "specular_tint", "roughness",
                      "anisotropic", "sheen", "sheen_tint", "clearcoat", "clearcoat_gloss", "energy_compensation", "emission",
-                     "two_sided", "light"});
+                     "two_sided", "light", "one_sided"});
     DisneyParams p;
     if (node.has("base_color")) p.base_color = node.child("base_color").color(true);
     p.metallic = unit_number(node, "metallic", p.metallic);
@@ -339,7 +340,8 @@ Material read_material(const Node& node, const std::string& name) {
     reject_misplaced(node, type,
                      {{"albedo", "its tints are 'reflectance' and 'transmittance'"},
                       {"eta", "the index of refraction is 'ior'"},
-                      {"emission", "glass does not emit"}});
+                      {"emission", "glass does not emit"},
+                      {"one_sided", "glass has an inside and an outside: both sides scatter"}});
     node.allow_only({"type", "ior", "reflectance", "transmittance"});
     DielectricParams p;
     p.ior = unit_number(node, "ior", p.ior, 1.0f, 10.0f);
@@ -357,6 +359,7 @@ Material read_material(const Node& node, const std::string& name) {
   }
   m.two_sided_emission = node.boolean_or("two_sided", false);
   m.sampled_as_light = node.boolean_or("light", true);
+  m.one_sided = node.boolean_or("one_sided", false);
   return m;
 }
 

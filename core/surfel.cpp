@@ -109,6 +109,7 @@ bool geometric_side_ok(const vec3& n, const vec3& wi, const vec3& wo, bool trans
 Spectrum Surfel::eval(const vec3& wi, const vec3& wo) const {
   const Material& m = *material;
   if (m.is_pure_impulse() || m.type == MaterialType::Emissive) return Spectrum(0.0f);
+  if (m.one_sided && !(on_front(wo) && on_front(wi))) return Spectrum(0.0f);
   if (shading_normal && !geometric_side_ok(n, wi, wo, false)) return Spectrum(0.0f);
   const LocalDirs d = to_local_upper(frame, wo, wi);
   switch (m.shading.path) {
@@ -123,6 +124,7 @@ Spectrum Surfel::eval(const vec3& wi, const vec3& wo) const {
 float Surfel::pdf(const vec3& wi, const vec3& wo) const {
   const Material& m = *material;
   if (m.is_pure_impulse() || m.type == MaterialType::Emissive) return 0.0f;
+  if (m.one_sided && !on_front(wo)) return 0.0f;  // scatter() samples nothing there
   const LocalDirs d = to_local_upper(frame, wo, wi);
   switch (m.shading.path) {
     case ShadingPath::LambertOnly: return pdf_as<0>(m, d);
@@ -134,6 +136,7 @@ float Surfel::pdf(const vec3& wi, const vec3& wo) const {
 }
 
 std::optional<BsdfSample> Surfel::scatter(const vec3& wo, float u_lobe, vec2 u) const {
+  if (material->one_sided && !on_front(wo)) return std::nullopt;  // the back of a one-sided surface is black
   if (!shading_normal) return scatter_in_frame(wo, u_lobe, u);
   // The dielectric tells inside from outside by the side of wo: with a
   // shading normal that must be the geometric side too.
@@ -196,6 +199,7 @@ std::optional<BsdfSample> Surfel::scatter_in_frame(const vec3& wo, float u_lobe,
 
 std::optional<BsdfSample> Surfel::scatter_cosine(const vec3& wo, vec2 u) const {
   if (material->is_pure_impulse()) return std::nullopt;
+  if (material->one_sided && !on_front(wo)) return std::nullopt;
   const float side = glm::dot(wo, frame.n) < 0.0f ? -1.0f : 1.0f;
   vec3 wi_local = square_to_cosine_hemisphere(u);
   const float pdf = cosine_hemisphere_pdf(wi_local);

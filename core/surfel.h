@@ -45,13 +45,18 @@ struct Surfel {
   float pdf(const vec3& wi, const vec3& wo) const;
   // `u_lobe` chooses among lobes and impulses (and absorption, for an impulse
   // whose reflectance is below 1); `u` samples the direction. Returns nothing
-  // if the path is absorbed here.
+  // if the path is absorbed here (always, on the back of a one-sided
+  // material, where eval() and pdf() are 0 too).
   std::optional<BsdfSample> scatter(const vec3& wo, float u_lobe, vec2 u) const;
   // Cosine-weighted sampling of the hemisphere on wo's side, whatever the
   // material (strategy "cosine"); weight = eval / pdf.
   std::optional<BsdfSample> scatter_cosine(const vec3& wo, vec2 u) const;
   // scatter() in the shading frame, before the shading-normal policy.
   std::optional<BsdfSample> scatter_in_frame(const vec3& wo, float u_lobe, vec2 u) const;
+
+  // True if `w` leaves the front side of the geometric surface (a one-sided
+  // material reflects only between such directions).
+  bool on_front(const vec3& w) const { return glm::dot(w, n) > 0.0f; }
 
   // A ray leaving this surface in direction `dir`, robustly offset.
   Ray spawn(const vec3& dir) const;

@@ -183,9 +183,10 @@ TEST(SceneLoader, MaterialsOfEachTypeAndTheirDefaults) {
     "glow": {"type": "diffuse", "albedo": [0.1, 0.2, 0.3], "emission": [1, 2, 3], "two_sided": true},
     "mirror": {"type": "mirror"},
     "tinted": {"type": "mirror", "reflectance": [0.9, 0.8, 0.7]},
-    "lamp": {"type": "emissive", "radiance": 7}
+    "lamp": {"type": "emissive", "radiance": 7},
+    "front": {"type": "disney", "one_sided": true}
   })", "[]"));
-  ASSERT_EQ(s.materials.size(), 6u);
+  ASSERT_EQ(s.materials.size(), 7u);
   const auto get = [&s](const std::string& name) -> const Material& {
     const auto it = std::find_if(s.materials.begin(), s.materials.end(),
                                  [&](const Material& m) { return m.name == name; });
@@ -211,6 +212,8 @@ TEST(SceneLoader, MaterialsOfEachTypeAndTheirDefaults) {
   expect_vec(get("lamp").albedo, vec3(0.0f));
   EXPECT_FALSE(get("lamp").scatters());
   EXPECT_FALSE(get("lamp").two_sided_emission);
+  EXPECT_FALSE(get("plain").one_sided);  // two-sided by default
+  EXPECT_TRUE(get("front").one_sided);
   // Emitting materials that no shape uses light nothing.
   ASSERT_EQ(s.warnings.size(), 1u);
   EXPECT_NE(s.warnings[0].find("no light"), std::string::npos) << s.warnings[0];
@@ -571,6 +574,12 @@ TEST(SceneLoaderErrors, UnknownKeysSuggestTheNearestValidOne) {
   EXPECT_NE(error_of(emissive).find("an emissive material has no 'emission'; its emitted light is 'radiance'"),
             std::string::npos)
       << error_of(emissive);
+  // "one_sided" is for reflecting materials only.
+  const std::string glass = scene_text(R"({"m": {"type": "dielectric", "one_sided": true}})", "[]");
+  EXPECT_NE(error_of(glass).find("a dielectric material has no 'one_sided'; glass has an inside"), std::string::npos)
+      << error_of(glass);
+  const std::string lamp = scene_text(R"({"m": {"type": "emissive", "radiance": 1, "one_sided": true}})", "[]");
+  EXPECT_NE(error_of(lamp).find("an emissive material has no 'one_sided'"), std::string::npos) << error_of(lamp);
 }
 
 TEST(SceneLoaderErrors, UnknownNamesSuggestTheNearest) {

@@ -232,6 +232,57 @@ TEST(ShadingNormals, PolicyAtTheExtremes) {
   }
 }
 
+// A one-sided material is black from behind (eval, pdf 0; scatter and
+// scatter_cosine absorb) and, on its front, exactly the two-sided material:
+// Lambert, mirror and Disney, flat and with a shading normal tilted 60 degrees.
+TEST(OneSided, BackIsBlackFrontIsTheTwoSidedMaterial) {
+  DisneyParams dp;
+  dp.roughness = 0.3f;
+  dp.metallic = 0.5f;
+  Material mirror = diffuse_material(Spectrum(0.9f));
+  mirror.type = MaterialType::Mirror;
+  for (const Material& two : {diffuse_material(Spectrum(0.8f)), mirror, disney_material(dp)}) {
+    Material one = two;
+    one.one_sided = true;
+    for (float degrees : {0.0f, 60.0f}) {
+      Surfel s2 = tilted_surfel(two, degrees), s1 = tilted_surfel(one, degrees);
+      s2.shading_normal = s1.shading_normal = degrees != 0.0f;
+      std::uint64_t state = 777;
+      const auto u01 = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return static_cast<float>(state >> 40) * 0x1p-24f;
+      };
+      int front = 0, back = 0;
+      for (int i = 0; i < 2000; ++i) {
+        const vec3 wo = square_to_uniform_sphere(vec2(u01(), u01()));
+        const vec3 wi = square_to_uniform_sphere(vec2(u01(), u01()));
+        const float ul = u01();
+        const vec2 u(u01(), u01());
+        if (wo.z <= 0.0f) {
+          ++back;
+          ASSERT_EQ(s1.eval(wi, wo), Spectrum(0.0f));
+          ASSERT_EQ(s1.pdf(wi, wo), 0.0f);
+          ASSERT_FALSE(s1.scatter(wo, ul, u).has_value());
+          ASSERT_FALSE(s1.scatter_cosine(wo, u).has_value());
+          continue;
+        }
+        ++front;
+        // Light from behind is not reflected.
+        ASSERT_EQ(s1.eval(wi, wo), wi.z > 0.0f ? s2.eval(wi, wo) : Spectrum(0.0f));
+        ASSERT_EQ(s1.pdf(wi, wo), s2.pdf(wi, wo));
+        const auto b1 = s1.scatter(wo, ul, u), b2 = s2.scatter(wo, ul, u);
+        ASSERT_EQ(b1.has_value(), b2.has_value());
+        if (b1) {
+          ASSERT_EQ(b1->wi, b2->wi);
+          ASSERT_EQ(b1->weight, b2->weight);
+        }
+      }
+      EXPECT_GT(front, 900);
+      EXPECT_GT(back, 900);
+    }
+  }
+}
+
 // A mesh whose vertex normals are its face normals shades exactly as the
 // flat mesh: same bits, both tracers.
 TEST(ShadingNormals, FaceNormalsAsVertexNormalsRenderTheFlatBits) {

@@ -146,6 +146,7 @@ struct WavefrontTracer::VectorStages {
       if (m.type == MaterialType::Emissive) continue;  // never scatters
       if (m.type != MaterialType::Diffuse)
         return no("material '" + m.name + "' is " + material_type_name(m.type) + ", not diffuse");
+      if (m.one_sided) return no("material '" + m.name + "' is one-sided");
       if (m.shading.path != ShadingPath::LambertOnly)
         return no(std::string("shading path ") + shading_path_name(m.shading.path));
       if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return no("materials with different min_pdf");
