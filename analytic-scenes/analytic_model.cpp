@@ -36,6 +36,9 @@ std::unique_ptr<AnalyticModel> make_analytic_model(const Scene& scene) {
     if (scene.analytic == e.name) {
       if (scene.camera.aperture_radius > 0.0f)
         analytic::refuse(scene, e.name, "the expected image is computed for a pinhole camera; set aperture_radius 0");
+      // The models read the shapes in world space.
+      if (!scene.groups.empty() || !scene.instances.empty())
+        analytic::refuse(scene, e.name, "the models read shapes placed in world space; remove \"groups\" and \"instances\"");
       return e.make(scene);
     }
   const auto names = analytic_model_names();

@@ -3,13 +3,33 @@
 #include "core/geometry.h"
 #include "core/parallel.h"
 
+#include <cmath>
+
 namespace pathlab {
+namespace {
+
+// A point with its error bound through an affine transform, the bound
+// growing as PBR 4th ed. 6.8.6 derives: the rounding of the three products
+// and three sums, plus the transformed input error.
+void transform_point(const mat4& m, vec3* p, vec3* p_error) {
+  constexpr float g3 = gamma_bound(3);
+  const vec3 in = *p, e = *p_error;
+  vec3 out, err;
+  for (int r = 0; r < 3; ++r) {
+    out[r] = m[0][r] * in.x + m[1][r] * in.y + m[2][r] * in.z + m[3][r];
+    err[r] = (g3 + 1.0f) * (std::abs(m[0][r]) * e.x + std::abs(m[1][r]) * e.y + std::abs(m[2][r]) * e.z) +
+             g3 * (std::abs(m[0][r] * in.x) + std::abs(m[1][r] * in.y) + std::abs(m[2][r] * in.z) + std::abs(m[3][r]));
+  }
+  *p = out;
+  *p_error = err;
+}
+
+}  // namespace
 
 CompiledScene::CompiledScene(Scene scene)
     : scene_(std::move(scene)), camera_(scene_.camera, scene_.film.width, scene_.film.height) {
   configure_shading(scene_);  // materials: shading path for the scene's lobes, sampling flavour, min pdf
-  vec3 lo(kInfinity), hi(-kInfinity);
-  for (const Shape& shape : scene_.shapes) {
+  const auto shape_bounds = [](const Shape& shape, vec3& lo, vec3& hi) {
     if (shape.kind == Shape::Kind::Sphere) {
       lo = glm::min(lo, shape.center - shape.radius);
       hi = glm::max(hi, shape.center + shape.radius);
@@ -19,13 +39,36 @@ CompiledScene::CompiledScene(Scene scene)
         hi = glm::max(hi, p);
       }
     }
+  };
+  vec3 lo(kInfinity), hi(-kInfinity);
+  for (const Shape& shape : scene_.shapes) {
+    if (!shape.in_group) shape_bounds(shape, lo, hi);
     lobes_ |= scene_.materials[shape.material].lobes();
   }
+  // An instance's bounds: the corners of its group's box, placed.
+  std::vector<std::pair<vec3, vec3>> group_bounds;
+  for (const ShapeGroup& group : scene_.groups) {
+    vec3 glo(kInfinity), ghi(-kInfinity);
+    for (const std::uint32_t s : group.shapes) shape_bounds(scene_.shapes[s], glo, ghi);
+    group_bounds.emplace_back(glo, ghi);
+  }
+  for (const Instance& inst : scene_.instances) {
+    const auto& [glo, ghi] = group_bounds[inst.group];
+    if (!(glo.x <= ghi.x)) continue;
+    for (int c = 0; c < 8; ++c) {
+      const vec3 corner((c & 1) ? ghi.x : glo.x, (c & 2) ? ghi.y : glo.y, (c & 4) ? ghi.z : glo.z);
+      const vec3 p = vec3(inst.to_world * vec4(corner, 1.0f));
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    }
+  }
+  for (const Instance& inst : scene_.instances)
+    placements_.push_back({inst.to_world, glm::inverse(inst.to_world), glm::transpose(glm::inverse(mat3(inst.to_world)))});
   if (lo.x <= hi.x) {
     bounds_center_ = 0.5f * (lo + hi);
     bounds_radius_ = std::max(0.5f * glm::length(hi - lo), 1e-3f);
   }
-  accel_ = std::make_unique<EmbreeAccel>(scene_.shapes);
+  accel_ = std::make_unique<EmbreeAccel>(scene_.shapes, scene_.groups, scene_.instances);
   first_triangle_.resize(scene_.shapes.size() + 1, 0);
   for (std::size_t i = 0; i < scene_.shapes.size(); ++i) {
     const Shape& shape = scene_.shapes[i];
@@ -50,16 +93,16 @@ bool CompiledScene::intersect(const Ray& ray, Surfel* s) const {
   return true;
 }
 
-void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const {
-  const Shape& shape = scene_.shapes[hit.shape];
+void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, Surfel* s,
+                                  vec3* ns_sum) const {
   const SurfacePoint sp = shape.kind == Shape::Kind::Sphere
-                              ? sphere_point(shape, ray.origin + hit.t * ray.dir)
+                              ? sphere_point(shape, p_approx)
                               : triangle_point(triangles_[first_triangle_[hit.shape] + hit.prim], hit.uv);
   s->p = sp.p;
   s->p_error = sp.p_error;
   s->n = sp.n;
   s->uv = hit.uv;
-  vec3 ns = sp.n;
+  *ns_sum = sp.n;
   if (shape.kind == Shape::Kind::Triangles && (shape.mesh.has_normals() || shape.mesh.has_uvs())) {
     const glm::uvec3 v = shape.mesh.triangles[hit.prim];
     const float b0 = 1.0f - hit.uv.x - hit.uv.y;
@@ -67,14 +110,36 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const 
       s->uv = b0 * shape.mesh.uvs[v.x] + hit.uv.x * shape.mesh.uvs[v.y] + hit.uv.y * shape.mesh.uvs[v.z];
     if (shape.mesh.has_normals()) {
       const std::vector<vec3>& n = shape.mesh.normals;
-      ns = shading_normal(sp.n, b0 * n[v.x] + hit.uv.x * n[v.y] + hit.uv.y * n[v.z]);
+      *ns_sum = b0 * n[v.x] + hit.uv.x * n[v.y] + hit.uv.y * n[v.z];
     }
   }
-  s->shading_normal = ns != sp.n;
+}
+
+void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const {
+  const Shape& shape = scene_.shapes[hit.shape];
+  vec3 ns_sum;
+  if (hit.instance == kNoInstance) {
+    resolve_local(shape, hit, ray.origin + hit.t * ray.dir, s, &ns_sum);
+  } else {
+    // Embree intersected the group in its own space; the hit distance is the
+    // same along the world ray.
+    const Placement& place = placements_[hit.instance];
+    const vec3 p_world = ray.origin + hit.t * ray.dir;
+    resolve_local(shape, hit, vec3(place.to_local * vec4(p_world, 1.0f)), s, &ns_sum);
+    transform_point(place.to_world, &s->p, &s->p_error);
+    // Normals by the inverse transpose keep pointing to the image of their
+    // side, so the front stays the front under a mirroring placement too.
+    s->n = glm::normalize(place.to_normal * s->n);
+    ns_sum = place.to_normal * ns_sum;
+  }
+  const bool interpolated = shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals();
+  const vec3 ns = interpolated ? shading_normal(s->n, ns_sum) : s->n;
+  s->shading_normal = ns != s->n;
   s->frame = Frame(ns);
   s->material = &scene_.materials[shape.material];
   s->shape = hit.shape;
   s->prim = hit.prim;
+  s->instance = hit.instance;
 }
 
 }  // namespace pathlab

@@ -60,11 +60,13 @@ class CompiledScene {
                        bool coherent = false) const {
     accel_->occluded_arrays(rays, n, occluded, mode, coherent);
   }
-  // The Surfel of a hit `ray` found.
+  // The Surfel of a hit `ray` found, in world space (a hit on a shape in a
+  // group is resolved in the group's space, then placed by its instance).
   void resolve(const Ray& ray, const RayHit& hit, Surfel* surfel) const;
   // Every shape's triangles as resolve() reads them, one shape after the
   // other: triangle k of shape s is triangles()[first_triangle(s) + k]
-  // (a sphere has none).
+  // (a sphere has none). A shape in a group has its triangles in the
+  // group's space, stored once however many instances place it.
   std::span<const Triangle> triangles() const { return triangles_; }
   std::size_t first_triangle(std::uint32_t shape) const { return first_triangle_[shape]; }
   // Starts loading what resolve() will read for a hit on triangle `prim`
@@ -78,7 +80,19 @@ class CompiledScene {
   void prefetch(const RayHit& hit) const { prefetch(hit.shape, hit.prim); }
 
  private:
+  // An instance's transforms, as resolve() applies them.
+  struct Placement {
+    mat4 to_world;
+    mat4 to_local;     // its inverse
+    mat3 to_normal;    // the inverse transpose of to_world's linear part
+  };
+  // The point, front normal and unnormalised interpolated shading normal of
+  // a hit on `shape`, in the shape's own space; `p_approx` is the hit point
+  // there (spheres reproject it).
+  void resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, Surfel* s, vec3* ns_sum) const;
+
   Scene scene_;
+  std::vector<Placement> placements_;  // per instance
   Camera camera_;
   std::unique_ptr<EmbreeAccel> accel_;
   std::unique_ptr<LightSampler> lights_;

@@ -12,9 +12,10 @@
 namespace pathlab {
 namespace {
 
-// Hits set instID[0] only: scenes have no instances, and Embree is built
-// with one instance level.
+// Hits set instID[0] only: instances place groups of shapes, never other
+// instances, and Embree is built with one instance level.
 static_assert(RTC_MAX_INSTANCE_LEVEL_COUNT == 1);
+static_assert(kNoInstance == RTC_INVALID_GEOMETRY_ID);
 
 // Embree reports errors through a callback registered when the device is
 // created; we keep the first one and turn it into an exception after the
@@ -40,58 +41,101 @@ struct EmbreeAccel::Impl {
   ErrorSink errors;
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
+  std::uint32_t first_instance = 0;  // geometry ID of instance 0 in `scene`
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
   }
+  RTCScene new_scene() const {
+    RTCScene s = rtcNewScene(device);
+    // ROBUST: no arithmetic shortcuts that could let a ray slip through an
+    // edge shared by two triangles.
+    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
+    return s;
+  }
+  void attach(RTCScene target, const Shape& shape, std::uint32_t id);
+  // The instance ID Embree reports, as RayHit::instance.
+  std::uint32_t instance_of(unsigned inst_id) const {
+    return inst_id == RTC_INVALID_GEOMETRY_ID ? kNoInstance : inst_id - first_instance;
+  }
 };
 
-EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes) : impl_(std::make_unique<Impl>()) {
+EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups,
+                         std::span<const Instance> instances)
+    : impl_(std::make_unique<Impl>()) {
   impl_->device = rtcNewDevice(nullptr);
   if (!impl_->device)
     throw SystemError(std::string("Embree: cannot create device: error ") +
                       std::to_string(static_cast<int>(rtcGetDeviceError(nullptr))));
   rtcSetDeviceErrorFunction(impl_->device, &ErrorSink::callback, &impl_->errors);
 
-  impl_->scene = rtcNewScene(impl_->device);
-  // ROBUST: no arithmetic shortcuts that could let a ray slip through an
-  // edge shared by two triangles.
-  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  impl_->scene = impl_->new_scene();
+  for (std::uint32_t id = 0; id < shapes.size(); ++id)
+    if (!shapes[id].in_group) impl_->attach(impl_->scene, shapes[id], id);
 
-  for (std::uint32_t id = 0; id < shapes.size(); ++id) {
-    const Shape& shape = shapes[id];
-    RTCGeometry geom = nullptr;
-    if (shape.kind == Shape::Kind::Triangles) {
-      geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-      const auto& m = shape.mesh;
-      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                            3 * sizeof(float), m.positions.size()));
-      auto* t = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                               3 * sizeof(unsigned), m.triangles.size()));
-      if (v && t) {
-        std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(vec3));
-        std::memcpy(t, m.triangles.data(), m.triangles.size() * sizeof(glm::uvec3));
-      }
-    } else {
-      geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-      auto* v = static_cast<float*>(
-          rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
-      if (v) {
-        v[0] = shape.center.x;
-        v[1] = shape.center.y;
-        v[2] = shape.center.z;
-        v[3] = shape.radius;
-      }
+  // Each group's BVH is built once; its shapes keep their scene-wide IDs,
+  // so a hit names the shape directly and the instance separately.
+  struct GroupScenes {  // released however the constructor ends: the instances hold their own references
+    std::vector<RTCScene> scenes;
+    ~GroupScenes() {
+      for (RTCScene gs : scenes) rtcReleaseScene(gs);
     }
-    impl_->errors.check(shape.description.c_str());
+  } group_scenes;
+  for (const ShapeGroup& group : groups) {
+    group_scenes.scenes.push_back(impl_->new_scene());
+    for (const std::uint32_t id : group.shapes) impl_->attach(group_scenes.scenes.back(), shapes[id], id);
+    rtcCommitScene(group_scenes.scenes.back());
+    impl_->errors.check(("building the BVH of group " + group.name).c_str());
+  }
+  impl_->first_instance = static_cast<std::uint32_t>(shapes.size());
+  for (std::uint32_t i = 0; i < instances.size(); ++i) {
+    const Instance& inst = instances[i];
+    RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(geom, group_scenes.scenes[inst.group]);
+    // glm is column-major: column c, row r is to_world[c][r].
+    float xfm[12];
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 3; ++r) xfm[3 * c + r] = inst.to_world[c][r];
+    rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
     rtcCommitGeometry(geom);
-    rtcAttachGeometryByID(impl_->scene, geom, id);
+    rtcAttachGeometryByID(impl_->scene, geom, impl_->first_instance + i);
     rtcReleaseGeometry(geom);
-    impl_->errors.check(shape.description.c_str());
+    impl_->errors.check(inst.description.c_str());
   }
   rtcCommitScene(impl_->scene);
   impl_->errors.check("building the BVH");
+}
+
+void EmbreeAccel::Impl::attach(RTCScene target, const Shape& shape, std::uint32_t id) {
+  RTCGeometry geom = nullptr;
+  if (shape.kind == Shape::Kind::Triangles) {
+    geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    const auto& m = shape.mesh;
+    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                          3 * sizeof(float), m.positions.size()));
+    auto* t = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                             3 * sizeof(unsigned), m.triangles.size()));
+    if (v && t) {
+      std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(vec3));
+      std::memcpy(t, m.triangles.data(), m.triangles.size() * sizeof(glm::uvec3));
+    }
+  } else {
+    geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    auto* v = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
+    if (v) {
+      v[0] = shape.center.x;
+      v[1] = shape.center.y;
+      v[2] = shape.center.z;
+      v[3] = shape.radius;
+    }
+  }
+  errors.check(shape.description.c_str());
+  rtcCommitGeometry(geom);
+  rtcAttachGeometryByID(target, geom, id);
+  rtcReleaseGeometry(geom);
+  errors.check(shape.description.c_str());
 }
 
 EmbreeAccel::~EmbreeAccel() = default;
@@ -136,6 +180,7 @@ bool EmbreeAccel::intersect(const Ray& ray, RayHit* hit) const {
   hit->shape = rh.hit.geomID;
   hit->prim = rh.hit.primID;
   hit->uv = vec2(rh.hit.u, rh.hit.v);
+  hit->instance = impl_->instance_of(rh.hit.instID[0]);
   return true;
 }
 
@@ -220,9 +265,9 @@ void for_each_packet(std::size_t n, Packet&& packet) {
 void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found,
                                   RayBatchMode mode, bool coherent) const {
   RTCIntersectContext context = make_context(coherent);
-  auto record = [&](std::size_t i, float tfar, unsigned geom, unsigned prim, float u, float v) {
+  auto record = [&](std::size_t i, float tfar, unsigned geom, unsigned prim, float u, float v, unsigned inst) {
     found[i] = geom != RTC_INVALID_GEOMETRY_ID;
-    if (found[i]) hits[i] = RayHit{tfar, geom, prim, vec2(u, v)};
+    if (found[i]) hits[i] = RayHit{tfar, geom, prim, vec2(u, v), impl_->instance_of(inst)};
   };
   switch (mode) {
     case RayBatchMode::Single:
@@ -230,7 +275,7 @@ void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> h
         RTCRayHit rh;
         fill(rh, rays[i]);
         rtcIntersect1(impl_->scene, &context, &rh);
-        record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v);
+        record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.instID[0]);
       }
       return;
     case RayBatchMode::Packet16:
@@ -244,7 +289,8 @@ void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> h
         disable_lanes(rh.ray, n);
         rtcIntersect16(valid, impl_->scene, &context, &rh);
         for (std::size_t k = 0; k < n; ++k)
-          record(b + k, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]);
+          record(b + k, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k],
+                 rh.hit.instID[0][k]);
       });
       return;
     case RayBatchMode::Stream: {
@@ -254,7 +300,7 @@ void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> h
       rtcIntersect1M(impl_->scene, &context, buffer.data(), static_cast<unsigned>(buffer.size()), sizeof(RTCRayHit));
       for (std::size_t i = 0; i < rays.size(); ++i) {
         const RTCRayHit& rh = buffer[i];
-        record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v);
+        record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.instID[0]);
       }
       return;
     }
@@ -356,9 +402,10 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, cons
   const RayArrays rays = rays_in;
   const HitArrays hits = hits_in;
   // Every field written, hit or miss: no branch on a coin flip per ray.
-  auto record = [&](std::size_t i, float tfar, unsigned geom, unsigned prim, float u, float v) {
+  auto record = [&](std::size_t i, float tfar, unsigned geom, unsigned prim, float u, float v, unsigned inst) {
     hits.found[i] = geom != RTC_INVALID_GEOMETRY_ID;
     hits.t[i] = tfar, hits.shape[i] = geom, hits.prim[i] = prim, hits.u[i] = u, hits.v[i] = v;
+    if (hits.instance) hits.instance[i] = impl_->instance_of(inst);
   };
   switch (mode) {
     case RayBatchMode::Single:
@@ -366,7 +413,7 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, cons
         RTCRayHit rh;
         fill(rh, ray_at(rays, i));
         rtcIntersect1(impl_->scene, &context, &rh);
-        record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v);
+        record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.instID[0]);
       }
       return;
     case RayBatchMode::Packet16:
@@ -379,7 +426,8 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, cons
         }
         rtcIntersect16(valid, impl_->scene, &context, &rh);
         for (std::size_t k = 0; k < m; ++k)
-          record(b + k, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k]);
+          record(b + k, rh.ray.tfar[k], rh.hit.geomID[k], rh.hit.primID[k], rh.hit.u[k], rh.hit.v[k],
+                 rh.hit.instID[0][k]);
       });
       return;
     case RayBatchMode::Stream: {
@@ -389,7 +437,7 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, cons
       const RTCRayHitNp rh{s.ray(rays), RTCHitNp{s.ng.data(), s.ng.data(), s.ng.data(), s.u.data(), s.v.data(),
                                                  s.prim.data(), s.geom.data(), {s.inst.data()}}};
       rtcIntersectNp(impl_->scene, &context, &rh, static_cast<unsigned>(n));
-      for (std::size_t i = 0; i < n; ++i) record(i, s.tfar[i], s.geom[i], s.prim[i], s.u[i], s.v[i]);
+      for (std::size_t i = 0; i < n; ++i) record(i, s.tfar[i], s.geom[i], s.prim[i], s.u[i], s.v[i], s.inst[i]);
       return;
     }
   }

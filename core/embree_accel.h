@@ -1,6 +1,9 @@
 // The Embree 3 BVH over a scene's shapes: triangle meshes as Embree
 // triangles, spheres as Embree's true (analytic) spheres. Embree geometry ID
-// equals the shape index. This is the only file that includes Embree.
+// equals the shape index. A group (Scene::groups) is a scene of its own,
+// built once, and each of the scene's instances places it through an Embree
+// instance (geometry ID shapes.size() + instance index in the top scene).
+// This is the only file that includes Embree.
 #pragma once
 
 #include "core/ray.h"
@@ -18,6 +21,7 @@ struct RayHit {
   std::uint32_t shape = 0;
   std::uint32_t prim = 0;
   vec2 uv{0.0f};  // Embree's barycentrics (b1, b2) for a triangle
+  std::uint32_t instance = kNoInstance;  // index into Scene::instances, for a shape in a group
 };
 
 // How a batch of rays reaches Embree.
@@ -39,13 +43,15 @@ struct HitArrays {
   float *t, *u, *v;               // distance; Embree's barycentrics (b1, b2) for a triangle
   std::uint32_t *shape, *prim;
   std::uint8_t* found;
+  std::uint32_t* instance = nullptr;  // as RayHit::instance; may be null for a scene without instances
 };
 
 class EmbreeAccel {
  public:
   // Builds the BVH. Throws SystemError with Embree's message if the device
-  // or the build fails. `shapes` must outlive nothing: data is copied.
-  explicit EmbreeAccel(const std::vector<Shape>& shapes);
+  // or the build fails. The arguments must outlive nothing: data is copied.
+  explicit EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups = {},
+                       std::span<const Instance> instances = {});
   ~EmbreeAccel();
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;

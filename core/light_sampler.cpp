@@ -52,7 +52,9 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&sce
   for (std::uint32_t s = 0; s < scene.shapes.size(); ++s) {
     const Shape& shape = scene.shapes[s];
     const Material& m = scene.materials[shape.material];
-    if (!m.emits() || !m.sampled_as_light) continue;
+    // Emitters in groups are not sampled: the scene loader refuses them
+    // unless their material says "light": false.
+    if (!m.emits() || !m.sampled_as_light || shape.in_group) continue;
     // Flux of a Lambertian emitter: pi * L * area per emitting side.
     const double per_area = kPi * luminance(m.emission) * (m.two_sided_emission ? 2.0 : 1.0);
     first_entry_[s] = static_cast<std::int64_t>(entries_.size());

@@ -77,7 +77,27 @@ struct Shape {
   vec3 center{0.0f};           // Kind::Sphere
   float radius = 0.0f;
   bool flip_normals = false;   // front side faces the other way
+  // Defined in a group's own space (Scene::groups) and placed only by the
+  // scene's instances; false for a shape placed in world space.
+  bool in_group = false;
 };
+
+// Shapes defined once, in their own space, and placed many times by
+// instances (Embree instances, one level: a group holds shapes, never
+// instances). Its shapes are in Scene::shapes, marked in_group.
+struct ShapeGroup {
+  std::string name;
+  std::vector<std::uint32_t> shapes;  // indices into Scene::shapes
+};
+
+// One placement of a group.
+struct Instance {
+  std::uint32_t group = 0;  // index into Scene::groups
+  mat4 to_world{1.0f};      // affine, invertible
+  std::string description;  // for messages, e.g. "instances[0][17] (dragon)"
+};
+// The instance of a hit on a shape placed in world space (RayHit, Surfel).
+inline constexpr std::uint32_t kNoInstance = 0xffffffffu;
 
 struct PointLight {
   vec3 position{0.0f};
@@ -91,7 +111,11 @@ struct Scene {
   FilmDesc film;
   RenderSettings render;
   std::vector<Material> materials;
+  // The file's shapes in its order (shapes[i] is the file's shapes[i]), then
+  // the groups' shapes.
   std::vector<Shape> shapes;
+  std::vector<ShapeGroup> groups;
+  std::vector<Instance> instances;
   std::vector<PointLight> point_lights;
   std::optional<Spectrum> environment;  // uniform radiance from every direction
   std::vector<std::string> warnings;    // non-fatal problems found while loading

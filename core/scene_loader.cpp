@@ -458,12 +458,13 @@ std::size_t transform_mesh(TriangleMesh* mesh, const mat4& xf) {
   return dropped;
 }
 
+// `label` names the shape in messages: "shapes[3]", "groups/tree[0]".
 Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
-                 const std::map<std::string, std::uint32_t>& materials, std::size_t index) {
+                 const std::map<std::string, std::uint32_t>& materials, const std::string& label) {
   node.expect_object();
   const std::string type = node.required("type").string();
   Shape shape;
-  shape.description = "shapes[" + std::to_string(index) + "] (" + type + ")";
+  shape.description = label + " (" + type + ")";
   if (type == "mesh") {
     node.allow_only({"type", "file", "material", "transform", "flip_normals", "normals"});
   } else if (type == "sphere") {
@@ -517,7 +518,7 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
     const Node file = node.required("file");
     if (file.string().empty()) file.fail("the mesh file name is empty");
     const std::filesystem::path path = resolve_scene_path(folder, file.string());
-    shape.description = "shapes[" + std::to_string(index) + "] (mesh " + file.string() + ")";
+    shape.description = label + " (mesh " + file.string() + ")";
     if (names_data_file(file.string()) && !std::filesystem::exists(path))
       file.fail(file.string() + ": " + path.string() + " does not exist; " + data_directory_hint());
     const std::string normals = node.has("normals") ? node.child("normals").string() : "file";
@@ -564,6 +565,91 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
   return shape;
 }
 
+// "groups": {"name": [shape, ...], ...}: shapes in the group's own space,
+// appended to scene.shapes and marked in_group.
+void read_groups(const Node& node, Scene& scene, const std::filesystem::path& folder,
+                 const std::map<std::string, std::uint32_t>& materials) {
+  node.expect_object();
+  for (const auto& [name, unused] : node.value().items()) {
+    const Node list = node.child(name);
+    if (!list.value().is_array() || list.value().empty()) list.fail("expected a non-empty array of shapes");
+    ShapeGroup group{name, {}};
+    for (std::size_t i = 0; i < list.value().size(); ++i) {
+      const Node item = list.child(i);
+      if (item.value().is_object() && item.has("type") && item.child("type").value() == "instance")
+        item.child("type").fail("a group holds shapes, not instances (instances of instances are not supported)");
+      Shape shape = read_shape(item, scene, folder, materials, "groups/" + name + "[" + std::to_string(i) + "]");
+      const Material& m = scene.materials[shape.material];
+      // As in pbrt-v4: an instanced emitter would need a light per placement.
+      if (m.emits() && m.sampled_as_light)
+        item.child("material").fail("material " + in_quotes(m.name) +
+                                    " emits: emitters in a group are not sampled as lights; place the shape in "
+                                    "'shapes', or give the material \"light\": false");
+      shape.in_group = true;
+      group.shapes.push_back(static_cast<std::uint32_t>(scene.shapes.size()));
+      scene.shapes.push_back(std::move(shape));
+    }
+    scene.groups.push_back(std::move(group));
+  }
+}
+
+// "instances": [{"group": name, "transform": T} or {"group": name,
+// "transforms": [T, ...]}, ...].
+void read_instances(const Node& node, Scene* scene) {
+  if (!node.value().is_array()) node.fail("expected an array of instances");
+  for (std::size_t i = 0; i < node.value().size(); ++i) {
+    const Node item = node.child(i);
+    item.expect_object();
+    item.allow_only({"group", "transform", "transforms"});
+    const Node group = item.required("group");
+    const std::string name = group.string();
+    const auto found = std::find_if(scene->groups.begin(), scene->groups.end(),
+                                    [&](const ShapeGroup& g) { return g.name == name; });
+    if (found == scene->groups.end()) {
+      std::vector<std::string_view> names;
+      for (const ShapeGroup& g : scene->groups) names.push_back(g.name);
+      group.fail("no group named " + in_quotes(name) +
+                 (names.empty() ? std::string(" (the scene has no \"groups\")") : suggestion(name, names)));
+    }
+    const auto index = static_cast<std::uint32_t>(found - scene->groups.begin());
+    const std::string label = "instances[" + std::to_string(i) + "]";
+    // The group's bounding box, whose placed corners must stay finite.
+    vec3 lo(kInfinity), hi(-kInfinity);
+    for (const std::uint32_t id : found->shapes) {
+      const Shape& shape = scene->shapes[id];
+      if (shape.kind == Shape::Kind::Sphere) {
+        lo = glm::min(lo, shape.center - shape.radius), hi = glm::max(hi, shape.center + shape.radius);
+      } else {
+        for (const vec3& p : shape.mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+      }
+    }
+    // Every placement must be invertible (Embree and the normals need its
+    // inverse) and keep the group within the float range.
+    const auto place = [&](const Node& where, const std::string& description) {
+      const mat4 xf = read_transform(where);
+      const float det = glm::determinant(mat3(xf));
+      if (!(std::abs(det) > 0.0f) || !std::isfinite(det) || !std::isfinite(1.0f / det))
+        where.fail("the transform is singular or not finite (determinant " + std::to_string(det) + ")");
+      for (int c = 0; c < 8; ++c) {
+        const vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+        if (!is_finite(vec3(xf * vec4(corner, 1.0f))))
+          where.fail("the transform moves the group beyond the float range (about 3.4e38)");
+      }
+      scene->instances.push_back({index, xf, description});
+    };
+    if (item.has("transform") == item.has("transforms"))
+      item.fail("an instance needs exactly one of 'transform' (one placement) and 'transforms' (a list)");
+    if (item.has("transform")) {
+      place(item.child("transform"), label + " (" + name + ")");
+    } else {
+      const Node list = item.child("transforms");
+      if (!list.value().is_array() || list.value().empty()) list.fail("expected a non-empty array of transforms");
+      for (std::size_t k = 0; k < list.value().size(); ++k)
+        place(list.child(k), label + "[" + std::to_string(k) + "] (" + name + ")");
+    }
+  }
+}
+
 void read_lights(const Node& node, Scene* scene) {
   if (!node.value().is_array()) node.fail("expected an array of lights");
   for (std::size_t i = 0; i < node.value().size(); ++i) {
@@ -597,7 +683,8 @@ Scene read_scene(const JsonDocument& doc) {
   if (const std::int64_t v = version.integer(); v != kSceneFormatVersion)
     version.fail("unsupported scene format version " + std::to_string(v) + " (this pathlab reads version " +
                  std::to_string(kSceneFormatVersion) + ")");
-  root.allow_only({"pathlab_scene", "camera", "film", "render", "materials", "shapes", "lights", "analytic"});
+  root.allow_only({"pathlab_scene", "camera", "film", "render", "materials", "shapes", "groups", "instances", "lights",
+                   "analytic"});
   Scene scene;
   scene.file = doc.file();
   scene.name = doc.file().stem().string();
@@ -621,7 +708,13 @@ Scene read_scene(const JsonDocument& doc) {
   if (!shapes.value().is_array()) shapes.fail("expected an array of shapes");
   const std::filesystem::path folder = doc.file().parent_path();
   for (std::size_t i = 0; i < shapes.value().size(); ++i)
-    scene.shapes.push_back(read_shape(shapes.child(i), scene, folder, materials, i));
+    scene.shapes.push_back(read_shape(shapes.child(i), scene, folder, materials, "shapes[" + std::to_string(i) + "]"));
+  if (root.has("groups")) read_groups(root.child("groups"), scene, folder, materials);
+  if (root.has("instances")) read_instances(root.child("instances"), &scene);
+  for (std::uint32_t g = 0; g < scene.groups.size(); ++g)
+    if (std::none_of(scene.instances.begin(), scene.instances.end(), [g](const Instance& i) { return i.group == g; }))
+      scene.warnings.push_back(root.child("groups").child(scene.groups[g].name).message(
+          "group " + in_quotes(scene.groups[g].name) + " is never placed (no instance names it)"));
 
   if (root.has("lights")) read_lights(root.child("lights"), &scene);
 

@@ -10,6 +10,7 @@
 #include "core/material.h"
 #include "core/math.h"
 #include "core/ray.h"
+#include "core/scene.h"
 
 #include <cstdint>
 #include <optional>
@@ -39,6 +40,7 @@ struct Surfel {
   const Material* material = nullptr;
   std::uint32_t shape = 0;      // index into Scene::shapes
   std::uint32_t prim = 0;       // triangle index within the shape (0 for a sphere)
+  std::uint32_t instance = kNoInstance;  // index into Scene::instances for a shape in a group
 
   Spectrum emitted(const vec3& wo) const;
   Spectrum eval(const vec3& wi, const vec3& wo) const;

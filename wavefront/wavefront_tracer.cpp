@@ -153,6 +153,7 @@ struct WavefrontTracer::VectorStages {
       diffuse = &m;
     }
     if (diffuse) sc.min_pdf = diffuse->shading.min_pdf;
+    if (!scene.instances.empty()) return no("instances");
     // Flat triangles only: the stages shade with the geometric normal.
     for (const Shape& shape : scene.shapes)
       if (shape.mesh.has_normals()) return no(shape.description + " has vertex normals (smooth shading)");
