@@ -135,9 +135,9 @@ TEST_F(Gltf, StripsAndFansAndSkippedLines) {
 TEST_F(Gltf, HierarchyTransformsNormalsTangentsAndWinding) {
   GltfWriter w;
   const int pos = w.add(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}, test::kGltfFloat, "VEC3", 3);
-  const float s = std::sqrt(0.5f);
-  // A normal tilted in x-z, so that the non-uniform scale matters.
-  const int nrm = w.add(std::vector<float>{s, 0, s, s, 0, s, s, 0, s}, test::kGltfFloat, "VEC3", 3);
+  const float s = std::sqrt(1.0f / 3.0f);
+  // A normal with a y component, so that the non-uniform scale matters.
+  const int nrm = w.add(std::vector<float>{s, s, s, s, s, s, s, s, s}, test::kGltfFloat, "VEC3", 3);
   const int tan = w.add(std::vector<float>{1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1}, test::kGltfFloat, "VEC4", 4);
   w.mesh({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}, {"TANGENT", tan}}}}});
   const float h = std::sqrt(0.5f);
@@ -151,9 +151,10 @@ TEST_F(Gltf, HierarchyTransformsNormalsTangentsAndWinding) {
   EXPECT_NEAR(glm::distance(m.positions[1], vec3(1, -1, 3)), 0.0f, 1e-5f);
   // (0,1,0) -> (0,2,0) -> (0,6,0) -> (-6,0,0) -> (-5,2,3).
   EXPECT_NEAR(glm::distance(m.positions[2], vec3(-5, 2, 3)), 0.0f, 1e-5f);
-  // Normal (1,0,1)/sqrt2: inverse transpose of diag(-1,2,1) keeps (-1,0,1),
-  // then the rotation: (0,-1,1)/sqrt2.
-  EXPECT_NEAR(glm::distance(m.normals[0], glm::normalize(vec3(0, -1, 1))), 0.0f, 1e-5f);
+  // Normal (1,1,1)/sqrt3: the inverse transpose of diag(-1,2,1) gives
+  // (-1,0.5,1) (the plain matrix would give (-1,2,1)), the rotation
+  // (-0.5,-1,1).
+  EXPECT_NEAR(glm::distance(m.normals[0], glm::normalize(vec3(-0.5f, -1, 1))), 0.0f, 1e-5f);
   // Tangent (1,0,0) -> (-1,0,0) -> (0,-1,0); mirrored, so w = -1.
   EXPECT_NEAR(glm::distance(vec3(m.tangents[0]), vec3(0, -1, 0)), 0.0f, 1e-5f);
   EXPECT_EQ(m.tangents[0].w, -1.0f);
