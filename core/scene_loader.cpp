@@ -431,6 +431,18 @@ TriangleMesh unit_box() {
   return m;
 }
 
+// The scene material `node` names, with "did you mean" when there is none.
+std::uint32_t material_index(const Node& node, const std::map<std::string, std::uint32_t>& materials) {
+  const std::string name = node.string();
+  const auto found = materials.find(name);
+  if (found == materials.end()) {
+    std::vector<std::string_view> names;
+    for (const auto& [known, unused] : materials) names.push_back(known);
+    node.fail("no material named " + in_quotes(name) + suggestion(name, names));
+  }
+  return found->second;
+}
+
 Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
                  const std::map<std::string, std::uint32_t>& materials, std::size_t index) {
   node.expect_object();
@@ -450,15 +462,7 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
                             (near.empty() ? " (expected mesh, sphere, rectangle, box or gltf)" : near));
   }
 
-  const Node mat = node.required("material");
-  const std::string mat_name = mat.string();
-  const auto found = materials.find(mat_name);
-  if (found == materials.end()) {
-    std::vector<std::string_view> names;
-    for (const auto& [name, unused] : materials) names.push_back(name);
-    mat.fail("no material named " + in_quotes(mat_name) + suggestion(mat_name, names));
-  }
-  shape.material = found->second;
+  shape.material = material_index(node.required("material"), materials);
   shape.flip_normals = node.boolean_or("flip_normals", false);
   const mat4 xf = node.has("transform") ? read_transform(node.child("transform")) : mat4(1.0f);
 
@@ -544,16 +548,6 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
 void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
                      const std::map<std::string, std::uint32_t>& materials) {
   node.allow_only({"type", "file", "transform", "material", "materials"});
-  const auto scene_material = [&](const Node& name_node) {
-    const std::string name = name_node.string();
-    const auto found = materials.find(name);
-    if (found == materials.end()) {
-      std::vector<std::string_view> names;
-      for (const auto& [known, unused] : materials) names.push_back(known);
-      name_node.fail("no material named " + in_quotes(name) + suggestion(name, names));
-    }
-    return found->second;
-  };
   if (node.has("material") && node.has("materials"))
     node.child("materials").fail("give either 'material' (for every primitive) or 'materials' (by glTF name)");
   const Node file = node.required("file");
@@ -570,7 +564,7 @@ void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path
   }
   std::vector<std::optional<std::uint32_t>> material_for(content.materials.size());
   if (node.has("material")) {
-    const std::uint32_t all = scene_material(node.child("material"));
+    const std::uint32_t all = material_index(node.child("material"), materials);
     std::fill(material_for.begin(), material_for.end(), all);
   } else if (node.has("materials")) {
     const Node map = node.child("materials");
@@ -583,7 +577,7 @@ void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path
       bool any = false;
       for (std::size_t i = 0; i < content.materials.size(); ++i)
         if (content.materials[i].gltf_name == gltf_name) {
-          material_for[i] = scene_material(entry);
+          material_for[i] = material_index(entry, materials);
           any = true;
         }
       if (!any)
