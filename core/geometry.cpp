@@ -3,8 +3,46 @@
 #include "core/sampling.h"
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
 namespace pathlab {
+
+std::size_t transform_mesh(TriangleMesh* mesh, const mat4& xf) {
+  for (vec3& p : mesh->positions) p = vec3(xf * vec4(p, 1.0f));
+  // Normals by the inverse transpose, in double so that a strong
+  // non-uniform scale does not lose them; a normal the transform squashes to
+  // nothing (a singular matrix) is caught with the triangles it belongs to.
+  if (mesh->has_normals()) {
+    const glm::dmat3 to_normal = glm::transpose(glm::inverse(glm::dmat3(mat3(xf))));
+    for (vec3& n : mesh->normals) {
+      const dvec3 m = to_normal * dvec3(n);
+      const double length = glm::length(m);
+      n = length > 0.0 && std::isfinite(length) ? vec3(m / length) : vec3(0.0f, 0.0f, 1.0f);
+    }
+  }
+  const bool mirrors = glm::determinant(mat3(xf)) < 0.0f;
+  // Tangents lie in the surface, so they move with it (the plain matrix).
+  // The bitangent is w * cross(n, t): a mirror flips cross(n', t') against
+  // the mirrored bitangent, so w flips too.
+  for (vec4& t : mesh->tangents) {
+    const dvec3 m = glm::dmat3(mat3(xf)) * dvec3(vec3(t));
+    const double length = glm::length(m);
+    const vec3 dir = length > 0.0 && std::isfinite(length) ? vec3(m / length) : vec3(1.0f, 0.0f, 0.0f);
+    t = vec4(dir, mirrors ? -t.w : t.w);
+  }
+  // A mirroring transform turns counter-clockwise into clockwise: swap two
+  // indices so the front side stays the side the normal was on.
+  if (mirrors)
+    for (glm::uvec3& t : mesh->triangles) std::swap(t.y, t.z);
+  std::vector<glm::uvec3> kept;
+  kept.reserve(mesh->triangles.size());
+  for (std::uint32_t i = 0; i < mesh->triangles.size(); ++i)
+    if (triangle_area(*mesh, i) > 0.0f) kept.push_back(mesh->triangles[i]);
+  const std::size_t dropped = mesh->triangles.size() - kept.size();
+  mesh->triangles = std::move(kept);
+  return dropped;
+}
 
 float triangle_area(const TriangleMesh& mesh, std::uint32_t tri) {
   const glm::uvec3 t = mesh.triangles[tri];

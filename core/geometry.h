@@ -4,6 +4,7 @@
 
 #include "core/scene.h"
 
+#include <cstddef>
 #include <cstdint>
 
 namespace pathlab {
@@ -22,6 +23,10 @@ constexpr float gamma_bound(int n) {
 }
 
 float triangle_area(const TriangleMesh& mesh, std::uint32_t tri);
+// Applies `xf` to a mesh (positions; normals by the inverse transpose;
+// tangents by `xf`, their handedness flipped with the winding of a mirroring
+// transform) and drops the triangles it made degenerate; returns how many.
+std::size_t transform_mesh(TriangleMesh* mesh, const mat4& xf);
 // Front normal of a triangle: counter-clockwise winding, unless flipped.
 vec3 triangle_normal(const Shape& shape, std::uint32_t tri);
 

@@ -22,7 +22,10 @@ struct TriangleMesh {
   std::vector<vec3> positions;
   std::vector<glm::uvec3> triangles;  // indices into `positions`
   std::vector<vec3> normals;          // unit shading normals, or empty (flat shading)
-  std::vector<vec2> uvs;              // texture coordinates, or empty
+  std::vector<vec2> uvs;              // texture coordinates (origin bottom-left, v up), or empty
+  // Unit tangents (xyz) and the bitangent's handedness (w = +-1: bitangent =
+  // w * cross(normal, tangent)), or empty. Only glTF files bring them today.
+  std::vector<glm::vec4> tangents;
 
   bool has_normals() const { return !normals.empty(); }
   bool has_uvs() const { return !uvs.empty(); }

@@ -111,8 +111,8 @@ struct Scene {
   FilmDesc film;
   RenderSettings render;
   std::vector<Material> materials;
-  // The file's shapes in its order (shapes[i] is the file's shapes[i]), then
-  // the groups' shapes.
+  // The file's shapes in its order (a "gltf" entry adds one per primitive),
+  // then the groups' shapes.
   std::vector<Shape> shapes;
   std::vector<ShapeGroup> groups;
   std::vector<Instance> instances;

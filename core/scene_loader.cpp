@@ -3,6 +3,7 @@
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "core/geometry.h"
+#include "core/gltf_loader.h"
 #include "core/json_document.h"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -11,6 +12,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <optional>
 #include <span>
 #include <sstream>
 #include <string>
@@ -431,31 +434,16 @@ TriangleMesh unit_box() {
   return m;
 }
 
-// Applies `xf` to a mesh and drops triangles that it made degenerate.
-std::size_t transform_mesh(TriangleMesh* mesh, const mat4& xf) {
-  for (vec3& p : mesh->positions) p = vec3(xf * vec4(p, 1.0f));
-  // Normals by the inverse transpose, in double so that a strong
-  // non-uniform scale does not lose them; a normal the transform squashes to
-  // nothing (a singular matrix) is caught with the triangles it belongs to.
-  if (mesh->has_normals()) {
-    const glm::dmat3 to_normal = glm::transpose(glm::inverse(glm::dmat3(mat3(xf))));
-    for (vec3& n : mesh->normals) {
-      const dvec3 m = to_normal * dvec3(n);
-      const double length = glm::length(m);
-      n = length > 0.0 && std::isfinite(length) ? vec3(m / length) : vec3(0.0f, 0.0f, 1.0f);
-    }
+// The scene material `node` names, with "did you mean" when there is none.
+std::uint32_t material_index(const Node& node, const std::map<std::string, std::uint32_t>& materials) {
+  const std::string name = node.string();
+  const auto found = materials.find(name);
+  if (found == materials.end()) {
+    std::vector<std::string_view> names;
+    for (const auto& [known, unused] : materials) names.push_back(known);
+    node.fail("no material named " + in_quotes(name) + suggestion(name, names));
   }
-  // A mirroring transform turns counter-clockwise into clockwise: swap two
-  // indices so the front side stays the side the normal was on.
-  if (glm::determinant(mat3(xf)) < 0.0f)
-    for (glm::uvec3& t : mesh->triangles) std::swap(t.y, t.z);
-  std::vector<glm::uvec3> kept;
-  kept.reserve(mesh->triangles.size());
-  for (std::uint32_t i = 0; i < mesh->triangles.size(); ++i)
-    if (triangle_area(*mesh, i) > 0.0f) kept.push_back(mesh->triangles[i]);
-  const std::size_t dropped = mesh->triangles.size() - kept.size();
-  mesh->triangles = std::move(kept);
-  return dropped;
+  return found->second;
 }
 
 // `label` names the shape in messages: "shapes[3]", "groups/tree[0]".
@@ -472,21 +460,13 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
   } else if (type == "rectangle" || type == "box") {
     node.allow_only({"type", "material", "transform", "flip_normals"});
   } else {
-    const std::array<std::string_view, 4> types{"mesh", "sphere", "rectangle", "box"};
+    const std::array<std::string_view, 5> types{"mesh", "sphere", "rectangle", "box", "gltf"};
     const std::string near = suggestion(type, types);
     node.child("type").fail("unknown shape type " + in_quotes(type) +
-                            (near.empty() ? " (expected mesh, sphere, rectangle or box)" : near));
+                            (near.empty() ? " (expected mesh, sphere, rectangle, box or gltf)" : near));
   }
 
-  const Node mat = node.required("material");
-  const std::string mat_name = mat.string();
-  const auto found = materials.find(mat_name);
-  if (found == materials.end()) {
-    std::vector<std::string_view> names;
-    for (const auto& [name, unused] : materials) names.push_back(name);
-    mat.fail("no material named " + in_quotes(mat_name) + suggestion(mat_name, names));
-  }
-  shape.material = found->second;
+  shape.material = material_index(node.required("material"), materials);
   shape.flip_normals = node.boolean_or("flip_normals", false);
   const mat4 xf = node.has("transform") ? read_transform(node.child("transform")) : mat4(1.0f);
 
@@ -565,6 +545,9 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
   return shape;
 }
 
+void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
+                     const std::map<std::string, std::uint32_t>& materials);
+
 // "groups": {"name": [shape, ...], ...}: shapes in the group's own space,
 // appended to scene.shapes and marked in_group.
 void read_groups(const Node& node, Scene& scene, const std::filesystem::path& folder,
@@ -578,16 +561,25 @@ void read_groups(const Node& node, Scene& scene, const std::filesystem::path& fo
       const Node item = list.child(i);
       if (item.value().is_object() && item.has("type") && item.child("type").value() == "instance")
         item.child("type").fail("a group holds shapes, not instances (instances of instances are not supported)");
-      Shape shape = read_shape(item, scene, folder, materials, "groups/" + name + "[" + std::to_string(i) + "]");
-      const Material& m = scene.materials[shape.material];
-      // As in pbrt-v4: an instanced emitter would need a light per placement.
-      if (m.emits() && m.sampled_as_light)
-        item.child("material").fail("material " + in_quotes(m.name) +
-                                    " emits: emitters in a group are not sampled as lights; place the shape in "
-                                    "'shapes', or give the material \"light\": false");
-      shape.in_group = true;
-      group.shapes.push_back(static_cast<std::uint32_t>(scene.shapes.size()));
-      scene.shapes.push_back(std::move(shape));
+      const std::size_t first = scene.shapes.size(), point_lights = scene.point_lights.size();
+      if (item.value().is_object() && item.has("type") && item.child("type").value() == "gltf")
+        read_gltf_shape(item, scene, folder, materials);
+      else
+        scene.shapes.push_back(read_shape(item, scene, folder, materials, "groups/" + name + "[" + std::to_string(i) + "]"));
+      if (scene.point_lights.size() != point_lights)
+        item.child("file").fail("the glTF file has point lights, which instances do not place; put it in 'shapes'");
+      for (std::size_t k = first; k < scene.shapes.size(); ++k) {
+        Shape& shape = scene.shapes[k];
+        const Material& m = scene.materials[shape.material];
+        // As in pbrt-v4: an instanced emitter would need a light per placement.
+        if (m.emits() && m.sampled_as_light)
+          (item.has("material") ? item.child("material") : item)
+              .fail("material " + in_quotes(m.name) +
+                    " emits: emitters in a group are not sampled as lights; place the shape in 'shapes', or give "
+                    "the material \"light\": false");
+        shape.in_group = true;
+        group.shapes.push_back(static_cast<std::uint32_t>(k));
+      }
     }
     scene.groups.push_back(std::move(group));
   }
@@ -650,6 +642,55 @@ void read_instances(const Node& node, Scene* scene) {
   }
 }
 
+// A "gltf" shape: every primitive of the file's default scene, with the
+// file's materials unless "material" (all) or "materials" (by glTF name)
+// says otherwise, and the file's point lights.
+void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
+                     const std::map<std::string, std::uint32_t>& materials) {
+  node.allow_only({"type", "file", "transform", "material", "materials"});
+  if (node.has("material") && node.has("materials"))
+    node.child("materials").fail("give either 'material' (for every primitive) or 'materials' (by glTF name)");
+  const Node file = node.required("file");
+  if (file.string().empty()) file.fail("the glTF file name is empty");
+  const std::filesystem::path path = resolve_scene_path(folder, file.string());
+  if (names_data_file(file.string()) && !std::filesystem::exists(path))
+    file.fail(file.string() + ": " + path.string() + " does not exist; " + data_directory_hint());
+  const mat4 xf = node.has("transform") ? read_transform(node.child("transform")) : mat4(1.0f);
+  GltfContent content;
+  try {
+    content = load_gltf(path, xf);
+  } catch (const InputError& e) {
+    file.fail(e.what());
+  }
+  std::vector<std::optional<std::uint32_t>> material_for(content.materials.size());
+  if (node.has("material")) {
+    const std::uint32_t all = material_index(node.child("material"), materials);
+    std::fill(material_for.begin(), material_for.end(), all);
+  } else if (node.has("materials")) {
+    const Node map = node.child("materials");
+    map.expect_object();
+    std::vector<std::string_view> gltf_names;
+    for (const GltfMaterial& m : content.materials)
+      if (!m.gltf_name.empty()) gltf_names.push_back(m.gltf_name);
+    for (const auto& [gltf_name, unused] : map.value().items()) {
+      const Node entry = map.child(gltf_name);
+      bool any = false;
+      for (std::size_t i = 0; i < content.materials.size(); ++i)
+        if (content.materials[i].gltf_name == gltf_name) {
+          material_for[i] = material_index(entry, materials);
+          any = true;
+        }
+      if (!any)
+        entry.fail(path.filename().string() + " has no material named " + in_quotes(gltf_name) +
+                   suggestion(gltf_name, gltf_names));
+    }
+  }
+  for (const std::string& w : content.warnings) scene.warnings.push_back(file.message(w));
+  const std::size_t before = scene.shapes.size();
+  append_gltf(scene, content, material_for);
+  if (scene.shapes.size() == before) file.fail(path.string() + ": the file's scene holds no triangles");
+}
+
 void read_lights(const Node& node, Scene* scene) {
   if (!node.value().is_array()) node.fail("expected an array of lights");
   for (std::size_t i = 0; i < node.value().size(); ++i) {
@@ -707,8 +748,13 @@ Scene read_scene(const JsonDocument& doc) {
   const Node shapes = root.required("shapes");
   if (!shapes.value().is_array()) shapes.fail("expected an array of shapes");
   const std::filesystem::path folder = doc.file().parent_path();
-  for (std::size_t i = 0; i < shapes.value().size(); ++i)
-    scene.shapes.push_back(read_shape(shapes.child(i), scene, folder, materials, "shapes[" + std::to_string(i) + "]"));
+  for (std::size_t i = 0; i < shapes.value().size(); ++i) {
+    const Node shape = shapes.child(i);
+    if (shape.value().is_object() && shape.has("type") && shape.child("type").value() == "gltf")
+      read_gltf_shape(shape, scene, folder, materials);
+    else
+      scene.shapes.push_back(read_shape(shape, scene, folder, materials, "shapes[" + std::to_string(i) + "]"));
+  }
   if (root.has("groups")) read_groups(root.child("groups"), scene, folder, materials);
   if (root.has("instances")) read_instances(root.child("instances"), &scene);
   for (std::uint32_t g = 0; g < scene.groups.size(); ++g)
@@ -731,7 +777,10 @@ Scene parse_scene(std::string_view text, const std::filesystem::path& file) {
   return read_scene(JsonDocument::parse(text, file));
 }
 
-Scene load_scene(const std::filesystem::path& file) { return read_scene(JsonDocument::load(file)); }
+Scene load_scene(const std::filesystem::path& file) {
+  if (is_gltf_file(file)) return load_gltf_scene(file);
+  return read_scene(JsonDocument::load(file));
+}
 
 Scene builtin_cornell_box() {
   Scene scene = parse_scene(builtin_cornell_box_text(), "<built-in cornell-box>");

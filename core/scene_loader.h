@@ -11,7 +11,8 @@ namespace pathlab {
 
 inline constexpr int kSceneFormatVersion = 1;
 
-// Loads a scene file; mesh paths are relative to its folder.
+// Loads a scene file; mesh paths are relative to its folder. A .gltf or .glb
+// file is a scene of its own (load_gltf_scene in gltf_loader.h).
 Scene load_scene(const std::filesystem::path& file);
 
 // Parses scene text. `file` names it in messages and anchors relative mesh

@@ -3,6 +3,7 @@
 // code 2, no crash, and nothing left behind in the output folder. Warnings
 // (no light, degenerate triangles) still render.
 #include "tests/cli_util.h"
+#include "tests/gltf_writer.h"
 #include "tests/temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -453,6 +454,124 @@ TEST_F(BadInput, OptionOutOfRange) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("--spp"), std::string::npos) << r.err;
   expect_nothing_written();
+}
+
+// ------------------------------------------------------------ glTF files
+
+// A quad (4 vertices, u8 indices) with normals and UVs, one node.
+test::GltfWriter gltf_quad(std::vector<float> positions = test::kQuadPositions, std::vector<float> normals = test::kQuadNormals,
+                           std::vector<float> uvs = {0, 0, 1, 0, 1, 1, 0, 1},
+                           std::vector<std::uint8_t> indices = {0, 1, 2, 0, 2, 3}) {
+  test::GltfWriter w;
+  const int pos = w.add(positions, test::kGltfFloat, "VEC3", 3);
+  const int nrm = w.add(normals, test::kGltfFloat, "VEC3", 3);
+  const int uv = w.add(uvs, test::kGltfFloat, "VEC2", 2);
+  const int idx = w.add(indices, test::kGltfByte, "SCALAR", 1);
+  w.mesh({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}, {"TEXCOORD_0", uv}}}, {"indices", idx}}});
+  w.node({{"mesh", 0}});
+  return w;
+}
+
+TEST_F(BadInput, GltfRendersDirectlyAndAsAShape) {
+  const CliResult direct = render(write("quad.gltf", gltf_quad().embedded()));
+  EXPECT_EQ(direct.code, 0) << direct.err;
+  const CliResult shape = render(write("shape.json", scene(kMaterials, "    {\"type\": \"gltf\", \"file\": \"quad.gltf\"},\n" + kLamp)),
+                                 (dir_ / "y.exr").string());
+  EXPECT_EQ(shape.code, 0) << shape.err;
+}
+
+TEST_F(BadInput, GltfIndexOutOfRange) {
+  const std::string file = write("index.gltf", gltf_quad(test::kQuadPositions, test::kQuadNormals, {0, 0, 1, 0, 1, 1, 0, 1},
+                                                         {0, 1, 2, 0, 2, 9}).embedded());
+  expect_rejected(render(file), {"index.gltf: /meshes/0/primitives/0/indices: index 9 out of range (4 vertices)"});
+  // The same through a scene names the scene's place first.
+  const std::string text = scene(kMaterials, "    {\"type\": \"gltf\", \"file\": \"index.gltf\"},\n" + kLamp);
+  expect_rejected(render(write("index.json", text)),
+                  {"index.json:" + where_in(text, "\"file\""), "/shapes/0/file", "index 9 out of range"});
+}
+
+TEST_F(BadInput, GltfNonFiniteAttributes) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  std::vector<float> p = test::kQuadPositions, n = test::kQuadNormals, uv = {0, 0, 1, 0, 1, 1, 0, 1};
+  p[4] = nan;
+  expect_rejected(render(write("p.gltf", gltf_quad(p).embedded())),
+                  {"p.gltf: /meshes/0/primitives/0/attributes/POSITION: element 1 is not finite (/accessors/0)"});
+  n[11] = -inf;
+  expect_rejected(render(write("n.gltf", gltf_quad(test::kQuadPositions, n).embedded())),
+                  {"n.gltf: /meshes/0/primitives/0/attributes/NORMAL: element 3 is not finite"});
+  uv[5] = inf;
+  expect_rejected(render(write("uv.gltf", gltf_quad(test::kQuadPositions, test::kQuadNormals, uv).embedded())),
+                  {"uv.gltf: /meshes/0/primitives/0/attributes/TEXCOORD_0: element 2 is not finite"});
+}
+
+TEST_F(BadInput, GltfAttributeCountMismatch) {
+  const std::vector<float> three(test::kQuadNormals.begin(), test::kQuadNormals.begin() + 9);
+  expect_rejected(render(write("count.gltf", gltf_quad(test::kQuadPositions, three).embedded())),
+                  {"count.gltf: /meshes/0/primitives/0/attributes/NORMAL: 3 elements, but POSITION has 4"});
+}
+
+TEST_F(BadInput, GltfTruncatedGlb) {
+  const std::string glb = gltf_quad().glb();
+  expect_rejected(render(write("cut.glb", glb.substr(0, glb.size() - 10))),
+                  {"cut.glb: truncated .glb: the header says " + std::to_string(glb.size()) + " bytes, the file has " +
+                   std::to_string(glb.size() - 10)});
+  expect_rejected(render(write("stub.glb", glb.substr(0, 14))), {"stub.glb: truncated .glb: 14 bytes"});
+}
+
+TEST_F(BadInput, GltfBufferUris) {
+  const test::GltfWriter w = gltf_quad();
+  expect_rejected(render(write("missing.gltf", w.external("nothere.bin"))),
+                  {"missing.gltf: /buffers/0/uri: buffer file", "nothere.bin does not exist"});
+  for (const char* uri : {"../x.bin", "sub/../../x.bin", "/etc/hostname", "file:///etc/hostname"}) {
+    SCOPED_TRACE(uri);
+    expect_rejected(render(write("escape.gltf", w.external(uri))),
+                    {"escape.gltf: /buffers/0/uri: buffer URI '", "refused"});
+  }
+  // 2 GB claimed by a tiny file: refused before anything is allocated.
+  write("tiny.bin", std::string(w.bin.begin(), w.bin.end()));
+  std::string huge = w.external("tiny.bin");
+  huge.replace(huge.find("\"byteLength\": " + std::to_string(w.bin.size())), 14 + std::to_string(w.bin.size()).size(),
+               "\"byteLength\": 2147483648");
+  expect_rejected(render(write("huge.gltf", huge)),
+                  {"huge.gltf: /buffers/0/byteLength: byteLength is 2147483648 but tiny.bin has " +
+                   std::to_string(w.bin.size()) + " bytes"});
+  nlohmann::json doc = nlohmann::json::parse(w.embedded());
+  doc["buffers"][0]["byteLength"] = 2147483648u;
+  expect_rejected(render(write("huge-data.gltf", doc.dump())),
+                  {"huge-data.gltf: /buffers/0/byteLength: byteLength is 2147483648 but the data URI has"});
+}
+
+TEST_F(BadInput, GltfUnsupportedRequiredExtension) {
+  test::GltfWriter w = gltf_quad();
+  w.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+  w.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+  expect_rejected(render(write("draco.gltf", w.embedded())),
+                  {"draco.gltf: /extensionsRequired/0: required extension 'KHR_draco_mesh_compression' is not supported"});
+}
+
+TEST_F(BadInput, GltfAccessorPastItsView) {
+  test::GltfWriter w = gltf_quad();
+  w.doc["accessors"][1]["count"] = 5;
+  expect_rejected(render(write("past.gltf", w.embedded())),
+                  {"past.gltf: /accessors/1: 5 elements of 12 bytes (stride 12) from byte 0 read past the end of bufferView 1 (48 bytes)"});
+  w.doc["accessors"][1]["count"] = 4;
+  w.doc["bufferViews"][1]["byteLength"] = 4000;
+  expect_rejected(render(write("view.gltf", w.embedded())), {"view.gltf: /bufferViews/1: bytes [48, 4048) lie past the end of buffer 0"});
+  w.doc["bufferViews"][1]["byteLength"] = 48;
+  w.doc["accessors"][1]["sparse"] = nlohmann::json::object();
+  expect_rejected(render(write("sparse.gltf", w.embedded())), {"sparse.gltf: /accessors/1/sparse: sparse accessors are not supported"});
+}
+
+TEST_F(BadInput, GltfNodeCycleAndUnknownMesh) {
+  test::GltfWriter w = gltf_quad();
+  w.node({{"children", {2}}});
+  w.node({{"children", {1}}});
+  expect_rejected(render(write("cycle.gltf", w.embedded())),
+                  {"cycle.gltf: /nodes/2/children/0: node 1 is its own descendant (a cycle in the node graph)"});
+  w.doc["nodes"][1] = {{"children", {1}}};
+  expect_rejected(render(write("self.gltf", w.embedded())), {"self.gltf: /nodes/1/children/0: node 1 is its own descendant"});
+  w.doc["nodes"][1] = {{"mesh", 7}};
+  expect_rejected(render(write("mesh.gltf", w.embedded())), {"mesh.gltf: /nodes/1/mesh: no mesh 7 (the file has 1)"});
 }
 
 TEST_F(BadInput, TracePixelBadPixel) {

@@ -12,6 +12,7 @@ packages=(
   libglm-dev              # vector math
   nlohmann-json3-dev      # scene files, JSON output
   libtinyobjloader-dev    # OBJ meshes
+  libtinygltf-dev         # glTF 2.0 files (header only: core/gltf_loader.cpp)
   zlib1g-dev              # .gz meshes
   libcli11-dev            # the command line
   libgtest-dev libgmock-dev  # tests

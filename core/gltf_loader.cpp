@@ -1,0 +1,505 @@
+// glTF 2.0 through tinygltf. The JSON is checked first (gltf_validate.cpp) so
+// that tinygltf reads only files the checks approved and never allocates a
+// size the file does not back; then the default scene is flattened into
+// world-space meshes here.
+#include "core/gltf_loader.h"
+
+#include "core/error.h"
+#include "core/geometry.h"
+#include "core/gltf_validate.h"
+
+// No image decoding (textures are not supported yet), no default file system
+// access (the callbacks below read only approved buffers), no external image
+// read at all. tiny_gltf.h lies in a system include folder, so its own
+// warnings stay out of the project's -Werror build.
+#include <fstream>  // tiny_gltf.h needs it but includes it only with its default file access
+
+#define TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#define TINYGLTF_NO_FS
+#include <tiny_gltf.h>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <set>
+#include <utility>
+
+namespace pathlab {
+namespace {
+
+namespace fs = std::filesystem;
+using gltf::fail;
+
+// --------------------------------------------------------------- file access
+
+struct Approved {
+  std::set<fs::path> files;
+};
+
+bool file_exists(const std::string& path, void* user) {
+  return static_cast<Approved*>(user)->files.count(fs::path(path).lexically_normal()) > 0;
+}
+std::string expand_path(const std::string& path, void*) { return path; }
+bool read_whole_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  if (!file_exists(path, user)) {
+    *err = "not read";
+    return false;
+  }
+  std::ifstream in(path, std::ios::binary);
+  out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return static_cast<bool>(in) || in.eof();
+}
+bool write_whole_file(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  *err = "pathlab does not write glTF files";
+  return false;
+}
+// Images are kept undecoded: no textures yet.
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
+
+tinygltf::Model parse(const fs::path& file) {
+  const gltf::Container container = gltf::read_container(file);
+  const nlohmann::json doc = nlohmann::json::parse(container.json_text, nullptr, false);
+  if (doc.is_discarded()) fail(file, "", "not valid JSON");
+  Approved approved{gltf::validate(doc, file, container)};
+
+  tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks({&file_exists, &expand_path, &read_whole_file, &write_whole_file, &approved});
+  loader.SetImageLoader(&skip_image, nullptr);
+  tinygltf::Model model;
+  std::string err, warn;  // tinygltf's warnings repeat what pathlab reports itself
+  const std::string base = file.parent_path().string();
+  const bool ok =
+      container.binary
+          ? loader.LoadBinaryFromMemory(&model, &err, &warn, container.bytes.data(),
+                                        static_cast<unsigned int>(container.bytes.size()), base)
+          : loader.LoadASCIIFromString(&model, &err, &warn, container.json_text.data(),
+                                       static_cast<unsigned int>(container.json_text.size()), base);
+  if (!ok || !err.empty()) {
+    while (!err.empty() && err.back() == '\n') err.pop_back();
+    std::replace(err.begin(), err.end(), '\n', ';');
+    throw InputError(file.string() + ": " + (err.empty() ? std::string("tinygltf could not read it") : err));
+  }
+  return model;
+}
+
+// ------------------------------------------------------------------ accessors
+
+const char* component_name(int type) {
+  switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: return "byte";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "unsigned byte";
+    case TINYGLTF_COMPONENT_TYPE_SHORT: return "short";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "unsigned short";
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "unsigned int";
+    default: return "float";
+  }
+}
+
+template <typename T>
+T load(const unsigned char* p) {
+  T v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// One component as a float: floats as they are, normalized integers mapped
+// to [0, 1] or [-1, 1] as glTF defines, other integers by value.
+float component(const unsigned char* p, int type, bool normalized) {
+  switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return load<float>(p);
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0f : p[0];
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      const auto v = load<std::uint16_t>(p);
+      return normalized ? v / 65535.0f : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      const auto v = load<std::int8_t>(p);
+      return normalized ? std::max(v / 127.0f, -1.0f) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      const auto v = load<std::int16_t>(p);
+      return normalized ? std::max(v / 32767.0f, -1.0f) : v;
+    }
+    default: return static_cast<float>(load<std::uint32_t>(p));
+  }
+}
+
+class Flattener {
+ public:
+  Flattener(const tinygltf::Model& model, const fs::path& file, const mat4& transform)
+      : model_(model), file_(file), transform_(transform) {}
+
+  GltfContent run();
+
+ private:
+  // Every component of every element of accessor `index`, element after
+  // element. `what` names the attribute; `types` are the component types
+  // glTF allows for it (the first one float).
+  std::vector<float> floats(int index, int type, std::initializer_list<int> types, bool need_normalized,
+                            const std::string& where) const;
+  std::vector<std::uint32_t> indices(int index, const std::string& where) const;
+  TriangleMesh primitive_mesh(std::size_t mesh, std::size_t prim);
+  void place_mesh(std::size_t mesh, const mat4& world, std::size_t node);
+  void place_node(std::size_t node, const mat4& world);
+  std::uint32_t material(int index);
+  void warn_once(const std::string& key, const std::string& text) {
+    if (warned_.insert(key).second) out_.warnings.push_back(file_.string() + ": " + text);
+  }
+
+  const tinygltf::Model& model_;
+  const fs::path& file_;
+  const mat4 transform_;
+  GltfContent out_;
+  std::map<int, std::uint32_t> materials_;  // glTF material (-1: default) -> out_.materials
+  std::map<std::pair<std::size_t, std::size_t>, TriangleMesh> meshes_;  // primitives read once, copied per node
+  std::set<std::string> ignored_, warned_;
+};
+
+std::vector<float> Flattener::floats(int index, int type, std::initializer_list<int> types, bool need_normalized,
+                                     const std::string& where) const {
+  const tinygltf::Accessor& a = model_.accessors[static_cast<std::size_t>(index)];
+  const std::string at = "/accessors/" + std::to_string(index);
+  const int n = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(type));
+  const bool allowed = std::find(types.begin(), types.end(), a.componentType) != types.end();
+  const bool float_type = a.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT;
+  if (a.type != type || !allowed || (need_normalized && !float_type && !a.normalized))
+    fail(file_, where, "expected " + std::to_string(n) + "-component " +
+                           (types.size() > 1 ? "float or normalized integer" : std::string("float")) + " data, found " +
+                           std::to_string(tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(a.type))) +
+                           "-component " + component_name(a.componentType) + " (" + at + ")");
+  std::vector<float> values(a.count * static_cast<std::size_t>(n), 0.0f);
+  if (a.bufferView < 0) return values;  // glTF: no bufferView means zeros
+  // Bounds were checked against the JSON (gltf_validate.cpp), whose sizes
+  // tinygltf has loaded exactly.
+  const tinygltf::BufferView& v = model_.bufferViews[static_cast<std::size_t>(a.bufferView)];
+  const unsigned char* base = model_.buffers[static_cast<std::size_t>(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
+  const int size = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(a.componentType));
+  const std::size_t stride = v.byteStride != 0 ? v.byteStride : static_cast<std::size_t>(size * n);
+  for (std::size_t i = 0; i < a.count; ++i)
+    for (int c = 0; c < n; ++c)
+      values[i * static_cast<std::size_t>(n) + static_cast<std::size_t>(c)] =
+          component(base + i * stride + static_cast<std::size_t>(c * size), a.componentType, a.normalized);
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i]))
+      fail(file_, where, "element " + std::to_string(i / static_cast<std::size_t>(n)) + " is not finite (" + at + ")");
+  return values;
+}
+
+std::vector<std::uint32_t> Flattener::indices(int index, const std::string& where) const {
+  const tinygltf::Accessor& a = model_.accessors[static_cast<std::size_t>(index)];
+  if (a.type != TINYGLTF_TYPE_SCALAR ||
+      (a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+       a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && a.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+    fail(file_, where, "indices must be scalar unsigned byte, short or int, found " +
+                           std::string(component_name(a.componentType)) + " (/accessors/" + std::to_string(index) + ")");
+  std::vector<std::uint32_t> out(a.count, 0);
+  if (a.bufferView < 0) return out;
+  const tinygltf::BufferView& v = model_.bufferViews[static_cast<std::size_t>(a.bufferView)];
+  const unsigned char* base = model_.buffers[static_cast<std::size_t>(v.buffer)].data.data() + v.byteOffset + a.byteOffset;
+  const auto size = static_cast<std::size_t>(tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(a.componentType)));
+  const std::size_t stride = v.byteStride != 0 ? v.byteStride : size;
+  for (std::size_t i = 0; i < a.count; ++i) {
+    const unsigned char* p = base + i * stride;
+    out[i] = size == 1 ? p[0] : size == 2 ? load<std::uint16_t>(p) : load<std::uint32_t>(p);
+  }
+  return out;
+}
+
+TriangleMesh Flattener::primitive_mesh(std::size_t mesh, std::size_t prim) {
+  const tinygltf::Primitive& p = model_.meshes[mesh].primitives[prim];
+  const std::string ptr = "/meshes/" + std::to_string(mesh) + "/primitives/" + std::to_string(prim);
+  TriangleMesh m;
+  const std::string pos_at = ptr + "/attributes/POSITION";
+  const std::vector<float> pos = floats(p.attributes.at("POSITION"), TINYGLTF_TYPE_VEC3,
+                                        {TINYGLTF_COMPONENT_TYPE_FLOAT}, false, pos_at);
+  const std::size_t count = pos.size() / 3;
+  for (std::size_t i = 0; i < count; ++i) m.positions.emplace_back(pos[3 * i], pos[3 * i + 1], pos[3 * i + 2]);
+  const auto attribute = [&](const char* name, int type, std::initializer_list<int> types) {
+    const auto it = p.attributes.find(name);
+    if (it == p.attributes.end()) return std::vector<float>();
+    const std::string at = ptr + "/attributes/" + name;
+    std::vector<float> v = floats(it->second, type, types, types.size() > 1, at);
+    const std::size_t n = v.size() / static_cast<std::size_t>(tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(type)));
+    if (n != count)
+      fail(file_, at, std::to_string(n) + " elements, but POSITION has " + std::to_string(count));
+    return v;
+  };
+  const std::vector<float> normals = attribute("NORMAL", TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+  for (std::size_t i = 0; i < normals.size() / 3; ++i) {
+    const vec3 n(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+    if (!(glm::length(n) > 0.0f)) fail(file_, ptr + "/attributes/NORMAL", "element " + std::to_string(i) + " has zero length");
+    m.normals.push_back(glm::normalize(n));
+  }
+  // glTF's UV origin is the image's top-left corner (v down); pathlab keeps
+  // the OBJ / PLY / pbrt convention (origin bottom-left, v up): v -> 1 - v.
+  const std::vector<float> uvs = attribute("TEXCOORD_0", TINYGLTF_TYPE_VEC2,
+                                           {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                                            TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
+  for (std::size_t i = 0; i < uvs.size() / 2; ++i) m.uvs.emplace_back(uvs[2 * i], 1.0f - uvs[2 * i + 1]);
+  const std::vector<float> tangents = attribute("TANGENT", TINYGLTF_TYPE_VEC4, {TINYGLTF_COMPONENT_TYPE_FLOAT});
+  for (std::size_t i = 0; i < tangents.size() / 4; ++i) {
+    const vec3 t(tangents[4 * i], tangents[4 * i + 1], tangents[4 * i + 2]);
+    if (!(glm::length(t) > 0.0f)) fail(file_, ptr + "/attributes/TANGENT", "element " + std::to_string(i) + " has zero length");
+    m.tangents.emplace_back(glm::normalize(t), tangents[4 * i + 3] < 0.0f ? -1.0f : 1.0f);
+  }
+  for (const auto& [name, unused] : p.attributes)
+    if (name != "POSITION" && name != "NORMAL" && name != "TEXCOORD_0" && name != "TANGENT")
+      ignored_.insert("attribute " + name);
+  if (!p.targets.empty()) ignored_.insert("morph targets");
+
+  std::vector<std::uint32_t> idx;
+  if (p.indices >= 0) {
+    idx = indices(p.indices, ptr + "/indices");
+    for (const std::uint32_t i : idx)
+      if (i >= count)
+        fail(file_, ptr + "/indices", "index " + std::to_string(i) + " out of range (" + std::to_string(count) + " vertices)");
+  } else {
+    idx.resize(count);
+    for (std::size_t i = 0; i < count; ++i) idx[i] = static_cast<std::uint32_t>(i);
+  }
+  // Strips and fans as glTF defines them, keeping each triangle's winding.
+  const std::size_t n = idx.size();
+  if (p.mode == TINYGLTF_MODE_TRIANGLES || p.mode == -1) {
+    for (std::size_t i = 0; i + 2 < n; i += 3) m.triangles.emplace_back(idx[i], idx[i + 1], idx[i + 2]);
+  } else if (p.mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+    for (std::size_t i = 0; i + 2 < n; ++i)
+      m.triangles.push_back(i % 2 == 0 ? glm::uvec3(idx[i], idx[i + 1], idx[i + 2]) : glm::uvec3(idx[i], idx[i + 2], idx[i + 1]));
+  } else if (p.mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+    for (std::size_t i = 1; i + 1 < n; ++i) m.triangles.emplace_back(idx[i], idx[i + 1], idx[0]);
+  }
+  return m;
+}
+
+// The local transform of a node: its matrix, or T * R * S.
+mat4 local_transform(const tinygltf::Node& node) {
+  if (node.matrix.size() == 16) {
+    mat4 m;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) m[c][r] = static_cast<float>(node.matrix[static_cast<std::size_t>(4 * c + r)]);
+    return m;
+  }
+  mat4 m(1.0f);
+  if (node.translation.size() == 3)
+    m = glm::translate(m, vec3(static_cast<float>(node.translation[0]), static_cast<float>(node.translation[1]),
+                               static_cast<float>(node.translation[2])));
+  if (node.rotation.size() == 4)
+    m = m * glm::mat4_cast(glm::normalize(glm::quat(static_cast<float>(node.rotation[3]), static_cast<float>(node.rotation[0]),
+                                                    static_cast<float>(node.rotation[1]), static_cast<float>(node.rotation[2]))));
+  if (node.scale.size() == 3)
+    m = glm::scale(m, vec3(static_cast<float>(node.scale[0]), static_cast<float>(node.scale[1]), static_cast<float>(node.scale[2])));
+  return m;
+}
+
+// The one place a mesh is put into the world (a later change makes these
+// instances of one mesh instead of copies).
+void Flattener::place_mesh(std::size_t mesh, const mat4& world, std::size_t node) {
+  const mat4 xf = transform_ * world;
+  for (std::size_t prim = 0; prim < model_.meshes[mesh].primitives.size(); ++prim) {
+    const tinygltf::Primitive& p = model_.meshes[mesh].primitives[prim];
+    if (p.mode >= 0 && p.mode < TINYGLTF_MODE_TRIANGLES) {
+      warn_once("points", "primitives of points or lines skipped");
+      continue;
+    }
+    const auto key = std::make_pair(mesh, prim);
+    if (meshes_.count(key) == 0) meshes_[key] = primitive_mesh(mesh, prim);
+    GltfPrimitive out{file_.string() + ": /meshes/" + std::to_string(mesh) + "/primitives/" + std::to_string(prim) +
+                          " (node " + std::to_string(node) + ")",
+                      meshes_[key], material(p.material)};
+    const std::size_t before = out.mesh.triangles.size();
+    const std::size_t dropped = transform_mesh(&out.mesh, xf);
+    for (const vec3& v : out.mesh.positions)
+      if (!is_finite(v)) fail(file_, "/nodes/" + std::to_string(node), "the transform moves vertices beyond the float range");
+    if (dropped > 0)
+      out_.warnings.push_back(out.description + ": dropped " + std::to_string(dropped) + " degenerate triangle(s) of " +
+                              std::to_string(before));
+    if (!out.mesh.triangles.empty()) out_.primitives.push_back(std::move(out));
+  }
+}
+
+void Flattener::place_node(std::size_t index, const mat4& world) {
+  const tinygltf::Node& node = model_.nodes[index];
+  if (node.mesh >= 0) place_mesh(static_cast<std::size_t>(node.mesh), world, index);
+  if (node.skin >= 0) ignored_.insert("skins");
+  const mat4 xf = transform_ * world;
+  if (node.camera >= 0) {
+    const tinygltf::Camera& cam = model_.cameras[static_cast<std::size_t>(node.camera)];
+    const std::string at = "/cameras/" + std::to_string(node.camera);
+    if (cam.type == "perspective") {
+      const double yfov = cam.perspective.yfov;
+      if (!(yfov > 0.0 && yfov < M_PI)) fail(file_, at + "/perspective/yfov", "yfov must lie in (0, pi) radians");
+      GltfCamera c;
+      // A glTF camera looks down its -z axis with +y up.
+      c.desc.position = vec3(xf * vec4(0, 0, 0, 1));
+      const vec3 forward = glm::normalize(vec3(xf * vec4(0, 0, -1, 0)));
+      c.desc.look_at = c.desc.position + forward;
+      c.desc.up = glm::normalize(vec3(xf * vec4(0, 1, 0, 0)));
+      c.desc.fov_y_degrees = static_cast<float>(yfov * 180.0 / M_PI);
+      c.desc.focus_distance = 1.0f;
+      if (!is_finite(c.desc.position) || !is_finite(forward) || !is_finite(c.desc.up) ||
+          !(glm::length(glm::cross(forward, c.desc.up)) > 0.0f))
+        fail(file_, "/nodes/" + std::to_string(index), "the camera's transform is degenerate");
+      if (cam.perspective.aspectRatio > 0.0) c.aspect_ratio = static_cast<float>(cam.perspective.aspectRatio);
+      out_.cameras.push_back(c);
+    } else {
+      warn_once("ortho", "orthographic cameras ignored");
+    }
+  }
+  const auto light = node.extensions.find("KHR_lights_punctual");
+  if (light != node.extensions.end() && light->second.Has("light")) {
+    const int l = light->second.Get("light").GetNumberAsInt();
+    const tinygltf::Light& src = model_.lights[static_cast<std::size_t>(l)];
+    if (src.type == "point") {
+      Spectrum color(1.0f);
+      if (src.color.size() == 3) color = Spectrum(static_cast<float>(src.color[0]), static_cast<float>(src.color[1]),
+                                                   static_cast<float>(src.color[2]));
+      // Candela taken as W/sr per channel (docs/scene-format.md).
+      const Spectrum intensity = color * static_cast<float>(src.intensity);
+      if (!is_finite(intensity) || intensity.x < 0.0f || intensity.y < 0.0f || intensity.z < 0.0f)
+        fail(file_, "/extensions/KHR_lights_punctual/lights/" + std::to_string(l),
+             "colour and intensity must be finite and not negative");
+      out_.point_lights.push_back({vec3(xf * vec4(0, 0, 0, 1)), intensity});
+    } else {
+      warn_once("lights", "spot and directional lights are not supported yet; ignored");
+    }
+  }
+}
+
+// glTF metallic-roughness onto Disney (table in docs/scene-format.md).
+std::uint32_t Flattener::material(int index) {
+  if (const auto it = materials_.find(index); it != materials_.end()) return it->second;
+  const std::string label = file_.filename().string() + "/";
+  GltfMaterial out;
+  DisneyParams p;
+  p.specular = 0.5f;  // F0 = 0.08 * 0.5 = 0.04, glTF's dielectric F0
+  p.specular_tint = 0.0f;
+  p.sheen = 0.0f;
+  Spectrum emission(0.0f);
+  if (index < 0) {
+    // glTF's default material: base colour 1, metallic 1, roughness 1.
+    p.base_color = Spectrum(1.0f);
+    p.metallic = 1.0f;
+    p.roughness = 1.0f;
+    out.material.name = label + "(default)";
+  } else {
+    const tinygltf::Material& m = model_.materials[static_cast<std::size_t>(index)];
+    const std::string at = "/materials/" + std::to_string(index);
+    const auto unit = [&](double v, const std::string& key) {
+      if (!(v >= 0.0 && v <= 1.0)) fail(file_, at + key, "must lie in [0, 1], found " + std::to_string(v));
+      return static_cast<float>(v);
+    };
+    const auto& pbr = m.pbrMetallicRoughness;
+    if (pbr.baseColorFactor.size() != 4) fail(file_, at + "/pbrMetallicRoughness/baseColorFactor", "expected 4 numbers");
+    for (int c = 0; c < 3; ++c)
+      p.base_color[c] = unit(pbr.baseColorFactor[static_cast<std::size_t>(c)], "/pbrMetallicRoughness/baseColorFactor");
+    const float alpha = unit(pbr.baseColorFactor[3], "/pbrMetallicRoughness/baseColorFactor");
+    p.metallic = unit(pbr.metallicFactor, "/pbrMetallicRoughness/metallicFactor");
+    p.roughness = unit(pbr.roughnessFactor, "/pbrMetallicRoughness/roughnessFactor");
+    if (m.emissiveFactor.size() == 3) {
+      for (int c = 0; c < 3; ++c) emission[c] = unit(m.emissiveFactor[static_cast<std::size_t>(c)], "/emissiveFactor");
+    }
+    for (const auto& [name, value] : m.extensions) {
+      if (name == "KHR_materials_emissive_strength" && value.Has("emissiveStrength")) {
+        const double s = value.Get("emissiveStrength").GetNumberAsDouble();
+        if (!(s >= 0.0 && std::isfinite(s)))
+          fail(file_, at + "/extensions/" + name + "/emissiveStrength", "must be finite and not negative");
+        emission *= static_cast<float>(s);
+      } else if (name != "KHR_materials_emissive_strength") {
+        ignored_.insert("extension " + name);
+      }
+    }
+    if (alpha < 1.0f || m.alphaMode == "BLEND" || m.alphaMode == "MASK") ignored_.insert("alpha (rendered opaque)");
+    if (pbr.baseColorTexture.index >= 0) ignored_.insert("baseColorTexture");
+    if (pbr.metallicRoughnessTexture.index >= 0) ignored_.insert("metallicRoughnessTexture");
+    if (m.normalTexture.index >= 0) ignored_.insert("normalTexture");
+    if (m.emissiveTexture.index >= 0) ignored_.insert("emissiveTexture");
+    if (m.occlusionTexture.index >= 0) ignored_.insert("occlusion");
+    out.gltf_name = m.name;
+    out.double_sided = m.doubleSided;
+    out.material.name = label + (m.name.empty() ? "#" + std::to_string(index) : m.name);
+  }
+  const std::string name = out.material.name;
+  out.material = disney_material(p);
+  out.material.name = name;
+  out.material.emission = emission;
+  // Single-sided: the back neither reflects nor emits (Material::one_sided).
+  // glTF's back-face culling, which makes the back invisible in a
+  // rasteriser, is not modelled: the back still occludes.
+  out.material.two_sided_emission = out.double_sided;
+  out.material.one_sided = !out.double_sided;
+  // Two glTF materials of one name stay apart.
+  for (const GltfMaterial& other : out_.materials)
+    if (other.material.name == out.material.name) out.material.name += "#" + std::to_string(index);
+  const auto at = static_cast<std::uint32_t>(out_.materials.size());
+  out_.materials.push_back(std::move(out));
+  materials_[index] = at;
+  return at;
+}
+
+GltfContent Flattener::run() {
+  for (const std::string& ext : model_.extensionsUsed)
+    if (std::find(std::begin(gltf::kSupportedExtensions), std::end(gltf::kSupportedExtensions), ext) ==
+        std::end(gltf::kSupportedExtensions))
+      ignored_.insert("extension " + ext);
+  if (!model_.animations.empty()) ignored_.insert("animations");
+  if (!model_.textures.empty()) ignored_.insert("textures");
+  // The file's materials in file order, used or not, so that names can be
+  // overridden whatever the scene shows.
+  for (std::size_t m = 0; m < model_.materials.size(); ++m) material(static_cast<int>(m));
+
+  std::vector<int> roots;
+  const int scene = model_.defaultScene >= 0 ? model_.defaultScene : model_.scenes.empty() ? -1 : 0;
+  if (scene >= 0) {
+    roots = model_.scenes[static_cast<std::size_t>(scene)].nodes;
+  } else {
+    std::vector<bool> child(model_.nodes.size(), false);
+    for (const tinygltf::Node& n : model_.nodes)
+      for (const int c : n.children) child[static_cast<std::size_t>(c)] = true;
+    for (std::size_t i = 0; i < model_.nodes.size(); ++i)
+      if (!child[i]) roots.push_back(static_cast<int>(i));
+  }
+  // Depth first without recursion; the validator refused cycles.
+  std::vector<std::pair<std::size_t, mat4>> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(static_cast<std::size_t>(*it), mat4(1.0f));
+  while (!stack.empty()) {
+    const auto [node, parent] = stack.back();
+    stack.pop_back();
+    const mat4 world = parent * local_transform(model_.nodes[node]);
+    place_node(node, world);
+    const std::vector<int>& children = model_.nodes[node].children;
+    for (auto it = children.rbegin(); it != children.rend(); ++it) stack.emplace_back(static_cast<std::size_t>(*it), world);
+  }
+  if (out_.primitives.empty() && out_.point_lights.empty())
+    out_.warnings.push_back(file_.string() + ": the scene holds no triangles");
+  if (!ignored_.empty()) {
+    std::string list;
+    for (const std::string& what : ignored_) list += (list.empty() ? "" : ", ") + what;
+    out_.warnings.push_back(file_.string() + ": ignored (not supported yet): " + list);
+  }
+  return std::move(out_);
+}
+
+}  // namespace
+
+bool is_gltf_file(const fs::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".gltf" || ext == ".glb";
+}
+
+GltfContent load_gltf(const fs::path& file, const mat4& transform) {
+  const tinygltf::Model model = parse(file);
+  return Flattener(model, file, transform).run();
+}
+
+}  // namespace pathlab
