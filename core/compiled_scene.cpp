@@ -93,8 +93,8 @@ bool CompiledScene::intersect(const Ray& ray, Surfel* s) const {
   return true;
 }
 
-void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, Surfel* s,
-                                  vec3* ns_sum) const {
+void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, const mat3* to_normal,
+                                  Surfel* s, vec3* ns_sum) const {
   const SurfacePoint sp = shape.kind == Shape::Kind::Sphere
                               ? sphere_point(shape, p_approx)
                               : triangle_point(triangles_[first_triangle_[hit.shape] + hit.prim], hit.uv);
@@ -110,7 +110,16 @@ void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const v
       s->uv = b0 * shape.mesh.uvs[v.x] + hit.uv.x * shape.mesh.uvs[v.y] + hit.uv.y * shape.mesh.uvs[v.z];
     if (shape.mesh.has_normals()) {
       const std::vector<vec3>& n = shape.mesh.normals;
-      *ns_sum = b0 * n[v.x] + hit.uv.x * n[v.y] + hit.uv.y * n[v.z];
+      if (to_normal == nullptr) {
+        *ns_sum = b0 * n[v.x] + hit.uv.x * n[v.y] + hit.uv.y * n[v.z];
+      } else {
+        // The vertex normals placed first, then blended, as a copy of the
+        // mesh placed by transform_mesh would blend them: under a
+        // non-uniform scale, blending first and placing the sum points
+        // elsewhere.
+        const auto placed = [&](std::uint32_t i) { return glm::normalize(*to_normal * n[i]); };
+        *ns_sum = b0 * placed(v.x) + hit.uv.x * placed(v.y) + hit.uv.y * placed(v.z);
+      }
     }
   }
 }
@@ -119,18 +128,18 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const 
   const Shape& shape = scene_.shapes[hit.shape];
   vec3 ns_sum;
   if (hit.instance == kNoInstance) {
-    resolve_local(shape, hit, ray.origin + hit.t * ray.dir, s, &ns_sum);
+    resolve_local(shape, hit, ray.origin + hit.t * ray.dir, nullptr, s, &ns_sum);
   } else {
     // Embree intersected the group in its own space; the hit distance is the
     // same along the world ray.
     const Placement& place = placements_[hit.instance];
     const vec3 p_world = ray.origin + hit.t * ray.dir;
-    resolve_local(shape, hit, vec3(place.to_local * vec4(p_world, 1.0f)), s, &ns_sum);
+    resolve_local(shape, hit, vec3(place.to_local * vec4(p_world, 1.0f)), &place.to_normal, s, &ns_sum);
     transform_point(place.to_world, &s->p, &s->p_error);
     // Normals by the inverse transpose keep pointing to the image of their
     // side, so the front stays the front under a mirroring placement too.
     s->n = glm::normalize(place.to_normal * s->n);
-    ns_sum = place.to_normal * ns_sum;
+    if (!(shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals())) ns_sum = s->n;
   }
   const bool interpolated = shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals();
   const vec3 ns = interpolated ? shading_normal(s->n, ns_sum) : s->n;

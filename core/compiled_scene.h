@@ -86,10 +86,13 @@ class CompiledScene {
     mat4 to_local;     // its inverse
     mat3 to_normal;    // the inverse transpose of to_world's linear part
   };
-  // The point, front normal and unnormalised interpolated shading normal of
-  // a hit on `shape`, in the shape's own space; `p_approx` is the hit point
-  // there (spheres reproject it).
-  void resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, Surfel* s, vec3* ns_sum) const;
+  // The point, front normal and texture coordinates of a hit on `shape`, in
+  // the shape's own space (`p_approx` is the hit point there: spheres
+  // reproject it), and the unnormalised interpolated shading normal - in
+  // world space: its vertex normals are placed by `to_normal` (an instance's
+  // inverse transpose; null for a shape placed in world space) first.
+  void resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, const mat3* to_normal, Surfel* s,
+                     vec3* ns_sum) const;
 
   Scene scene_;
   std::vector<Placement> placements_;  // per instance

@@ -574,6 +574,48 @@ TEST_F(BadInput, GltfNodeCycleAndUnknownMesh) {
   expect_rejected(render(write("mesh.gltf", w.embedded())), {"mesh.gltf: /nodes/1/mesh: no mesh 7 (the file has 1)"});
 }
 
+// ------------------------------------------------------------ groups and instances
+
+const std::string kGroup = "\"groups\": {\n    \"ball\": [" + kSphere + "]\n  }";
+
+TEST_F(BadInput, InstanceOfAnUnknownGroup) {
+  const std::string text =
+      scene(kMaterials, kLamp, kGroup + ",\n  \"instances\": [{\"group\": \"bal\", \"transform\": {\"translate\": [0, 0, 1]}}]");
+  expect_rejected(render(write("unknown-group.json", text)), {"unknown-group.json:" + where_in(text, "\"group\": \"bal\""),
+                                                              "/instances/0/group", "no group named 'bal'",
+                                                              "did you mean 'ball'"});
+}
+
+TEST_F(BadInput, InstancesOfInstancesAreRefused) {
+  const std::string text = scene(kMaterials, kLamp,
+                                 "\"groups\": {\"nest\": [{\"type\": \"instance\", \"group\": \"ball\"}]}");
+  expect_rejected(render(write("nested.json", text)), {"nested.json:", "/groups/nest/0/type", "instances of instances"});
+}
+
+TEST_F(BadInput, EmitterInAGroup) {
+  const std::string text =
+      scene(kMaterials, kSphere, "\"groups\": {\"lamps\": [" + kLamp + "]},\n  \"instances\": [{\"group\": \"lamps\", \"transform\": []}]");
+  expect_rejected(render(write("group-lamp.json", text)),
+                  {"group-lamp.json:", "/groups/lamps/0/material", "emitters in a group are not sampled", "\"light\": false"});
+}
+
+TEST_F(BadInput, SingularOrHugeInstanceTransform) {
+  const std::string singular = scene(kMaterials, kLamp, kGroup + ",\n  \"instances\": [{\"group\": \"ball\", \"transforms\": "
+                                                          "[[], [{\"scale\": 1e-30}, {\"scale\": 1e-30}]]}]");
+  expect_rejected(render(write("singular.json", singular)),
+                  {"singular.json:", "/instances/0/transforms/1", "singular or not finite"});
+  const std::string huge = scene(kMaterials, kLamp, kGroup + ",\n  \"instances\": [{\"group\": \"ball\", \"transform\": "
+                                                      "[{\"scale\": [2e38, 1e-38, 1]}, {\"translate\": [3e38, 0, 0]}]}]");
+  expect_rejected(render(write("huge.json", huge)), {"huge.json:", "/instances/0/transform", "beyond the float range"});
+  const std::string both = scene(kMaterials, kLamp, kGroup + ",\n  \"instances\": [{\"group\": \"ball\"}]");
+  expect_rejected(render(write("both.json", both)), {"both.json:", "/instances/0", "exactly one of 'transform'"});
+}
+
+TEST_F(BadInput, GroupNeverPlacedIsAWarning) {
+  const std::string text = scene(kMaterials, kSphere + ",\n" + kLamp, kGroup);
+  expect_warned_and_rendered(render(write("unplaced.json", text)), {"/groups/ball", "never placed"});
+}
+
 TEST_F(BadInput, TracePixelBadPixel) {
   const std::string good = write("good.json", scene(kMaterials, kSphere + ",\n" + kLamp));
   for (const char* pixel : {"8,0", "0,8", "-1,0", "100000,1"}) {

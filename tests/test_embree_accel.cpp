@@ -8,6 +8,7 @@
 #include "core/embree_accel.h"
 #include "core/sampling.h"
 #include "core/scene_loader.h"
+#include "tests/test_scenes.h"
 
 #include <gtest/gtest.h>
 
@@ -28,10 +29,15 @@ std::vector<Ray> rays_inside_the_box(std::size_t n) {
   return rays;
 }
 
-TEST(EmbreeAccel, EveryModeAndLayoutGivesTheOneRayAnswer) {
-  const Scene scene = builtin_cornell_box();
-  const EmbreeAccel accel(scene.shapes);
-  for (std::size_t n : {1u, 5u, 15u, 16u, 17u, 40u}) {
+class EmbreeAccelModes : public testing::TestWithParam<bool> {};
+
+// With and without instances (test_scenes.h's group placed three times):
+// an instanced hit names its instance the same way in every mode and layout.
+TEST_P(EmbreeAccelModes, EveryModeAndLayoutGivesTheOneRayAnswer) {
+  const Scene scene = GetParam() ? test::cornell_with_instances() : builtin_cornell_box();
+  const EmbreeAccel accel(scene.shapes, scene.groups, scene.instances);
+  std::size_t instanced_hits = 0;
+  for (std::size_t n : {1u, 5u, 15u, 16u, 17u, 40u, 200u}) {
     const std::vector<Ray> rays = rays_inside_the_box(n);
     std::vector<float> ox(n), oy(n), oz(n), dx(n), dy(n), dz(n), tmax(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -45,10 +51,10 @@ TEST(EmbreeAccel, EveryModeAndLayoutGivesTheOneRayAnswer) {
         std::vector<RayHit> hits(n);
         std::vector<std::uint8_t> found(n), blocked(n), found_a(n), blocked_a(n);
         std::vector<float> t(n), u(n), v(n);
-        std::vector<std::uint32_t> shape(n), prim(n);
+        std::vector<std::uint32_t> shape(n), prim(n), instance(n);
         accel.intersect_batch(rays, hits, found, mode, coherent);
         accel.occluded_batch(rays, blocked, mode, coherent);
-        accel.intersect_arrays(arrays, n, HitArrays{t.data(), u.data(), v.data(), shape.data(), prim.data(), found_a.data()},
+        accel.intersect_arrays(arrays, n, HitArrays{t.data(), u.data(), v.data(), shape.data(), prim.data(), found_a.data(), instance.data()},
                                mode, coherent);
         accel.occluded_arrays(arrays, n, blocked_a.data(), mode, coherent);
         std::size_t hit_count = 0, blocked_count = 0;
@@ -66,6 +72,11 @@ TEST(EmbreeAccel, EveryModeAndLayoutGivesTheOneRayAnswer) {
           EXPECT_EQ(hits[i].prim, one.prim);
           EXPECT_EQ(shape[i], one.shape);
           EXPECT_EQ(prim[i], one.prim);
+          EXPECT_EQ(hits[i].instance, one.instance);
+          EXPECT_EQ(instance[i], one.instance);
+          instanced_hits += one.instance != kNoInstance;
+          // A group's shape is found only through an instance.
+          EXPECT_EQ(scene.shapes[one.shape].in_group, one.instance != kNoInstance);
           EXPECT_FLOAT_EQ(hits[i].t, one.t);
           EXPECT_FLOAT_EQ(t[i], one.t);
         }
@@ -77,7 +88,13 @@ TEST(EmbreeAccel, EveryModeAndLayoutGivesTheOneRayAnswer) {
       }
     }
   }
+  if (GetParam()) {
+    EXPECT_GT(instanced_hits, 0u);
+  }
 }
+
+INSTANTIATE_TEST_SUITE_P(EmbreeAccel, EmbreeAccelModes, testing::Bool(),
+                         [](const testing::TestParamInfo<bool>& p) { return p.param ? "Instanced" : "Plain"; });
 
 }  // namespace
 }  // namespace pathlab

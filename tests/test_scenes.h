@@ -4,10 +4,13 @@
 #include "core/scene.h"
 #include "core/scene_loader.h"
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace pathlab::test {
 
@@ -72,6 +75,50 @@ inline Scene cornell_with_smooth_sphere() {
   sphere.material = scene.shapes.front().material;
   sphere.mesh = uv_sphere(vec3(-0.3f, -0.6f, 0.2f), 0.4f, 24);
   scene.shapes.push_back(std::move(sphere));
+  return scene;
+}
+
+// Three placements that exercise every part of an instance transform:
+// rotated and moved; mirrored with a non-uniform scale; sheared. They put a
+// unit-sized group inside the built-in Cornell box ([-1, 1]^3).
+inline std::vector<mat4> instance_placements() {
+  const mat4 turned = glm::translate(mat4(1.0f), vec3(-0.45f, -0.7f, 0.35f)) *
+                      glm::rotate(mat4(1.0f), 0.6f, glm::normalize(vec3(0.3f, 1.0f, 0.2f))) *
+                      glm::scale(mat4(1.0f), vec3(0.22f));
+  const mat4 mirrored = glm::translate(mat4(1.0f), vec3(0.45f, -0.55f, -0.25f)) *
+                        glm::scale(mat4(1.0f), vec3(-0.3f, 0.18f, 0.24f));
+  mat4 sheared = glm::scale(mat4(1.0f), vec3(0.16f));
+  sheared[1][0] = 0.08f;  // x += 0.5 y (column-major: column 1, row 0)
+  sheared[3] = vec4(0.1f, 0.25f, 0.3f, 1.0f);
+  return {turned, mirrored, sheared};
+}
+
+// The built-in Cornell box with a group - a smooth UV sphere (unit radius,
+// 16 rings) and a true sphere beside it - placed by instance_placements():
+// the instanced scene of the same-path tests.
+inline Scene cornell_with_instances() {
+  Scene scene = builtin_cornell_box();
+  const std::uint32_t white = scene.shapes.front().material;
+  ShapeGroup group{"pair", {}};
+  Shape ball;
+  ball.description = "groups/pair[0] (smooth UV sphere)";
+  ball.material = white;
+  ball.mesh = uv_sphere(vec3(0.0f), 1.0f, 16);
+  Shape bead;
+  bead.kind = Shape::Kind::Sphere;
+  bead.description = "groups/pair[1] (sphere)";
+  bead.material = white;
+  bead.center = vec3(1.6f, -0.5f, 0.0f);
+  bead.radius = 0.5f;
+  for (Shape* s : {&ball, &bead}) {
+    s->in_group = true;
+    group.shapes.push_back(static_cast<std::uint32_t>(scene.shapes.size()));
+    scene.shapes.push_back(std::move(*s));
+  }
+  scene.groups.push_back(std::move(group));
+  int k = 0;
+  for (const mat4& m : instance_placements())
+    scene.instances.push_back({0, m, "instances[" + std::to_string(k++) + "] (pair)"});
   return scene;
 }
 

@@ -23,14 +23,15 @@ namespace pathlab {
 namespace {
 
 struct SameSeedCase {
-  std::string scene;  // "" = the built-in Cornell box, "smooth" = with a smooth sphere, else a file in analytic-scenes/
+  std::string scene;  // "" = the built-in Cornell box, "smooth" / "instanced" (test_scenes.h), else a file in analytic-scenes/
   Strategy strategy;
 };
 
 Scene load_case(const SameSeedCase& c) {
-  Scene s = c.scene.empty()    ? builtin_cornell_box()
-            : c.scene == "smooth" ? test::cornell_with_smooth_sphere()
-                                  : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
+  Scene s = c.scene.empty()          ? builtin_cornell_box()
+            : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
+            : c.scene == "instanced" ? test::cornell_with_instances()
+                                     : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
   s.render.spp = 4;
@@ -86,7 +87,8 @@ std::vector<SameSeedCase> same_seed_cases() {
   for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes"))
     if (e.path().extension() == ".json") scenes.push_back(e.path().filename().string());
   std::sort(scenes.begin(), scenes.end());
-  scenes.push_back("smooth");  // the Cornell box with a smooth-shaded sphere (test_scenes.h)
+  scenes.push_back("smooth");     // the Cornell box with a smooth-shaded sphere (test_scenes.h)
+  scenes.push_back("instanced");  // the Cornell box with a group placed three times (test_scenes.h)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
