@@ -12,6 +12,7 @@
 #include "core/tangents.h"
 
 #include "tests/temp_dir.h"
+#include "tests/test_scenes.h"
 
 #include <gtest/gtest.h>
 
@@ -42,26 +43,15 @@ TriangleMesh quad(vec3 origin, vec3 a, vec3 b, bool normals = true, bool mirror_
   return m;
 }
 
-// A UV sphere (u = phi / 2 pi, v = 1 - theta / pi, y up) with exact normals;
-// the seam's vertices are doubled, as a loader would split them.
+// test::uv_sphere (unit, exact normals, its vertices row by row from the
+// north pole, the seam's doubled as a loader would split them) with u = phi /
+// 2 pi and v = 1 - theta / pi (v grows northwards, +y).
 TriangleMesh uv_sphere_with_uvs(int rings) {
-  TriangleMesh m;
+  TriangleMesh m = test::uv_sphere(vec3(0.0f), 1.0f, rings);
   const int segments = 2 * rings;
   for (int i = 0; i <= rings; ++i)
-    for (int j = 0; j <= segments; ++j) {
-      const double theta = kPiD * i / rings, phi = 2.0 * kPiD * j / segments;
-      const dvec3 n(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
-      m.positions.push_back(vec3(n));
-      m.normals.push_back(vec3(n));
+    for (int j = 0; j <= segments; ++j)
       m.uvs.push_back(vec2(static_cast<float>(j) / segments, 1.0f - static_cast<float>(i) / rings));
-    }
-  const auto at = [&](int i, int j) { return static_cast<unsigned>(i * (segments + 1) + j); };
-  for (int i = 0; i < rings; ++i)
-    for (int j = 0; j < segments; ++j) {
-      // Counter-clockwise seen from outside.
-      if (i > 0) m.triangles.push_back({at(i, j), at(i, j + 1), at(i + 1, j)});
-      if (i + 1 < rings) m.triangles.push_back({at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)});
-    }
   return m;
 }
 
