@@ -2,6 +2,7 @@
 
 #include "core/geometry.h"
 #include "core/parallel.h"
+#include "core/tangents.h"
 
 #include <cmath>
 
@@ -144,7 +145,16 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const 
   const bool interpolated = shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals();
   const vec3 ns = interpolated ? shading_normal(s->n, ns_sum) : s->n;
   s->shading_normal = ns != s->n;
-  s->frame = Frame(ns);
+  if (shape.kind == Shape::Kind::Triangles && !shape.mesh.tangents.empty()) {
+    // The mesh's tangents orient the frame (anisotropic lobes stretch along
+    // s). Their handedness refers to the mesh's own normal: the interpolated
+    // one, or the winding normal of a flat mesh (before flip_normals).
+    const mat3 to_world = hit.instance == kNoInstance ? mat3(1.0f) : mat3(placements_[hit.instance].to_world);
+    const vec3 n_mesh = interpolated ? ns_sum : (shape.flip_normals ? -s->n : s->n);
+    s->frame = mesh_tangent_frame(shape.mesh, hit.prim, hit.uv, to_world, n_mesh, ns);
+  } else {
+    s->frame = Frame(ns);
+  }
   s->material = &scene_.materials[shape.material];
   s->shape = hit.shape;
   s->prim = hit.prim;

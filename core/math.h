@@ -50,6 +50,12 @@ struct Frame {
     s = vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
     t = vec3(b, sign + n.y * n.y * a, -n.y);
   }
+  // The frame of a unit tangent `tangent` perpendicular to `normal`: s along
+  // it, t = handedness * cross(n, s), so that a mesh's bitangent (handedness
+  // w = +-1, glTF's convention) is the t axis. With w = -1 the frame is
+  // left-handed; the reflection models only read directions in it.
+  Frame(const vec3& normal, const vec3& tangent, float handedness)
+      : s(tangent), t(handedness * glm::cross(normal, tangent)), n(normal) {}
   vec3 to_local(const vec3& v) const { return vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)); }
   vec3 to_world(const vec3& v) const { return s * v.x + t * v.y + n * v.z; }
 };

@@ -5,6 +5,7 @@
 #include "core/geometry.h"
 #include "core/gltf_loader.h"
 #include "core/json_document.h"
+#include "core/tangents.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -763,6 +764,8 @@ Scene read_scene(const JsonDocument& doc) {
           "group " + in_quotes(scene.groups[g].name) + " is never placed (no instance names it)"));
 
   if (root.has("lights")) read_lights(root.child("lights"), &scene);
+  // Tangents for the meshes whose material needs them (core/tangents.h).
+  add_needed_tangents(&scene);
 
   bool any_light = scene.environment && !is_black(*scene.environment);
   for (const PointLight& p : scene.point_lights) any_light = any_light || !is_black(p.intensity);

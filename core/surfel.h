@@ -29,7 +29,7 @@ struct Surfel {
   vec3 p;                       // position
   vec3 p_error{0.0f};           // bound on |computed p - true p|, per axis
   vec3 n;                       // unit geometric normal of the front (emitting) side
-  Frame frame;                  // shading frame: about n, or about the interpolated vertex normal
+  Frame frame;                  // shading frame: about n or the interpolated vertex normal; s along the mesh's tangent if it has tangents
   vec2 uv{0.0f};                // the mesh's texture coordinates where it has them, else the barycentrics (b1, b2)
   // True when frame.n is a shading normal that differs from n. Then the
   // shading-normal policy of docs/ARCHITECTURE.md applies: a reflection

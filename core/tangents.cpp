@@ -1,0 +1,88 @@
+#include "core/tangents.h"
+
+#include "core/error.h"
+#include "core/material.h"
+
+#include <cmath>
+
+namespace pathlab {
+namespace {
+
+// `v` minus its component along the unit vector `n`.
+dvec3 reject(const dvec3& v, const dvec3& n) { return v - glm::dot(v, n) * n; }
+
+}  // namespace
+
+std::vector<vec4> compute_tangents(const TriangleMesh& mesh) {
+  if (!mesh.has_uvs()) throw InputError("compute_tangents: the mesh has no texture coordinates");
+  const std::vector<vec3> normals = mesh.has_normals() ? mesh.normals : smooth_vertex_normals(mesh);
+  std::vector<dvec3> t_sum(mesh.positions.size(), dvec3(0.0)), b_sum(mesh.positions.size(), dvec3(0.0));
+  for (const glm::uvec3& tri : mesh.triangles) {
+    const dvec3 p[3] = {dvec3(mesh.positions[tri.x]), dvec3(mesh.positions[tri.y]), dvec3(mesh.positions[tri.z])};
+    const glm::dvec2 uv[3] = {glm::dvec2(mesh.uvs[tri.x]), glm::dvec2(mesh.uvs[tri.y]), glm::dvec2(mesh.uvs[tri.z])};
+    // Solve [e1 e2] = [dP/du dP/dv] [d1 d2] for the two derivatives.
+    const dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0];
+    const glm::dvec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
+    const double det = d1.x * d2.y - d2.x * d1.y;
+    // Zero UV area: the texture coordinates say nothing about a direction.
+    if (!(std::abs(det) > 0.0)) continue;
+    const dvec3 dpdu = (d2.y * e1 - d1.y * e2) / det, dpdv = (d1.x * e2 - d2.x * e1) / det;
+    if (!std::isfinite(glm::length(dpdu)) || !std::isfinite(glm::length(dpdv))) continue;
+    for (int k = 0; k < 3; ++k) {
+      const dvec3 a = p[(k + 1) % 3] - p[k], c = p[(k + 2) % 3] - p[k];
+      // The corner's angle, from atan2 (accurate for slivers, unlike acos).
+      const double angle = std::atan2(glm::length(glm::cross(a, c)), glm::dot(a, c));
+      // Each corner sees the derivatives in its own vertex's tangent plane,
+      // as MikkTSpace does, so that a curved surface's corners agree.
+      const dvec3 n(normals[tri[k]]);
+      const dvec3 t = reject(dpdu, n), b = reject(dpdv, n);
+      const double tl = glm::length(t), bl = glm::length(b);
+      if (tl > 0.0) t_sum[tri[k]] += angle * (t / tl);
+      if (bl > 0.0) b_sum[tri[k]] += angle * (b / bl);
+    }
+  }
+  std::vector<vec4> tangents(mesh.positions.size());
+  for (std::size_t v = 0; v < tangents.size(); ++v) {
+    const dvec3 n(normals[v]);
+    const dvec3 t = reject(t_sum[v], n);
+    const double length = glm::length(t);
+    if (!(length > 1e-12) || !std::isfinite(length)) {
+      tangents[v] = vec4(Frame(normals[v]).s, 1.0f);  // no usable triangle: a tangent from the normal
+      continue;
+    }
+    const dvec3 unit = t / length;
+    tangents[v] = vec4(vec3(unit), glm::dot(glm::cross(n, unit), b_sum[v]) < 0.0 ? -1.0f : 1.0f);
+  }
+  return tangents;
+}
+
+bool needs_tangents(const Shape& shape, const Material& material) {
+  return shape.kind == Shape::Kind::Triangles && shape.mesh.has_uvs() && shape.mesh.tangents.empty() &&
+         material.type == MaterialType::Disney && material.disney.anisotropic > 0.0f;
+}
+
+void add_needed_tangents(Scene* scene) {
+  for (Shape& shape : scene->shapes)
+    if (needs_tangents(shape, scene->materials[shape.material])) shape.mesh.tangents = compute_tangents(shape.mesh);
+}
+
+Frame mesh_tangent_frame(const TriangleMesh& mesh, std::uint32_t tri, vec2 b, const mat3& to_world,
+                         const vec3& n_mesh, const vec3& ns) {
+  const glm::uvec3 v = mesh.triangles[tri];
+  const float b0 = 1.0f - b.x - b.y;
+  const vec4 sum = b0 * mesh.tangents[v.x] + b.x * mesh.tangents[v.y] + b.y * mesh.tangents[v.z];
+  const vec3 placed = to_world * vec3(sum);
+  // Gram-Schmidt against the shading normal: the interpolated tangent is
+  // not perpendicular to it in general (curved meshes, interpolated normals).
+  const vec3 s = placed - glm::dot(placed, ns) * ns;
+  const float length = glm::length(s);
+  if (!(length > 1e-4f * glm::length(placed)) || !std::isfinite(length)) return Frame(ns);
+  // The bitangent w * cross(n, t) keeps its direction in the surface if the
+  // normal turns (ns opposite n_mesh) or a mirror reverses cross().
+  float w = sum.w < 0.0f ? -1.0f : 1.0f;
+  if (glm::determinant(to_world) < 0.0f) w = -w;
+  if (glm::dot(ns, n_mesh) < 0.0f) w = -w;
+  return Frame(ns, s / length, w);
+}
+
+}  // namespace pathlab
