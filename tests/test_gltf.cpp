@@ -32,13 +32,13 @@ class Gltf : public test::TempDirTest {
  protected:
   // Writes `w` as name.gltf (embedded), name.glb and name-ext.gltf + .bin,
   // loads each and checks that they agree; returns the first.
-  GltfContent load_all(const GltfWriter& w, const std::string& name, const mat4& xf = mat4(1.0f)) const {
+  GltfContent load_all(const GltfWriter& w, const std::string& name, const GltfOptions& options = {}) const {
     GltfWriter::write(dir_ / (name + ".gltf"), w.embedded());
     GltfWriter::write(dir_ / (name + ".glb"), w.glb());
     w.write_external(dir_ / (name + "-ext.gltf"), name + ".bin");
-    GltfContent a = load_gltf(dir_ / (name + ".gltf"), xf);
+    GltfContent a = load_gltf(dir_ / (name + ".gltf"), options);
     for (const char* other : {".glb", "-ext.gltf"}) {
-      const GltfContent b = load_gltf(dir_ / (name + other), xf);
+      const GltfContent b = load_gltf(dir_ / (name + other), options);
       EXPECT_EQ(a.primitives.size(), b.primitives.size()) << other;
       for (std::size_t i = 0; i < std::min(a.primitives.size(), b.primitives.size()); ++i) {
         EXPECT_EQ(a.primitives[i].mesh.positions, b.primitives[i].mesh.positions) << other;
