@@ -17,6 +17,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -547,6 +548,27 @@ TEST_F(Gltf, MeshesThatAreLightsStayCopies) {
       scene_json(R"({"type": "gltf", "file": "three.gltf", "material": "glow"})", R"(, "glow": {"type": "emissive", "radiance": 1, "light": false})"),
       file);
   EXPECT_EQ(unsampled.groups.size(), 2u);
+  // A scene group may not take a glTF group's name.
+  try {
+    parse_scene(R"({"pathlab_scene": 1, "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0]},
+      "materials": {"white": {"type": "diffuse"}}, "shapes": [{"type": "gltf", "file": "three.gltf"}],
+      "groups": {"three.gltf/mesh #0": [{"type": "box", "material": "white"}]}})",
+                file);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is taken by a glTF mesh's group"), std::string::npos) << e.what();
+  }
+  // append_gltf refuses a group whose material is a light (the loader was
+  // told otherwise by is_light).
+  GltfOptions never;
+  never.is_light = [](const GltfMaterial&) { return false; };
+  const GltfContent all_grouped = load_gltf(dir_ / "three.gltf", never);
+  ASSERT_EQ(all_grouped.groups.size(), 2u);
+  Scene s = parse_scene(scene_json(R"({"type": "box", "material": "white"})"), file);
+  const auto lamp = static_cast<std::uint32_t>(
+      std::find_if(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.name == "lamp"; }) - s.materials.begin());
+  ASSERT_TRUE(s.materials.at(lamp).emits());
+  EXPECT_THROW(append_gltf(s, all_grouped, std::vector<std::optional<std::uint32_t>>(3, lamp)), InputError);
 }
 
 // A placement without an inverse (zero scale) is copied instead, losing its
