@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pathlab {
@@ -296,6 +297,33 @@ TEST_F(Gltf, SceneShapeWithMaterialOverrides) {
   }
 }
 
+// glTF materials: opaque metallic-roughness, and a black emitter of
+// white emission times `strength`.
+json pbr_material(const std::string& name, const std::vector<double>& rgb, double metallic, double roughness) {
+  return {{"name", name},
+          {"pbrMetallicRoughness",
+           {{"baseColorFactor", {rgb[0], rgb[1], rgb[2], 1}}, {"metallicFactor", metallic}, {"roughnessFactor", roughness}}}};
+}
+json emitter_material(const std::string& name, double strength) {
+  return {{"name", name},
+          {"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}}},
+          {"emissiveFactor", {1, 1, 1}},
+          {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", strength}}}}}};
+}
+
+// Every sample of both scenes (same film, spp and seed) by the reference
+// tracer, with the second scene's settings.
+std::pair<std::vector<FilmSample>, std::vector<FilmSample>> render_both(Scene first, Scene second) {
+  const RenderSettings settings = second.render;
+  const std::size_t n = static_cast<std::size_t>(second.film.width) * static_cast<std::size_t>(second.film.height) *
+                        static_cast<std::size_t>(settings.spp);
+  const CompiledScene a(std::move(first)), b(std::move(second));
+  std::vector<FilmSample> sa(n), sb(n);
+  ReferenceTracer(a, settings).render_batch(0, static_cast<std::uint32_t>(settings.spp), sa);
+  ReferenceTracer(b, settings).render_batch(0, static_cast<std::uint32_t>(settings.spp), sb);
+  return {std::move(sa), std::move(sb)};
+}
+
 // A small Cornell-like glTF scene (floor, back wall, a mirrored box side,
 // an emissive quad, a camera) and the same scene as pathlab JSON with OBJ
 // meshes: the reference tracer renders the same bits.
@@ -311,11 +339,8 @@ TEST_F(Gltf, RendersTheSameBitsAsTheEquivalentPathlabScene) {
       {{-1, -1, 1, -1, -1, -1, -1, 1, -1, -1, 1, 1}, 0},        // left wall, faces +x
   };
   GltfWriter w;
-  w.doc["materials"] = json::array(
-      {{{"name", "white"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.75, 0.75, 0.75, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.5}}}},
-       {{"name", "red"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.75, 0.25, 0.25, 1}}, {"metallicFactor", 0.25}, {"roughnessFactor", 0.75}}}},
-       {{"name", "lamp"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}}}, {"emissiveFactor", {1, 1, 1}},
-        {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 6.0}}}}}}});
+  w.doc["materials"] = json::array({pbr_material("white", {0.75, 0.75, 0.75}, 0.0, 0.5),
+                                     pbr_material("red", {0.75, 0.25, 0.25}, 0.25, 0.75), emitter_material("lamp", 6.0)});
   std::string obj_shapes;
   const int idx = w.add(std::vector<std::uint16_t>{0, 1, 2, 0, 2, 3}, test::kGltfShort, "SCALAR", 1);
   for (std::size_t q = 0; q < quads.size(); ++q) {
@@ -361,12 +386,8 @@ TEST_F(Gltf, RendersTheSameBitsAsTheEquivalentPathlabScene) {
     s->render.spp = 4;
     s->render.seed = 11;
   }
-  const RenderSettings settings = from_json.render;
-  const CompiledScene a(std::move(from_gltf)), b(std::move(from_json));
-  const std::size_t n = 16 * 12 * 4;
-  std::vector<FilmSample> sa(n), sb(n);
-  ReferenceTracer(a, settings).render_batch(0, 4, sa);
-  ReferenceTracer(b, settings).render_batch(0, 4, sb);
+  const auto [sa, sb] = render_both(std::move(from_gltf), std::move(from_json));
+  const std::size_t n = sa.size();
   double sum = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     ASSERT_EQ(std::memcmp(&sa[i].L, &sb[i].L, sizeof(Spectrum)), 0) << i;
@@ -411,11 +432,8 @@ json mirror_x_at(float x, float y, float z) { return {-1, 0, 0, 0, 0, 1, 0, 0, 0
 // placed twice (emissive: stays copies).
 GltfWriter three_pyramids(bool smooth = true, const json& scale = {1.5, 0.5, 1}) {
   GltfWriter w;
-  w.doc["materials"] = json::array(
-      {{{"name", "white"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.6}}}},
-       {{"name", "red"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.3, 0.2, 1}}, {"metallicFactor", 0.2}, {"roughnessFactor", 0.4}}}},
-       {{"name", "lamp"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}}}, {"emissiveFactor", {1, 1, 1}},
-        {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 8.0}}}}}}});
+  w.doc["materials"] = json::array({pbr_material("white", {0.8, 0.8, 0.8}, 0.0, 0.6),
+                                     pbr_material("red", {0.8, 0.3, 0.2}, 0.2, 0.4), emitter_material("lamp", 8.0)});
   const int pyramid = add_pyramid(w, 1, smooth), floor = add_square(w, 2.0f, true, 0), lamp = add_square(w, 0.25f, false, 2);
   const float s = std::sin(glm::radians(10.0f)), c = std::cos(glm::radians(10.0f));  // 20 degrees about y
   const float s45 = std::sin(glm::radians(22.5f)), c45 = std::cos(glm::radians(22.5f));
@@ -623,12 +641,8 @@ TEST_F(Gltf, InstancedRendersAsFlattened) {
     Scene instanced = scene(false), flat = scene(true);
     ASSERT_EQ(instanced.instances.size(), 3u);
     ASSERT_TRUE(flat.instances.empty());
-    const RenderSettings settings = flat.render;
-    const CompiledScene a(std::move(instanced)), b(std::move(flat));
-    const std::size_t n = 32 * 24 * 4;
-    std::vector<FilmSample> sa(n), sb(n);
-    ReferenceTracer(a, settings).render_batch(0, 4, sa);
-    ReferenceTracer(b, settings).render_batch(0, 4, sb);
+    const auto [sa, sb] = render_both(std::move(instanced), std::move(flat));
+    const std::size_t n = sa.size();
     std::size_t equal = 0;
     double sum = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
