@@ -1,7 +1,7 @@
 // glTF 2.0 through tinygltf. The JSON is checked first (gltf_validate.cpp) so
 // that tinygltf reads only files the checks approved and never allocates a
-// size the file does not back; then the default scene is flattened into
-// world-space meshes here.
+// size the file does not back; then the default scene is put into the world
+// here: world-space copies of the meshes, or groups and instances.
 #include "core/gltf_loader.h"
 
 #include "core/error.h"
@@ -29,7 +29,9 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -137,8 +139,8 @@ float component(const unsigned char* p, int type, bool normalized) {
 
 class Flattener {
  public:
-  Flattener(const tinygltf::Model& model, const fs::path& file, const mat4& transform)
-      : model_(model), file_(file), transform_(transform) {}
+  Flattener(const tinygltf::Model& model, const fs::path& file, const GltfOptions& options)
+      : model_(model), file_(file), options_(options) {}
 
   GltfContent run();
 
@@ -150,6 +152,14 @@ class Flattener {
                             const std::string& where) const;
   std::vector<std::uint32_t> indices(int index, const std::string& where) const;
   TriangleMesh primitive_mesh(std::size_t mesh, std::size_t prim);
+  std::optional<GltfPrimitive> transformed_primitive(std::size_t mesh, std::size_t prim, const mat4& xf,
+                                                     const std::string& label, const std::string& node_at);
+  std::vector<int> roots() const;
+  template <typename Visit>
+  void walk(const std::vector<int>& roots, Visit&& visit) const;
+  bool may_instance(std::size_t mesh);
+  std::optional<std::uint32_t> group(std::size_t mesh);
+  bool place_instance(std::size_t mesh, const mat4& xf, std::size_t node);
   void place_mesh(std::size_t mesh, const mat4& world, std::size_t node);
   void place_node(std::size_t node, const mat4& world);
   std::uint32_t material(int index);
@@ -159,10 +169,13 @@ class Flattener {
 
   const tinygltf::Model& model_;
   const fs::path& file_;
-  const mat4 transform_;
+  const GltfOptions& options_;
   GltfContent out_;
   std::map<int, std::uint32_t> materials_;  // glTF material (-1: default) -> out_.materials
   std::map<std::pair<std::size_t, std::size_t>, TriangleMesh> meshes_;  // primitives read once, copied per node
+  std::vector<bool> instanced_;  // per glTF mesh: placed by instances of a group
+  std::map<std::size_t, std::optional<std::uint32_t>> groups_;  // glTF mesh -> out_.groups (none: no triangles)
+  std::vector<std::pair<vec3, vec3>> group_bounds_;              // per out_.groups entry, mesh space
   std::set<std::string> ignored_, warned_;
 };
 
@@ -301,37 +314,113 @@ mat4 local_transform(const tinygltf::Node& node) {
   return m;
 }
 
-// The one place a mesh is put into the world (a later change makes these
-// instances of one mesh instead of copies).
-void Flattener::place_mesh(std::size_t mesh, const mat4& world, std::size_t node) {
-  const mat4 xf = transform_ * world;
-  for (std::size_t prim = 0; prim < model_.meshes[mesh].primitives.size(); ++prim) {
-    const tinygltf::Primitive& p = model_.meshes[mesh].primitives[prim];
-    if (p.mode >= 0 && p.mode < TINYGLTF_MODE_TRIANGLES) {
-      warn_once("points", "primitives of points or lines skipped");
-      continue;
-    }
-    const auto key = std::make_pair(mesh, prim);
-    if (meshes_.count(key) == 0) meshes_[key] = primitive_mesh(mesh, prim);
-    GltfPrimitive out{file_.string() + ": /meshes/" + std::to_string(mesh) + "/primitives/" + std::to_string(prim) +
-                          " (node " + std::to_string(node) + ")",
-                      meshes_[key], material(p.material)};
-    const std::size_t before = out.mesh.triangles.size();
-    const std::size_t dropped = transform_mesh(&out.mesh, xf);
-    for (const vec3& v : out.mesh.positions)
-      if (!is_finite(v)) fail(file_, "/nodes/" + std::to_string(node), "the transform moves vertices beyond the float range");
-    if (dropped > 0)
-      out_.warnings.push_back(out.description + ": dropped " + std::to_string(dropped) + " degenerate triangle(s) of " +
-                              std::to_string(before));
-    if (!out.mesh.triangles.empty()) out_.primitives.push_back(std::move(out));
+// Primitive `prim` of `mesh` moved by `xf`, without the triangles that are
+// degenerate after it (a warning says how many); none for points and lines
+// or when no triangle is left. `node_at` is the JSON pointer blamed for a
+// transform that leaves the float range.
+std::optional<GltfPrimitive> Flattener::transformed_primitive(std::size_t mesh, std::size_t prim, const mat4& xf,
+                                                              const std::string& label, const std::string& node_at) {
+  const tinygltf::Primitive& p = model_.meshes[mesh].primitives[prim];
+  if (p.mode >= 0 && p.mode < TINYGLTF_MODE_TRIANGLES) {
+    warn_once("points", "primitives of points or lines skipped");
+    return std::nullopt;
   }
+  const auto key = std::make_pair(mesh, prim);
+  if (meshes_.count(key) == 0) meshes_[key] = primitive_mesh(mesh, prim);
+  GltfPrimitive out{file_.string() + ": /meshes/" + std::to_string(mesh) + "/primitives/" + std::to_string(prim) + " (" +
+                        label + ")",
+                    meshes_[key], material(p.material)};
+  const std::size_t before = out.mesh.triangles.size();
+  const std::size_t dropped = transform_mesh(&out.mesh, xf);
+  for (const vec3& v : out.mesh.positions)
+    if (!is_finite(v)) fail(file_, node_at, "the transform moves vertices beyond the float range");
+  if (dropped > 0)
+    out_.warnings.push_back(out.description + ": dropped " + std::to_string(dropped) + " degenerate triangle(s) of " +
+                            std::to_string(before));
+  if (out.mesh.triangles.empty()) return std::nullopt;
+  return out;
+}
+
+// Whether `mesh` may be a group: not if one of its primitives would be
+// sampled as a light, since the light sampler does not sample emitters in
+// groups (an instanced emitter would need a light per placement); such a
+// mesh stays copies, which stay lights.
+bool Flattener::may_instance(std::size_t mesh) {
+  for (const tinygltf::Primitive& p : model_.meshes[mesh].primitives) {
+    if (p.mode >= 0 && p.mode < TINYGLTF_MODE_TRIANGLES) continue;
+    const GltfMaterial& m = out_.materials[material(p.material)];
+    if (options_.is_light ? options_.is_light(m) : m.material.emits() && m.material.sampled_as_light) return false;
+  }
+  return true;
+}
+
+// The group of `mesh`, made when first placed: its primitives in mesh space.
+// None if no triangle is left (points and lines only, or all degenerate).
+std::optional<std::uint32_t> Flattener::group(std::size_t mesh) {
+  if (const auto it = groups_.find(mesh); it != groups_.end()) return it->second;
+  const std::string& gltf_name = model_.meshes[mesh].name;
+  GltfGroup g;
+  g.name = file_.filename().string() + "/mesh " + (gltf_name.empty() ? "#" + std::to_string(mesh) : gltf_name);
+  for (const GltfGroup& other : out_.groups)
+    if (other.name == g.name) g.name += " #" + std::to_string(mesh);  // two glTF meshes of one name stay apart
+  vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (std::size_t prim = 0; prim < model_.meshes[mesh].primitives.size(); ++prim) {
+    std::optional<GltfPrimitive> p = transformed_primitive(mesh, prim, mat4(1.0f), "mesh space", "/meshes/" + std::to_string(mesh));
+    if (!p) continue;
+    for (const vec3& v : p->mesh.positions) lo = glm::min(lo, v), hi = glm::max(hi, v);
+    g.primitives.push_back(std::move(*p));
+  }
+  std::optional<std::uint32_t> index;
+  if (!g.primitives.empty()) {
+    index = static_cast<std::uint32_t>(out_.groups.size());
+    out_.groups.push_back(std::move(g));
+    group_bounds_.emplace_back(lo, hi);
+  }
+  groups_[mesh] = index;
+  return index;
+}
+
+// Places `mesh` by an instance of its group at `xf`, or returns false if
+// that placement cannot be an instance: Embree and the normals need its
+// inverse, and the placed group must stay within the float range. The
+// caller copies such a placement instead, as for a mesh placed once: a
+// singular one loses its (now degenerate) triangles with a warning naming
+// the node, one beyond the float range is refused there.
+bool Flattener::place_instance(std::size_t mesh, const mat4& xf, std::size_t node) {
+  const float det = glm::determinant(mat3(xf));
+  if (!(std::abs(det) > 0.0f) || !std::isfinite(det) || !std::isfinite(1.0f / det)) return false;
+  const mat4 inverse = glm::inverse(xf);
+  for (int c = 0; c < 4; ++c)
+    if (!is_finite(vec3(inverse[c])) || !std::isfinite(inverse[c].w)) return false;
+  const std::optional<std::uint32_t> g = group(mesh);
+  if (!g) return true;  // nothing to place
+  const auto& [lo, hi] = group_bounds_[*g];
+  for (int c = 0; c < 8; ++c) {
+    const vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
+    if (!is_finite(vec3(xf * vec4(corner, 1.0f)))) return false;
+  }
+  out_.instances.push_back(
+      {*g, xf, file_.string() + ": /nodes/" + std::to_string(node) + " (mesh " + std::to_string(mesh) + ")"});
+  return true;
+}
+
+// The one place a mesh is put into the world: an instance of its group if
+// several nodes place it, else (or if that placement cannot be an instance)
+// a world-space copy of each primitive.
+void Flattener::place_mesh(std::size_t mesh, const mat4& world, std::size_t node) {
+  const mat4 xf = options_.transform * world;
+  if (instanced_[mesh] && place_instance(mesh, xf, node)) return;
+  for (std::size_t prim = 0; prim < model_.meshes[mesh].primitives.size(); ++prim)
+    if (std::optional<GltfPrimitive> p =
+            transformed_primitive(mesh, prim, xf, "node " + std::to_string(node), "/nodes/" + std::to_string(node)))
+      out_.primitives.push_back(std::move(*p));
 }
 
 void Flattener::place_node(std::size_t index, const mat4& world) {
   const tinygltf::Node& node = model_.nodes[index];
   if (node.mesh >= 0) place_mesh(static_cast<std::size_t>(node.mesh), world, index);
   if (node.skin >= 0) ignored_.insert("skins");
-  const mat4 xf = transform_ * world;
+  const mat4 xf = options_.transform * world;
   if (node.camera >= 0) {
     const tinygltf::Camera& cam = model_.cameras[static_cast<std::size_t>(node.camera)];
     const std::string at = "/cameras/" + std::to_string(node.camera);
@@ -446,6 +535,36 @@ std::uint32_t Flattener::material(int index) {
   return at;
 }
 
+// The default scene's root nodes (`scene`, else scene 0, else every node
+// that is no node's child).
+std::vector<int> Flattener::roots() const {
+  const int scene = model_.defaultScene >= 0 ? model_.defaultScene : model_.scenes.empty() ? -1 : 0;
+  if (scene >= 0) return model_.scenes[static_cast<std::size_t>(scene)].nodes;
+  std::vector<int> out;
+  std::vector<bool> child(model_.nodes.size(), false);
+  for (const tinygltf::Node& n : model_.nodes)
+    for (const int c : n.children) child[static_cast<std::size_t>(c)] = true;
+  for (std::size_t i = 0; i < model_.nodes.size(); ++i)
+    if (!child[i]) out.push_back(static_cast<int>(i));
+  return out;
+}
+
+// visit(node, world matrix) for every path from a root, parents first,
+// depth first without recursion (the validator refused cycles).
+template <typename Visit>
+void Flattener::walk(const std::vector<int>& roots, Visit&& visit) const {
+  std::vector<std::pair<std::size_t, mat4>> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(static_cast<std::size_t>(*it), mat4(1.0f));
+  while (!stack.empty()) {
+    const auto [node, parent] = stack.back();
+    stack.pop_back();
+    const mat4 world = parent * local_transform(model_.nodes[node]);
+    visit(node, world);
+    const std::vector<int>& children = model_.nodes[node].children;
+    for (auto it = children.rbegin(); it != children.rend(); ++it) stack.emplace_back(static_cast<std::size_t>(*it), world);
+  }
+}
+
 GltfContent Flattener::run() {
   for (const std::string& ext : model_.extensionsUsed)
     if (std::find(std::begin(gltf::kSupportedExtensions), std::end(gltf::kSupportedExtensions), ext) ==
@@ -457,29 +576,18 @@ GltfContent Flattener::run() {
   // overridden whatever the scene shows.
   for (std::size_t m = 0; m < model_.materials.size(); ++m) material(static_cast<int>(m));
 
-  std::vector<int> roots;
-  const int scene = model_.defaultScene >= 0 ? model_.defaultScene : model_.scenes.empty() ? -1 : 0;
-  if (scene >= 0) {
-    roots = model_.scenes[static_cast<std::size_t>(scene)].nodes;
-  } else {
-    std::vector<bool> child(model_.nodes.size(), false);
-    for (const tinygltf::Node& n : model_.nodes)
-      for (const int c : n.children) child[static_cast<std::size_t>(c)] = true;
-    for (std::size_t i = 0; i < model_.nodes.size(); ++i)
-      if (!child[i]) roots.push_back(static_cast<int>(i));
-  }
-  // Depth first without recursion; the validator refused cycles.
-  std::vector<std::pair<std::size_t, mat4>> stack;
-  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(static_cast<std::size_t>(*it), mat4(1.0f));
-  while (!stack.empty()) {
-    const auto [node, parent] = stack.back();
-    stack.pop_back();
-    const mat4 world = parent * local_transform(model_.nodes[node]);
-    place_node(node, world);
-    const std::vector<int>& children = model_.nodes[node].children;
-    for (auto it = children.rbegin(); it != children.rend(); ++it) stack.emplace_back(static_cast<std::size_t>(*it), world);
-  }
-  if (out_.primitives.empty() && out_.point_lights.empty())
+  const std::vector<int> from = roots();
+  // A mesh is a group if two or more placements (paths through the node
+  // graph) use it.
+  std::vector<std::size_t> uses(model_.meshes.size(), 0);
+  walk(from, [&](std::size_t node, const mat4&) {
+    if (model_.nodes[node].mesh >= 0) ++uses[static_cast<std::size_t>(model_.nodes[node].mesh)];
+  });
+  instanced_.assign(model_.meshes.size(), false);
+  for (std::size_t m = 0; m < model_.meshes.size(); ++m)
+    instanced_[m] = !options_.flatten && uses[m] >= 2 && may_instance(m);
+  walk(from, [&](std::size_t node, const mat4& world) { place_node(node, world); });
+  if (out_.primitives.empty() && out_.groups.empty() && out_.point_lights.empty())
     out_.warnings.push_back(file_.string() + ": the scene holds no triangles");
   if (!ignored_.empty()) {
     std::string list;
@@ -497,9 +605,9 @@ bool is_gltf_file(const fs::path& file) {
   return ext == ".gltf" || ext == ".glb";
 }
 
-GltfContent load_gltf(const fs::path& file, const mat4& transform) {
+GltfContent load_gltf(const fs::path& file, const GltfOptions& options) {
   const tinygltf::Model model = parse(file);
-  return Flattener(model, file, transform).run();
+  return Flattener(model, file, options).run();
 }
 
 }  // namespace pathlab

@@ -1,5 +1,6 @@
 // glTF 2.0 files (.gltf with embedded or external buffers, .glb) read into
-// world-space triangle meshes, Disney materials, cameras and point lights.
+// triangle meshes (world-space copies, or groups placed by instances for a
+// mesh several nodes use), Disney materials, cameras and point lights.
 // The mapping and what is ignored: docs/scene-format.md ("gltf" shapes).
 #pragma once
 
@@ -9,6 +10,7 @@
 #include "core/scene.h"
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,11 +26,18 @@ struct GltfMaterial {
   bool double_sided = false;
 };
 
-// One primitive of one mesh placed by one node.
+// One primitive of one mesh: placed by one node (GltfContent::primitives),
+// or in mesh space as a member of a group (GltfGroup::primitives).
 struct GltfPrimitive {
-  std::string description;  // "<file>: /meshes/0/primitives/1 (node 3)"
-  TriangleMesh mesh;        // world space: node transforms, then the caller's transform
+  std::string description;  // "<file>: /meshes/0/primitives/1 (node 3)", "... (mesh space)"
+  TriangleMesh mesh;        // world space: node transforms, then the caller's transform; or mesh space
   std::uint32_t material;   // into GltfContent::materials
+};
+
+// A mesh that several nodes place: its primitives once, in mesh space.
+struct GltfGroup {
+  std::string name;  // "<file name>/mesh <glTF name>", "mesh #<index>" if unnamed; unique in the file
+  std::vector<GltfPrimitive> primitives;
 };
 
 struct GltfCamera {
@@ -40,26 +49,49 @@ struct GltfContent {
   // The file's materials in file order, then glTF's default material if a
   // primitive has none.
   std::vector<GltfMaterial> materials;
-  std::vector<GltfPrimitive> primitives;
+  std::vector<GltfPrimitive> primitives;   // world space
+  std::vector<GltfGroup> groups;
+  // One per node placement of a group: Instance::group indexes `groups`,
+  // to_world = the caller's transform x the node's world matrix.
+  std::vector<Instance> instances;
   std::vector<GltfCamera> cameras;         // perspective cameras, in node order
   std::vector<PointLight> point_lights;    // KHR_lights_punctual point lights
   std::vector<std::string> warnings;       // one line each, naming the file
 };
 
+struct GltfOptions {
+  mat4 transform{1.0f};  // applied after the node transforms
+  // Every mesh as world-space copies, none instanced: for a file that is
+  // itself a member of a scene group (Embree instances one level deep).
+  bool flatten = false;
+  // Whether a primitive of this material would be sampled as a light, once
+  // the caller's material overrides apply; empty: the glTF material's own
+  // emission. A mesh with such a primitive is always copied, since the light
+  // sampler does not sample emitters in groups.
+  std::function<bool(const GltfMaterial&)> is_light;
+};
+
 // Reads the default scene (`scene`, else scene 0, else every root node) of a
-// glTF 2.0 file and flattens it: each primitive becomes one mesh in world
-// space, `transform` applied after the node transforms. Images are not read.
+// glTF 2.0 file. A mesh that one node places (counting every path through
+// the node graph) becomes one world-space mesh per primitive; a mesh placed
+// two or more times becomes a group, placed by one instance per placement,
+// unless `options` or an emitting material says otherwise, or the placement
+// is singular (that placement is then a copy, losing its now degenerate
+// triangles with a warning). Images are not read.
 // Throws InputError "<file>: <JSON pointer>: <problem>" for a malformed or
 // truncated file, a missing or escaping buffer URI, a buffer larger than its
 // data, a view or accessor past its data, an index out of range, a non-finite
 // attribute, mismatched attribute counts, a cycle in the node graph, a
 // reference to a missing object, and an unsupported required extension.
-GltfContent load_gltf(const std::filesystem::path& file, const mat4& transform = mat4(1.0f));
+GltfContent load_gltf(const std::filesystem::path& file, const GltfOptions& options = {});
 
 // Appends `content` to `scene`: each primitive as a Triangles shape, its
 // material `material_for[i]` (a scene material) where set, else glTF
-// material i added to the scene once (named uniquely); and the point lights.
-// `material_for` is empty or has one entry per content material.
+// material i added to the scene once (named uniquely); each group as a
+// ShapeGroup (named uniquely) of shapes marked in_group, and its instances;
+// and the point lights. `material_for` is empty or has one entry per content
+// material. Throws InputError if a group's shape would be a sampled light
+// (`GltfOptions::is_light` disagreed with `material_for`).
 void append_gltf(Scene& scene, const GltfContent& content,
                  const std::vector<std::optional<std::uint32_t>>& material_for = {});
 

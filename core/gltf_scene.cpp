@@ -2,36 +2,76 @@
 // appended to a scene (the "gltf" shape of scene_loader.cpp).
 #include "core/gltf_loader.h"
 
+#include "core/error.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 namespace pathlab {
 
+namespace {
+
+// `base`, or `base (2)`, `base (3)`, ... the first that `taken` says is free
+// (the same file used twice).
+template <typename Taken>
+std::string unique_name(const std::string& base, Taken&& taken) {
+  std::string name = base;
+  for (int n = 2; taken(name); ++n) name = base + " (" + std::to_string(n) + ")";
+  return name;
+}
+
+}  // namespace
+
 void append_gltf(Scene& scene, const GltfContent& content, const std::vector<std::optional<std::uint32_t>>& material_for) {
   std::vector<std::optional<std::uint32_t>> index = material_for;
   index.resize(content.materials.size());
-  for (const GltfPrimitive& prim : content.primitives) {
-    std::optional<std::uint32_t>& m = index[prim.material];
+  // The scene material of glTF material `i`, added when first used.
+  const auto scene_material = [&](std::uint32_t i) {
+    std::optional<std::uint32_t>& m = index[i];
     if (!m) {
-      // Added when first used; a name already in the scene (the same file
-      // twice) gets a suffix.
-      Material added = content.materials[prim.material].material;
-      const std::string base = added.name;
-      for (int n = 2; std::any_of(scene.materials.begin(), scene.materials.end(),
-                                  [&](const Material& x) { return x.name == added.name; });
-           ++n)
-        added.name = base + " (" + std::to_string(n) + ")";
+      Material added = content.materials[i].material;
+      added.name = unique_name(added.name, [&](const std::string& name) {
+        return std::any_of(scene.materials.begin(), scene.materials.end(), [&](const Material& x) { return x.name == name; });
+      });
       m = static_cast<std::uint32_t>(scene.materials.size());
       scene.materials.push_back(std::move(added));
     }
+    return *m;
+  };
+  const auto add_shape = [&](const GltfPrimitive& prim, bool in_group) {
     Shape shape;
     shape.kind = Shape::Kind::Triangles;
     shape.description = prim.description;
-    shape.material = *m;
+    shape.material = scene_material(prim.material);
     shape.mesh = prim.mesh;
+    shape.in_group = in_group;
     scene.shapes.push_back(std::move(shape));
+    return static_cast<std::uint32_t>(scene.shapes.size() - 1);
+  };
+  for (const GltfPrimitive& prim : content.primitives) add_shape(prim, false);
+  const auto first_group = static_cast<std::uint32_t>(scene.groups.size());
+  for (const GltfGroup& group : content.groups) {
+    ShapeGroup added{unique_name(group.name,
+                                 [&](const std::string& name) {
+                                   return std::any_of(scene.groups.begin(), scene.groups.end(),
+                                                      [&](const ShapeGroup& g) { return g.name == name; });
+                                 }),
+                     {}};
+    for (const GltfPrimitive& prim : group.primitives) {
+      const std::uint32_t s = add_shape(prim, true);
+      // The loader copies a mesh with a light's material instead of grouping
+      // it (GltfOptions::is_light); the light sampler would miss it here.
+      const Material& m = scene.materials[scene.shapes[s].material];
+      if (m.emits() && m.sampled_as_light)
+        throw InputError(prim.description + ": material '" + m.name +
+                         "' emits, but the mesh was loaded as a group, whose emitters are not sampled as lights");
+      added.shapes.push_back(s);
+    }
+    scene.groups.push_back(std::move(added));
   }
+  for (const Instance& inst : content.instances)
+    scene.instances.push_back({first_group + inst.group, inst.to_world, inst.description});
   scene.point_lights.insert(scene.point_lights.end(), content.point_lights.begin(), content.point_lights.end());
 }
 
@@ -50,14 +90,21 @@ Scene load_gltf_scene(const std::filesystem::path& file) {
   } else {
     // Framing the bounds: the bounding sphere fits the 40 degree vertical
     // field of view, seen from the +z side and a little above.
+    // A group's vertices count where its instances place them.
     vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    const auto grow = [&](const vec3& p) {
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+    };
     for (const Shape& s : scene.shapes)
-      for (const vec3& p : s.mesh.positions) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-      }
-    const vec3 center = scene.shapes.empty() ? vec3(0.0f) : 0.5f * (lo + hi);
-    float radius = scene.shapes.empty() ? 1.0f : 0.5f * glm::length(hi - lo);
+      if (!s.in_group)
+        for (const vec3& p : s.mesh.positions) grow(p);
+    for (const Instance& inst : scene.instances)
+      for (const std::uint32_t s : scene.groups[inst.group].shapes)
+        for (const vec3& p : scene.shapes[s].mesh.positions) grow(vec3(inst.to_world * vec4(p, 1.0f)));
+    const bool empty = !(lo.x <= hi.x);
+    const vec3 center = empty ? vec3(0.0f) : 0.5f * (lo + hi);
+    float radius = empty ? 1.0f : 0.5f * glm::length(hi - lo);
     if (!(radius > 0.0f)) radius = 1.0f;
     const float distance = radius / std::sin(glm::radians(20.0f));
     scene.camera.fov_y_degrees = 40.0f;

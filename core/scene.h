@@ -111,8 +111,9 @@ struct Scene {
   FilmDesc film;
   RenderSettings render;
   std::vector<Material> materials;
-  // The file's shapes in its order (a "gltf" entry adds one per primitive),
-  // then the groups' shapes.
+  // The file's shapes in its order (a "gltf" entry adds one per primitive
+  // copied into the world, then the shapes of its groups: meshes several
+  // nodes place), then the groups' shapes.
   std::vector<Shape> shapes;
   std::vector<ShapeGroup> groups;
   std::vector<Instance> instances;

@@ -547,7 +547,7 @@ Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& fo
 }
 
 void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
-                     const std::map<std::string, std::uint32_t>& materials);
+                     const std::map<std::string, std::uint32_t>& materials, bool in_group);
 
 // "groups": {"name": [shape, ...], ...}: shapes in the group's own space,
 // appended to scene.shapes and marked in_group.
@@ -557,6 +557,10 @@ void read_groups(const Node& node, Scene& scene, const std::filesystem::path& fo
   for (const auto& [name, unused] : node.value().items()) {
     const Node list = node.child(name);
     if (!list.value().is_array() || list.value().empty()) list.fail("expected a non-empty array of shapes");
+    // A glTF file in "shapes" may have added groups already (its meshes that
+    // several nodes place).
+    if (std::any_of(scene.groups.begin(), scene.groups.end(), [&](const ShapeGroup& g) { return g.name == name; }))
+      list.fail("the group name " + in_quotes(name) + " is taken by a glTF mesh's group; choose another");
     ShapeGroup group{name, {}};
     for (std::size_t i = 0; i < list.value().size(); ++i) {
       const Node item = list.child(i);
@@ -564,7 +568,7 @@ void read_groups(const Node& node, Scene& scene, const std::filesystem::path& fo
         item.child("type").fail("a group holds shapes, not instances (instances of instances are not supported)");
       const std::size_t first = scene.shapes.size(), point_lights = scene.point_lights.size();
       if (item.value().is_object() && item.has("type") && item.child("type").value() == "gltf")
-        read_gltf_shape(item, scene, folder, materials);
+        read_gltf_shape(item, scene, folder, materials, true);
       else
         scene.shapes.push_back(read_shape(item, scene, folder, materials, "groups/" + name + "[" + std::to_string(i) + "]"));
       if (scene.point_lights.size() != point_lights)
@@ -645,9 +649,11 @@ void read_instances(const Node& node, Scene* scene) {
 
 // A "gltf" shape: every primitive of the file's default scene, with the
 // file's materials unless "material" (all) or "materials" (by glTF name)
-// says otherwise, and the file's point lights.
+// says otherwise, and the file's point lights. A mesh several nodes place
+// becomes a group and instances, unless the file is itself a member of a
+// group (`in_group`): Embree's instancing is one level deep.
 void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
-                     const std::map<std::string, std::uint32_t>& materials) {
+                     const std::map<std::string, std::uint32_t>& materials, bool in_group) {
   node.allow_only({"type", "file", "transform", "material", "materials"});
   if (node.has("material") && node.has("materials"))
     node.child("materials").fail("give either 'material' (for every primitive) or 'materials' (by glTF name)");
@@ -656,39 +662,55 @@ void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path
   const std::filesystem::path path = resolve_scene_path(folder, file.string());
   if (names_data_file(file.string()) && !std::filesystem::exists(path))
     file.fail(file.string() + ": " + path.string() + " does not exist; " + data_directory_hint());
-  const mat4 xf = node.has("transform") ? read_transform(node.child("transform")) : mat4(1.0f);
-  GltfContent content;
-  try {
-    content = load_gltf(path, xf);
-  } catch (const InputError& e) {
-    file.fail(e.what());
-  }
-  std::vector<std::optional<std::uint32_t>> material_for(content.materials.size());
+  // The overrides are read before the file, so that the loader knows which
+  // materials will be lights (meshes with one are never grouped).
+  std::optional<std::uint32_t> all;
+  std::map<std::string, std::uint32_t> by_name;
   if (node.has("material")) {
-    const std::uint32_t all = material_index(node.child("material"), materials);
-    std::fill(material_for.begin(), material_for.end(), all);
+    all = material_index(node.child("material"), materials);
   } else if (node.has("materials")) {
     const Node map = node.child("materials");
     map.expect_object();
-    std::vector<std::string_view> gltf_names;
-    for (const GltfMaterial& m : content.materials)
-      if (!m.gltf_name.empty()) gltf_names.push_back(m.gltf_name);
-    for (const auto& [gltf_name, unused] : map.value().items()) {
-      const Node entry = map.child(gltf_name);
-      bool any = false;
-      for (std::size_t i = 0; i < content.materials.size(); ++i)
-        if (content.materials[i].gltf_name == gltf_name) {
-          material_for[i] = material_index(entry, materials);
-          any = true;
-        }
-      if (!any)
-        entry.fail(path.filename().string() + " has no material named " + in_quotes(gltf_name) +
-                   suggestion(gltf_name, gltf_names));
-    }
+    for (const auto& [gltf_name, unused] : map.value().items())
+      by_name[gltf_name] = material_index(map.child(gltf_name), materials);
   }
+  const auto override_of = [&](const GltfMaterial& m) -> std::optional<std::uint32_t> {
+    if (all) return all;
+    const auto it = by_name.find(m.gltf_name);
+    return it == by_name.end() ? std::nullopt : std::optional<std::uint32_t>(it->second);
+  };
+  GltfOptions options;
+  options.transform = node.has("transform") ? read_transform(node.child("transform")) : mat4(1.0f);
+  options.flatten = in_group;
+  options.is_light = [&](const GltfMaterial& m) {
+    const std::optional<std::uint32_t> o = override_of(m);
+    const Material& used = o ? scene.materials[*o] : m.material;
+    return used.emits() && used.sampled_as_light;
+  };
+  GltfContent content;
+  try {
+    content = load_gltf(path, options);
+  } catch (const InputError& e) {
+    file.fail(e.what());
+  }
+  std::vector<std::optional<std::uint32_t>> material_for;
+  std::vector<std::string_view> gltf_names;
+  for (const GltfMaterial& m : content.materials) {
+    material_for.push_back(override_of(m));
+    if (!m.gltf_name.empty()) gltf_names.push_back(m.gltf_name);
+  }
+  for (const auto& [gltf_name, unused] : by_name)
+    if (std::none_of(content.materials.begin(), content.materials.end(),
+                     [&](const GltfMaterial& m) { return m.gltf_name == gltf_name; }))
+      node.child("materials").child(gltf_name).fail(path.filename().string() + " has no material named " +
+                                                    in_quotes(gltf_name) + suggestion(gltf_name, gltf_names));
   for (const std::string& w : content.warnings) scene.warnings.push_back(file.message(w));
   const std::size_t before = scene.shapes.size();
-  append_gltf(scene, content, material_for);
+  try {
+    append_gltf(scene, content, material_for);
+  } catch (const InputError& e) {
+    file.fail(e.what());
+  }
   if (scene.shapes.size() == before) file.fail(path.string() + ": the file's scene holds no triangles");
 }
 
@@ -752,7 +774,7 @@ Scene read_scene(const JsonDocument& doc) {
   for (std::size_t i = 0; i < shapes.value().size(); ++i) {
     const Node shape = shapes.child(i);
     if (shape.value().is_object() && shape.has("type") && shape.child("type").value() == "gltf")
-      read_gltf_shape(shape, scene, folder, materials);
+      read_gltf_shape(shape, scene, folder, materials, false);
     else
       scene.shapes.push_back(read_shape(shape, scene, folder, materials, "shapes[" + std::to_string(i) + "]"));
   }

@@ -13,12 +13,16 @@
 #include "tests/gltf_writer.h"
 #include "tests/temp_dir.h"
 
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pathlab {
@@ -32,13 +36,13 @@ class Gltf : public test::TempDirTest {
  protected:
   // Writes `w` as name.gltf (embedded), name.glb and name-ext.gltf + .bin,
   // loads each and checks that they agree; returns the first.
-  GltfContent load_all(const GltfWriter& w, const std::string& name, const mat4& xf = mat4(1.0f)) const {
+  GltfContent load_all(const GltfWriter& w, const std::string& name, const GltfOptions& options = {}) const {
     GltfWriter::write(dir_ / (name + ".gltf"), w.embedded());
     GltfWriter::write(dir_ / (name + ".glb"), w.glb());
     w.write_external(dir_ / (name + "-ext.gltf"), name + ".bin");
-    GltfContent a = load_gltf(dir_ / (name + ".gltf"), xf);
+    GltfContent a = load_gltf(dir_ / (name + ".gltf"), options);
     for (const char* other : {".glb", "-ext.gltf"}) {
-      const GltfContent b = load_gltf(dir_ / (name + other), xf);
+      const GltfContent b = load_gltf(dir_ / (name + other), options);
       EXPECT_EQ(a.primitives.size(), b.primitives.size()) << other;
       for (std::size_t i = 0; i < std::min(a.primitives.size(), b.primitives.size()); ++i) {
         EXPECT_EQ(a.primitives[i].mesh.positions, b.primitives[i].mesh.positions) << other;
@@ -293,6 +297,33 @@ TEST_F(Gltf, SceneShapeWithMaterialOverrides) {
   }
 }
 
+// glTF materials: opaque metallic-roughness, and a black emitter of
+// white emission times `strength`.
+json pbr_material(const std::string& name, const std::vector<double>& rgb, double metallic, double roughness) {
+  return {{"name", name},
+          {"pbrMetallicRoughness",
+           {{"baseColorFactor", {rgb[0], rgb[1], rgb[2], 1}}, {"metallicFactor", metallic}, {"roughnessFactor", roughness}}}};
+}
+json emitter_material(const std::string& name, double strength) {
+  return {{"name", name},
+          {"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}}},
+          {"emissiveFactor", {1, 1, 1}},
+          {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", strength}}}}}};
+}
+
+// Every sample of both scenes (same film, spp and seed) by the reference
+// tracer, with the second scene's settings.
+std::pair<std::vector<FilmSample>, std::vector<FilmSample>> render_both(Scene first, Scene second) {
+  const RenderSettings settings = second.render;
+  const std::size_t n = static_cast<std::size_t>(second.film.width) * static_cast<std::size_t>(second.film.height) *
+                        static_cast<std::size_t>(settings.spp);
+  const CompiledScene a(std::move(first)), b(std::move(second));
+  std::vector<FilmSample> sa(n), sb(n);
+  ReferenceTracer(a, settings).render_batch(0, static_cast<std::uint32_t>(settings.spp), sa);
+  ReferenceTracer(b, settings).render_batch(0, static_cast<std::uint32_t>(settings.spp), sb);
+  return {std::move(sa), std::move(sb)};
+}
+
 // A small Cornell-like glTF scene (floor, back wall, a mirrored box side,
 // an emissive quad, a camera) and the same scene as pathlab JSON with OBJ
 // meshes: the reference tracer renders the same bits.
@@ -308,11 +339,8 @@ TEST_F(Gltf, RendersTheSameBitsAsTheEquivalentPathlabScene) {
       {{-1, -1, 1, -1, -1, -1, -1, 1, -1, -1, 1, 1}, 0},        // left wall, faces +x
   };
   GltfWriter w;
-  w.doc["materials"] = json::array(
-      {{{"name", "white"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.75, 0.75, 0.75, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.5}}}},
-       {{"name", "red"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.75, 0.25, 0.25, 1}}, {"metallicFactor", 0.25}, {"roughnessFactor", 0.75}}}},
-       {{"name", "lamp"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 0, 1}}}}, {"emissiveFactor", {1, 1, 1}},
-        {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 6.0}}}}}}});
+  w.doc["materials"] = json::array({pbr_material("white", {0.75, 0.75, 0.75}, 0.0, 0.5),
+                                     pbr_material("red", {0.75, 0.25, 0.25}, 0.25, 0.75), emitter_material("lamp", 6.0)});
   std::string obj_shapes;
   const int idx = w.add(std::vector<std::uint16_t>{0, 1, 2, 0, 2, 3}, test::kGltfShort, "SCALAR", 1);
   for (std::size_t q = 0; q < quads.size(); ++q) {
@@ -358,12 +386,8 @@ TEST_F(Gltf, RendersTheSameBitsAsTheEquivalentPathlabScene) {
     s->render.spp = 4;
     s->render.seed = 11;
   }
-  const RenderSettings settings = from_json.render;
-  const CompiledScene a(std::move(from_gltf)), b(std::move(from_json));
-  const std::size_t n = 16 * 12 * 4;
-  std::vector<FilmSample> sa(n), sb(n);
-  ReferenceTracer(a, settings).render_batch(0, 4, sa);
-  ReferenceTracer(b, settings).render_batch(0, 4, sb);
+  const auto [sa, sb] = render_both(std::move(from_gltf), std::move(from_json));
+  const std::size_t n = sa.size();
   double sum = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
     ASSERT_EQ(std::memcmp(&sa[i].L, &sb[i].L, sizeof(Spectrum)), 0) << i;
@@ -372,5 +396,265 @@ TEST_F(Gltf, RendersTheSameBitsAsTheEquivalentPathlabScene) {
   EXPECT_GT(sum, 0.0);  // something was lit
 }
 
+// ------------------------------------------------------------ instancing
+
+// A lopsided pyramid (the mirror shows), one-sided (a placement that lost
+// the mirror's front would show its black back), smooth or flat shaded.
+int add_pyramid(GltfWriter& w, int material, bool smooth = true) {
+  const std::vector<float> p = {-0.3f, 0, -0.3f, 0.3f, 0, -0.3f, 0.3f, 0, 0.3f, -0.3f, 0, 0.3f, 0.1f, 0.5f, 0.05f};
+  std::vector<float> n;
+  for (std::size_t v = 0; v < 5; ++v) {
+    const vec3 d = glm::normalize(vec3(p[3 * v], p[3 * v + 1], p[3 * v + 2]) - vec3(0.05f, 0.15f, 0.0f));
+    n.insert(n.end(), {d.x, d.y, d.z});
+  }
+  const int pos = w.add(p, test::kGltfFloat, "VEC3", 3);
+  json attributes = {{"POSITION", pos}};
+  if (smooth) attributes["NORMAL"] = w.add(n, test::kGltfFloat, "VEC3", 3);
+  const int idx = w.add(std::vector<std::uint16_t>{3, 2, 4, 2, 1, 4, 1, 0, 4, 0, 3, 4, 0, 1, 2, 0, 2, 3}, test::kGltfShort, "SCALAR", 1);
+  return w.mesh({{{"attributes", attributes}, {"indices", idx}, {"material", material}}});
+}
+
+// A flat square of side 2 * half in y = 0, facing +y (or -y).
+int add_square(GltfWriter& w, float half, bool up, int material) {
+  const float h = half;
+  const std::vector<float> p = up ? std::vector<float>{-h, 0, h, h, 0, h, h, 0, -h, -h, 0, -h}
+                                  : std::vector<float>{-h, 0, -h, h, 0, -h, h, 0, h, -h, 0, h};
+  const int pos = w.add(p, test::kGltfFloat, "VEC3", 3);
+  const int idx = w.add(std::vector<std::uint16_t>{0, 1, 2, 0, 2, 3}, test::kGltfShort, "SCALAR", 1);
+  return w.mesh({{{"attributes", {{"POSITION", pos}}}, {"indices", idx}, {"material", material}}});
+}
+
+// Column-major 4x4 of a mirror in x, then a translation.
+json mirror_x_at(float x, float y, float z) { return {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, x, y, z, 1}; }
+
+// The pyramid placed by three nodes under one rotated parent (plain, mirrored
+// in x, scaled non-uniformly and turned), a floor placed once, and a lamp
+// placed twice (emissive: stays copies).
+GltfWriter three_pyramids(bool smooth = true, const json& scale = {1.5, 0.5, 1}) {
+  GltfWriter w;
+  w.doc["materials"] = json::array({pbr_material("white", {0.8, 0.8, 0.8}, 0.0, 0.6),
+                                     pbr_material("red", {0.8, 0.3, 0.2}, 0.2, 0.4), emitter_material("lamp", 8.0)});
+  const int pyramid = add_pyramid(w, 1, smooth), floor = add_square(w, 2.0f, true, 0), lamp = add_square(w, 0.25f, false, 2);
+  const float s = std::sin(glm::radians(10.0f)), c = std::cos(glm::radians(10.0f));  // 20 degrees about y
+  const float s45 = std::sin(glm::radians(22.5f)), c45 = std::cos(glm::radians(22.5f));
+  w.node({{"translation", {0, 0.01, 0}}, {"rotation", {0, s, 0, c}}, {"children", {1, 2, 3}}});  // 0
+  w.node({{"mesh", pyramid}, {"translation", {-0.8, 0, 0}}});                                     // 1
+  w.node({{"mesh", pyramid}, {"matrix", mirror_x_at(0, 0, 0.3f)}});                               // 2
+  w.node({{"mesh", pyramid}, {"translation", {0.8, 0, -0.2}}, {"rotation", {0, s45, 0, c45}}, {"scale", scale}});  // 3
+  w.node({{"mesh", floor}});                                                                      // 4
+  w.node({{"mesh", lamp}, {"translation", {-0.5, 1.5, 0}}});                                      // 5
+  w.node({{"mesh", lamp}, {"translation", {0.5, 1.5, 0}}});                                       // 6
+  w.doc["scenes"] = {{{"nodes", {0, 4, 5, 6}}}};
+  w.doc["scene"] = 0;
+  for (json& m : w.doc["materials"]) m["doubleSided"] = false;
+  return w;
+}
+
+// The scene transform used below: instances must apply it after the nodes'.
+mat4 scene_transform() {
+  return glm::translate(mat4(1.0f), vec3(0.1f, -0.2f, 0.0f)) * glm::rotate(mat4(1.0f), glm::radians(15.0f), vec3(0, 1, 0)) *
+         glm::scale(mat4(1.0f), vec3(1.1f));
+}
+
+std::size_t vertex_count(const Scene& s) {
+  std::size_t n = 0;
+  for (const Shape& shape : s.shapes) n += shape.mesh.positions.size();
+  return n;
+}
+
+TEST_F(Gltf, MeshPlacedByThreeNodesIsOneGroupOfThreeInstances) {
+  GltfOptions options;
+  options.transform = scene_transform();
+  const GltfContent c = load_all(three_pyramids(), "three", options);
+  // The floor once; the lamp twice (it emits: copies stay lights).
+  ASSERT_EQ(c.primitives.size(), 3u);
+  EXPECT_NE(c.primitives[0].description.find("(node 4)"), std::string::npos) << c.primitives[0].description;
+  ASSERT_EQ(c.groups.size(), 1u);
+  EXPECT_EQ(c.groups[0].name, "three.gltf/mesh #0");
+  ASSERT_EQ(c.groups[0].primitives.size(), 1u);
+  EXPECT_EQ(c.groups[0].primitives[0].mesh.positions.size(), 5u);  // in mesh space, once
+  EXPECT_EQ(c.groups[0].primitives[0].mesh.positions[4], vec3(0.1f, 0.5f, 0.05f));
+  ASSERT_EQ(c.instances.size(), 3u);
+  // to_world = the scene transform x the node's world matrix (parent x child).
+  const float s = std::sin(glm::radians(10.0f)), co = std::cos(glm::radians(10.0f));
+  const mat4 parent = glm::translate(mat4(1.0f), vec3(0, 0.01f, 0)) * glm::mat4_cast(glm::normalize(glm::quat(co, 0, s, 0)));
+  const mat4 mirror = glm::translate(mat4(1.0f), vec3(0, 0, 0.3f)) * glm::scale(mat4(1.0f), vec3(-1, 1, 1));
+  const vec3 p(0.3f, 0.2f, -0.1f);
+  EXPECT_NEAR(glm::distance(vec3(c.instances[1].to_world * vec4(p, 1)), vec3(scene_transform() * parent * mirror * vec4(p, 1))), 0.0f, 1e-5f);
+  EXPECT_LT(glm::determinant(mat3(c.instances[1].to_world)), 0.0f);
+  EXPECT_NE(c.instances[2].description.find("/nodes/3 (mesh 0)"), std::string::npos) << c.instances[2].description;
+  for (const Instance& inst : c.instances) EXPECT_EQ(inst.group, 0u);
+
+  // Forced flattening: a copy per placement, as before instancing.
+  options.flatten = true;
+  const GltfContent flat = load_all(three_pyramids(), "three-flat", options);
+  EXPECT_EQ(flat.primitives.size(), 6u);
+  EXPECT_TRUE(flat.groups.empty());
+  EXPECT_TRUE(flat.instances.empty());
+
+  // As a scene's shape: the group's shapes in_group, the vertices stored once.
+  const fs::path file = dir_ / "s.json";
+  const Scene scene = parse_scene(scene_json(R"({"type": "gltf", "file": "three.glb"})"), file);
+  ASSERT_EQ(scene.groups.size(), 1u);
+  EXPECT_EQ(scene.groups[0].name, "three.glb/mesh #0");
+  EXPECT_EQ(scene.instances.size(), 3u);
+  ASSERT_EQ(scene.groups[0].shapes.size(), 1u);
+  EXPECT_TRUE(scene.shapes[scene.groups[0].shapes[0]].in_group);
+  EXPECT_EQ(vertex_count(scene), 4u + 4u + 4u + 5u);  // floor, two lamps, the pyramid once (not 3 x 5)
+  // The same file twice: the second group named apart, instances offset.
+  const Scene twice = parse_scene(
+      scene_json(R"({"type": "gltf", "file": "three.glb"}, {"type": "gltf", "file": "three.gltf"}, {"type": "gltf", "file": "three.glb"})"),
+      file);
+  ASSERT_EQ(twice.groups.size(), 3u);
+  EXPECT_EQ(twice.groups[2].name, "three.glb/mesh #0 (2)");
+  ASSERT_EQ(twice.instances.size(), 9u);
+  EXPECT_EQ(twice.instances[8].group, 2u);
+
+  // Inside a scene group the file is flattened (instances are one level).
+  const Scene grouped = parse_scene(R"({"pathlab_scene": 1, "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0]},
+    "materials": {"white": {"type": "diffuse"}}, "shapes": [],
+    "groups": {"g": [{"type": "gltf", "file": "three.glb", "material": "white"}]},
+    "instances": [{"group": "g", "transforms": [{"translate": [0, 0, 0]}, {"translate": [5, 0, 0]}]}]})",
+                                    file);
+  ASSERT_EQ(grouped.groups.size(), 1u);
+  EXPECT_EQ(grouped.groups[0].shapes.size(), 6u);
+  EXPECT_EQ(grouped.instances.size(), 2u);
+  for (const Shape& shape : grouped.shapes) EXPECT_TRUE(shape.in_group);
+}
+
+// Counting every path: one node under two parents places its mesh twice.
+TEST_F(Gltf, PlacementsCountEveryPathThroughTheNodeGraph) {
+  GltfWriter w;
+  add_square(w, 1.0f, true, -1);
+  w.doc["meshes"][0]["primitives"][0].erase("material");
+  w.node({{"mesh", 0}});
+  w.node({{"translation", {0, 1, 0}}, {"children", {0}}});
+  w.node({{"translation", {0, 2, 0}}, {"children", {0}}});
+  w.doc["scenes"] = {{{"nodes", {1, 2}}}};
+  const GltfContent c = load_all(w, "dag");
+  EXPECT_TRUE(c.primitives.empty());
+  EXPECT_EQ(c.groups.size(), 1u);
+  ASSERT_EQ(c.instances.size(), 2u);
+  EXPECT_EQ(vec3(c.instances[1].to_world[3]), vec3(0, 2, 0));
+  // Placed once: a world-space copy, as ever.
+  w.doc["scenes"] = {{{"nodes", {1}}}};
+  const GltfContent once = load_all(w, "tree");
+  EXPECT_EQ(once.primitives.size(), 1u);
+  EXPECT_TRUE(once.groups.empty());
+  EXPECT_EQ(once.primitives[0].mesh.positions[0], vec3(-1, 1, 1));
+}
+
+// Emitters stay lights: a mesh with an emitting material (the file's, or a
+// scene material that overrides it) is copied; a scene material that
+// replaces the emitter lets it be a group.
+TEST_F(Gltf, MeshesThatAreLightsStayCopies) {
+  GltfWriter::write(dir_ / "three.gltf", three_pyramids().embedded());
+  const fs::path file = dir_ / "s.json";
+  const Scene own = parse_scene(scene_json(R"({"type": "gltf", "file": "three.gltf"})"), file);
+  EXPECT_EQ(own.groups.size(), 1u);  // the pyramid; the lamps are two shapes
+  EXPECT_EQ(own.shapes.size(), 4u);
+  const Scene lamp_everywhere = parse_scene(scene_json(R"({"type": "gltf", "file": "three.gltf", "material": "lamp"})"), file);
+  EXPECT_TRUE(lamp_everywhere.groups.empty());
+  EXPECT_EQ(lamp_everywhere.shapes.size(), 6u);
+  const Scene red_lamp = parse_scene(
+      scene_json(R"({"type": "gltf", "file": "three.gltf", "materials": {"red": "lamp", "lamp": "white"}})"), file);
+  ASSERT_EQ(red_lamp.groups.size(), 1u);  // the lamps now, white
+  EXPECT_EQ(red_lamp.materials[red_lamp.shapes[red_lamp.groups[0].shapes[0]].material].name, "white");
+  EXPECT_EQ(red_lamp.instances.size(), 2u);
+  // "light": false: not sampled, so it may be instanced.
+  const Scene unsampled = parse_scene(
+      scene_json(R"({"type": "gltf", "file": "three.gltf", "material": "glow"})", R"(, "glow": {"type": "emissive", "radiance": 1, "light": false})"),
+      file);
+  EXPECT_EQ(unsampled.groups.size(), 2u);
+  // A scene group may not take a glTF group's name.
+  try {
+    parse_scene(R"({"pathlab_scene": 1, "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0]},
+      "materials": {"white": {"type": "diffuse"}}, "shapes": [{"type": "gltf", "file": "three.gltf"}],
+      "groups": {"three.gltf/mesh #0": [{"type": "box", "material": "white"}]}})",
+                file);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is taken by a glTF mesh's group"), std::string::npos) << e.what();
+  }
+  // append_gltf refuses a group whose material is a light (the loader was
+  // told otherwise by is_light).
+  GltfOptions never;
+  never.is_light = [](const GltfMaterial&) { return false; };
+  const GltfContent all_grouped = load_gltf(dir_ / "three.gltf", never);
+  ASSERT_EQ(all_grouped.groups.size(), 2u);
+  Scene s = parse_scene(scene_json(R"({"type": "box", "material": "white"})"), file);
+  const auto lamp = static_cast<std::uint32_t>(
+      std::find_if(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.name == "lamp"; }) - s.materials.begin());
+  ASSERT_TRUE(s.materials.at(lamp).emits());
+  EXPECT_THROW(append_gltf(s, all_grouped, std::vector<std::optional<std::uint32_t>>(3, lamp)), InputError);
+}
+
+// A placement without an inverse (zero scale) is copied instead, losing its
+// degenerate triangles with a warning that names the node; one beyond the
+// float range is refused naming the node.
+TEST_F(Gltf, SingularPlacementsAreCopiesAndOverflowIsRefused) {
+  GltfWriter w;
+  add_pyramid(w, -1);
+  w.doc["meshes"][0]["primitives"][0].erase("material");
+  w.node({{"mesh", 0}});
+  w.node({{"mesh", 0}, {"translation", {2, 0, 0}}});
+  w.node({{"mesh", 0}, {"scale", {0, 0, 0}}});
+  const GltfContent c = load_all(w, "flat");
+  EXPECT_EQ(c.groups.size(), 1u);
+  EXPECT_EQ(c.instances.size(), 2u);
+  EXPECT_TRUE(c.primitives.empty());
+  std::string all;
+  for (const std::string& line : c.warnings) all += line + "\n";
+  EXPECT_NE(all.find("/meshes/0/primitives/0 (node 2): dropped 6 degenerate triangle(s) of 6"), std::string::npos) << all;
+  w.doc["nodes"][2] = {{"mesh", 0}, {"scale", {1e30, 1e30, 1e30}}, {"children", {1}}};
+  w.doc["nodes"][1]["scale"] = {1e30, 1e30, 1e30};
+  w.doc["scenes"] = {{{"nodes", {0, 2}}}};
+  const std::string error = error_of(w, "huge.gltf");
+  EXPECT_NE(error.find("huge.gltf: /nodes/1: the transform moves vertices beyond the float range"), std::string::npos) << error;
+}
+
+// The same file instanced and with flattening forced renders the same image
+// with the same seed, up to float rounding of the hit points: the mirror,
+// the parent and the scene transform must all reach the instances. Smooth
+// normals only under a uniform scale: under a non-uniform one CompiledScene
+// interpolates an instance's normals before transforming them, a copy's
+// after (each normalised), which shades differently, not by rounding.
+TEST_F(Gltf, InstancedRendersAsFlattened) {
+  for (const bool smooth : {true, false}) {
+    SCOPED_TRACE(smooth ? "smooth, uniform scale" : "flat, non-uniform scale");
+    const GltfWriter w = smooth ? three_pyramids(true, {1.2, 1.2, 1.2}) : three_pyramids(false);
+    GltfWriter::write(dir_ / "three.glb", w.glb());
+    const auto scene = [&](bool flatten) {
+      Scene s;
+      s.camera.position = vec3(0.0f, 1.3f, 3.0f);
+      s.camera.look_at = vec3(0.0f, 0.2f, 0.0f);
+      s.camera.fov_y_degrees = 45.0f;
+      s.film = FilmDesc{32, 24, FilterKind::Box};
+      s.render.spp = 4;
+      s.render.seed = 5;
+      GltfOptions options;
+      options.transform = scene_transform();
+      options.flatten = flatten;
+      append_gltf(s, load_gltf(dir_ / "three.glb", options));
+      return s;
+    };
+    Scene instanced = scene(false), flat = scene(true);
+    ASSERT_EQ(instanced.instances.size(), 3u);
+    ASSERT_TRUE(flat.instances.empty());
+    const auto [sa, sb] = render_both(std::move(instanced), std::move(flat));
+    const std::size_t n = sa.size();
+    std::size_t equal = 0;
+    double sum = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      bool same = true;
+      for (int k = 0; k < 3; ++k)
+        same = same && std::abs(sa[i].L[k] - sb[i].L[k]) <= 1e-4f * std::max(std::abs(sa[i].L[k]), std::abs(sb[i].L[k])) + 1e-6f;
+      equal += same ? 1 : 0;
+      sum += static_cast<double>(sb[i].L.x);
+    }
+    EXPECT_GT(sum, 0.0);
+    EXPECT_GE(static_cast<double>(equal), 0.99 * static_cast<double>(n)) << n - equal << " of " << n << " samples differ";
+  }
+}
 }  // namespace
 }  // namespace pathlab
