@@ -1,9 +1,18 @@
 #include "core/ray.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace pathlab {
 
 vec3 offset_ray_origin(const vec3& p, const vec3& error, const vec3& n) {
-  const float d = glm::dot(glm::abs(n), error);
+  float d = glm::dot(glm::abs(n), error);
+  // A point with no rounding error across its surface (every vertex on a
+  // coordinate plane through the origin: a PLY or glTF ground at y = 0)
+  // gets no offset from its bound, and Embree reports hits at t = tnear = 0,
+  // so its rays would find the surface again: move it by one float of its
+  // largest coordinate (2^-100 at the origin, far above the denormals).
+  if (d == 0.0f) d = std::max(std::max(std::abs(p.x), std::max(std::abs(p.y), std::abs(p.z))) * 0x1p-23f, 0x1p-100f);
   vec3 offset = d * n;
   vec3 po = p + offset;
   // p + offset is itself rounded: step one more float away from the surface.

@@ -87,6 +87,50 @@ TEST(RayOffset, NextFloatEqualsNextafter) {
 }
 
 TEST(RayOffset, NoSelfIntersectionAtTheOrigin) { expect_no_self_hits(vec3(0.0f)); }
+
+// A quad lying exactly in a coordinate plane through the origin (a PLY or
+// glTF ground at y = 0): its points have no rounding error across the plane,
+// so the error bound gives no offset; rays leaving either side must still
+// not find it again. Quads of size 2 and 2e-3 (small edge cross products).
+TEST(RayOffset, NoSelfIntersectionOnACoordinatePlaneThroughTheOrigin) {
+  for (const float size : {1.0f, 1e-3f}) {
+    for (int axis = 0; axis < 3; ++axis) {
+      Scene scene;
+      scene.name = "plane";
+      scene.materials.push_back(diffuse_material(Spectrum(0.5f)));
+      scene.camera.position = vec3(0, 5, 5);
+      Shape quad;
+      quad.description = "quad";
+      const auto corner = [&](float a, float b) {
+        vec3 p(0.0f);
+        p[(axis + 1) % 3] = a * size;
+        p[(axis + 2) % 3] = b * size;
+        return p;
+      };
+      quad.mesh = {{corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1)}, {{0, 1, 2}, {0, 2, 3}}};
+      scene.shapes.push_back(quad);
+      const CompiledScene compiled(std::move(scene));
+      int self_hits = 0;
+      for (std::uint32_t i = 0; i < 4000; ++i) {
+        const vec2 u(sample_u(3, axis, i, 0, Dim::LightX), sample_u(3, axis, i, 0, Dim::LightY));
+        const SurfacePoint sp = sample_triangle(compiled.scene().shapes[0], i % 2, u);
+        ASSERT_EQ(sp.p[axis], 0.0f);
+        ASSERT_EQ(sp.p_error[axis], 0.0f);
+        Surfel surfel;
+        surfel.p = sp.p;
+        surfel.p_error = sp.p_error;
+        surfel.n = sp.n;
+        vec3 w = square_to_cosine_hemisphere(vec2(sample_u(4, axis, i, 0, Dim::DirectionX),
+                                                  sample_u(4, axis, i, 0, Dim::DirectionY)));
+        if (i % 4 == 0) w = glm::normalize(vec3(w.x, w.y, 1e-3f));
+        if (i % 2 == 1) w.z = -w.z;  // the back
+        Surfel hit;
+        self_hits += compiled.intersect(surfel.spawn(Frame(sp.n).to_world(w)), &hit);
+      }
+      EXPECT_EQ(self_hits, 0) << "of 4000 rays, quad of size " << size << " across axis " << axis;
+    }
+  }
+}
 TEST(RayOffset, NoSelfIntersectionAt1e5) { expect_no_self_hits(vec3(1e5f, -1e5f, 1e5f)); }
 TEST(RayOffset, NoSelfIntersectionAt1e6) { expect_no_self_hits(vec3(-1e6f, 3e5f, 1e6f)); }
 

@@ -64,7 +64,11 @@ F next_float(F v, bool up) {
 
 // offset_ray_origin (core/ray.cpp).
 V3 offset_ray_origin(const V3& p, const V3& error, const V3& n) {
-  const F d = dot(abs(n), error);
+  F d = dot(abs(n), error);
+  // No error across the surface: one float of the largest coordinate.
+  const V3 a = abs(p);
+  const F largest = _mm512_max_ps(a.x, _mm512_max_ps(a.y, a.z));
+  d = _mm512_mask_mov_ps(d, eq(d, k(0.0f)), _mm512_max_ps(mul(largest, k(0x1p-23f)), k(0x1p-100f)));
   const V3 offset = mul(d, n);
   const V3 po = add(p, offset);
   auto step = [](F c, F o) {
