@@ -43,6 +43,7 @@ struct EmbreeAccel::Impl {
   RTCScene scene = nullptr;
   std::uint32_t first_instance = 0;  // geometry ID of instance 0 in `scene`
   bool has_instances = false;
+  bool compact = false;
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
@@ -51,7 +52,7 @@ struct EmbreeAccel::Impl {
     RTCScene s = rtcNewScene(device);
     // ROBUST: no arithmetic shortcuts that could let a ray slip through an
     // edge shared by two triangles.
-    rtcSetSceneFlags(s, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneFlags(s, compact ? RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT : RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
     return s;
   }
@@ -63,8 +64,9 @@ struct EmbreeAccel::Impl {
 };
 
 EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups,
-                         std::span<const Instance> instances)
+                         std::span<const Instance> instances, bool compact)
     : impl_(std::make_unique<Impl>()) {
+  impl_->compact = compact;
   impl_->device = rtcNewDevice(nullptr);
   if (!impl_->device)
     throw SystemError(std::string("Embree: cannot create device: error ") +
@@ -114,14 +116,20 @@ void EmbreeAccel::Impl::attach(RTCScene target, const Shape& shape, std::uint32_
   if (shape.kind == Shape::Kind::Triangles) {
     geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     const auto& m = shape.mesh;
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                          3 * sizeof(float), m.positions.size()));
-    auto* t = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                             3 * sizeof(unsigned), m.triangles.size()));
-    if (v && t) {
+    static_assert(sizeof(vec3) == 3 * sizeof(float) && sizeof(glm::uvec3) == 3 * sizeof(unsigned));
+    // Embree reads the mesh's own arrays where it may (no copy: 18 bytes a
+    // triangle less). Its vertex loads are 16 bytes wide, so the last vertex
+    // needs 4 readable bytes after it: room the positions keep when
+    // CompiledScene reserved one more element; otherwise they are copied.
+    if (m.positions.capacity() > m.positions.size()) {
+      rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m.positions.data(), 0, sizeof(vec3),
+                                 m.positions.size());
+    } else if (auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                                      sizeof(vec3), m.positions.size()))) {
       std::memcpy(v, m.positions.data(), m.positions.size() * sizeof(vec3));
-      std::memcpy(t, m.triangles.data(), m.triangles.size() * sizeof(glm::uvec3));
     }
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.triangles.data(), 0,
+                               sizeof(glm::uvec3), m.triangles.size());
   } else {
     geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
     auto* v = static_cast<float*>(

@@ -49,9 +49,13 @@ struct HitArrays {
 class EmbreeAccel {
  public:
   // Builds the BVH. Throws SystemError with Embree's message if the device
-  // or the build fails. The arguments must outlive nothing: data is copied.
+  // or the build fails. Embree reads the meshes' index arrays in place, and
+  // their vertex arrays too where they have capacity for one more vertex
+  // (CompiledScene reserves it): `shapes` must outlive the accel and keep
+  // those arrays unchanged. Groups and instances are copied.
+  // `compact`: RenderSettings::compact_bvh.
   explicit EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups = {},
-                       std::span<const Instance> instances = {});
+                       std::span<const Instance> instances = {}, bool compact = false);
   ~EmbreeAccel();
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;

@@ -209,7 +209,7 @@ FilmDesc read_film(const Node& node) {
 }
 
 RenderSettings read_render(const Node& node) {
-  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf"});
+  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh"});
   RenderSettings r;
   if (node.has("spp")) {
     const std::int64_t spp = node.child("spp").integer();
@@ -256,6 +256,11 @@ RenderSettings read_render(const Node& node) {
       node.child("bsdf_sampling").fail("unknown BSDF sampling " + in_quotes(name) + (near.empty() ? " (expected vndf or cospow)" : near));
     }
     r.bsdf_sampling = *s;
+  }
+  if (node.has("bvh")) {
+    const std::string name = node.child("bvh").string();
+    if (name != "fast" && name != "compact") node.child("bvh").fail("unknown bvh " + in_quotes(name) + " (expected fast or compact)");
+    r.compact_bvh = name == "compact";
   }
   if (node.has("clamp")) {
     r.clamp = static_cast<float>(node.child("clamp").number());

@@ -93,6 +93,30 @@ TEST_P(EmbreeAccelModes, EveryModeAndLayoutGivesTheOneRayAnswer) {
   }
 }
 
+// The compact BVH (leaves pointing into the vertex arrays) finds the same
+// hits, bit for bit.
+TEST(EmbreeAccel, CompactBvhFindsTheSameHits) {
+  const Scene scene = test::cornell_with_instances();
+  const EmbreeAccel fast(scene.shapes, scene.groups, scene.instances, false);
+  const EmbreeAccel compact(scene.shapes, scene.groups, scene.instances, true);
+  const std::vector<Ray> rays = rays_inside_the_box(2000);
+  std::size_t hits = 0;
+  for (const Ray& ray : rays) {
+    RayHit a, b;
+    const bool ha = fast.intersect(ray, &a), hb = compact.intersect(ray, &b);
+    ASSERT_EQ(ha, hb);
+    ASSERT_EQ(fast.occluded(ray), compact.occluded(ray));
+    if (!ha) continue;
+    ++hits;
+    ASSERT_EQ(a.shape, b.shape);
+    ASSERT_EQ(a.prim, b.prim);
+    ASSERT_EQ(a.instance, b.instance);
+    ASSERT_EQ(a.t, b.t);
+    ASSERT_EQ(a.uv, b.uv);
+  }
+  EXPECT_GT(hits, 1000u);
+}
+
 INSTANTIATE_TEST_SUITE_P(EmbreeAccel, EmbreeAccelModes, testing::Bool(),
                          [](const testing::TestParamInfo<bool>& p) { return p.param ? "Instanced" : "Plain"; });
 

@@ -33,6 +33,8 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
       ->check(CLI::Range(0.0f, 3.4e38f));
   cmd.add_option("--min-pdf", min_pdf, "Discard BSDF samples with a smaller density (biased; 0 = off)")
       ->check(CLI::Range(0.0f, 3.4e38f));
+  cmd.add_option("--bvh", bvh, "Embree's BVH: fast, or compact (less memory, slower; the same image)")
+      ->check(CLI::IsMember({"fast", "compact"}));
   cmd.add_flag("--general-shading", general_shading,
                "Shade every material through the general Disney-capable code instead of code specialised to the "
                "scene's lobes (same image, slower)");
@@ -49,6 +51,7 @@ Scene SceneOptions::load() const {
   if (clamp) r.clamp = *clamp;
   if (min_pdf) r.min_pdf = *min_pdf;
   if (general_shading) r.force_general_shading = true;
+  if (bvh) r.compact_bvh = *bvh == "compact";
   if (seed) {
     std::uint64_t value = 0;
     const char* end = seed->data() + seed->size();
