@@ -39,6 +39,19 @@ Scene box_and_sphere_at(const vec3& offset) {
   return scene;
 }
 
+// A ray leaving the point `sp` in a cosine-distributed direction of its
+// front (every fourth one grazing, cos theta ~ 1e-3), drawn from stream
+// (seed, a, i), offset as a surfel spawns it.
+Ray leaving(const SurfacePoint& sp, std::uint64_t seed, std::uint32_t a, std::uint32_t i) {
+  Surfel surfel;
+  surfel.p = sp.p;
+  surfel.p_error = sp.p_error;
+  surfel.n = sp.n;
+  vec3 w = square_to_cosine_hemisphere(vec2(sample_u(seed, a, i, 0, Dim::DirectionX), sample_u(seed, a, i, 0, Dim::DirectionY)));
+  if (i % 4 == 0) w = glm::normalize(vec3(w.x, w.y, 1e-3f));
+  return surfel.spawn(Frame(sp.n).to_world(w));
+}
+
 // Both shapes are convex: a ray leaving either surface outwards can hit
 // neither itself nor (the two being far apart and the directions drawn in
 // the outward hemisphere) anything nearby on the same shape.
@@ -52,18 +65,9 @@ void expect_no_self_hits(const vec3& offset) {
       const std::uint32_t prim = i % prims;
       const vec2 u(sample_u(1, shape, i, 0, Dim::LightX), sample_u(1, shape, i, 0, Dim::LightY));
       const SurfacePoint sp = s.kind == Shape::Kind::Sphere ? sample_sphere(s, u) : sample_triangle(s, prim, u);
-      Surfel surfel;
-      surfel.p = sp.p;
-      surfel.p_error = sp.p_error;
-      surfel.n = sp.n;
-      // Outward directions, down to grazing ones (cos theta ~ 1e-3).
-      vec3 w = square_to_cosine_hemisphere(vec2(sample_u(2, shape, i, 0, Dim::DirectionX),
-                                                sample_u(2, shape, i, 0, Dim::DirectionY)));
-      if (i % 4 == 0) w = glm::normalize(vec3(w.x, w.y, 1e-3f));
-      const vec3 dir = Frame(sp.n).to_world(w);
       Surfel hit;
       ++rays;
-      if (scene.intersect(surfel.spawn(dir), &hit) && hit.shape == shape) ++self_hits;
+      if (scene.intersect(leaving(sp, 2, shape, i), &hit) && hit.shape == shape) ++self_hits;
     }
   }
   EXPECT_EQ(self_hits, 0) << "of " << rays << " rays at offset (" << offset.x << ", " << offset.y << ", " << offset.z << ")";
@@ -116,16 +120,10 @@ TEST(RayOffset, NoSelfIntersectionOnACoordinatePlaneThroughTheOrigin) {
         const SurfacePoint sp = sample_triangle(compiled.scene().shapes[0], i % 2, u);
         ASSERT_EQ(sp.p[axis], 0.0f);
         ASSERT_EQ(sp.p_error[axis], 0.0f);
-        Surfel surfel;
-        surfel.p = sp.p;
-        surfel.p_error = sp.p_error;
-        surfel.n = sp.n;
-        vec3 w = square_to_cosine_hemisphere(vec2(sample_u(4, axis, i, 0, Dim::DirectionX),
-                                                  sample_u(4, axis, i, 0, Dim::DirectionY)));
-        if (i % 4 == 0) w = glm::normalize(vec3(w.x, w.y, 1e-3f));
-        if (i % 2 == 1) w.z = -w.z;  // the back
+        // Every other ray leaves the back.
+        const SurfacePoint side{sp.p, sp.p_error, i % 2 == 1 ? -sp.n : sp.n};
         Surfel hit;
-        self_hits += compiled.intersect(surfel.spawn(Frame(sp.n).to_world(w)), &hit);
+        self_hits += compiled.intersect(leaving(side, 4, static_cast<std::uint32_t>(axis), i), &hit);
       }
       EXPECT_EQ(self_hits, 0) << "of 4000 rays, quad of size " << size << " across axis " << axis;
     }
