@@ -9,6 +9,7 @@
 #include "core/material.h"
 #include "core/math.h"
 #include "core/ray.h"
+#include "core/scene.h"
 
 #include <cstdint>
 
@@ -35,6 +36,7 @@ struct HitEvent {
   vec3 p{0.0f}, n{0.0f};    // position and front geometric normal
   bool front = true;        // the ray arrived on the front side
   std::uint32_t material = 0, shape = 0, prim = 0;
+  std::uint32_t instance = kNoInstance;  // the instance that placed the shape, if it is in a group
   Spectrum emitted{0.0f};   // L_e towards the ray's origin
   float emission_weight = 0.0f;  // 0 when NEE already accounted for it, MIS weight under mis
   Spectrum added{0.0f};     // throughput * weight * L_e

@@ -51,7 +51,7 @@ Difference compare(const PathEvent& ea, const PathEvent& eb, float tol) {
         if constexpr (std::is_same_v<T, CameraEvent>) {
           check(near(a.film, b.film, tol) && near(a.origin, b.origin, tol) && near(a.dir, b.dir, tol), "camera ray");
         } else if constexpr (std::is_same_v<T, HitEvent>) {
-          check(a.shape == b.shape && a.material == b.material, "surface hit");
+          check(a.shape == b.shape && a.instance == b.instance && a.material == b.material, "surface hit");
           check(near(a.p, b.p, tol), "hit position");
           check(near(a.added, b.added, tol) && near(a.emission_weight, b.emission_weight, tol), "emission added");
         } else if constexpr (std::is_same_v<T, EscapeEvent>) {

@@ -36,7 +36,9 @@ struct JsonVisitor {
   json operator()(const HitEvent& e) const {
     return {{"type", "hit"},          {"vertex", e.vertex},        {"p", j3(e.p)},
             {"n", j3(e.n)},           {"front", e.front},          {"material", material_name(scene, e.material)},
-            {"shape", e.shape},       {"prim", e.prim},            {"emitted", j3(e.emitted)},
+            {"shape", e.shape},       {"prim", e.prim},
+            {"instance", e.instance == kNoInstance ? json(nullptr) : json(e.instance)},
+            {"emitted", j3(e.emitted)},
             {"emission_weight", e.emission_weight}, {"added", j3(e.added)}, {"throughput", j3(e.throughput)}};
   }
   json operator()(const EscapeEvent& e) const {
@@ -70,7 +72,9 @@ struct TextVisitor {
   }
   void operator()(const HitEvent& e) const {
     out << "#" << e.vertex << " hit      p " << fmt3(e.p) << "  n " << fmt3(e.n) << (e.front ? "  front" : "  back")
-        << "  material '" << material_name(scene, e.material) << "'  shape " << e.shape << " prim " << e.prim << "\n";
+        << "  material '" << material_name(scene, e.material) << "'  shape " << e.shape << " prim " << e.prim;
+    if (e.instance != kNoInstance) out << " instance " << e.instance;
+    out << "\n";
     if (!is_black(e.emitted))
       out << "   emission  Le " << fmt3(e.emitted) << "  weight " << fmt(e.emission_weight) << "  added "
           << fmt3(e.added) << "\n";

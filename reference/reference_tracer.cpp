@@ -40,7 +40,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
   if (path.observer)
     path.observer->on_hit({vertex, s.p, s.n, glm::dot(s.n, wo) > 0.0f,
                            static_cast<std::uint32_t>(s.material - scene.scene().materials.data()), s.shape, s.prim,
-                           Le, w_e, beta * L, beta});
+                           s.instance, Le, w_e, beta * L, beta});
 
   const int cap = settings_.max_depth >= 0 ? settings_.max_depth : kMaxVerticesUncapped;
   if (vertex > cap) {

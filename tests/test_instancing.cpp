@@ -14,6 +14,8 @@
 #include "core/render.h"
 #include "core/sampling.h"
 #include "core/scene_loader.h"
+#include "debugtools/path_compare.h"
+#include "debugtools/path_recorder.h"
 #include "reference/reference_tracer.h"
 #include "tests/test_scenes.h"
 #include "wavefront/wavefront_tracer.h"
@@ -22,6 +24,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <set>
 
 namespace pathlab {
 namespace {
@@ -162,6 +165,40 @@ TEST(Instancing, SameBitsForAnyThreadCount) {
     const Image a = image(1, wavefront, WavefrontTracer::kDefaultWaveSize), b = image(2, wavefront, 37);
     EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0) << wavefront;
   }
+}
+
+// trace-pixel names the instance a hit is on (JSON and text), and both
+// tracers report the same one.
+TEST(Instancing, TracedHitsNameTheirInstance) {
+  Scene scene = test::cornell_with_instances();
+  scene.film.width = scene.film.height = 24;
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const ReferenceTracer reference(compiled, settings);
+  const WavefrontTracer wavefront(compiled, settings);
+  std::set<std::uint32_t> seen;
+  for (std::uint32_t y = 0; y < 24; y += 2)
+    for (std::uint32_t x = 0; x < 24; x += 2) {
+      PathRecorder a, b;
+      reference.trace_sample(x, y, 0, &a);
+      wavefront.trace_sample(x, y, 0, &b);
+      EXPECT_TRUE(first_divergence(a.events(), b.events(), 1e-3f).rounding);
+      for (const PathEvent& e : a.events()) {
+        const auto* hit = std::get_if<HitEvent>(&e);
+        if (hit == nullptr) continue;
+        const bool in_group = compiled.scene().shapes[hit->shape].in_group;
+        ASSERT_EQ(in_group, hit->instance != kNoInstance);
+        const nlohmann::json j = path_to_json(TraceHeader{"t", "reference", x, y, 0, settings, 24, 24}, a, compiled.scene());
+        if (!in_group) continue;
+        seen.insert(hit->instance);
+        EXPECT_NE(event_to_text(e, compiled.scene()).find(" instance " + std::to_string(hit->instance)), std::string::npos);
+        bool named = false;
+        for (const nlohmann::json& ev : j["events"])
+          named = named || (ev["type"] == "hit" && ev["instance"] == hit->instance);
+        EXPECT_TRUE(named) << j.dump();
+      }
+    }
+  EXPECT_EQ(seen.size(), 3u);
 }
 
 TEST(Instancing, SceneFileGroupsAndInstances) {

@@ -339,7 +339,8 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
     w.L[i] += added;
     if (obs)
       obs->on_hit({w.vertex[i], s.p, s.n, glm::dot(s.n, wo) > 0.0f,
-                   static_cast<std::uint32_t>(s.material - scene_.scene().materials.data()), s.shape, s.prim, Le, we,
+                   static_cast<std::uint32_t>(s.material - scene_.scene().materials.data()), s.shape, s.prim, s.instance,
+                   Le, we,
                    added, w.beta[i]});
     if (w.vertex[i] > cap || !s.material->scatters()) {
       if (obs) obs->on_end({w.vertex[i], w.vertex[i] > cap ? PathEnd::MaxDepth : PathEnd::Absorbed});
