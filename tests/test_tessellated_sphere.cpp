@@ -36,7 +36,7 @@
 //    (Nusselt), the hemisphere is the unit disc and g's horizon the half
 //    ellipse of semi-axes cos theta and 1, so the lost set has area
 //    (pi - pi cos theta) / 2:
-//        P(theta) = (1 - cos theta) / 2           (LostFractionFormula)
+//        P(theta) = (1 - cos theta) / 2           (test_tessellation_bound.cpp)
 //    and the hit carries on (1 - P(theta)) in [on (1 - delta), on] with
 //        delta = (1 - cos theta_max) / 2 ~ theta_max^2 / 4.
 //    If instead wo.ns < 0 < wo.g (a view grazing the face by less than
@@ -73,32 +73,20 @@
 #include "tests/stat_util.h"
 #include "tests/test_scenes.h"
 
-#include "core/geometry.h"
-#include "core/rng.h"
-#include "core/sampling.h"
 #include "wavefront/wavefront_tracer.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <numbers>
+#include <string>
 
 namespace pathlab {
 namespace {
 
 constexpr double kAlpha = 1e-4;
-
-// theta_max of the header: the largest angle between a face normal and the
-// exact normal (p - c) / |p - c| of one of its vertices.
-double tessellation_angle(const TriangleMesh& mesh, const dvec3& c) {
-  double cos_min = 1.0;
-  for (const glm::uvec3& t : mesh.triangles) {
-    const dvec3 p0(mesh.positions[t.x]), p1(mesh.positions[t.y]), p2(mesh.positions[t.z]);
-    const dvec3 g = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-    for (const dvec3& p : {p0, p1, p2}) cos_min = std::min(cos_min, glm::dot(g, glm::normalize(p - c)));
-  }
-  return std::acos(cos_min);
-}
 
 // The sphere of a sphere-in-uniform-light scene, its model's two radiances
 // and the bounds of the header for one tessellation.
@@ -166,7 +154,7 @@ MeshScene tessellated(const std::string& file, int rings,
   sphere->kind = Shape::Kind::Triangles;
   sphere->description = "UV sphere, " + std::to_string(rings) + " rings";
   sphere->mesh = test::uv_sphere(sphere->center, sphere->radius, rings);
-  b.theta_max = tessellation_angle(sphere->mesh, b.c);
+  b.theta_max = test::tessellation_angle(sphere->mesh, b.c);
   if (normals) normals(sphere->mesh);
   return {std::move(scene), b};
 }
@@ -259,63 +247,6 @@ std::string describe(const Verdict& v) {
          " rendered " + std::to_string(w.rendered) + " nearest bound " + std::to_string(w.expected);
   }
   return s;
-}
-
-// 2. of the header: the cosine-weighted fraction of the shading hemisphere
-// below a plane tilted by theta is (1 - cos theta) / 2. Cosine-weighted
-// directions (the renderer's own mapping) below the tilted plane are counted
-// and z-tested against the binomial (Sidak over the angles); the other
-// candidate, (theta - sin theta cos theta) / pi, is rejected at the same level.
-TEST(TessellationBound, LostFractionFormula) {
-  constexpr int kSamples = 1 << 20;
-  const std::vector<double> angles = {0.017354, 0.06936, 0.2742, 0.6, 1.2};
-  const double threshold = test::sidak_z(kAlpha, static_cast<double>(angles.size()));
-  for (const double theta : angles) {
-    const dvec3 g(std::sin(theta), 0.0, std::cos(theta));
-    long below = 0;
-    for (std::uint64_t i = 0; i < kSamples; ++i) {
-      const vec2 u(to_unit_float(mix64(2 * i)), to_unit_float(mix64(2 * i + 1)));
-      if (glm::dot(dvec3(square_to_cosine_hemisphere(u)), g) < 0.0) ++below;
-    }
-    const auto z = [&](double p) { return (below - kSamples * p) / std::sqrt(kSamples * p * (1.0 - p)); };
-    const double p = 0.5 * (1.0 - std::cos(theta));
-    EXPECT_LT(std::abs(z(p)), threshold) << "theta " << theta << ": " << below << " of " << kSamples;
-    if (theta > 0.05) {  // below that, 1M samples cannot tell the two apart
-      EXPECT_GT(std::abs(z((theta - std::sin(theta) * std::cos(theta)) / std::numbers::pi)), threshold) << theta;
-    }
-  }
-}
-
-// 1. of the header: theta_max bounds the angle between the interpolated
-// normal and the face normal everywhere on the mesh (sampled on a grid of
-// barycentrics, the renderer's own shading_normal), is reached at the
-// vertices, shrinks as 1 / n, and the mesh's faces lie at distance
-// >= R cos theta_max from the centre.
-TEST(TessellationBound, TessellationAngleBoundsTheShadingNormal) {
-  double previous = std::numbers::pi;
-  for (const int rings : {8, 32, 128}) {
-    const TriangleMesh mesh = test::uv_sphere(vec3(0.0f), 1.0f, rings);
-    const double theta_max = tessellation_angle(mesh, dvec3(0.0));
-    EXPECT_LT(theta_max, previous / 3.0) << rings;
-    EXPECT_NEAR(theta_max * rings, std::numbers::pi / std::sqrt(2.0), 0.05) << rings;
-    previous = theta_max;
-    double worst = 0.0, nearest_plane = 1.0;
-    for (const glm::uvec3& t : mesh.triangles) {
-      const vec3 p0 = mesh.positions[t.x], p1 = mesh.positions[t.y], p2 = mesh.positions[t.z];
-      const vec3 g = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-      nearest_plane = std::min(nearest_plane, double(glm::dot(g, p0)));
-      for (int i = 0; i <= 8; ++i)
-        for (int j = 0; i + j <= 8; ++j) {
-          const float b1 = i / 8.0f, b2 = j / 8.0f;
-          const vec3 sum = (1.0f - b1 - b2) * mesh.normals[t.x] + b1 * mesh.normals[t.y] + b2 * mesh.normals[t.z];
-          worst = std::max(worst, std::acos(std::min(1.0, double(glm::dot(shading_normal(g, sum), g)))));
-        }
-    }
-    // float normals and dot products: a few 1e-7 rad of rounding
-    EXPECT_LE(worst, theta_max + 1e-5) << rings;
-    EXPECT_GT(worst, theta_max - 1e-3) << rings;
-    EXPECT_GE(nearest_plane, std::cos(theta_max) - 1e-6) << rings;
-  }
 }
 
 struct Case {
