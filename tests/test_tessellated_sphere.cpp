@@ -26,6 +26,7 @@
 //        to g within 0.08 degrees only brings it nearer);
 //    (c) a point x of F is R cos rho_F g + t from c with |t| <= R sin rho_F:
 //        angle(x - c, g) <= theta_max.
+//    ((a) and (b) on the mesh itself: test_tessellation_bound.cpp.)
 //
 // 2. A hit's radiance. At a hit with wo.ns > 0 and angle(ns, g) = theta, the
 //    Lambert lobe (in the shading frame, cosine to ns) reflects, by the
