@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -64,6 +65,19 @@ inline TriangleMesh uv_sphere(vec3 center, float radius, int rings, bool normals
       if (i + 1 < rings) m.triangles.push_back({at(i, j + 1), at(i + 1, j + 1), at(i + 1, j)});
     }
   return m;
+}
+
+// The tessellation angle of a mesh inscribed in the sphere about `c`: the
+// largest angle between a face normal and the exact normal (p - c) / |p - c|
+// of one of its vertices (the bound of test_tessellated_sphere.cpp).
+inline double tessellation_angle(const TriangleMesh& mesh, const dvec3& c) {
+  double cos_min = 1.0;
+  for (const glm::uvec3& t : mesh.triangles) {
+    const dvec3 p0(mesh.positions[t.x]), p1(mesh.positions[t.y]), p2(mesh.positions[t.z]);
+    const dvec3 g = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    for (const dvec3& p : {p0, p1, p2}) cos_min = std::min(cos_min, glm::dot(g, glm::normalize(p - c)));
+  }
+  return std::acos(cos_min);
 }
 
 // The built-in Cornell box with a smooth-shaded UV sphere on its floor
