@@ -178,14 +178,15 @@ TriangleMesh finish(const fs::path& file, RawMesh raw, MeshLoadReport* report) {
   // Smoothing only: each vertex's (position, group), and each triangle's group.
   std::vector<std::pair<std::int64_t, std::uint32_t>> vertex_group;
   std::vector<std::uint32_t> triangle_group;
-  // The unit normal of face f, from its first three corners.
+  // The unit normal of face f, from its first three corners. Adding 0 turns
+  // a -0 component into +0: the key is the bits, and equal normals must weld.
   const auto face_normal = [&](std::size_t f) {
     const std::size_t s = raw.face_start[f];
     const dvec3 a(raw.positions[raw.indices[s]]), b(raw.positions[raw.indices[s + 1]]),
         c(raw.positions[raw.indices[s + 2]]);
     const dvec3 cr = glm::cross(b - a, c - a);
     const double len = glm::length(cr);
-    return len > 0.0 ? vec3(cr / len) : vec3(0.0f, 0.0f, 1.0f);
+    return len > 0.0 ? vec3(cr / len) + vec3(0.0f) : vec3(0.0f, 0.0f, 1.0f);
   };
   const auto corner = [&](std::size_t k, std::size_t f) -> std::uint32_t {
     if (!per_corner) return static_cast<std::uint32_t>(raw.indices[k]);
