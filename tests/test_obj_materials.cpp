@@ -252,6 +252,7 @@ TEST_F(ObjMaterials, SixGroupsGiveFaceNormals) {
   const TriangleMesh m = load_mesh(write("six.obj", cube({"1", "2", "3", "4", "5", "6"})));
   ASSERT_EQ(m.triangles.size(), 12u);
   EXPECT_EQ(m.positions.size(), 24u);  // every corner split between its three groups
+  ASSERT_EQ(m.normals.size(), m.positions.size());
   for (std::size_t t = 0; t < 12; ++t)
     for (int k = 0; k < 3; ++k) EXPECT_EQ(m.normals[m.triangles[t][k]], kFaceNormals[t / 2]) << t;
 }
@@ -275,6 +276,7 @@ TEST_F(ObjMaterials, MixedGroupsSplitWhereGroupsMeet) {
   const TriangleMesh m = load_mesh(write("mix.obj", cube({"1", "1", "1", "1", "off", "2"})));
   // 8 for group 1 (4 side faces touch all 8 corners), 4 flat top corners, 4 bottom corners.
   EXPECT_EQ(m.positions.size(), 16u);
+  ASSERT_EQ(m.normals.size(), m.positions.size());
   for (std::size_t t = 0; t < 12; ++t) {
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t v = m.triangles[t][k];
@@ -304,7 +306,7 @@ TEST_F(ObjMaterials, FileNormalsAndTheNormalsKeyOverrideTheGroups) {
   const auto with = [&](const std::string& normals) {
     return scene(R"({"type": "mesh", "file": "six.obj", "material": "white", "normals": ")" + normals + "\"}");
   };
-  EXPECT_EQ(with("file").shapes[0].mesh.positions.size(), 24u);
+  EXPECT_EQ(with("file").shapes[0].mesh.normals.size(), 24u);
   const Scene flat = with("flat");
   EXPECT_TRUE(flat.shapes[0].mesh.normals.empty());
   EXPECT_EQ(flat.shapes[0].mesh.positions.size(), 8u);
