@@ -144,7 +144,9 @@ std::vector<MeshPart> read_mesh_parts(const Node& node, Scene& scene, const std:
                " that no scene material matches: " + list;
   }
   if (before_usemtl) problem += std::string(unmatched.empty() ? "" : ", and") + " has faces before its first 'usemtl'";
-  node.fail(problem + "; give 'material' for them, or map OBJ names to scene materials in 'materials'");
+  const bool one = unmatched.size() + (before_usemtl ? 1 : 0) == 1;
+  node.fail(problem + "; give 'material' for " + (one ? "it" : "them") +
+            ", or map OBJ names to scene materials in 'materials'");
 }
 
 
