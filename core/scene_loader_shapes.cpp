@@ -40,7 +40,7 @@ TriangleMesh unit_box() {
 // the shape's transform.
 struct MeshPart {
   TriangleMesh mesh;
-  std::optional<std::uint32_t> material;  // none: the shape's "material"
+  std::optional<std::uint32_t> material;  // none until resolved: every returned part has one
   std::string description;
 };
 
