@@ -67,6 +67,11 @@ struct RawMesh {
   std::vector<vec3> normals;
   std::vector<vec2> uvs;
   std::vector<std::int64_t> normal_indices, uv_indices;
+  // Per face, or empty: OBJ `usemtl` slots (TriangleMesh::face_material),
+  // and OBJ smoothing groups when they are to make the normals.
+  std::vector<std::uint16_t> face_material;
+  std::vector<std::string> material_names;
+  std::vector<std::uint32_t> smoothing_groups;
   std::vector<std::string> ignored;
 
   std::size_t face_count() const { return face_start.size() - 1; }
@@ -123,6 +128,23 @@ void check_indices(const fs::path& file, const RawMesh& raw) {
   }
 }
 
+// One triangle's angle-weighted contributions to its corners' normals
+// (Thürmer & Wüthrich 1998): the unit face normal times each corner's angle.
+// All zero for a triangle of zero area.
+std::array<dvec3, 3> angle_weighted(const vec3& a, const vec3& b, const vec3& c) {
+  const dvec3 p[3] = {dvec3(a), dvec3(b), dvec3(c)};
+  const dvec3 face = glm::cross(p[1] - p[0], p[2] - p[0]);
+  const double length = glm::length(face);
+  std::array<dvec3, 3> out{dvec3(0.0), dvec3(0.0), dvec3(0.0)};
+  if (!(length > 0.0)) return out;
+  for (int k = 0; k < 3; ++k) {
+    const dvec3 e1 = p[(k + 1) % 3] - p[k], e2 = p[(k + 2) % 3] - p[k];
+    // The corner's angle, from atan2 (accurate for slivers, unlike acos).
+    out[k] = std::atan2(glm::length(glm::cross(e1, e2)), glm::dot(e1, e2)) * (face / length);
+  }
+  return out;
+}
+
 // Validates `raw` (normalising its normals), fan-triangulates its polygons and
 // drops degenerate triangles.
 TriangleMesh finish(const fs::path& file, RawMesh raw, MeshLoadReport* report) {
@@ -144,32 +166,46 @@ TriangleMesh finish(const fs::path& file, RawMesh raw, MeshLoadReport* report) {
   // PLY's attributes are per vertex: the mesh takes raw's arrays as they
   // are (at the end). OBJ corners: one vertex per distinct (position,
   // normal, texture coordinate); a corner without a normal in a mesh with
-  // normals takes its face's, keyed by the normal's bits.
+  // normals takes its face's, keyed by the normal's bits. With smoothing
+  // groups, a corner of group g > 0 is keyed by (position, g, texture
+  // coordinate) and its normal computed at the end; a corner of group 0
+  // takes its face's normal, like a corner without one.
   TriangleMesh mesh;
-  const bool per_corner = raw.per_corner();
+  const bool smoothing = !raw.smoothing_groups.empty();
+  const bool per_corner = raw.per_corner() || smoothing;
   std::map<std::array<std::int64_t, 6>, std::uint32_t> welded;
   const bool has_normals = !raw.normals.empty(), has_uvs = !raw.uvs.empty();
-  // The unit normal of face f, from its first three corners.
+  // Smoothing only: each vertex's (position, group), and each triangle's group.
+  std::vector<std::pair<std::int64_t, std::uint32_t>> vertex_group;
+  std::vector<std::uint32_t> triangle_group;
+  // The unit normal of face f, from its first three corners. Adding 0 turns
+  // a -0 component into +0: the key is the bits, and equal normals must weld.
   const auto face_normal = [&](std::size_t f) {
     const std::size_t s = raw.face_start[f];
     const dvec3 a(raw.positions[raw.indices[s]]), b(raw.positions[raw.indices[s + 1]]),
         c(raw.positions[raw.indices[s + 2]]);
     const dvec3 cr = glm::cross(b - a, c - a);
     const double len = glm::length(cr);
-    return len > 0.0 ? vec3(cr / len) : vec3(0.0f, 0.0f, 1.0f);
+    return len > 0.0 ? vec3(cr / len) + vec3(0.0f) : vec3(0.0f, 0.0f, 1.0f);
   };
   const auto corner = [&](std::size_t k, std::size_t f) -> std::uint32_t {
     if (!per_corner) return static_cast<std::uint32_t>(raw.indices[k]);
     const std::int64_t ni = has_normals ? raw.normal_indices[k] : -1;
     const std::int64_t ti = has_uvs ? raw.uv_indices[k] : -1;
-    const vec3 n = !has_normals ? vec3(0.0f) : ni >= 0 ? raw.normals[static_cast<std::size_t>(ni)] : face_normal(f);
-    const std::array<std::int64_t, 6> key{raw.indices[k], ni, std::bit_cast<std::int32_t>(n.x),
-                                          std::bit_cast<std::int32_t>(n.y), std::bit_cast<std::int32_t>(n.z), ti};
+    const std::uint32_t group = smoothing ? raw.smoothing_groups[f] : 0;
+    // Group g > 0 stands where a normal index would (-1 - g: no index is).
+    const vec3 n = ni >= 0 ? raw.normals[static_cast<std::size_t>(ni)]
+                   : has_normals || smoothing ? face_normal(f) : vec3(0.0f);
+    const std::array<std::int64_t, 6> key =
+        group > 0 ? std::array<std::int64_t, 6>{raw.indices[k], -1 - static_cast<std::int64_t>(group), 0, 0, 0, ti}
+                  : std::array<std::int64_t, 6>{raw.indices[k], ni, std::bit_cast<std::int32_t>(n.x),
+                                                std::bit_cast<std::int32_t>(n.y), std::bit_cast<std::int32_t>(n.z), ti};
     const auto [it, added] = welded.try_emplace(key, static_cast<std::uint32_t>(mesh.positions.size()));
     if (added) {
       mesh.positions.push_back(raw.positions[static_cast<std::size_t>(raw.indices[k])]);
-      if (has_normals) mesh.normals.push_back(n);
+      if (has_normals || smoothing) mesh.normals.push_back(n);  // a group's: replaced at the end
       if (has_uvs) mesh.uvs.push_back(ti >= 0 ? raw.uvs[static_cast<std::size_t>(ti)] : vec2(0.0f));
+      if (smoothing) vertex_group.emplace_back(raw.indices[k], group);
     }
     return it->second;
   };
@@ -191,15 +227,35 @@ TriangleMesh finish(const fs::path& file, RawMesh raw, MeshLoadReport* report) {
       const std::uint32_t c1 = corner(k, f);
       const std::uint32_t c2 = corner(k + 1, f);
       mesh.triangles.emplace_back(c0, c1, c2);
+      if (!raw.face_material.empty()) mesh.face_material.push_back(raw.face_material[f]);
+      if (smoothing) triangle_group.push_back(raw.smoothing_groups[f]);
     }
   }
   if (mesh.triangles.empty())
     fail(file, "no usable triangles (" + std::to_string(dropped) + " degenerate dropped)");
+  if (smoothing) {
+    // A group's normal at a position sums over all of the group's triangles
+    // there, whatever their texture coordinates (a UV seam is no crease).
+    std::map<std::pair<std::int64_t, std::uint32_t>, dvec3> sums;
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      if (triangle_group[t] == 0) continue;
+      const glm::uvec3& tri = mesh.triangles[t];
+      const std::array<dvec3, 3> w = angle_weighted(mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z]);
+      for (int k = 0; k < 3; ++k) sums[vertex_group[tri[k]]] += w[k];
+    }
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+      if (vertex_group[v].second == 0) continue;
+      const dvec3 sum = sums[vertex_group[v]];
+      const double length = glm::length(sum);
+      if (length > 0.0) mesh.normals[v] = vec3(sum / length);  // else its first face's normal stays
+    }
+  }
   if (!per_corner) {
     mesh.positions = std::move(raw.positions);
     mesh.normals = std::move(raw.normals);
     mesh.uvs = std::move(raw.uvs);
   }
+  mesh.material_names = std::move(raw.material_names);
   if (report) {
     report->faces_in_file = raw.face_count();
     report->triangles_loaded = mesh.triangles.size();
@@ -211,12 +267,20 @@ TriangleMesh finish(const fs::path& file, RawMesh raw, MeshLoadReport* report) {
 
 // ---------------------------------------------------------------- OBJ
 
+// What scan_obj finds besides broken vertices.
+struct ObjDirectives {
+  std::vector<std::string> materials;  // `usemtl` names, in the order of first use
+  std::vector<std::string> libraries;  // what `mtllib` lines name
+};
+
 // tinyobj turns a coordinate it cannot parse ("nan", "inf", "1,5", "abc")
 // into 0 without a warning, so a broken vertex would load silently at the
 // origin. Check the coordinates of every vertex, normal and texture
 // coordinate line ("v", "vn", "vt" as tinyobj recognises them) before handing
-// the text over.
-void check_obj_vertices(const fs::path& file, std::string_view text) {
+// the text over. The same pass collects the `usemtl` names, read as tinyobj
+// reads them, and the `mtllib` lines.
+ObjDirectives scan_obj(const fs::path& file, std::string_view text) {
+  ObjDirectives found;
   const auto is_blank = [](char c) { return c == ' ' || c == '\t'; };
   struct Kind {
     std::string_view tag, name;
@@ -230,6 +294,23 @@ void check_obj_vertices(const fs::path& file, std::string_view text) {
     std::string_view line = text.substr(0, eol);
     text.remove_prefix(std::min(eol + (text.substr(eol).starts_with("\r\n") ? 2 : 1), text.size()));
     line.remove_prefix(std::min(line.find_first_not_of(" \t"), line.size()));
+    // tinyobj takes any line that starts with "usemtl" (no blank needed), and
+    // the name up to the next blank, "\r" or NUL; an empty name is no material.
+    if (line.starts_with("usemtl")) {
+      std::string_view name = line.substr(6);
+      name.remove_prefix(std::min(name.find_first_not_of(" \t"), name.size()));
+      name = name.substr(0, std::min(name.find_first_of(std::string_view(" \t\r\0", 4)), name.size()));
+      if (!name.empty() && std::find(found.materials.begin(), found.materials.end(), name) == found.materials.end())
+        found.materials.emplace_back(name);
+      continue;
+    }
+    if (line.size() > 6 && line.starts_with("mtllib") && is_blank(line[6])) {
+      std::string_view names = line.substr(7);
+      names.remove_prefix(std::min(names.find_first_not_of(" \t"), names.size()));
+      names = names.substr(0, names.find_last_not_of(" \t") + 1);
+      if (!names.empty()) found.libraries.emplace_back(names);
+      continue;
+    }
     Kind* kind = nullptr;
     for (Kind& k : kinds)
       if (line.size() > k.tag.size() && line.starts_with(k.tag) && is_blank(line[k.tag.size()])) kind = &k;
@@ -260,60 +341,112 @@ void check_obj_vertices(const fs::path& file, std::string_view text) {
       }
     }
   }
+  if (found.materials.size() >= TriangleMesh::kNoFileMaterial)
+    fail(file, "too many materials ('usemtl' names " + std::to_string(found.materials.size()) + ", at most " +
+                   std::to_string(TriangleMesh::kNoFileMaterial - 1) + ")");
+  return found;
 }
 
-RawMesh parse_obj(const fs::path& file, std::string_view text) {
-  check_obj_vertices(file, text);
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = true;
-  config.vertex_color = false;
-  tinyobj::ObjReader reader;
-  if (!reader.ParseFromString(std::string(text), "", config)) {
-    std::string error = reader.Error();
+// tinyobj numbers a face's material (material_ids) only by the names an
+// `mtllib` line brought in. This reader brings in the names the scan found,
+// as materials without content, whatever library is named: pathlab takes
+// nothing else from a .mtl file (the scene gives the materials).
+class UsemtlNames : public tinyobj::MaterialReader {
+ public:
+  explicit UsemtlNames(const std::vector<std::string>& names) : names_(names) {}
+  bool operator()(const std::string& /*library*/, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* ids, std::string* /*warning*/, std::string* /*error*/) override {
+    if (!materials->empty()) return true;  // a second `mtllib` line
+    for (const std::string& name : names_) {
+      ids->emplace(name, static_cast<int>(materials->size()));
+      tinyobj::material_t m;
+      m.name = name;
+      materials->push_back(std::move(m));
+    }
+    return true;
+  }
+
+ private:
+  const std::vector<std::string>& names_;
+};
+
+// The line numbers in a tinyobj message ("line 7.", "line: 7") less one:
+// for text that a line was put in front of.
+std::string renumber_lines(const std::string& message) {
+  std::string out;
+  std::size_t at = 0;
+  for (std::size_t found; (found = message.find("line", at)) != std::string::npos;) {
+    std::size_t digits = found + 4;
+    while (digits < message.size() && (message[digits] == ' ' || message[digits] == ':')) ++digits;
+    std::size_t end = digits;
+    while (end < message.size() && std::isdigit(static_cast<unsigned char>(message[end]))) ++end;
+    out += message.substr(at, digits - at);
+    if (end > digits) out += std::to_string(std::stoll(message.substr(digits, end - digits)) - 1);
+    at = end;
+  }
+  return out + message.substr(at);
+}
+
+RawMesh parse_obj(const fs::path& file, std::string_view text, const MeshLoadOptions& options) {
+  const ObjDirectives directives = scan_obj(file, text);
+  // The names reach tinyobj only through an `mtllib` line (UsemtlNames),
+  // which a file need not have before its first `usemtl`: put one in front.
+  const bool named = !directives.materials.empty();
+  std::istringstream in((named ? "mtllib pathlab-usemtl-names\n" : "") + std::string(text));
+  UsemtlNames names(directives.materials);
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> materials;
+  std::string warning, error;
+  if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warning, &error, &in, &names, /*triangulate=*/true,
+                        /*default_vcols_fallback=*/false)) {
+    if (named) error = renumber_lines(error);
     while (!error.empty() && std::isspace(static_cast<unsigned char>(error.back()))) error.pop_back();
     fail(file, "cannot parse OBJ: " + error);
   }
 
   RawMesh raw;
   raw.number_base = 1;
-  const tinyobj::attrib_t& attrib = reader.GetAttrib();
   const std::vector<tinyobj::real_t>& v = attrib.vertices;
   for (std::size_t i = 0; i + 2 < v.size(); i += 3) raw.positions.emplace_back(v[i], v[i + 1], v[i + 2]);
   for (std::size_t i = 0; i + 2 < attrib.normals.size(); i += 3)
     raw.normals.emplace_back(attrib.normals[i], attrib.normals[i + 1], attrib.normals[i + 2]);
   for (std::size_t i = 0; i + 1 < attrib.texcoords.size(); i += 2)
     raw.uvs.emplace_back(attrib.texcoords[i], attrib.texcoords[i + 1]);
+  // Smoothing groups make normals only where the file gives none.
+  bool smoothing = false;
+  if (raw.normals.empty() && options.smoothing_groups)
+    for (const tinyobj::shape_t& shape : shapes)
+      for (const unsigned id : shape.mesh.smoothing_group_ids) smoothing |= id != 0;
+  if (named) raw.material_names = directives.materials;
   // All shapes index the same vertex arrays, so concatenating them is trivial.
-  bool smoothing_groups = false;
-  std::vector<std::string> materials;
-  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
+  for (const tinyobj::shape_t& shape : shapes) {
     std::size_t k = 0;
-    for (const unsigned char n : shape.mesh.num_face_vertices) {
-      for (unsigned j = 0; j < n; ++j, ++k) {
+    for (std::size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
+      for (unsigned j = 0; j < shape.mesh.num_face_vertices[f]; ++j, ++k) {
         const tinyobj::index_t& index = shape.mesh.indices[k];
         raw.indices.push_back(index.vertex_index);
         if (!raw.normals.empty()) raw.normal_indices.push_back(index.normal_index);
         if (!raw.uvs.empty()) raw.uv_indices.push_back(index.texcoord_index);
       }
       raw.face_start.push_back(raw.indices.size());
+      // tinyobj's material -1: before the first `usemtl` (or an empty name).
+      const int id = shape.mesh.material_ids[f];
+      if (named) raw.face_material.push_back(id < 0 ? TriangleMesh::kNoFileMaterial : static_cast<std::uint16_t>(id));
+      if (smoothing) raw.smoothing_groups.push_back(shape.mesh.smoothing_group_ids[f]);
     }
-    for (const unsigned id : shape.mesh.smoothing_group_ids) smoothing_groups |= id != 0;
   }
-  // tinyobj adds an unnamed default material of its own: not the file's.
-  for (const tinyobj::material_t& m : reader.GetMaterials())
-    if (!m.name.empty()) materials.push_back(m.name);
-  if (smoothing_groups && raw.normals.empty())
-    raw.ignored.push_back("smoothing groups ('s'; \"normals\": \"smooth\" computes vertex normals)");
-  if (!materials.empty()) {
+  // The library's content is the one thing of the materials not used.
+  bool uses_materials = false;
+  for (const std::uint16_t m : raw.face_material) uses_materials |= m != TriangleMesh::kNoFileMaterial;
+  if (uses_materials && !directives.libraries.empty()) {
     std::string list;
-    for (const std::string& m : materials) list += (list.empty() ? "" : ", ") + m;
-    raw.ignored.push_back("OBJ materials (" + list + "; the scene's material applies)");
+    for (const std::string& l : directives.libraries) list += (list.empty() ? "" : ", ") + l;
+    raw.ignored.push_back("the material library's content (" + list +
+                          ": Kd, Ks, maps; the scene's materials give the colours)");
   }
-  if (text.find("\nusemtl") != std::string_view::npos && materials.empty())
-    raw.ignored.push_back("'usemtl' (the scene's material applies)");
 
   // tinyobj does not fail on these; it warns and silently drops the face.
-  const std::string& warning = reader.Warning();
   if (warning.find("Degenerated face") != std::string::npos)
     fail(file, "a face has fewer than 3 vertices");
   if (warning.find("invalid vertex index") != std::string::npos ||
@@ -632,16 +765,8 @@ std::vector<char> read_file_maybe_gz(const std::filesystem::path& file) {
 std::vector<vec3> smooth_vertex_normals(const TriangleMesh& mesh) {
   std::vector<dvec3> sum(mesh.positions.size(), dvec3(0.0));
   for (const glm::uvec3& t : mesh.triangles) {
-    const dvec3 p[3] = {dvec3(mesh.positions[t.x]), dvec3(mesh.positions[t.y]), dvec3(mesh.positions[t.z])};
-    const dvec3 face = glm::cross(p[1] - p[0], p[2] - p[0]);
-    const double length = glm::length(face);
-    if (!(length > 0.0)) continue;
-    for (int k = 0; k < 3; ++k) {
-      const dvec3 a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
-      // The corner's angle, from atan2 (accurate for slivers, unlike acos).
-      const double angle = std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
-      sum[t[k]] += angle * (face / length);
-    }
+    const std::array<dvec3, 3> w = angle_weighted(mesh.positions[t.x], mesh.positions[t.y], mesh.positions[t.z]);
+    for (int k = 0; k < 3; ++k) sum[t[k]] += w[k];
   }
   std::vector<vec3> normals(sum.size());
   for (std::size_t v = 0; v < sum.size(); ++v) {
@@ -651,7 +776,54 @@ std::vector<vec3> smooth_vertex_normals(const TriangleMesh& mesh) {
   return normals;
 }
 
-TriangleMesh load_mesh(const std::filesystem::path& file, MeshLoadReport* report) {
+std::vector<std::pair<std::uint16_t, TriangleMesh>> split_by_face_material(TriangleMesh mesh) {
+  std::vector<std::pair<std::uint16_t, TriangleMesh>> parts;
+  // kNoFileMaterial first (its faces come before every `usemtl`), then by name.
+  std::vector<std::uint16_t> slots;
+  if (std::find(mesh.face_material.begin(), mesh.face_material.end(), TriangleMesh::kNoFileMaterial) !=
+          mesh.face_material.end() || mesh.face_material.empty())
+    slots.push_back(TriangleMesh::kNoFileMaterial);
+  std::vector<char> used(mesh.material_names.size(), 0);
+  for (const std::uint16_t m : mesh.face_material)
+    if (m != TriangleMesh::kNoFileMaterial) used[m] = 1;
+  for (std::size_t m = 0; m < used.size(); ++m)
+    if (used[m]) slots.push_back(static_cast<std::uint16_t>(m));
+  if (slots.size() == 1) {
+    // All triangles in one part: the mesh as it is, without the copy.
+    mesh.face_material.clear();
+    mesh.material_names.clear();
+    parts.emplace_back(slots[0], std::move(mesh));
+    return parts;
+  }
+  constexpr std::uint32_t kUnused = 0xffffffffu;
+  std::vector<std::uint32_t> remap(mesh.positions.size(), kUnused);
+  for (const std::uint16_t slot : slots) {
+    TriangleMesh part;
+    std::vector<std::uint32_t> taken;  // vertices to reset in `remap`
+    const auto vertex = [&](std::uint32_t v) {
+      if (remap[v] == kUnused) {
+        remap[v] = static_cast<std::uint32_t>(part.positions.size());
+        taken.push_back(v);
+        part.positions.push_back(mesh.positions[v]);
+        if (mesh.has_normals()) part.normals.push_back(mesh.normals[v]);
+        if (mesh.has_uvs()) part.uvs.push_back(mesh.uvs[v]);
+        if (!mesh.tangents.empty()) part.tangents.push_back(mesh.tangents[v]);
+      }
+      return remap[v];
+    };
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      if (mesh.face_material[t] != slot) continue;
+      const glm::uvec3& tri = mesh.triangles[t];
+      const std::uint32_t a = vertex(tri.x), b = vertex(tri.y), c = vertex(tri.z);
+      part.triangles.emplace_back(a, b, c);
+    }
+    for (const std::uint32_t v : taken) remap[v] = kUnused;
+    parts.emplace_back(slot, std::move(part));
+  }
+  return parts;
+}
+
+TriangleMesh load_mesh(const std::filesystem::path& file, MeshLoadReport* report, const MeshLoadOptions& options) {
   std::string name = file.filename().string();
   std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
   if (name.ends_with(".gz")) name.resize(name.size() - 3);
@@ -662,7 +834,7 @@ TriangleMesh load_mesh(const std::filesystem::path& file, MeshLoadReport* report
 
   const std::vector<char> data = read_file_maybe_gz(file);
   const std::string_view text(data.data(), data.size());
-  RawMesh raw = extension == ".obj" ? parse_obj(file, text) : parse_ply(file, text);
+  RawMesh raw = extension == ".obj" ? parse_obj(file, text, options) : parse_ply(file, text);
   return finish(file, std::move(raw), report);
 }
 

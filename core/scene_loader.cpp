@@ -5,6 +5,7 @@
 #include "core/geometry.h"
 #include "core/gltf_loader.h"
 #include "core/json_document.h"
+#include "core/scene_loader_internal.h"
 #include "core/tangents.h"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -25,144 +26,7 @@
 namespace pathlab {
 namespace {
 
-using json = nlohmann::json;
-using Pointer = json::json_pointer;
-
-// A name from the file, quoted for a one-line message: control characters
-// become '?' and very long names are cut.
-std::string in_quotes(std::string_view name) {
-  std::string out(name.substr(0, 60));
-  std::replace_if(out.begin(), out.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }, '?');
-  return "'" + out + (name.size() > 60 ? "...'" : "'");
-}
-
-// " (did you mean 'x'?)" if one of `candidates` is close to `name`, else "".
-std::string suggestion(std::string_view name, std::span<const std::string_view> candidates) {
-  const std::string near = nearest_name(name, candidates);
-  return near.empty() ? std::string() : " (did you mean " + in_quotes(near) + "?)";
-}
-
-// What a value is, for "expected X, found Y": the value itself when short.
-std::string describe(const json& v) {
-  switch (v.type()) {
-    case json::value_t::object: return "an object";
-    case json::value_t::array: return "an array of " + std::to_string(v.size());
-    case json::value_t::string: {
-      const std::string& s = v.get_ref<const std::string&>();
-      return "the string " + (s.size() <= 40 ? v.dump() : "\"" + s.substr(0, 40) + "...\"");
-    }
-    case json::value_t::null: return "null";
-    case json::value_t::boolean: return v.get<bool>() ? "true" : "false";
-    case json::value_t::discarded: return "nothing";
-    default: return "the number " + v.dump();
-  }
-}
-
-// The value at `ptr`, or null if there is none (a const json's operator[]
-// on a missing key is undefined behaviour).
-const json& resolve(const JsonDocument& doc, const Pointer& ptr) {
-  static const json missing;
-  return doc.root().contains(ptr) ? doc.root()[ptr] : missing;
-}
-
-// A cursor on one JSON object of the scene: typed accessors that report
-// their own location, and a check that no key is misspelt.
-class Node {
- public:
-  Node(const JsonDocument& doc, Pointer ptr) : doc_(doc), ptr_(std::move(ptr)), value_(resolve(doc, ptr_)) {}
-
-  const json& value() const { return value_; }
-  const Pointer& pointer() const { return ptr_; }
-  bool has(const std::string& key) const { return value_.is_object() && value_.contains(key); }
-  Node child(const std::string& key) const { return Node(doc_, ptr_ / key); }
-  Node child(std::size_t index) const { return Node(doc_, ptr_ / index); }
-
-  // "<file>:<line>:<col>: <pointer>: <problem>". A value that is not in the
-  // file (a default) is placed at its nearest enclosing value that is.
-  std::string message(const std::string& problem) const {
-    Pointer located = ptr_;
-    while (!located.empty() && doc_.position(located).line == 0) located = located.parent_pointer();
-    const std::string path = ptr_.empty() ? std::string("(top level)") : ptr_.to_string();
-    return doc_.where(located) + ": " + path + ": " + problem;
-  }
-  [[noreturn]] void fail(const std::string& problem) const { throw InputError(message(problem)); }
-
-  void expect_object() const {
-    if (!value_.is_object()) fail("expected an object, found " + describe(value_));
-  }
-
-  void allow_only(std::initializer_list<std::string_view> keys) const {
-    expect_object();
-    const std::vector<std::string_view> allowed(keys);
-    for (const auto& [key, unused] : value_.items()) {
-      if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
-      child(key).fail("unknown key " + in_quotes(key) + suggestion(key, allowed));
-    }
-  }
-
-  // Every number ends up a float: reject what a float cannot hold.
-  double number() const {
-    if (!value_.is_number()) fail("expected a number, found " + describe(value_));
-    const double v = value_.get<double>();
-    if (!std::isfinite(v)) fail("number is not finite");
-    if (std::abs(v) > std::numeric_limits<float>::max())
-      fail("number " + value_.dump() + " is too large (the limit is 3.4e38)");
-    return v;
-  }
-  std::int64_t integer() const {
-    if (!value_.is_number_integer()) fail("expected an integer, found " + describe(value_));
-    if (value_.is_number_unsigned() && value_.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX))
-      fail("integer " + value_.dump() + " is too large");
-    return value_.get<std::int64_t>();
-  }
-  std::string string() const {
-    if (!value_.is_string()) fail("expected a string, found " + describe(value_));
-    return value_.get<std::string>();
-  }
-  bool boolean() const {
-    if (!value_.is_boolean()) fail("expected true or false, found " + describe(value_));
-    return value_.get<bool>();
-  }
-  vec3 vector3() const {
-    if (!value_.is_array() || value_.size() != 3) fail("expected an array of 3 numbers, found " + describe(value_));
-    return vec3(static_cast<float>(child(0).number()), static_cast<float>(child(1).number()),
-                static_cast<float>(child(2).number()));
-  }
-  // A colour: [r,g,b] or one number for grey; each component >= 0 (and <= 1
-  // if `max_one`).
-  Spectrum color(bool max_one) const {
-    if (!value_.is_number() && !(value_.is_array() && value_.size() == 3))
-      fail("expected a colour: one number or an array of 3 numbers, found " + describe(value_));
-    const Spectrum c = value_.is_number() ? Spectrum(static_cast<float>(number())) : vector3();
-    for (int i = 0; i < 3; ++i) {
-      if (c[i] < 0.0f) fail("components must not be negative");
-      if (max_one && c[i] > 1.0f) fail("components must lie in [0, 1] (a reflectance above 1 creates energy)");
-    }
-    return c;
-  }
-
-  double number_or(const std::string& key, double fallback) const { return has(key) ? child(key).number() : fallback; }
-  bool boolean_or(const std::string& key, bool fallback) const { return has(key) ? child(key).boolean() : fallback; }
-  // The member `key`, which must be there. If it is missing but a key close
-  // to it is present, the message says which (a misspelt required key would
-  // otherwise only be reported as missing).
-  Node required(const std::string& key) const {
-    expect_object();
-    if (!has(key)) {
-      std::string hint;
-      const std::array<std::string_view, 1> wanted{key};
-      for (const auto& [present, unused] : value_.items())
-        if (!nearest_name(present, wanted).empty()) hint = " (is " + in_quotes(present) + " a misspelling of it?)";
-      fail("missing required key " + in_quotes(key) + hint);
-    }
-    return child(key);
-  }
-
- private:
-  const JsonDocument& doc_;
-  Pointer ptr_;
-  const json& value_;
-};
+using namespace scene_detail;
 
 CameraDesc read_camera(const Node& node) {
   node.allow_only({"position", "look_at", "up", "fov_y", "aperture_radius", "focus_distance"});
@@ -372,9 +236,9 @@ Material read_material(const Node& node, const std::string& name) {
   return m;
 }
 
-// One transform step, or a list applied in order (the first listed is
-// applied to the shape first).
-mat4 read_transform(const Node& node) {
+}  // namespace
+
+mat4 scene_detail::read_transform(const Node& node) {
   if (node.value().is_array()) {
     mat4 m(1.0f);
     for (std::size_t i = 0; i < node.value().size(); ++i) m = read_transform(node.child(i)) * m;
@@ -416,140 +280,7 @@ mat4 read_transform(const Node& node) {
                        (near.empty() ? " (expected translate, scale, rotate or matrix)" : near));
 }
 
-TriangleMesh unit_rectangle() {
-  TriangleMesh m;
-  m.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
-  m.triangles = {{0, 1, 2}, {0, 2, 3}};
-  return m;
-}
-
-TriangleMesh unit_box() {
-  TriangleMesh m;
-  // Six faces, each with its own four corners, wound counter-clockwise seen
-  // from outside.
-  const vec3 n[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  for (const vec3& normal : n) {
-    const Frame f(normal);
-    const auto base = static_cast<unsigned>(m.positions.size());
-    for (const vec2 c : {vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, 1)})
-      m.positions.push_back(normal + c.x * f.s + c.y * f.t);
-    // (s, t, n) is right-handed, so s -> t is counter-clockwise about n.
-    m.triangles.push_back({base, base + 1, base + 2});
-    m.triangles.push_back({base, base + 2, base + 3});
-  }
-  return m;
-}
-
-// The scene material `node` names, with "did you mean" when there is none.
-std::uint32_t material_index(const Node& node, const std::map<std::string, std::uint32_t>& materials) {
-  const std::string name = node.string();
-  const auto found = materials.find(name);
-  if (found == materials.end()) {
-    std::vector<std::string_view> names;
-    for (const auto& [known, unused] : materials) names.push_back(known);
-    node.fail("no material named " + in_quotes(name) + suggestion(name, names));
-  }
-  return found->second;
-}
-
-// `label` names the shape in messages: "shapes[3]", "groups/tree[0]".
-Shape read_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
-                 const std::map<std::string, std::uint32_t>& materials, const std::string& label) {
-  node.expect_object();
-  const std::string type = node.required("type").string();
-  Shape shape;
-  shape.description = label + " (" + type + ")";
-  if (type == "mesh") {
-    node.allow_only({"type", "file", "material", "transform", "flip_normals", "normals"});
-  } else if (type == "sphere") {
-    node.allow_only({"type", "center", "radius", "material", "transform", "flip_normals"});
-  } else if (type == "rectangle" || type == "box") {
-    node.allow_only({"type", "material", "transform", "flip_normals"});
-  } else {
-    const std::array<std::string_view, 5> types{"mesh", "sphere", "rectangle", "box", "gltf"};
-    const std::string near = suggestion(type, types);
-    node.child("type").fail("unknown shape type " + in_quotes(type) +
-                            (near.empty() ? " (expected mesh, sphere, rectangle, box or gltf)" : near));
-  }
-
-  shape.material = material_index(node.required("material"), materials);
-  shape.flip_normals = node.boolean_or("flip_normals", false);
-  const mat4 xf = node.has("transform") ? read_transform(node.child("transform")) : mat4(1.0f);
-
-  if (type == "sphere") {
-    shape.kind = Shape::Kind::Sphere;
-    shape.center = node.has("center") ? node.child("center").vector3() : vec3(0.0f);
-    shape.radius = static_cast<float>(node.number_or("radius", 1.0));
-    if (!(shape.radius > 0.0f)) node.child("radius").fail("radius must be positive");
-    // A sphere stays a sphere only under rotation, uniform scale, translation.
-    const mat3 l(xf);
-    const float sx = glm::length(l[0]), sy = glm::length(l[1]), sz = glm::length(l[2]);
-    const float tol = 1e-5f * std::max(sx, std::max(sy, sz));
-    if (std::abs(sx - sy) > tol || std::abs(sx - sz) > tol || std::abs(glm::dot(l[0], l[1])) > tol * sx ||
-        std::abs(glm::dot(l[0], l[2])) > tol * sx || std::abs(glm::dot(l[1], l[2])) > tol * sx)
-      node.child("transform").fail("a sphere's transform may only rotate, translate and scale uniformly");
-    shape.center = vec3(xf * vec4(shape.center, 1.0f));
-    shape.radius *= sx;
-    const Node where = node.has("transform") ? node.child("transform") : node.child("radius");
-    if (!is_finite(shape.center) || !std::isfinite(shape.radius))
-      where.fail("the sphere lies beyond the float range after its transform");
-    if (!(shape.radius > 0.0f))
-      where.fail(std::string(scene.materials[shape.material].emits() ? "zero-area light: " : "") +
-                 "the sphere's radius is zero after its transform");
-    return shape;
-  }
-
-  shape.kind = Shape::Kind::Triangles;
-  if (type == "mesh") {
-    const Node file = node.required("file");
-    if (file.string().empty()) file.fail("the mesh file name is empty");
-    const std::filesystem::path path = resolve_scene_path(folder, file.string());
-    shape.description = label + " (mesh " + file.string() + ")";
-    if (names_data_file(file.string()) && !std::filesystem::exists(path))
-      file.fail(file.string() + ": " + path.string() + " does not exist; " + data_directory_hint());
-    const std::string normals = node.has("normals") ? node.child("normals").string() : "file";
-    if (normals != "file" && normals != "flat" && normals != "smooth")
-      node.child("normals").fail("unknown normals " + in_quotes(normals) + " (expected file, flat or smooth)");
-    MeshLoadReport report;
-    try {
-      shape.mesh = load_mesh(path, &report);
-    } catch (const InputError& e) {
-      file.fail(e.what());
-    }
-    if (!report.ignored.empty()) {
-      std::string list;
-      for (const std::string& what : report.ignored) list += (list.empty() ? "" : "; ") + what;
-      scene.warnings.push_back(file.message(path.string() + ": ignored " + list));
-    }
-    // "file": the file's normals where it has them (flat otherwise);
-    // "flat": none; "smooth": angle-weighted vertex normals, computed.
-    if (normals == "flat") {
-      shape.mesh.normals.clear();
-    } else if (normals == "smooth") {
-      shape.mesh.normals = smooth_vertex_normals(shape.mesh);
-    }
-    if (report.degenerate_dropped > 0)
-      scene.warnings.push_back(file.message(
-          path.string() + ": dropped " + std::to_string(report.degenerate_dropped) + " degenerate triangle(s) of " +
-          std::to_string(report.degenerate_dropped + report.triangles_loaded) +
-          " (zero area or a repeated vertex)"));
-  } else {
-    shape.mesh = type == "rectangle" ? unit_rectangle() : unit_box();
-  }
-  const Node where = node.has("transform") ? node.child("transform") : node;
-  const std::size_t dropped = transform_mesh(&shape.mesh, xf);
-  for (const vec3& p : shape.mesh.positions)
-    if (!is_finite(p)) where.fail("the transform moves vertices beyond the float range (about 3.4e38)");
-  if (dropped > 0 && !shape.mesh.triangles.empty())
-    scene.warnings.push_back(where.message(shape.description + ": the transform made " + std::to_string(dropped) +
-                                           " triangle(s) degenerate; dropped"));
-  if (shape.mesh.triangles.empty()) {
-    const bool emits = scene.materials[shape.material].emits();
-    where.fail(emits ? "zero-area light: the shape has no area left after its transform"
-                     : "the shape has no area left after its transform");
-  }
-  return shape;
-}
+namespace {
 
 void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
                      const std::map<std::string, std::uint32_t>& materials, bool in_group);
@@ -575,7 +306,7 @@ void read_groups(const Node& node, Scene& scene, const std::filesystem::path& fo
       if (item.value().is_object() && item.has("type") && item.child("type").value() == "gltf")
         read_gltf_shape(item, scene, folder, materials, true);
       else
-        scene.shapes.push_back(read_shape(item, scene, folder, materials, "groups/" + name + "[" + std::to_string(i) + "]"));
+        read_shape(item, scene, folder, materials, "groups/" + name + "[" + std::to_string(i) + "]");
       if (scene.point_lights.size() != point_lights)
         item.child("file").fail("the glTF file has point lights, which instances do not place; put it in 'shapes'");
       for (std::size_t k = first; k < scene.shapes.size(); ++k) {
@@ -781,7 +512,7 @@ Scene read_scene(const JsonDocument& doc) {
     if (shape.value().is_object() && shape.has("type") && shape.child("type").value() == "gltf")
       read_gltf_shape(shape, scene, folder, materials, false);
     else
-      scene.shapes.push_back(read_shape(shape, scene, folder, materials, "shapes[" + std::to_string(i) + "]"));
+      read_shape(shape, scene, folder, materials, "shapes[" + std::to_string(i) + "]");
   }
   if (root.has("groups")) read_groups(root.child("groups"), scene, folder, materials);
   if (root.has("instances")) read_instances(root.child("instances"), &scene);

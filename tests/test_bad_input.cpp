@@ -337,6 +337,23 @@ TEST_F(BadInput, BrokenNormalsAndTextureCoordinates) {
   expect_rejected(render(write("normals-key.json", text)), {"normals-key.json:", "/shapes/0/normals", "unknown normals 'soft'"});
 }
 
+// OBJ materials (`usemtl`) map to scene materials by name; one that matches
+// none needs the shape's "material", and a "materials" key the file does
+// not have is a typo. Both point at the place in the scene file.
+TEST_F(BadInput, ObjMaterialsWithoutAFallback) {
+  write("parts.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl whit\nf 1 2 3\nusemtl steel\nf 1 3 2\n");
+  const std::string shape = "    {\"type\": \"mesh\", \"file\": \"parts.obj\"},\n";
+  const std::string text = scene(kMaterials, shape + kLamp);
+  expect_rejected(render(write("unmatched.json", text)),
+                  {"unmatched.json:" + where_in(text, "{\"type\": \"mesh\"") + ": /shapes/0: missing required key 'material'",
+                   "parts.obj uses materials that no scene material matches: 'whit' (did you mean 'white'?), 'steel'"});
+  const std::string mapped = scene(kMaterials, "    {\"type\": \"mesh\", \"file\": \"parts.obj\",\n"
+                                               "     \"materials\": {\"whit\": \"white\", \"stel\": \"white\"}},\n" + kLamp);
+  expect_rejected(render(write("unknown-name.json", mapped)),
+                  {"unknown-name.json:" + where_in(mapped, "\"stel\"") + ": /shapes/0/materials/stel",
+                   "parts.obj has no material named 'stel' (did you mean 'steel'?)"});
+}
+
 TEST_F(BadInput, NanAndInfiniteVerticesInPly) {
   for (const char* bad : {"nan", "-inf"}) {
     SCOPED_TRACE(bad);

@@ -109,12 +109,19 @@ TEST_F(ShadingData, ObjCornersAreWelded) {
   EXPECT_TRUE(report.ignored.empty()) << report.ignored.front();
 }
 
-// A face material the scene cannot use is named in the one warning.
-TEST_F(ShadingData, ObjMaterialsAreWarnedAbout) {
+// Face materials are used by name; the library's content is not read, and
+// the one warning says so (so that a user knows the colours come from the scene).
+TEST_F(ShadingData, ObjMaterialLibraryContentIsWarnedAbout) {
   MeshLoadReport report;
-  (void)load_mesh(write("m.obj", "mtllib none.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"), &report);
+  const TriangleMesh m =
+      load_mesh(write("m.obj", "mtllib none.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"), &report);
   ASSERT_EQ(report.ignored.size(), 1u);
-  EXPECT_NE(report.ignored[0].find("'usemtl'"), std::string::npos) << report.ignored[0];
+  EXPECT_NE(report.ignored[0].find("the material library's content (none.mtl: Kd, Ks, maps; the scene's materials give "
+                                   "the colours)"),
+            std::string::npos)
+      << report.ignored[0];
+  ASSERT_EQ(m.material_names, std::vector<std::string>{"red"});
+  EXPECT_EQ(m.face_material, std::vector<std::uint16_t>{0});
 }
 
 TEST_F(ShadingData, SceneNormalsKey) {
