@@ -1,5 +1,6 @@
 #include "core/compiled_scene.h"
 
+#include "core/error.h"
 #include "core/geometry.h"
 #include "core/parallel.h"
 #include "core/tangents.h"
@@ -25,10 +26,31 @@ void transform_point(const mat4& m, vec3* p, vec3* p_error) {
   *p_error = err;
 }
 
+// The loaders check what a file says; a scene built in code gets the same
+// guarantees here: groups name existing shapes marked in_group, instances
+// existing groups, and every placement is finite and invertible.
+void check_instancing(const Scene& scene) {
+  for (const ShapeGroup& group : scene.groups)
+    for (const std::uint32_t s : group.shapes)
+      if (s >= scene.shapes.size() || !scene.shapes[s].in_group)
+        throw InputError("group '" + group.name + "': shape " + std::to_string(s) +
+                         (s >= scene.shapes.size() ? " does not exist" : " is not marked in_group"));
+  for (const Instance& inst : scene.instances) {
+    if (inst.group >= scene.groups.size())
+      throw InputError(inst.description + ": no group " + std::to_string(inst.group));
+    const float det = glm::determinant(mat3(inst.to_world));
+    bool finite = std::isfinite(det) && det != 0.0f;
+    const mat4 inverse = glm::inverse(inst.to_world);
+    for (int c = 0; c < 4; ++c) finite = finite && is_finite(vec3(inst.to_world[c])) && is_finite(vec3(inverse[c]));
+    if (!finite) throw InputError(inst.description + ": the placement is singular or not finite");
+  }
+}
+
 }  // namespace
 
 CompiledScene::CompiledScene(Scene scene)
     : scene_(std::move(scene)), camera_(scene_.camera, scene_.film.width, scene_.film.height) {
+  check_instancing(scene_);
   configure_shading(scene_);  // materials: shading path for the scene's lobes, sampling flavour, min pdf
   const auto shape_bounds = [](const Shape& shape, vec3& lo, vec3& hi) {
     if (shape.kind == Shape::Kind::Sphere) {

@@ -43,6 +43,11 @@ struct EmbreeAccel::Impl {
   RTCScene scene = nullptr;
   std::uint32_t first_instance = 0;  // geometry ID of instance 0 in `scene`
   bool has_instances = false;
+  // A group's shapes have IDs 0, 1, ... in the group's Embree scene (IDs
+  // there cost Embree memory up to the largest): the scene's shape of
+  // geometry k in instance i's group is group_shapes[instance_group[i]][k].
+  std::vector<std::vector<std::uint32_t>> group_shapes;
+  std::vector<std::uint32_t> instance_group;
   bool compact = false;
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -61,6 +66,12 @@ struct EmbreeAccel::Impl {
   std::uint32_t instance_of(unsigned inst_id) const {
     return inst_id == RTC_INVALID_GEOMETRY_ID ? kNoInstance : inst_id - first_instance;
   }
+  // The scene's shape index of a hit on geometry `geom_id`, in the top scene
+  // or in the group an instance placed.
+  std::uint32_t shape_of(unsigned geom_id, unsigned inst_id) const {
+    if (inst_id == RTC_INVALID_GEOMETRY_ID || geom_id == RTC_INVALID_GEOMETRY_ID) return geom_id;
+    return group_shapes[instance_group[inst_id - first_instance]][geom_id];
+  }
 };
 
 EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups,
@@ -77,8 +88,7 @@ EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const Shape
   for (std::uint32_t id = 0; id < shapes.size(); ++id)
     if (!shapes[id].in_group) impl_->attach(impl_->scene, shapes[id], id);
 
-  // Each group's BVH is built once; its shapes keep their scene-wide IDs,
-  // so a hit names the shape directly and the instance separately.
+  // Each group's BVH is built once, its shapes numbered from 0 in it.
   struct GroupScenes {  // released however the constructor ends: the instances hold their own references
     std::vector<RTCScene> scenes;
     ~GroupScenes() {
@@ -87,7 +97,9 @@ EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const Shape
   } group_scenes;
   for (const ShapeGroup& group : groups) {
     group_scenes.scenes.push_back(impl_->new_scene());
-    for (const std::uint32_t id : group.shapes) impl_->attach(group_scenes.scenes.back(), shapes[id], id);
+    for (std::uint32_t k = 0; k < group.shapes.size(); ++k)
+      impl_->attach(group_scenes.scenes.back(), shapes[group.shapes[k]], k);
+    impl_->group_shapes.push_back(group.shapes);
     rtcCommitScene(group_scenes.scenes.back());
     impl_->errors.check(("building the BVH of group " + group.name).c_str());
   }
@@ -97,6 +109,7 @@ EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const Shape
     const Instance& inst = instances[i];
     RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_INSTANCE);
     rtcSetGeometryInstancedScene(geom, group_scenes.scenes[inst.group]);
+    impl_->instance_group.push_back(inst.group);
     // glm is column-major: column c, row r is to_world[c][r].
     float xfm[12];
     for (int c = 0; c < 4; ++c)
@@ -187,7 +200,7 @@ bool EmbreeAccel::intersect(const Ray& ray, RayHit* hit) const {
   rtcIntersect1(impl_->scene, &context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit->t = rh.ray.tfar;
-  hit->shape = rh.hit.geomID;
+  hit->shape = impl_->shape_of(rh.hit.geomID, rh.hit.instID[0]);
   hit->prim = rh.hit.primID;
   hit->uv = vec2(rh.hit.u, rh.hit.v);
   hit->instance = impl_->instance_of(rh.hit.instID[0]);
@@ -277,7 +290,7 @@ void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> h
   RTCIntersectContext context = make_context(coherent);
   auto record = [&](std::size_t i, float tfar, unsigned geom, unsigned prim, float u, float v, unsigned inst) {
     found[i] = geom != RTC_INVALID_GEOMETRY_ID;
-    if (found[i]) hits[i] = RayHit{tfar, geom, prim, vec2(u, v), impl_->instance_of(inst)};
+    if (found[i]) hits[i] = RayHit{tfar, impl_->shape_of(geom, inst), prim, vec2(u, v), impl_->instance_of(inst)};
   };
   switch (mode) {
     case RayBatchMode::Single:
@@ -423,7 +436,7 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, cons
   // Every field written, hit or miss: no branch on a coin flip per ray.
   auto record = [&](std::size_t i, float tfar, unsigned geom, unsigned prim, float u, float v, unsigned inst) {
     hits.found[i] = geom != RTC_INVALID_GEOMETRY_ID;
-    hits.t[i] = tfar, hits.shape[i] = geom, hits.prim[i] = prim, hits.u[i] = u, hits.v[i] = v;
+    hits.t[i] = tfar, hits.shape[i] = impl_->shape_of(geom, inst), hits.prim[i] = prim, hits.u[i] = u, hits.v[i] = v;
     if (hits.instance) hits.instance[i] = impl_->instance_of(inst);
   };
   switch (mode) {

@@ -1,8 +1,10 @@
 // The Embree 3 BVH over a scene's shapes: triangle meshes as Embree
 // triangles, spheres as Embree's true (analytic) spheres. Embree geometry ID
 // equals the shape index. A group (Scene::groups) is a scene of its own,
-// built once, and each of the scene's instances places it through an Embree
-// instance (geometry ID shapes.size() + instance index in the top scene).
+// built once (its shapes numbered 0, 1, ... there; hits are given the
+// scene's shape index), and each of the scene's instances places it through
+// an Embree instance (geometry ID shapes.size() + instance index in the top
+// scene).
 // This is the only file that includes Embree.
 #pragma once
 

@@ -71,7 +71,14 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
 
 tinygltf::Model parse(const fs::path& file) {
   const gltf::Container container = gltf::read_container(file);
-  const nlohmann::json doc = nlohmann::json::parse(container.json_text, nullptr, false);
+  // tinygltf reads "extras" and "extensions" recursively: a file nested
+  // deeper than any real one is refused before it can exhaust the stack.
+  constexpr int kMaxDepth = 64;
+  const auto depth_limit = [&](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+    if (depth > kMaxDepth) fail(file, "", "JSON nested more than " + std::to_string(kMaxDepth) + " levels deep");
+    return true;
+  };
+  const nlohmann::json doc = nlohmann::json::parse(container.json_text, depth_limit, false);
   if (doc.is_discarded()) fail(file, "", "not valid JSON");
   Approved approved{gltf::validate(doc, file, container)};
 

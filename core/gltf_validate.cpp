@@ -209,6 +209,10 @@ void Checker::accessors() {
     if (count == 0) fail_at(ptr + "/count", "count must be at least 1");
     const std::int64_t view = index(a, ptr, "bufferView", view_length_.size(), "bufferView");
     const std::uint64_t offset = uint(a, ptr, "byteOffset", 0);
+    // Without a bufferView the data is all zeros, and nothing bounds the
+    // count but this (pathlab would allocate it).
+    if (view < 0 && count > (std::uint64_t{1} << 24))
+      fail_at(ptr + "/count", "count " + std::to_string(count) + " without a bufferView: more than 2^24 zeros");
     if (view < 0) continue;  // all zeros
     // Matrices' columns are padded to 4 bytes; pathlab reads no matrices,
     // so their element size only needs to bound the read.
@@ -256,6 +260,9 @@ void Checker::nodes_and_scenes() {
       doc_["extensions"]["KHR_lights_punctual"].contains("lights") &&
       doc_["extensions"]["KHR_lights_punctual"]["lights"].is_array())
     lights = doc_["extensions"]["KHR_lights_punctual"]["lights"].size();
+  // glTF gives a node one parent at most: with more, every path through the
+  // graph would be a placement, 2^n of them for a chain of n doubled links.
+  std::vector<std::int64_t> parent(nodes.size(), -1);
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const std::string ptr = "/nodes/" + std::to_string(i);
     index(nodes[i], ptr, "mesh", count("meshes"), "mesh");
@@ -270,6 +277,12 @@ void Checker::nodes_and_scenes() {
         if (!children[k].is_number_unsigned() || children[k].get<std::uint64_t>() >= nodes.size())
           fail_at(ptr + "/children/" + std::to_string(k), "no node " + children[k].dump().substr(0, 20) +
                                                               " (the file has " + std::to_string(nodes.size()) + ")");
+        const auto child = children[k].get<std::size_t>();
+        if (parent[child] >= 0)
+          fail_at(ptr + "/children/" + std::to_string(k),
+                  "node " + std::to_string(child) + " already has parent node " + std::to_string(parent[child]) +
+                      " (glTF allows one parent per node)");
+        parent[child] = static_cast<std::int64_t>(i);
       }
     }
   }
@@ -311,6 +324,9 @@ void Checker::nodes_and_scenes() {
       if (!scenes[s]["nodes"][k].is_number_unsigned() || scenes[s]["nodes"][k].get<std::uint64_t>() >= nodes.size())
         fail_at(ptr + "/nodes/" + std::to_string(k), "no node " + scenes[s]["nodes"][k].dump().substr(0, 20) +
                                                          " (the file has " + std::to_string(nodes.size()) + ")");
+      else if (const auto root = scenes[s]["nodes"][k].get<std::size_t>(); parent[root] >= 0)
+        fail_at(ptr + "/nodes/" + std::to_string(k), "node " + std::to_string(root) + " is a child of node " +
+                                                         std::to_string(parent[root]) + ", not a root");
   }
   index(doc_, "", "scene", scenes.size(), "scene");
 }

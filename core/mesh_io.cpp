@@ -26,7 +26,9 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <stdexcept>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 namespace pathlab {
@@ -288,6 +290,7 @@ ObjDirectives scan_obj(const fs::path& file, std::string_view text) {
     int count = 0;
   };
   Kind kinds[] = {{"v", "vertex", 3, 3}, {"vn", "normal", 3, 3}, {"vt", "texture coordinate", 1, 2}};
+  std::unordered_set<std::string_view> seen_materials;  // views into `text`, which outlives the scan
   for (int line_no = 1; !text.empty(); ++line_no) {
     // Lines end like tinyobj's: at "\n", "\r\n" or a lone "\r".
     const std::size_t eol = std::min(text.find_first_of("\r\n"), text.size());
@@ -300,8 +303,12 @@ ObjDirectives scan_obj(const fs::path& file, std::string_view text) {
       std::string_view name = line.substr(6);
       name.remove_prefix(std::min(name.find_first_not_of(" \t"), name.size()));
       name = name.substr(0, std::min(name.find_first_of(std::string_view(" \t\r\0", 4)), name.size()));
-      if (!name.empty() && std::find(found.materials.begin(), found.materials.end(), name) == found.materials.end())
+      if (!name.empty() && seen_materials.emplace(name).second) {
         found.materials.emplace_back(name);
+        if (found.materials.size() >= TriangleMesh::kNoFileMaterial)
+          fail(file, "too many materials (more than " + std::to_string(TriangleMesh::kNoFileMaterial - 1) +
+                         " 'usemtl' names)", line_no);
+      }
       continue;
     }
     if (line.size() > 6 && line.starts_with("mtllib") && is_blank(line[6])) {
@@ -341,9 +348,6 @@ ObjDirectives scan_obj(const fs::path& file, std::string_view text) {
       }
     }
   }
-  if (found.materials.size() >= TriangleMesh::kNoFileMaterial)
-    fail(file, "too many materials ('usemtl' names " + std::to_string(found.materials.size()) + ", at most " +
-                   std::to_string(TriangleMesh::kNoFileMaterial - 1) + ")");
   return found;
 }
 
@@ -784,8 +788,12 @@ std::vector<std::pair<std::uint16_t, TriangleMesh>> split_by_face_material(Trian
           mesh.face_material.end() || mesh.face_material.empty())
     slots.push_back(TriangleMesh::kNoFileMaterial);
   std::vector<char> used(mesh.material_names.size(), 0);
-  for (const std::uint16_t m : mesh.face_material)
-    if (m != TriangleMesh::kNoFileMaterial) used[m] = 1;
+  for (const std::uint16_t m : mesh.face_material) {
+    if (m == TriangleMesh::kNoFileMaterial) continue;
+    if (m >= used.size()) throw std::invalid_argument("split_by_face_material: a face names material slot " +
+                                                      std::to_string(m) + " of " + std::to_string(used.size()));
+    used[m] = 1;
+  }
   for (std::size_t m = 0; m < used.size(); ++m)
     if (used[m]) slots.push_back(static_cast<std::uint16_t>(m));
   if (slots.size() == 1) {
@@ -794,6 +802,13 @@ std::vector<std::pair<std::uint16_t, TriangleMesh>> split_by_face_material(Trian
     mesh.material_names.clear();
     parts.emplace_back(slots[0], std::move(mesh));
     return parts;
+  }
+  // The triangles of each slot, in one pass (not one pass per slot: a file
+  // may have thousands of materials).
+  std::vector<std::vector<std::uint32_t>> by_slot(mesh.material_names.size() + 1);
+  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    const std::uint16_t m = mesh.face_material[t];
+    by_slot[m == TriangleMesh::kNoFileMaterial ? mesh.material_names.size() : m].push_back(t);
   }
   constexpr std::uint32_t kUnused = 0xffffffffu;
   std::vector<std::uint32_t> remap(mesh.positions.size(), kUnused);
@@ -811,8 +826,7 @@ std::vector<std::pair<std::uint16_t, TriangleMesh>> split_by_face_material(Trian
       }
       return remap[v];
     };
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-      if (mesh.face_material[t] != slot) continue;
+    for (const std::uint32_t t : by_slot[slot == TriangleMesh::kNoFileMaterial ? mesh.material_names.size() : slot]) {
       const glm::uvec3& tri = mesh.triangles[t];
       const std::uint32_t a = vertex(tri.x), b = vertex(tri.y), c = vertex(tri.z);
       part.triangles.emplace_back(a, b, c);

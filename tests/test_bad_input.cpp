@@ -586,7 +586,19 @@ TEST_F(BadInput, GltfNodeCycleAndUnknownMesh) {
   expect_rejected(render(write("cycle.gltf", w.embedded())),
                   {"cycle.gltf: /nodes/2/children/0: node 1 is its own descendant (a cycle in the node graph)"});
   w.doc["nodes"][1] = {{"children", {1}}};
+  w.doc["nodes"][2] = {{"name", "no children"}};
   expect_rejected(render(write("self.gltf", w.embedded())), {"self.gltf: /nodes/1/children/0: node 1 is its own descendant"});
+  // A second parent: every path would be a placement (2^n for n doubled links).
+  w.doc["nodes"][1] = {{"name", "leaf"}};
+  w.doc["nodes"][2] = {{"children", {1}}};
+  w.node({{"children", {1}}});
+  expect_rejected(render(write("dag.gltf", w.embedded())),
+                  {"dag.gltf: /nodes/3/children/0: node 1 already has parent node 2 (glTF allows one parent per node)"});
+  // So deep that tinygltf's recursive reading of "extras" would overflow.
+  w.doc["nodes"].erase(3);
+  std::string text = w.embedded();
+  text.insert(text.rfind('}'), ", \"extras\": " + std::string(100000, '[') + "1" + std::string(100000, ']'));
+  expect_rejected(render(write("deep.gltf", text)), {"deep.gltf", "nested more than 64 levels deep"});
   w.doc["nodes"][1] = {{"mesh", 7}};
   expect_rejected(render(write("mesh.gltf", w.embedded())), {"mesh.gltf: /nodes/1/mesh: no mesh 7 (the file has 1)"});
 }

@@ -522,8 +522,10 @@ TEST_F(Gltf, MeshPlacedByThreeNodesIsOneGroupOfThreeInstances) {
   for (const Shape& shape : grouped.shapes) EXPECT_TRUE(shape.in_group);
 }
 
-// Counting every path: one node under two parents places its mesh twice.
-TEST_F(Gltf, PlacementsCountEveryPathThroughTheNodeGraph) {
+// glTF allows a node one parent: a second one is refused (every path would
+// be a placement, 2^n for a chain of n doubled links), as is a scene root
+// that is some node's child. Two nodes naming one mesh place it twice.
+TEST_F(Gltf, NodesHaveOneParentAndMeshesArePlacedPerNode) {
   GltfWriter w;
   add_square(w, 1.0f, true, -1);
   w.doc["meshes"][0]["primitives"][0].erase("material");
@@ -531,7 +533,21 @@ TEST_F(Gltf, PlacementsCountEveryPathThroughTheNodeGraph) {
   w.node({{"translation", {0, 1, 0}}, {"children", {0}}});
   w.node({{"translation", {0, 2, 0}}, {"children", {0}}});
   w.doc["scenes"] = {{{"nodes", {1, 2}}}};
-  const GltfContent c = load_all(w, "dag");
+  const auto refused = [&](const std::string& name, const std::string& words) {
+    try {
+      (void)load_all(w, name);
+      ADD_FAILURE() << name << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  refused("dag", "/nodes/2/children/0: node 0 already has parent node 1 (glTF allows one parent per node)");
+  w.doc["nodes"][2].erase("children");
+  w.doc["nodes"][2]["mesh"] = 0;
+  w.doc["scenes"] = {{{"nodes", {0, 1, 2}}}};
+  refused("root", "/scenes/0/nodes/0: node 0 is a child of node 1, not a root");
+  w.doc["scenes"] = {{{"nodes", {1, 2}}}};
+  const GltfContent c = load_all(w, "two");
   EXPECT_TRUE(c.primitives.empty());
   EXPECT_EQ(c.groups.size(), 1u);
   ASSERT_EQ(c.instances.size(), 2u);

@@ -8,6 +8,7 @@
 // count; the scene file's "groups" and "instances"; a group's triangles are
 // stored once.
 #include "core/compiled_scene.h"
+#include "core/error.h"
 #include "core/film.h"
 #include "core/geometry.h"
 #include "core/parallel.h"
@@ -20,6 +21,7 @@
 #include "tests/test_scenes.h"
 #include "wavefront/wavefront_tracer.h"
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -199,6 +201,72 @@ TEST(Instancing, TracedHitsNameTheirInstance) {
       }
     }
   EXPECT_EQ(seen.size(), 3u);
+}
+
+// Rays leaving an instanced convex surface outwards never find it again,
+// with placements far from the origin, turned and strongly scaled: the
+// placed point's error bound covers what Embree does to the ray when it
+// takes it into the group's space.
+TEST(Instancing, NoSelfIntersectionOnFarTurnedScaledInstances) {
+  Scene scene;
+  scene.name = "far instances";
+  scene.materials.push_back(diffuse_material(Spectrum(0.5f)));
+  Shape ball;
+  ball.in_group = true;
+  ball.mesh = test::uv_sphere(vec3(0.0f), 1.0f, 12, false);
+  scene.shapes.push_back(ball);
+  scene.groups.push_back({"ball", {0}});
+  const mat4 turn = glm::rotate(mat4(1.0f), 0.785f, glm::normalize(vec3(1, 2, 3)));
+  std::vector<mat4> placements;
+  for (const float far : {1e3f, 1e4f, 1e5f})
+    for (const vec3 scale : {vec3(1.0f), vec3(1e-2f, 1e2f, 1.0f), vec3(-3.0f, 0.5f, 2.0f)})
+      placements.push_back(glm::translate(mat4(1.0f), vec3(far, -0.7f * far, 0.3f * far)) * turn *
+                           glm::scale(mat4(1.0f), scale));
+  for (const mat4& m : placements) scene.instances.push_back({0, m, "far"});
+  const CompiledScene compiled(std::move(scene));
+  int self_hits = 0, rays = 0;
+  for (std::uint32_t k = 0; k < placements.size(); ++k) {
+    const vec3 centre = vec3(placements[k][3]);
+    const float reach = 3.0f * glm::length(vec3(placements[k] * vec4(1, 1, 1, 0)));
+    for (std::uint32_t i = 0; i < 300; ++i) {
+      const vec2 u((static_cast<float>(i) + 0.5f) / 300.0f, std::fmod(0.618034f * static_cast<float>(i), 1.0f));
+      const vec3 origin = centre + reach * square_to_uniform_sphere(u);
+      Surfel s, again;
+      if (!compiled.intersect(Ray{origin, glm::normalize(centre - origin), kInfinity}, &s) || s.instance != k) continue;
+      for (std::uint32_t j = 0; j < 8; ++j) {
+        vec3 w = square_to_cosine_hemisphere(vec2((static_cast<float>(j) + 0.5f) / 8.0f, u.x));
+        if (j % 4 == 0) w = glm::normalize(vec3(w.x, w.y, 1e-3f));  // grazing
+        ++rays;
+        if (compiled.intersect(s.spawn(Frame(s.n).to_world(w)), &again) && again.instance == k) ++self_hits;
+      }
+    }
+  }
+  EXPECT_GT(rays, 5000);
+  EXPECT_EQ(self_hits, 0) << "of " << rays << " rays";
+}
+
+// A scene built in code gets the loaders' checks when it is compiled.
+TEST(Instancing, CompiledSceneRefusesBrokenInstancing) {
+  const auto refused = [](Scene scene, const std::string& words) {
+    try {
+      const CompiledScene compiled(std::move(scene));
+      ADD_FAILURE() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  Scene bad = test::cornell_with_instances();
+  bad.instances[1].group = 7;
+  refused(bad, "instances[1] (pair): no group 7");
+  bad = test::cornell_with_instances();
+  bad.instances[2].to_world[0][0] = std::nanf("");
+  refused(bad, "instances[2] (pair): the placement is singular or not finite");
+  bad = test::cornell_with_instances();
+  bad.instances[0].to_world = glm::scale(mat4(1.0f), vec3(1.0f, 0.0f, 1.0f));
+  refused(bad, "singular");
+  bad = test::cornell_with_instances();
+  bad.groups[0].shapes.push_back(0);  // placed in the world, not in_group
+  refused(bad, "group 'pair': shape 0 is not marked in_group");
 }
 
 TEST(Instancing, SceneFileGroupsAndInstances) {
