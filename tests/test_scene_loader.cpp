@@ -121,7 +121,7 @@ TEST(SceneLoader, MinimalSceneGetsEveryDefault) {
   EXPECT_EQ(s.render.strategy, Strategy::Mis);
   EXPECT_EQ(s.render.seed, 0u);
   // Lights: none, which is worth a warning naming the file.
-  EXPECT_TRUE(s.point_lights.empty());
+  EXPECT_TRUE(s.delta_lights.empty());
   EXPECT_FALSE(s.environment.has_value());
   ASSERT_EQ(s.warnings.size(), 1u);
   EXPECT_NE(s.warnings[0].find("folder/minimal.json"), std::string::npos) << s.warnings[0];
@@ -397,10 +397,10 @@ TEST(SceneLoader, PointAndEnvironmentLights) {
     {"type": "point", "position": [1, 2, 3], "intensity": [4, 5, 6]},
     {"type": "point", "position": [0, 0, 0], "intensity": 2},
     {"type": "environment", "radiance": 0.5}])"));
-  ASSERT_EQ(s.point_lights.size(), 2u);
-  expect_vec(s.point_lights[0].position, vec3(1, 2, 3));
-  expect_vec(s.point_lights[0].intensity, vec3(4, 5, 6));
-  expect_vec(s.point_lights[1].intensity, vec3(2.0f));
+  ASSERT_EQ(s.delta_lights.size(), 2u);
+  expect_vec(s.delta_lights[0].position, vec3(1, 2, 3));
+  expect_vec(s.delta_lights[0].intensity, vec3(4, 5, 6));
+  expect_vec(s.delta_lights[1].intensity, vec3(2.0f));
   ASSERT_TRUE(s.environment.has_value());
   expect_vec(*s.environment, vec3(0.5f));
   EXPECT_TRUE(s.warnings.empty());

@@ -354,7 +354,7 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
   sphere_light.shapes.push_back(bulb);
   EXPECT_FALSE(vectorised(sphere_light, Strategy::Mis));
   Scene point_light = cornell;
-  point_light.point_lights.push_back({vec3(0.0f, 1.0f, 0.0f), Spectrum(1.0f)});
+  point_light.delta_lights.push_back({vec3(0.0f, 1.0f, 0.0f), Spectrum(1.0f)});
   EXPECT_FALSE(vectorised(point_light, Strategy::Mis));
   EXPECT_FALSE(vectorised(load_scene(analytic / "sphere-in-environment.json"), Strategy::Mis));      // environment
   EXPECT_FALSE(vectorised(load_scene(analytic / "mirror-sphere-gray-room.json"), Strategy::Mis));    // mirror
