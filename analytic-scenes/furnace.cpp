@@ -50,7 +50,7 @@ std::unique_ptr<AnalyticModel> make_furnace(const Scene& scene) {
   if (!contains(room, scene.camera.position)) refuse(scene, kName, "the camera must be inside the room");
   if (!emits_inwards(room, m))
     refuse(scene, kName, "the room's emission faces outwards: set \"flip_normals\": true or \"two_sided\": true");
-  if (!scene.point_lights.empty()) refuse(scene, kName, "point lights break the uniform radiance; remove them");
+  if (!scene.delta_lights.empty()) refuse(scene, kName, "delta lights (point, spot, directional) break the uniform radiance; remove them");
   const int D = scene.render.max_depth;
   // Seen from inside, a one-sided room whose front faces out reflects nothing.
   const Spectrum rho = reflectance_inside(room, m);

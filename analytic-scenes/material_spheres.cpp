@@ -40,7 +40,7 @@ std::string fmt(const Spectrum& c) {
 const Shape& lone_sphere(const Scene& scene, std::string_view model) {
   if (scene.shapes.size() != 1 || scene.shapes[0].kind != Shape::Kind::Sphere)
     refuse(scene, model, "needs exactly one shape, a sphere");
-  if (!scene.point_lights.empty()) refuse(scene, model, "point lights break the uniform surroundings; remove them");
+  if (!scene.delta_lights.empty()) refuse(scene, model, "delta lights (point, spot, directional) break the uniform surroundings; remove them");
   if (!scene.environment) refuse(scene, model, "needs a uniform environment light");
   if (scene.materials[scene.shapes[0].material].emits()) refuse(scene, model, "the sphere must not emit");
   if (scene.materials[scene.shapes[0].material].one_sided && scene.shapes[0].flip_normals)

@@ -165,7 +165,7 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
   if (!model->emitter) refuse(scene, kName, "needs an emitting polygon");
   if (!model->ground) refuse(scene, kName, "needs a reflecting ground");
   if (scene.environment && !is_black(*scene.environment)) refuse(scene, kName, "an environment would light the ground too; remove it");
-  if (!scene.point_lights.empty()) refuse(scene, kName, "point lights would light the ground too; remove them");
+  if (!scene.delta_lights.empty()) refuse(scene, kName, "delta lights (point, spot, directional) would light the ground too; remove them");
 
   const Material& em = scene.materials[model->emitter->material];
   const Material& gm = scene.materials[model->ground->material];

@@ -60,7 +60,7 @@ std::unique_ptr<AnalyticModel> make_sphere_in_uniform_light(const Scene& scene) 
   const Material& sm = scene.materials[sphere->material];
   if (sm.type != MaterialType::Diffuse && sm.type != MaterialType::Mirror)
     refuse(scene, kName, "the sphere must be diffuse or mirror");
-  if (!scene.point_lights.empty()) refuse(scene, kName, "point lights break the uniform surroundings; remove them");
+  if (!scene.delta_lights.empty()) refuse(scene, kName, "delta lights (point, spot, directional) break the uniform surroundings; remove them");
   const int D = scene.render.max_depth;
 
   Spectrum surround;

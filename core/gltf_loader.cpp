@@ -455,18 +455,39 @@ void Flattener::place_node(std::size_t index, const mat4& world) {
   if (light != node.extensions.end() && light->second.Has("light")) {
     const int l = light->second.Get("light").GetNumberAsInt();
     const tinygltf::Light& src = model_.lights[static_cast<std::size_t>(l)];
+    const std::string where = "/extensions/KHR_lights_punctual/lights/" + std::to_string(l);
+    Spectrum color(1.0f);
+    if (src.color.size() == 3) color = Spectrum(static_cast<float>(src.color[0]), static_cast<float>(src.color[1]),
+                                                 static_cast<float>(src.color[2]));
+    // Candela taken as W/sr, lux as W/m^2, per channel (docs/scene-format.md).
+    const Spectrum intensity = color * static_cast<float>(src.intensity);
+    if (!is_finite(intensity) || intensity.x < 0.0f || intensity.y < 0.0f || intensity.z < 0.0f)
+      fail(file_, where, "colour and intensity must be finite and not negative");
+    DeltaLight out;
+    out.position = vec3(xf * vec4(0, 0, 0, 1));
+    out.intensity = intensity;
+    if (src.type == "spot" || src.type == "directional") {
+      // Both shine down the node's -z axis.
+      const vec3 axis = vec3(xf * vec4(0, 0, -1, 0));
+      if (!is_finite(axis) || !(glm::length(axis) > 0.0f))
+        fail(file_, "/nodes/" + std::to_string(index), "the light's transform is degenerate");
+      out.direction = glm::normalize(axis);
+    }
     if (src.type == "point") {
-      Spectrum color(1.0f);
-      if (src.color.size() == 3) color = Spectrum(static_cast<float>(src.color[0]), static_cast<float>(src.color[1]),
-                                                   static_cast<float>(src.color[2]));
-      // Candela taken as W/sr per channel (docs/scene-format.md).
-      const Spectrum intensity = color * static_cast<float>(src.intensity);
-      if (!is_finite(intensity) || intensity.x < 0.0f || intensity.y < 0.0f || intensity.z < 0.0f)
-        fail(file_, "/extensions/KHR_lights_punctual/lights/" + std::to_string(l),
-             "colour and intensity must be finite and not negative");
-      out_.point_lights.push_back({vec3(xf * vec4(0, 0, 0, 1)), intensity});
+      out_.delta_lights.push_back(out);
+    } else if (src.type == "spot") {
+      const double inner = src.spot.innerConeAngle, outer = src.spot.outerConeAngle;
+      if (!(inner >= 0.0 && inner < outer && outer <= M_PI / 2))
+        fail(file_, where, "spot cone angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi/2");
+      out.kind = DeltaLight::Kind::Spot;
+      out.cos_outer = static_cast<float>(std::cos(outer));
+      out.cos_inner = static_cast<float>(std::cos(inner));
+      out_.delta_lights.push_back(out);
+    } else if (src.type == "directional") {
+      out.kind = DeltaLight::Kind::Directional;
+      out_.delta_lights.push_back(out);
     } else {
-      warn_once("lights", "spot and directional lights are not supported yet; ignored");
+      warn_once("lights", "lights of a type other than point, spot and directional ignored");
     }
   }
 }
@@ -594,7 +615,7 @@ GltfContent Flattener::run() {
   for (std::size_t m = 0; m < model_.meshes.size(); ++m)
     instanced_[m] = !options_.flatten && uses[m] >= 2 && may_instance(m);
   walk(from, [&](std::size_t node, const mat4& world) { place_node(node, world); });
-  if (out_.primitives.empty() && out_.groups.empty() && out_.point_lights.empty())
+  if (out_.primitives.empty() && out_.groups.empty() && out_.delta_lights.empty())
     out_.warnings.push_back(file_.string() + ": the scene holds no triangles");
   if (!ignored_.empty()) {
     std::string list;

@@ -55,7 +55,7 @@ struct GltfContent {
   // to_world = the caller's transform x the node's world matrix.
   std::vector<Instance> instances;
   std::vector<GltfCamera> cameras;         // perspective cameras, in node order
-  std::vector<PointLight> point_lights;    // KHR_lights_punctual point lights
+  std::vector<DeltaLight> delta_lights;    // KHR_lights_punctual point, spot and directional lights
   std::vector<std::string> warnings;       // one line each, naming the file
 };
 

@@ -72,7 +72,7 @@ void append_gltf(Scene& scene, const GltfContent& content, const std::vector<std
   }
   for (const Instance& inst : content.instances)
     scene.instances.push_back({first_group + inst.group, inst.to_world, inst.description});
-  scene.point_lights.insert(scene.point_lights.end(), content.point_lights.begin(), content.point_lights.end());
+  scene.delta_lights.insert(scene.delta_lights.end(), content.delta_lights.begin(), content.delta_lights.end());
 }
 
 Scene load_gltf_scene(const std::filesystem::path& file) {
@@ -113,7 +113,7 @@ Scene load_gltf_scene(const std::filesystem::path& file) {
     scene.camera.up = vec3(0.0f, 1.0f, 0.0f);
     scene.camera.focus_distance = distance;
   }
-  bool emits = !scene.point_lights.empty();
+  bool emits = !scene.delta_lights.empty();
   for (const Shape& s : scene.shapes) emits = emits || scene.materials[s.material].emits();
   if (!emits) scene.environment = Spectrum(1.0f);  // so that any model is visible
   return scene;

@@ -44,6 +44,29 @@ float faulty_distance(float dist) { return PATHLAB_FAULT(LightPdfWithoutDistance
 
 }  // namespace
 
+float spot_profile(float cos_theta, float cos_outer, float cos_inner) {
+  if (cos_theta >= cos_inner) return 1.0f;
+  if (cos_theta <= cos_outer) return 0.0f;
+  const float t = (cos_theta - cos_outer) / (cos_inner - cos_outer);
+  return t * t * (3.0f - 2.0f * t);
+}
+
+double delta_power_over_4pi(const DeltaLight& light, float scene_radius) {
+  const double y = luminance(light.intensity);
+  switch (light.kind) {
+    case DeltaLight::Kind::Point:
+      return y;  // 4 pi Y(I)
+    case DeltaLight::Kind::Spot:
+      // 2 pi Y(I) (1 - (cos_inner + cos_outer) / 2): the exact integral of the
+      // profile over the sphere (a smoothstep in cos theta averages 1/2).
+      return 0.5 * y * (1.0 - 0.5 * (double(light.cos_inner) + double(light.cos_outer)));
+    case DeltaLight::Kind::Directional:
+      // pi r^2 Y(E): the flux it sends through the scene's bounding sphere.
+      return 0.25 * y * double(scene_radius) * double(scene_radius);
+  }
+  return 0.0;
+}
+
 float LightSampler::area_density(const Entry& e) { return PATHLAB_FAULT(LightPdfWithoutArea) ? 1.0f : 1.0f / e.area; }
 
 LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&scene) {
@@ -77,11 +100,14 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&sce
   }
   build_distribution(power, &pmf_, &cdf_);
 
+  // Delta lights by power (docs/scene-format.md, "How a light is picked"),
+  // each divided by 4 pi so that a point light's weight is the luminance of
+  // its intensity, as it was before there were other kinds (same bits).
   std::vector<double> intensity;
-  for (const PointLight& pl : scene.point_lights) {
-    if (is_black(pl.intensity)) continue;
-    points_.push_back(pl);
-    intensity.push_back(luminance(pl.intensity));
+  for (const DeltaLight& dl : scene.delta_lights) {
+    if (is_black(dl.intensity)) continue;
+    points_.push_back(dl);
+    intensity.push_back(delta_power_over_4pi(dl, scene_radius));
   }
   build_distribution(intensity, &point_pmf_, &point_cdf_);
 }
@@ -139,16 +165,30 @@ float LightSampler::pdf(const vec3& ref, const Surfel& hit) const {
 std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_choice) const {
   if (points_.empty()) return std::nullopt;
   const std::size_t i = pick(point_cdf_, u_choice);
+  const DeltaLight& light = points_[i];
   LightSample ls;
   ls.light = static_cast<std::uint32_t>(i);
-  ls.p = points_[i].position;
+  ls.pdf = point_pmf_[i];
+  if (light.kind == DeltaLight::Kind::Directional) {
+    // The shadow ray escapes (infinite): nothing may block it anywhere.
+    ls.wi = -light.direction;
+    ls.dist = kInfinity;
+    ls.infinite = true;
+    ls.Le = light.intensity;
+    return ls;
+  }
+  ls.p = light.position;
   const vec3 d = ls.p - ref;
   const float dist2 = glm::dot(d, d);
   if (!(dist2 > 0.0f)) return std::nullopt;
   ls.dist = std::sqrt(dist2);
   ls.wi = d / ls.dist;
-  ls.Le = points_[i].intensity / dist2;
-  ls.pdf = point_pmf_[i];
+  ls.Le = light.intensity / dist2;
+  if (light.kind == DeltaLight::Kind::Spot) {
+    const float profile = spot_profile(glm::dot(-ls.wi, light.direction), light.cos_outer, light.cos_inner);
+    if (!(profile > 0.0f)) return std::nullopt;
+    ls.Le *= profile;
+  }
   return ls;
 }
 

@@ -8,9 +8,10 @@
 // `pdf()` of an emitter that a BSDF-sampled ray hits is directly comparable
 // with the BSDF's pdf (MIS).
 //
-// Point lights are delta lights: no ray can hit them, so they live in a
-// separate list that every strategy samples explicitly (DESIGN: the
-// strategies differ only on lights a ray can find).
+// Point, spot and directional lights are delta lights: no ray can hit them,
+// so they live in a separate list that every strategy samples explicitly
+// (DESIGN: the strategies differ only on lights a ray can find). One is
+// picked in proportion to an estimate of its power (delta_power_over_4pi).
 #pragma once
 
 #include "core/geometry.h"
@@ -29,13 +30,19 @@ struct LightSample {
   vec3 p_error{0.0f};  // bound on its rounding error
   vec3 n{0.0f};        // the light's normal at p (unused for points / environment)
   vec3 wi{0.0f};       // unit direction from the shading point towards the light
-  float dist = 0.0f;   // distance to p; infinity for the environment
-  Spectrum Le{0.0f};   // radiance (or intensity / dist^2 for a point light) arriving
+  float dist = 0.0f;   // distance to p; infinity for the environment and a directional light
+  Spectrum Le{0.0f};   // radiance arriving (for a delta light: intensity * profile / dist^2,
+                       // or a directional light's irradiance)
   float pdf = 0.0f;    // solid angle, times the probability of choosing this light;
-                       // for a point light just that probability
+                       // for a delta light just that probability
   std::uint32_t light = 0;
-  bool infinite = false;
+  bool infinite = false;  // the shadow ray is unbounded (environment, directional light)
 };
+
+// A delta light's power divided by 4 pi, the weight with which sample_delta
+// picks it: Y(I) for a point, Y(I) (1 - (cos_inner + cos_outer) / 2) / 2 for
+// a spot, Y(E) r^2 / 4 for a directional light (r: the scene's radius).
+double delta_power_over_4pi(const DeltaLight& light, float scene_radius);
 
 class LightSampler {
  public:
@@ -61,8 +68,12 @@ class LightSampler {
   // environment (0 without one).
   float pdf_environment() const { return env_index_ < 0 ? 0.0f : pmf_[env_index_] * kInv4Pi; }
 
-  // A point light picked in proportion to its intensity.
+  // A delta light picked in proportion to its power. Nothing if it sends no
+  // light towards `ref` (outside a spot's cone, or at its position).
   std::optional<LightSample> sample_delta(const vec3& ref, float u_choice) const;
+  // The probability with which sample_delta picks delta light i (its index
+  // among the non-black ones, LightSample::light).
+  std::span<const float> delta_pmf() const { return point_pmf_; }
 
   // The area-light distribution itself, for code that samples lights in
   // bulk (the wavefront's vectorised stages) and must pick exactly as
@@ -92,7 +103,7 @@ class LightSampler {
   std::vector<float> pmf_, cdf_;         // over entries_
   std::vector<std::int64_t> first_entry_;  // per shape: index of its prim 0, or -1
   std::int64_t env_index_ = -1;
-  std::vector<PointLight> points_;
+  std::vector<DeltaLight> points_;  // the non-black delta lights
   std::vector<float> point_pmf_, point_cdf_;
 };
 

@@ -104,10 +104,27 @@ struct Instance {
 // The instance of a hit on a shape placed in world space (RayHit, Surfel).
 inline constexpr std::uint32_t kNoInstance = 0xffffffffu;
 
-struct PointLight {
+// A light no ray can hit, reached only by next-event estimation
+// (docs/scene-format.md, Lights).
+//   Point:       intensity I (W/sr per channel) in every direction from `position`.
+//   Spot:        I on the axis `direction` (unit, pointing away from `position`),
+//                times smoothstep(cos theta; cos_outer, cos_inner) (pbrt-v4's
+//                SpotLight): 1 inside the inner cone, 0 outside the outer.
+//   Directional: `intensity` is the irradiance E (W/m^2 per channel) on a
+//                surface facing the light; `direction` (unit) is the way the
+//                light travels. `position` unused.
+struct DeltaLight {
+  enum class Kind : std::uint8_t { Point, Spot, Directional };
   vec3 position{0.0f};
-  Spectrum intensity{0.0f};  // radiant intensity, W/sr per channel
+  Spectrum intensity{0.0f};
+  Kind kind = Kind::Point;
+  vec3 direction{0.0f, 0.0f, -1.0f};
+  float cos_outer = 0.0f;  // spot: cosine of the outer half-angle (cone_angle)
+  float cos_inner = 0.0f;  // spot: cosine of the inner half-angle (falloff_start)
 };
+// The spot profile: 1 for cos_theta >= cos_inner, 0 for cos_theta <= cos_outer,
+// a smoothstep in cos theta between.
+float spot_profile(float cos_theta, float cos_outer, float cos_inner);
 
 struct Scene {
   std::filesystem::path file;  // empty for a built-in scene
@@ -122,7 +139,7 @@ struct Scene {
   std::vector<Shape> shapes;
   std::vector<ShapeGroup> groups;
   std::vector<Instance> instances;
-  std::vector<PointLight> point_lights;
+  std::vector<DeltaLight> delta_lights;  // point, spot and directional lights
   std::optional<Spectrum> environment;  // uniform radiance from every direction
   std::vector<std::string> warnings;    // non-fatal problems found while loading
   // The closed-form model whose answer this scene has ("furnace", ...; see

@@ -302,13 +302,13 @@ void read_groups(const Node& node, Scene& scene, const std::filesystem::path& fo
       const Node item = list.child(i);
       if (item.value().is_object() && item.has("type") && item.child("type").value() == "instance")
         item.child("type").fail("a group holds shapes, not instances (instances of instances are not supported)");
-      const std::size_t first = scene.shapes.size(), point_lights = scene.point_lights.size();
+      const std::size_t first = scene.shapes.size(), delta_lights = scene.delta_lights.size();
       if (item.value().is_object() && item.has("type") && item.child("type").value() == "gltf")
         read_gltf_shape(item, scene, folder, materials, true);
       else
         read_shape(item, scene, folder, materials, "groups/" + name + "[" + std::to_string(i) + "]");
-      if (scene.point_lights.size() != point_lights)
-        item.child("file").fail("the glTF file has point lights, which instances do not place; put it in 'shapes'");
+      if (scene.delta_lights.size() != delta_lights)
+        item.child("file").fail("the glTF file has lights (KHR_lights_punctual), which instances do not place; put it in 'shapes'");
       for (std::size_t k = first; k < scene.shapes.size(); ++k) {
         Shape& shape = scene.shapes[k];
         const Material& m = scene.materials[shape.material];
@@ -458,16 +458,47 @@ void read_lights(const Node& node, Scene* scene) {
     const std::string type = l.required("type").string();
     if (type == "point") {
       l.allow_only({"type", "position", "intensity"});
-      scene->point_lights.push_back({l.required("position").vector3(), l.required("intensity").color(false)});
+      scene->delta_lights.push_back({l.required("position").vector3(), l.required("intensity").color(false)});
+    } else if (type == "spot") {
+      l.allow_only({"type", "position", "direction", "look_at", "intensity", "cone_angle", "falloff_start"});
+      DeltaLight spot;
+      spot.kind = DeltaLight::Kind::Spot;
+      spot.position = l.required("position").vector3();
+      spot.intensity = l.required("intensity").color(false);
+      if (l.has("direction") == l.has("look_at")) l.fail("a spot light needs exactly one of 'direction' and 'look_at'");
+      const Node aim = l.has("direction") ? l.child("direction") : l.child("look_at");
+      const vec3 axis = l.has("direction") ? aim.vector3() : aim.vector3() - spot.position;
+      if (!(glm::length(axis) > 0.0f) || !is_finite(axis))
+        aim.fail(l.has("direction") ? "direction must not be zero" : "look_at must differ from position");
+      spot.direction = glm::normalize(axis);
+      const float outer = static_cast<float>(l.required("cone_angle").number());
+      if (!(outer > 0.0f && outer <= 90.0f)) {
+        std::ostringstream m;
+        m << "cone_angle (the half-angle of the cone, degrees) must lie in (0, 90], found " << outer;
+        l.child("cone_angle").fail(m.str());
+      }
+      const float inner = unit_number(l, "falloff_start", outer, 0.0f, outer);
+      spot.cos_outer = std::cos(glm::radians(outer));
+      spot.cos_inner = std::cos(glm::radians(inner));
+      scene->delta_lights.push_back(spot);
+    } else if (type == "directional") {
+      l.allow_only({"type", "direction", "irradiance"});
+      DeltaLight sun;
+      sun.kind = DeltaLight::Kind::Directional;
+      sun.intensity = l.required("irradiance").color(false);
+      const vec3 d = l.required("direction").vector3();
+      if (!(glm::length(d) > 0.0f) || !is_finite(d)) l.child("direction").fail("direction must not be zero");
+      sun.direction = glm::normalize(d);
+      scene->delta_lights.push_back(sun);
     } else if (type == "environment") {
       l.allow_only({"type", "radiance"});
       if (scene->environment) l.fail("only one environment light is allowed");
       scene->environment = l.required("radiance").color(false);
     } else {
-      const std::array<std::string_view, 2> types{"point", "environment"};
+      const std::array<std::string_view, 4> types{"point", "spot", "directional", "environment"};
       const std::string near = suggestion(type, types);
       l.child("type").fail("unknown light type " + in_quotes(type) +
-                           (near.empty() ? " (expected point or environment)" : near));
+                           (near.empty() ? " (expected point, spot, directional or environment)" : near));
     }
   }
 }
@@ -526,7 +557,7 @@ Scene read_scene(const JsonDocument& doc) {
   add_needed_tangents(&scene);
 
   bool any_light = scene.environment && !is_black(*scene.environment);
-  for (const PointLight& p : scene.point_lights) any_light = any_light || !is_black(p.intensity);
+  for (const DeltaLight& p : scene.delta_lights) any_light = any_light || !is_black(p.intensity);
   for (const Shape& s : scene.shapes) any_light = any_light || scene.materials[s.material].emits();
   if (!any_light) scene.warnings.push_back(doc.file().string() + ": the scene has no light; it will render black");
   return scene;

@@ -52,7 +52,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
     return L;
   }
 
-  // Light a ray cannot find: point lights, in every strategy.
+  // Light a ray cannot find: point, spot and directional lights, in every strategy.
   L += direct_delta(s, wo, vertex, beta, path);
 
   // Light a ray can find, as the strategy says.
@@ -103,12 +103,13 @@ Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vert
   const Spectrum f = s.eval(ls->wi, wo);
   if (is_black(f)) return Spectrum(0.0f);
   ++path.rays;
-  const Ray shadow = s.spawn_to(ls->p, vec3(0.0f), -ls->wi);
+  // A directional light's shadow ray is unbounded (it must escape).
+  const Ray shadow = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, vec3(0.0f), -ls->wi);
   const bool visible = !scene_.occluded(shadow);
   const Spectrum L = visible ? f * ls->Le / ls->pdf : Spectrum(0.0f);
   if (path.observer)
     path.observer->on_light(
-        {vertex, true, false, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, 1.0f, beta * L, shadow});
+        {vertex, true, ls->infinite, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, 1.0f, beta * L, shadow});
   return L;
 }
 

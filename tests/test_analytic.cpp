@@ -126,7 +126,7 @@ TEST(AnalyticRefusals, FurnaceAssumptions) {
   expect_refused("furnace-sphere.json", [](Scene& s) { s.camera.position = vec3(0, 0, 3); }, "camera must be inside");
   expect_refused("furnace-sphere.json", [](Scene& s) { s.materials[0].emission = Spectrum(0.0f); }, "must emit");
   expect_refused("furnace-sphere.json", [](Scene& s) { s.materials[0].type = MaterialType::Mirror; }, "diffuse");
-  expect_refused("furnace-sphere.json", [](Scene& s) { s.point_lights.push_back({vec3(0.0f), Spectrum(1.0f)}); }, "point lights");
+  expect_refused("furnace-sphere.json", [](Scene& s) { s.delta_lights.push_back({vec3(0.0f), Spectrum(1.0f)}); }, "delta lights");
   expect_refused("furnace-sphere.json", [](Scene& s) { s.render.max_depth = -1; s.materials[0].albedo = Spectrum(1.0f); }, "below 1");
   expect_refused("furnace-box.json", [](Scene& s) { s.shapes[0].mesh.triangles.pop_back(); }, "closed");
   expect_refused("furnace-box.json", [](Scene& s) { s.camera.aperture_radius = 0.1f; }, "pinhole");

@@ -179,6 +179,36 @@ TEST_F(BadInput, UnknownTopLevelKeySuggestsTheNearest) {
   expect_rejected(render(write("top.json", text)), {"top.json:", "unknown key 'light'", "did you mean 'lights'"});
 }
 
+// Spot and directional lights: each bad value is named with its place.
+TEST_F(BadInput, BadSpotAndDirectionalLights) {
+  struct Case {
+    std::string light, at, words;
+  };
+  const std::string spot = R"({"type": "spot", "position": [0, 1, 0], )";
+  const std::vector<Case> cases{
+      {spot + R"("direction": [0, -1, 0], "intensity": 1, "cone_angle": 120})", "\"cone_angle\"",
+       "cone_angle (the half-angle of the cone, degrees) must lie in (0, 90], found 120"},
+      {spot + R"("direction": [0, -1, 0], "intensity": 1, "cone_angle": 0})", "\"cone_angle\"", "must lie in (0, 90], found 0"},
+      {spot + R"("direction": [0, -1, 0], "intensity": 1, "cone_angle": 30, "falloff_start": 40})", "\"falloff_start\"",
+       "falloff_start must lie in [0, 30], found 40"},
+      {spot + R"("direction": [0, 0, 0], "intensity": 1, "cone_angle": 30})", "\"direction\"", "direction must not be zero"},
+      {spot + R"("look_at": [0, 1, 0], "intensity": 1, "cone_angle": 30})", "\"look_at\": [0, 1, 0]", "look_at must differ from position"},
+      {spot + R"("intensity": 1, "cone_angle": 30})", spot, "exactly one of 'direction' and 'look_at'"},
+      {spot + R"("direction": [0, -1, 0], "intensity": [1, -1, 1], "cone_angle": 30})", "\"intensity\"",
+       "components must not be negative"},
+      {R"({"type": "directional", "direction": [0, 0, 0], "irradiance": 1})", "\"direction\"", "direction must not be zero"},
+      {R"({"type": "directional", "direction": [0, -1, 0], "irradiance": -2})", "\"irradiance\"",
+       "components must not be negative"},
+      {R"({"type": "directional", "direction": [0, -1, 0], "intensity": 2})", "\"intensity\"", "unknown key 'intensity'"},
+      {R"({"type": "directonal"})", "\"type\": \"directonal\"", "did you mean 'directional'"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.light);
+    const std::string text = scene(kMaterials, kSphere, "\"lights\": [\n    " + c.light + "\n  ]");
+    expect_rejected(render(write("light.json", text)), {"light.json:" + where_in(text, c.at) + ": /lights/0", c.words});
+  }
+}
+
 TEST_F(BadInput, UnknownMaterialType) {
   const std::string text = scene("    \"white\": {\"type\": \"difuse\"}", kSphere);
   expect_rejected(render(write("mtype.json", text)),

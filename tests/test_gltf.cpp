@@ -228,21 +228,37 @@ TEST_F(Gltf, MaterialsMapOntoDisney) {
   EXPECT_NE(all.find("ignored (not supported yet): alpha (rendered opaque), baseColorTexture"), std::string::npos) << all;
 }
 
-TEST_F(Gltf, PointLightCameraAndTheDirectScene) {
+TEST_F(Gltf, PunctualLightsCameraAndTheDirectScene) {
+  const float h = std::sqrt(0.5f);
   GltfWriter w = quad(test::kGltfByte);
   w.doc["extensionsUsed"] = {"KHR_lights_punctual"};
   w.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
-      {{"type", "point"}, {"color", {1.0, 0.5, 0.25}}, {"intensity", 8.0}}, {{"type", "spot"}, {"spot", json::object()}}};
+      {{"type", "point"}, {"color", {1.0, 0.5, 0.25}}, {"intensity", 8.0}},
+      {{"type", "spot"}, {"intensity", 2.0}, {"spot", {{"innerConeAngle", 0.25}, {"outerConeAngle", 0.5}}}},
+      {{"type", "directional"}, {"color", {0.5, 1.0, 1.0}}, {"intensity", 3.0}}};
   w.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"aspectRatio", 2.0}, {"znear", 0.1}}}}};
   w.node({{"translation", {0, 3, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
   w.node({{"translation", {0, 0, 4}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
+  // Turned -90 degrees about x: -z becomes -y (shining down).
+  w.node({{"rotation", {-h, 0, 0, h}}, {"extensions", {{"KHR_lights_punctual", {{"light", 2}}}}}});
   // Turned 90 degrees about y: looks down -x.
-  const float h = std::sqrt(0.5f);
   w.node({{"translation", {5, 0.5, 0.5}}, {"rotation", {0, h, 0, h}}, {"camera", 0}});
   const GltfContent c = load_all(w, "lit");
-  ASSERT_EQ(c.point_lights.size(), 1u);
-  EXPECT_EQ(c.point_lights[0].position, vec3(0, 3, 0));
-  EXPECT_EQ(c.point_lights[0].intensity, Spectrum(8.0f, 4.0f, 2.0f));
+  ASSERT_EQ(c.delta_lights.size(), 3u);
+  EXPECT_EQ(c.delta_lights[0].kind, DeltaLight::Kind::Point);
+  EXPECT_EQ(c.delta_lights[0].position, vec3(0, 3, 0));
+  EXPECT_EQ(c.delta_lights[0].intensity, Spectrum(8.0f, 4.0f, 2.0f));
+  // A spot shines down the node's -z axis; cone angles are half-angles in radians.
+  EXPECT_EQ(c.delta_lights[1].kind, DeltaLight::Kind::Spot);
+  EXPECT_EQ(c.delta_lights[1].position, vec3(0, 0, 4));
+  EXPECT_EQ(c.delta_lights[1].direction, vec3(0, 0, -1));
+  EXPECT_EQ(c.delta_lights[1].intensity, Spectrum(2.0f));
+  EXPECT_FLOAT_EQ(c.delta_lights[1].cos_inner, std::cos(0.25f));
+  EXPECT_FLOAT_EQ(c.delta_lights[1].cos_outer, std::cos(0.5f));
+  // Lux taken as W/m^2; the light travels down the node's -z axis.
+  EXPECT_EQ(c.delta_lights[2].kind, DeltaLight::Kind::Directional);
+  EXPECT_NEAR(glm::distance(c.delta_lights[2].direction, vec3(0, -1, 0)), 0.0f, 1e-6f);
+  EXPECT_EQ(c.delta_lights[2].intensity, Spectrum(1.5f, 3.0f, 3.0f));
   ASSERT_EQ(c.cameras.size(), 1u);
   EXPECT_NEAR(glm::distance(c.cameras[0].desc.position, vec3(5, 0.5, 0.5)), 0.0f, 1e-6f);
   EXPECT_NEAR(glm::distance(c.cameras[0].desc.look_at, vec3(4, 0.5, 0.5)), 0.0f, 1e-6f);
@@ -256,7 +272,8 @@ TEST_F(Gltf, PointLightCameraAndTheDirectScene) {
   EXPECT_EQ(s.shapes.size(), 1u);
   std::string all;
   for (const std::string& line : s.warnings) all += line + "\n";
-  EXPECT_NE(all.find("spot and directional lights are not supported yet"), std::string::npos) << all;
+  EXPECT_EQ(all.find("lights"), std::string::npos) << all;
+  EXPECT_EQ(s.delta_lights.size(), 3u);
 
   // Without camera and lights: the bounds framed, a white environment.
   GltfWriter::write(dir_ / "bare.gltf", quad(test::kGltfByte).embedded());

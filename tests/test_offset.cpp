@@ -202,7 +202,7 @@ TEST(RayOffset, NoShadowSpeckleOnAPlaneAt1e5) {
   plane.mesh = {{o + vec3(-40, 0, -40), o + vec3(40, 0, -40), o + vec3(40, 0, 40), o + vec3(-40, 0, 40)},
                 {{0, 2, 1}, {0, 3, 2}}};
   scene.shapes.push_back(plane);
-  scene.point_lights.push_back({o + vec3(0, 20, 0), Spectrum(400.0f)});
+  scene.delta_lights.push_back({o + vec3(0, 20, 0), Spectrum(400.0f)});
   scene.camera.position = o + vec3(0, 30, 10);
   scene.camera.look_at = o;
   scene.film = {32, 32, FilterKind::Box};
@@ -219,7 +219,7 @@ TEST(RayOffset, NoShadowSpeckleOnAPlaneAt1e5) {
       const Ray r = compiled.camera().generate_ray(vec2(x + 0.5f, y + 0.5f), vec2(0.5f));
       Surfel s;
       ASSERT_TRUE(compiled.intersect(r, &s));
-      const vec3 to_light = compiled.scene().point_lights[0].position - s.p;
+      const vec3 to_light = compiled.scene().delta_lights[0].position - s.p;
       const float d2 = glm::dot(to_light, to_light);
       const float expected = 0.8f * kInvPi * 400.0f * glm::dot(s.n, to_light) / std::sqrt(d2) / d2;
       if (film.mean(x, y).x < 0.5f * expected) ++dark;

@@ -121,7 +121,7 @@ TEST(SceneLoader, MinimalSceneGetsEveryDefault) {
   EXPECT_EQ(s.render.strategy, Strategy::Mis);
   EXPECT_EQ(s.render.seed, 0u);
   // Lights: none, which is worth a warning naming the file.
-  EXPECT_TRUE(s.point_lights.empty());
+  EXPECT_TRUE(s.delta_lights.empty());
   EXPECT_FALSE(s.environment.has_value());
   ASSERT_EQ(s.warnings.size(), 1u);
   EXPECT_NE(s.warnings[0].find("folder/minimal.json"), std::string::npos) << s.warnings[0];
@@ -397,12 +397,34 @@ TEST(SceneLoader, PointAndEnvironmentLights) {
     {"type": "point", "position": [1, 2, 3], "intensity": [4, 5, 6]},
     {"type": "point", "position": [0, 0, 0], "intensity": 2},
     {"type": "environment", "radiance": 0.5}])"));
-  ASSERT_EQ(s.point_lights.size(), 2u);
-  expect_vec(s.point_lights[0].position, vec3(1, 2, 3));
-  expect_vec(s.point_lights[0].intensity, vec3(4, 5, 6));
-  expect_vec(s.point_lights[1].intensity, vec3(2.0f));
+  ASSERT_EQ(s.delta_lights.size(), 2u);
+  expect_vec(s.delta_lights[0].position, vec3(1, 2, 3));
+  expect_vec(s.delta_lights[0].intensity, vec3(4, 5, 6));
+  expect_vec(s.delta_lights[1].intensity, vec3(2.0f));
   ASSERT_TRUE(s.environment.has_value());
   expect_vec(*s.environment, vec3(0.5f));
+  EXPECT_TRUE(s.warnings.empty());
+}
+
+TEST(SceneLoader, SpotAndDirectionalLights) {
+  const Scene s = parse(scene_text("{}", "[]", R"("lights": [
+    {"type": "spot", "position": [1, 2, 3], "look_at": [1, 2, 0], "intensity": [4, 5, 6], "cone_angle": 60, "falloff_start": 30},
+    {"type": "spot", "position": [0, 0, 0], "direction": [0, 2, 0], "intensity": 2, "cone_angle": 90},
+    {"type": "directional", "direction": [0, 0, -3], "irradiance": [1, 2, 3]}])"));
+  ASSERT_EQ(s.delta_lights.size(), 3u);
+  EXPECT_EQ(s.delta_lights[0].kind, DeltaLight::Kind::Spot);
+  expect_vec(s.delta_lights[0].position, vec3(1, 2, 3));
+  expect_vec(s.delta_lights[0].direction, vec3(0, 0, -1));
+  expect_vec(s.delta_lights[0].intensity, vec3(4, 5, 6));
+  EXPECT_NEAR(s.delta_lights[0].cos_outer, 0.5f, 1e-6f);
+  EXPECT_NEAR(s.delta_lights[0].cos_inner, std::sqrt(0.75f), 1e-6f);
+  // Without falloff_start the edge is hard (inner = outer).
+  expect_vec(s.delta_lights[1].direction, vec3(0, 1, 0));
+  EXPECT_NEAR(s.delta_lights[1].cos_outer, 0.0f, 1e-6f);
+  EXPECT_EQ(s.delta_lights[1].cos_inner, s.delta_lights[1].cos_outer);
+  EXPECT_EQ(s.delta_lights[2].kind, DeltaLight::Kind::Directional);
+  expect_vec(s.delta_lights[2].direction, vec3(0, 0, -1));
+  expect_vec(s.delta_lights[2].intensity, vec3(1, 2, 3));
   EXPECT_TRUE(s.warnings.empty());
 }
 

@@ -92,6 +92,24 @@ inline Scene cornell_with_smooth_sphere() {
   return scene;
 }
 
+// The built-in Cornell box (open towards the camera at +z) lit also by a
+// point, a spot and a directional light that comes in through the opening.
+inline Scene cornell_with_delta_lights() {
+  Scene scene = builtin_cornell_box();
+  scene.delta_lights.push_back({vec3(0.4f, 0.7f, 0.3f), Spectrum(0.3f, 0.2f, 0.1f)});
+  DeltaLight spot{vec3(-0.5f, 0.8f, 0.5f), Spectrum(2.0f)};
+  spot.kind = DeltaLight::Kind::Spot;
+  spot.direction = glm::normalize(vec3(0.3f, -1.0f, -0.4f));
+  spot.cos_outer = std::cos(0.6f);
+  spot.cos_inner = std::cos(0.3f);
+  scene.delta_lights.push_back(spot);
+  DeltaLight sun{vec3(0.0f), Spectrum(1.0f, 0.9f, 0.7f)};
+  sun.kind = DeltaLight::Kind::Directional;
+  sun.direction = glm::normalize(vec3(0.2f, -0.6f, -1.0f));
+  scene.delta_lights.push_back(sun);
+  return scene;
+}
+
 // Three placements that exercise every part of an instance transform:
 // rotated and moved; mirrored with a non-uniform scale; sheared. They put a
 // unit-sized group inside the built-in Cornell box ([-1, 1]^3).

@@ -23,7 +23,7 @@ namespace pathlab {
 namespace {
 
 struct SameSeedCase {
-  std::string scene;  // "" = the built-in Cornell box, "smooth" / "instanced" (test_scenes.h), else a file in analytic-scenes/
+  std::string scene;  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" (test_scenes.h), else a file in analytic-scenes/
   Strategy strategy;
 };
 
@@ -31,6 +31,7 @@ Scene load_case(const SameSeedCase& c) {
   Scene s = c.scene.empty()          ? builtin_cornell_box()
             : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
             : c.scene == "instanced" ? test::cornell_with_instances()
+            : c.scene == "delta"     ? test::cornell_with_delta_lights()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -89,6 +90,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   std::sort(scenes.begin(), scenes.end());
   scenes.push_back("smooth");     // the Cornell box with a smooth-shaded sphere (test_scenes.h)
   scenes.push_back("instanced");  // the Cornell box with a group placed three times (test_scenes.h)
+  scenes.push_back("delta");      // the Cornell box with point, spot and directional lights (test_scenes.h)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
@@ -354,8 +356,13 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
   sphere_light.shapes.push_back(bulb);
   EXPECT_FALSE(vectorised(sphere_light, Strategy::Mis));
   Scene point_light = cornell;
-  point_light.point_lights.push_back({vec3(0.0f, 1.0f, 0.0f), Spectrum(1.0f)});
+  point_light.delta_lights.push_back({vec3(0.0f, 1.0f, 0.0f), Spectrum(1.0f)});
   EXPECT_FALSE(vectorised(point_light, Strategy::Mis));
+  Scene spot = cornell, sun = cornell;
+  spot.delta_lights.push_back({vec3(0.0f, 1.0f, 0.0f), Spectrum(1.0f), DeltaLight::Kind::Spot, vec3(0, -1, 0), 0.5f, 0.9f});
+  sun.delta_lights.push_back({vec3(0.0f), Spectrum(1.0f), DeltaLight::Kind::Directional, vec3(0, -1, 0), 0.0f, 0.0f});
+  EXPECT_FALSE(vectorised(spot, Strategy::Mis));
+  EXPECT_FALSE(vectorised(sun, Strategy::Mis));
   EXPECT_FALSE(vectorised(load_scene(analytic / "sphere-in-environment.json"), Strategy::Mis));      // environment
   EXPECT_FALSE(vectorised(load_scene(analytic / "mirror-sphere-gray-room.json"), Strategy::Mis));    // mirror
   EXPECT_FALSE(vectorised(load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "scenes" / "materials.json"),

@@ -157,9 +157,9 @@ struct WavefrontTracer::VectorStages {
     // Flat triangles only: the stages shade with the geometric normal.
     for (const Shape& shape : scene.shapes)
       if (shape.mesh.has_normals()) return no(shape.description + " has vertex normals (smooth shading)");
-    // Only triangle area lights: no point light, sphere light or environment.
+    // Only triangle area lights: no delta light, sphere light or environment.
     const LightSampler& lights = compiled.lights();
-    if (lights.has_delta_lights()) return no("point lights");
+    if (lights.has_delta_lights()) return no("delta lights (point, spot, directional)");
     if (lights.samples_environment()) return no("an environment light");
     for (const LightSampler::Entry& e : lights.entries()) {
       const Shape& shape = scene.shapes[e.shape];
@@ -367,7 +367,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
           if (obs) w.light[2 * i] = *ls;  // only the observer reads it back
           w.unoccluded[2 * i] = f * ls->Le / ls->pdf;
           w.light_weight[2 * i] = 1.0f;
-          w.shadow[2 * i] = s.spawn_to(ls->p, vec3(0.0f), -ls->wi);
+          w.shadow[2 * i] = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, vec3(0.0f), -ls->wi);
           w.shadow_state[2 * i] = 1;
         }
       }
