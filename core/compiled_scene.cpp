@@ -93,7 +93,14 @@ CompiledScene::CompiledScene(Scene scene)
   }
   // Room for Embree's 16-byte loads past the last vertex, so that it reads
   // the positions in place instead of copying them (EmbreeAccel).
-  for (Shape& shape : scene_.shapes) shape.mesh.positions.reserve(shape.mesh.positions.size() + 1);
+  // (Written once, as zeros, so that nothing reads uninitialised bytes.)
+  for (Shape& shape : scene_.shapes) {
+    std::vector<vec3>& p = shape.mesh.positions;
+    if (p.empty()) continue;
+    p.reserve(p.size() + 1);
+    p.emplace_back(0.0f);
+    p.pop_back();
+  }
   accel_ = std::make_unique<EmbreeAccel>(scene_.shapes, scene_.groups, scene_.instances, scene_.render.compact_bvh);
   first_triangle_.resize(scene_.shapes.size() + 1, 0);
   for (std::size_t i = 0; i < scene_.shapes.size(); ++i) {

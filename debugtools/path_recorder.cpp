@@ -28,6 +28,24 @@ const std::string& material_name(const Scene& scene, std::uint32_t m) {
   return m < scene.materials.size() ? scene.materials[m].name : unknown;
 }
 
+// What a light event sampled: a delta light's own kind ("point", "spot",
+// "directional"; its index counts the scene's delta lights of non-zero
+// intensity, as the light sampler does), "area" or "environment".
+const char* light_kind(const Scene& scene, const LightEvent& e) {
+  if (!e.delta) return e.infinite ? "environment" : "area";
+  std::uint32_t k = 0;
+  for (const DeltaLight& d : scene.delta_lights) {
+    if (is_black(d.intensity)) continue;
+    if (k++ != e.light) continue;
+    switch (d.kind) {
+      case DeltaLight::Kind::Point: return "point";
+      case DeltaLight::Kind::Spot: return "spot";
+      case DeltaLight::Kind::Directional: return "directional";
+    }
+  }
+  return "point";
+}
+
 struct JsonVisitor {
   const Scene& scene;
   json operator()(const CameraEvent& e) const {
@@ -46,7 +64,7 @@ struct JsonVisitor {
             {"emission_weight", e.emission_weight}, {"added", j3(e.added)}};
   }
   json operator()(const LightEvent& e) const {
-    json j = {{"type", "light"}, {"vertex", e.vertex}, {"kind", e.delta ? "point" : e.infinite ? "environment" : "area"},
+    json j = {{"type", "light"}, {"vertex", e.vertex}, {"kind", light_kind(scene, e)},
               {"light", e.light}, {"point", j3(e.point)}, {"wi", j3(e.wi)},
               {"pdf", e.pdf},     {"Le", j3(e.Le)},       {"visible", e.visible},
               {"mis_weight", e.mis_weight}, {"added", j3(e.added)}};
@@ -84,7 +102,7 @@ struct TextVisitor {
         << "  added " << fmt3(e.added) << "\n";
   }
   void operator()(const LightEvent& e) const {
-    out << "#" << e.vertex << " light    " << (e.delta ? "point " : e.infinite ? "environment " : "area ") << e.light;
+    out << "#" << e.vertex << " light    " << light_kind(scene, e) << " " << e.light;
     if (!e.infinite) out << "  point " << fmt3(e.point) << "  dist " << fmt(e.dist);
     out << "  wi " << fmt3(e.wi) << "  pdf " << fmt(e.pdf) << "  Le " << fmt3(e.Le)
         << (e.visible ? "  visible" : "  occluded") << "  mis " << fmt(e.mis_weight) << "  added " << fmt3(e.added)

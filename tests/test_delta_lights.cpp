@@ -4,6 +4,7 @@
 #include "core/light_sampler.h"
 #include "core/rng.h"
 #include "core/scene_loader.h"
+#include "debugtools/path_recorder.h"
 #include "reference/reference_tracer.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -177,6 +179,27 @@ TEST(DeltaLights, OutsideTheSpotsConeNothingIsSampled) {
   const CompiledScene compiled(scene);
   EXPECT_TRUE(compiled.lights().sample_delta(vec3(0.9f, 0.0f, 0.0f), 0.5f).has_value());
   EXPECT_FALSE(compiled.lights().sample_delta(vec3(1.1f, 0.0f, 0.0f), 0.5f).has_value());
+}
+
+// trace-pixel names the kind of delta light a vertex sampled (its index
+// counts the delta lights of non-zero intensity, a black one skipped).
+TEST(DeltaLights, TracePixelNamesTheKind) {
+  const Scene scene = floor_scene(R"({"type": "point", "position": [0, 2, 0], "intensity": 0},
+      {"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0], "intensity": 5, "cone_angle": 60},
+      {"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": 2})");
+  const CompiledScene compiled(scene);
+  const ReferenceTracer tracer(compiled, scene.render);
+  std::set<std::string> kinds;
+  for (std::uint32_t s = 0; s < 16; ++s) {
+    PathRecorder path;
+    tracer.trace_sample(12, 12, s, &path);
+    const nlohmann::json j = path_to_json(TraceHeader{"floor", "reference", 12, 12, s, scene.render, 24, 24}, path, scene);
+    for (const nlohmann::json& e : j["events"])
+      if (e["type"] == "light") kinds.insert(e["kind"].get<std::string>());
+    const std::string text = path_to_text(TraceHeader{"floor", "reference", 12, 12, s, scene.render, 24, 24}, path, scene);
+    EXPECT_EQ(text.find("light    point"), std::string::npos) << text;
+  }
+  EXPECT_EQ(kinds, (std::set<std::string>{"spot", "directional"}));
 }
 
 }  // namespace
