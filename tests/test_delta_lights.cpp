@@ -185,12 +185,14 @@ TEST(DeltaLights, OutsideTheSpotsConeNothingIsSampled) {
 // counts the delta lights of non-zero intensity, a black one skipped).
 TEST(DeltaLights, TracePixelNamesTheKind) {
   const Scene scene = floor_scene(R"({"type": "point", "position": [0, 2, 0], "intensity": 0},
-      {"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0], "intensity": 5, "cone_angle": 60},
+      {"type": "spot", "position": [0, 3, 0], "direction": [0, -1, 0], "intensity": 500, "cone_angle": 60},
       {"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": 2})");
   const CompiledScene compiled(scene);
   const ReferenceTracer tracer(compiled, scene.render);
   std::set<std::string> kinds;
-  for (std::uint32_t s = 0; s < 16; ++s) {
+  // Picked in proportion to power: the spot 2 pi 500 (1 - cos 60), the sun
+  // pi 10^2 2 (the floor's bounding radius is about 10): both within 64 samples.
+  for (std::uint32_t s = 0; s < 64; ++s) {
     PathRecorder path;
     tracer.trace_sample(12, 12, s, &path);
     const nlohmann::json j = path_to_json(TraceHeader{"floor", "reference", 12, 12, s, scene.render, 24, 24}, path, scene);
