@@ -38,11 +38,8 @@ void check_instancing(const Scene& scene) {
   for (const Instance& inst : scene.instances) {
     if (inst.group >= scene.groups.size())
       throw InputError(inst.description + ": no group " + std::to_string(inst.group));
-    const float det = glm::determinant(mat3(inst.to_world));
-    bool finite = std::isfinite(det) && det != 0.0f;
-    const mat4 inverse = glm::inverse(inst.to_world);
-    for (int c = 0; c < 4; ++c) finite = finite && is_finite(vec3(inst.to_world[c])) && is_finite(vec3(inverse[c]));
-    if (!finite) throw InputError(inst.description + ": the placement is singular or not finite");
+    if (!invertible_placement(inst.to_world))
+      throw InputError(inst.description + ": the placement is singular or not finite");
   }
 }
 
@@ -52,44 +49,24 @@ CompiledScene::CompiledScene(Scene scene)
     : scene_(std::move(scene)), camera_(scene_.camera, scene_.film.width, scene_.film.height) {
   check_instancing(scene_);
   configure_shading(scene_);  // materials: shading path for the scene's lobes, sampling flavour, min pdf
-  const auto shape_bounds = [](const Shape& shape, vec3& lo, vec3& hi) {
-    if (shape.kind == Shape::Kind::Sphere) {
-      lo = glm::min(lo, shape.center - shape.radius);
-      hi = glm::max(hi, shape.center + shape.radius);
-    } else {
-      for (const vec3& p : shape.mesh.positions) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-      }
-    }
-  };
-  vec3 lo(kInfinity), hi(-kInfinity);
+  Box box;
   for (const Shape& shape : scene_.shapes) {
-    if (!shape.in_group) shape_bounds(shape, lo, hi);
+    if (!shape.in_group) box.add(bounds(shape));
     lobes_ |= scene_.materials[shape.material].lobes();
   }
   // An instance's bounds: the corners of its group's box, placed.
-  std::vector<std::pair<vec3, vec3>> group_bounds;
+  std::vector<Box> group_boxes;
   for (const ShapeGroup& group : scene_.groups) {
-    vec3 glo(kInfinity), ghi(-kInfinity);
-    for (const std::uint32_t s : group.shapes) shape_bounds(scene_.shapes[s], glo, ghi);
-    group_bounds.emplace_back(glo, ghi);
+    Box& g = group_boxes.emplace_back();
+    for (const std::uint32_t s : group.shapes) g.add(bounds(scene_.shapes[s]));
   }
   for (const Instance& inst : scene_.instances) {
-    const auto& [glo, ghi] = group_bounds[inst.group];
-    if (!(glo.x <= ghi.x)) continue;
-    for (int c = 0; c < 8; ++c) {
-      const vec3 corner((c & 1) ? ghi.x : glo.x, (c & 2) ? ghi.y : glo.y, (c & 4) ? ghi.z : glo.z);
-      const vec3 p = vec3(inst.to_world * vec4(corner, 1.0f));
-      lo = glm::min(lo, p);
-      hi = glm::max(hi, p);
-    }
-  }
-  for (const Instance& inst : scene_.instances)
+    box.add(placed(group_boxes[inst.group], inst.to_world));
     placements_.push_back({inst.to_world, glm::inverse(inst.to_world), glm::transpose(glm::inverse(mat3(inst.to_world)))});
-  if (lo.x <= hi.x) {
-    bounds_center_ = 0.5f * (lo + hi);
-    bounds_radius_ = std::max(0.5f * glm::length(hi - lo), 1e-3f);
+  }
+  if (!box.empty()) {
+    bounds_center_ = 0.5f * (box.lo + box.hi);
+    bounds_radius_ = std::max(0.5f * glm::length(box.hi - box.lo), 1e-3f);
   }
   // Room for Embree's 16-byte loads past the last vertex, so that it reads
   // the positions in place instead of copying them (EmbreeAccel).
@@ -159,7 +136,8 @@ void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const v
 
 void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const {
   const Shape& shape = scene_.shapes[hit.shape];
-  vec3 ns_sum;
+  const bool interpolated = shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals();
+  vec3 ns_sum;  // read only when `interpolated`
   if (hit.instance == kNoInstance) {
     resolve_local(shape, hit, ray.origin + hit.t * ray.dir, nullptr, s, &ns_sum);
   } else {
@@ -172,9 +150,7 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const 
     // Normals by the inverse transpose keep pointing to the image of their
     // side, so the front stays the front under a mirroring placement too.
     s->n = glm::normalize(place.to_normal * s->n);
-    if (!(shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals())) ns_sum = s->n;
   }
-  const bool interpolated = shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals();
   const vec3 ns = interpolated ? shading_normal(s->n, ns_sum) : s->n;
   s->shading_normal = ns != s->n;
   if (shape.kind == Shape::Kind::Triangles && !shape.mesh.tangents.empty()) {

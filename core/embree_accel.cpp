@@ -42,12 +42,11 @@ struct EmbreeAccel::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::uint32_t first_instance = 0;  // geometry ID of instance 0 in `scene`
-  bool has_instances = false;
   // A group's shapes have IDs 0, 1, ... in the group's Embree scene (IDs
   // there cost Embree memory up to the largest): the scene's shape of
   // geometry k in instance i's group is group_shapes[instance_group[i]][k].
   std::vector<std::vector<std::uint32_t>> group_shapes;
-  std::vector<std::uint32_t> instance_group;
+  std::vector<std::uint32_t> instance_group;  // per instance; empty for a scene without instances
   bool compact = false;
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
@@ -104,7 +103,6 @@ EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const Shape
     impl_->errors.check(("building the BVH of group " + group.name).c_str());
   }
   impl_->first_instance = static_cast<std::uint32_t>(shapes.size());
-  impl_->has_instances = !instances.empty();
   for (std::uint32_t i = 0; i < instances.size(); ++i) {
     const Instance& inst = instances[i];
     RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_INSTANCE);
@@ -341,7 +339,7 @@ bool coherent_occlusion(bool coherent, bool has_instances) { return coherent && 
 
 void EmbreeAccel::occluded_batch(std::span<const Ray> rays, std::span<std::uint8_t> occluded, RayBatchMode mode,
                                  bool coherent) const {
-  RTCIntersectContext context = make_context(coherent_occlusion(coherent, impl_->has_instances));
+  RTCIntersectContext context = make_context(coherent_occlusion(coherent, !impl_->instance_group.empty()));
   switch (mode) {
     case RayBatchMode::Single:
       for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -477,7 +475,7 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, cons
 
 void EmbreeAccel::occluded_arrays(const RayArrays& rays, std::size_t n, std::uint8_t* occluded, RayBatchMode mode,
                                   bool coherent) const {
-  RTCIntersectContext context = make_context(coherent_occlusion(coherent, impl_->has_instances));
+  RTCIntersectContext context = make_context(coherent_occlusion(coherent, !impl_->instance_group.empty()));
   switch (mode) {
     case RayBatchMode::Single:
       for (std::size_t i = 0; i < n; ++i) {

@@ -44,6 +44,44 @@ std::size_t transform_mesh(TriangleMesh* mesh, const mat4& xf) {
   return dropped;
 }
 
+Box bounds(const Shape& shape) {
+  Box box;
+  if (shape.kind == Shape::Kind::Sphere) {
+    box.add(shape.center - shape.radius);
+    box.add(shape.center + shape.radius);
+  } else {
+    for (const vec3& p : shape.mesh.positions) box.add(p);
+  }
+  return box;
+}
+
+Box placed(const Box& box, const mat4& to_world) {
+  Box out;
+  if (!box.empty())
+    for (int c = 0; c < 8; ++c) out.add(vec3(to_world * vec4(box.corner(c), 1.0f)));
+  return out;
+}
+
+bool placed_finite(const Box& box, const mat4& to_world) {
+  for (int c = 0; c < 8 && !box.empty(); ++c)
+    if (!is_finite(vec3(to_world * vec4(box.corner(c), 1.0f)))) return false;
+  return true;
+}
+
+bool invertible_placement(const mat4& to_world) {
+  const float det = glm::determinant(mat3(to_world));
+  if (!(std::abs(det) > 0.0f) || !std::isfinite(det) || !std::isfinite(1.0f / det)) return false;
+  const mat4 inverse = glm::inverse(to_world);
+  for (int c = 0; c < 4; ++c)
+    if (!is_finite(vec3(to_world[c])) || !is_finite(vec3(inverse[c])) || !std::isfinite(inverse[c].w)) return false;
+  return true;
+}
+
+double corner_angle(const dvec3& a, const dvec3& b, const dvec3& c) {
+  const dvec3 e1 = b - a, e2 = c - a;
+  return std::atan2(glm::length(glm::cross(e1, e2)), glm::dot(e1, e2));
+}
+
 float triangle_area(const TriangleMesh& mesh, std::uint32_t tri) {
   const glm::uvec3 t = mesh.triangles[tri];
   const dvec3 p0(mesh.positions[t.x]), p1(mesh.positions[t.y]), p2(mesh.positions[t.z]);

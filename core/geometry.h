@@ -22,6 +22,34 @@ constexpr float gamma_bound(int n) {
   return (static_cast<float>(n) * eps) / (1.0f - static_cast<float>(n) * eps);
 }
 
+// An axis-aligned box, empty until something is added to it.
+struct Box {
+  vec3 lo{kInfinity}, hi{-kInfinity};
+  bool empty() const { return !(lo.x <= hi.x); }
+  void add(const vec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  void add(const Box& b) {
+    if (!b.empty()) add(b.lo), add(b.hi);
+  }
+  vec3 corner(int c) const { return {(c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z}; }
+};
+// The box around a shape (a sphere's, or a mesh's vertices).
+Box bounds(const Shape& shape);
+// The box around the eight corners of `box` placed by `to_world`.
+Box placed(const Box& box, const mat4& to_world);
+// True if every corner of `box` placed by `to_world` is finite.
+bool placed_finite(const Box& box, const mat4& to_world);
+// True if `to_world` can place an instance: finite, with a non-zero
+// determinant, and an inverse that is finite too (Embree and the normals'
+// inverse transpose need it).
+bool invertible_placement(const mat4& to_world);
+
+// The angle at corner `a` of the triangle (a, b, c), from atan2 (accurate
+// for slivers, unlike acos).
+double corner_angle(const dvec3& a, const dvec3& b, const dvec3& c);
+
 float triangle_area(const TriangleMesh& mesh, std::uint32_t tri);
 // Applies `xf` to a mesh (positions; normals by the inverse transpose;
 // tangents by `xf`, their handedness flipped with the winding of a mirroring

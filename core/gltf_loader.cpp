@@ -28,8 +28,6 @@
 #include <cctype>
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -182,7 +180,7 @@ class Flattener {
   std::map<std::pair<std::size_t, std::size_t>, TriangleMesh> meshes_;  // primitives read once, copied per node
   std::vector<bool> instanced_;  // per glTF mesh: placed by instances of a group
   std::map<std::size_t, std::optional<std::uint32_t>> groups_;  // glTF mesh -> out_.groups (none: no triangles)
-  std::vector<std::pair<vec3, vec3>> group_bounds_;              // per out_.groups entry, mesh space
+  std::vector<Box> group_boxes_;                                  // per out_.groups entry, mesh space
   std::set<std::string> ignored_, warned_;
 };
 
@@ -370,18 +368,18 @@ std::optional<std::uint32_t> Flattener::group(std::size_t mesh) {
   g.name = file_.filename().string() + "/mesh " + (gltf_name.empty() ? "#" + std::to_string(mesh) : gltf_name);
   for (const GltfGroup& other : out_.groups)
     if (other.name == g.name) g.name += " #" + std::to_string(mesh);  // two glTF meshes of one name stay apart
-  vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  Box box;
   for (std::size_t prim = 0; prim < model_.meshes[mesh].primitives.size(); ++prim) {
     std::optional<GltfPrimitive> p = transformed_primitive(mesh, prim, mat4(1.0f), "mesh space", "/meshes/" + std::to_string(mesh));
     if (!p) continue;
-    for (const vec3& v : p->mesh.positions) lo = glm::min(lo, v), hi = glm::max(hi, v);
+    for (const vec3& v : p->mesh.positions) box.add(v);
     g.primitives.push_back(std::move(*p));
   }
   std::optional<std::uint32_t> index;
   if (!g.primitives.empty()) {
     index = static_cast<std::uint32_t>(out_.groups.size());
     out_.groups.push_back(std::move(g));
-    group_bounds_.emplace_back(lo, hi);
+    group_boxes_.push_back(box);
   }
   groups_[mesh] = index;
   return index;
@@ -394,18 +392,10 @@ std::optional<std::uint32_t> Flattener::group(std::size_t mesh) {
 // singular one loses its (now degenerate) triangles with a warning naming
 // the node, one beyond the float range is refused there.
 bool Flattener::place_instance(std::size_t mesh, const mat4& xf, std::size_t node) {
-  const float det = glm::determinant(mat3(xf));
-  if (!(std::abs(det) > 0.0f) || !std::isfinite(det) || !std::isfinite(1.0f / det)) return false;
-  const mat4 inverse = glm::inverse(xf);
-  for (int c = 0; c < 4; ++c)
-    if (!is_finite(vec3(inverse[c])) || !std::isfinite(inverse[c].w)) return false;
+  if (!invertible_placement(xf)) return false;
   const std::optional<std::uint32_t> g = group(mesh);
   if (!g) return true;  // nothing to place
-  const auto& [lo, hi] = group_bounds_[*g];
-  for (int c = 0; c < 8; ++c) {
-    const vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-    if (!is_finite(vec3(xf * vec4(corner, 1.0f)))) return false;
-  }
+  if (!placed_finite(group_boxes_[*g], xf)) return false;
   out_.instances.push_back(
       {*g, xf, file_.string() + ": /nodes/" + std::to_string(node) + " (mesh " + std::to_string(mesh) + ")"});
   return true;
@@ -577,8 +567,9 @@ std::vector<int> Flattener::roots() const {
   return out;
 }
 
-// visit(node, world matrix) for every path from a root, parents first,
-// depth first without recursion (the validator refused cycles).
+// visit(node, world matrix) for every node under the roots, parents first,
+// depth first without recursion (the validator refused cycles and second
+// parents, so each node is visited once).
 template <typename Visit>
 void Flattener::walk(const std::vector<int>& roots, Visit&& visit) const {
   std::vector<std::pair<std::size_t, mat4>> stack;
@@ -605,8 +596,7 @@ GltfContent Flattener::run() {
   for (std::size_t m = 0; m < model_.materials.size(); ++m) material(static_cast<int>(m));
 
   const std::vector<int> from = roots();
-  // A mesh is a group if two or more placements (paths through the node
-  // graph) use it.
+  // A mesh is a group if two or more nodes place it.
   std::vector<std::size_t> uses(model_.meshes.size(), 0);
   walk(from, [&](std::size_t node, const mat4&) {
     if (model_.nodes[node].mesh >= 0) ++uses[static_cast<std::size_t>(model_.nodes[node].mesh)];

@@ -67,6 +67,17 @@ double delta_power_over_4pi(const DeltaLight& light, float scene_radius) {
   return 0.0;
 }
 
+Ray shadow_ray(const Surfel& s, const LightSample& ls) {
+  return ls.infinite ? s.spawn(ls.wi) : s.spawn_to(ls.p, ls.p_error, ls.n);
+}
+
+std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene) {
+  std::vector<const DeltaLight*> out;
+  for (const DeltaLight& dl : scene.delta_lights)
+    if (!is_black(dl.intensity)) out.push_back(&dl);
+  return out;
+}
+
 float LightSampler::area_density(const Entry& e) { return PATHLAB_FAULT(LightPdfWithoutArea) ? 1.0f : 1.0f / e.area; }
 
 LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&scene) {
@@ -104,12 +115,11 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&sce
   // each divided by 4 pi so that a point light's weight is the luminance of
   // its intensity, as it was before there were other kinds (same bits).
   std::vector<double> intensity;
-  for (const DeltaLight& dl : scene.delta_lights) {
-    if (is_black(dl.intensity)) continue;
-    points_.push_back(dl);
-    intensity.push_back(delta_power_over_4pi(dl, scene_radius));
+  for (const DeltaLight* dl : sampled_delta_lights(scene)) {
+    deltas_.push_back(*dl);
+    intensity.push_back(delta_power_over_4pi(*dl, scene_radius));
   }
-  build_distribution(intensity, &point_pmf_, &point_cdf_);
+  build_distribution(intensity, &delta_pmf_, &delta_cdf_);
 }
 
 std::size_t LightSampler::unsampled_light_count() const {
@@ -163,12 +173,12 @@ float LightSampler::pdf(const vec3& ref, const Surfel& hit) const {
 }
 
 std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_choice) const {
-  if (points_.empty()) return std::nullopt;
-  const std::size_t i = pick(point_cdf_, u_choice);
-  const DeltaLight& light = points_[i];
+  if (deltas_.empty()) return std::nullopt;
+  const std::size_t i = pick(delta_cdf_, u_choice);
+  const DeltaLight& light = deltas_[i];
   LightSample ls;
   ls.light = static_cast<std::uint32_t>(i);
-  ls.pdf = point_pmf_[i];
+  ls.pdf = delta_pmf_[i];
   if (light.kind == DeltaLight::Kind::Directional) {
     // The shadow ray escapes (infinite): nothing may block it anywhere.
     ls.wi = -light.direction;
@@ -183,6 +193,7 @@ std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_c
   if (!(dist2 > 0.0f)) return std::nullopt;
   ls.dist = std::sqrt(dist2);
   ls.wi = d / ls.dist;
+  ls.n = -ls.wi;  // a point has no surface: its ray ends as if at one facing the shading point
   ls.Le = light.intensity / dist2;
   if (light.kind == DeltaLight::Kind::Spot) {
     const float profile = spot_profile(glm::dot(-ls.wi, light.direction), light.cos_outer, light.cos_inner);

@@ -28,7 +28,7 @@ namespace pathlab {
 struct LightSample {
   vec3 p{0.0f};        // point on the light (unused for the environment)
   vec3 p_error{0.0f};  // bound on its rounding error
-  vec3 n{0.0f};        // the light's normal at p (unused for points / environment)
+  vec3 n{0.0f};        // the light's normal at p (a point or spot light: -wi, facing the shading point)
   vec3 wi{0.0f};       // unit direction from the shading point towards the light
   float dist = 0.0f;   // distance to p; infinity for the environment and a directional light
   Spectrum Le{0.0f};   // radiance arriving (for a delta light: intensity * profile / dist^2,
@@ -39,10 +39,19 @@ struct LightSample {
   bool infinite = false;  // the shadow ray is unbounded (environment, directional light)
 };
 
+// The shadow ray from `s` to the light sample `ls`: unbounded towards an
+// infinite light (the environment, a directional light), else ending just
+// before the point on the light. Both tracers cast exactly this ray.
+Ray shadow_ray(const Surfel& s, const LightSample& ls);
+
 // A delta light's power divided by 4 pi, the weight with which sample_delta
 // picks it: Y(I) for a point, Y(I) (1 - (cos_inner + cos_outer) / 2) / 2 for
 // a spot, Y(E) r^2 / 4 for a directional light (r: the scene's radius).
 double delta_power_over_4pi(const DeltaLight& light, float scene_radius);
+// The scene's delta lights that LightSampler samples, in its order
+// (LightSample::light of a delta light indexes this list): all but the
+// black ones.
+std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene);
 
 class LightSampler {
  public:
@@ -56,7 +65,7 @@ class LightSampler {
   // their emission.
   std::size_t unsampled_light_count() const;
   bool has_area_lights() const { return !entries_.empty(); }
-  bool has_delta_lights() const { return !points_.empty(); }
+  bool has_delta_lights() const { return !deltas_.empty(); }
 
   // An area or environment light sample as seen from `ref`. Nothing if the
   // sample cannot contribute (back of a one-sided emitter, seen edge-on).
@@ -73,7 +82,7 @@ class LightSampler {
   std::optional<LightSample> sample_delta(const vec3& ref, float u_choice) const;
   // The probability with which sample_delta picks delta light i (its index
   // among the non-black ones, LightSample::light).
-  std::span<const float> delta_pmf() const { return point_pmf_; }
+  std::span<const float> delta_pmf() const { return delta_pmf_; }
 
   // The area-light distribution itself, for code that samples lights in
   // bulk (the wavefront's vectorised stages) and must pick exactly as
@@ -103,8 +112,8 @@ class LightSampler {
   std::vector<float> pmf_, cdf_;         // over entries_
   std::vector<std::int64_t> first_entry_;  // per shape: index of its prim 0, or -1
   std::int64_t env_index_ = -1;
-  std::vector<DeltaLight> points_;  // the non-black delta lights
-  std::vector<float> point_pmf_, point_cdf_;
+  std::vector<DeltaLight> deltas_;  // sampled_delta_lights(), copied
+  std::vector<float> delta_pmf_, delta_cdf_;
 };
 
 }  // namespace pathlab

@@ -5,6 +5,7 @@
 #include "core/mesh.h"
 
 #include "core/error.h"
+#include "core/geometry.h"
 
 #include <tiny_obj_loader.h>
 #include <zlib.h>
@@ -139,11 +140,7 @@ std::array<dvec3, 3> angle_weighted(const vec3& a, const vec3& b, const vec3& c)
   const double length = glm::length(face);
   std::array<dvec3, 3> out{dvec3(0.0), dvec3(0.0), dvec3(0.0)};
   if (!(length > 0.0)) return out;
-  for (int k = 0; k < 3; ++k) {
-    const dvec3 e1 = p[(k + 1) % 3] - p[k], e2 = p[(k + 2) % 3] - p[k];
-    // The corner's angle, from atan2 (accurate for slivers, unlike acos).
-    out[k] = std::atan2(glm::length(glm::cross(e1, e2)), glm::dot(e1, e2)) * (face / length);
-  }
+  for (int k = 0; k < 3; ++k) out[k] = corner_angle(p[k], p[(k + 1) % 3], p[(k + 2) % 3]) * (face / length);
   return out;
 }
 
@@ -782,33 +779,32 @@ std::vector<vec3> smooth_vertex_normals(const TriangleMesh& mesh) {
 
 std::vector<std::pair<std::uint16_t, TriangleMesh>> split_by_face_material(TriangleMesh mesh) {
   std::vector<std::pair<std::uint16_t, TriangleMesh>> parts;
-  // kNoFileMaterial first (its faces come before every `usemtl`), then by name.
-  std::vector<std::uint16_t> slots;
-  if (std::find(mesh.face_material.begin(), mesh.face_material.end(), TriangleMesh::kNoFileMaterial) !=
-          mesh.face_material.end() || mesh.face_material.empty())
-    slots.push_back(TriangleMesh::kNoFileMaterial);
-  std::vector<char> used(mesh.material_names.size(), 0);
-  for (const std::uint16_t m : mesh.face_material) {
-    if (m == TriangleMesh::kNoFileMaterial) continue;
-    if (m >= used.size()) throw std::invalid_argument("split_by_face_material: a face names material slot " +
-                                                      std::to_string(m) + " of " + std::to_string(used.size()));
-    used[m] = 1;
+  // The triangles of each slot, in one pass (a file may have thousands of
+  // materials); the last bucket holds kNoFileMaterial's.
+  const std::size_t names = mesh.material_names.size();
+  const auto bucket = [names](std::uint16_t slot) -> std::size_t {
+    return slot == TriangleMesh::kNoFileMaterial ? names : slot;
+  };
+  std::vector<std::vector<std::uint32_t>> by_slot(names + 1);
+  for (std::uint32_t t = 0; t < mesh.face_material.size(); ++t) {
+    const std::uint16_t m = mesh.face_material[t];
+    if (m != TriangleMesh::kNoFileMaterial && m >= names)
+      throw std::invalid_argument("split_by_face_material: a face names material slot " + std::to_string(m) + " of " +
+                                  std::to_string(names));
+    by_slot[bucket(m)].push_back(t);
   }
-  for (std::size_t m = 0; m < used.size(); ++m)
-    if (used[m]) slots.push_back(static_cast<std::uint16_t>(m));
+  // kNoFileMaterial first (its faces come before every `usemtl`), then by
+  // name; a mesh without face materials is all kNoFileMaterial.
+  std::vector<std::uint16_t> slots;
+  if (mesh.face_material.empty() || !by_slot[names].empty()) slots.push_back(TriangleMesh::kNoFileMaterial);
+  for (std::size_t m = 0; m < names; ++m)
+    if (!by_slot[m].empty()) slots.push_back(static_cast<std::uint16_t>(m));
   if (slots.size() == 1) {
     // All triangles in one part: the mesh as it is, without the copy.
     mesh.face_material.clear();
     mesh.material_names.clear();
     parts.emplace_back(slots[0], std::move(mesh));
     return parts;
-  }
-  // The triangles of each slot, in one pass (not one pass per slot: a file
-  // may have thousands of materials).
-  std::vector<std::vector<std::uint32_t>> by_slot(mesh.material_names.size() + 1);
-  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-    const std::uint16_t m = mesh.face_material[t];
-    by_slot[m == TriangleMesh::kNoFileMaterial ? mesh.material_names.size() : m].push_back(t);
   }
   constexpr std::uint32_t kUnused = 0xffffffffu;
   std::vector<std::uint32_t> remap(mesh.positions.size(), kUnused);
@@ -826,7 +822,7 @@ std::vector<std::pair<std::uint16_t, TriangleMesh>> split_by_face_material(Trian
       }
       return remap[v];
     };
-    for (const std::uint32_t t : by_slot[slot == TriangleMesh::kNoFileMaterial ? mesh.material_names.size() : slot]) {
+    for (const std::uint32_t t : by_slot[bucket(slot)]) {
       const glm::uvec3& tri = mesh.triangles[t];
       const std::uint32_t a = vertex(tri.x), b = vertex(tri.y), c = vertex(tri.z);
       part.triangles.emplace_back(a, b, c);

@@ -347,27 +347,16 @@ void read_instances(const Node& node, Scene* scene) {
     const auto index = static_cast<std::uint32_t>(found - scene->groups.begin());
     const std::string label = "instances[" + std::to_string(i) + "]";
     // The group's bounding box, whose placed corners must stay finite.
-    vec3 lo(kInfinity), hi(-kInfinity);
-    for (const std::uint32_t id : found->shapes) {
-      const Shape& shape = scene->shapes[id];
-      if (shape.kind == Shape::Kind::Sphere) {
-        lo = glm::min(lo, shape.center - shape.radius), hi = glm::max(hi, shape.center + shape.radius);
-      } else {
-        for (const vec3& p : shape.mesh.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-      }
-    }
+    Box box;
+    for (const std::uint32_t id : found->shapes) box.add(bounds(scene->shapes[id]));
     // Every placement must be invertible (Embree and the normals need its
     // inverse) and keep the group within the float range.
     const auto place = [&](const Node& where, const std::string& description) {
       const mat4 xf = read_transform(where);
-      const float det = glm::determinant(mat3(xf));
-      if (!(std::abs(det) > 0.0f) || !std::isfinite(det) || !std::isfinite(1.0f / det))
-        where.fail("the transform is singular or not finite (determinant " + std::to_string(det) + ")");
-      for (int c = 0; c < 8; ++c) {
-        const vec3 corner((c & 1) ? hi.x : lo.x, (c & 2) ? hi.y : lo.y, (c & 4) ? hi.z : lo.z);
-        if (!is_finite(vec3(xf * vec4(corner, 1.0f))))
-          where.fail("the transform moves the group beyond the float range (about 3.4e38)");
-      }
+      if (!invertible_placement(xf))
+        where.fail("the transform is singular or not finite (determinant " +
+                   std::to_string(glm::determinant(mat3(xf))) + ")");
+      if (!placed_finite(box, xf)) where.fail("the transform moves the group beyond the float range (about 3.4e38)");
       scene->instances.push_back({index, xf, description});
     };
     if (item.has("transform") == item.has("transforms"))

@@ -1,6 +1,7 @@
 #include "core/tangents.h"
 
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/material.h"
 
 #include <cmath>
@@ -29,9 +30,7 @@ std::vector<vec4> compute_tangents(const TriangleMesh& mesh) {
     const dvec3 dpdu = (d2.y * e1 - d1.y * e2) / det, dpdv = (d1.x * e2 - d2.x * e1) / det;
     if (!std::isfinite(glm::length(dpdu)) || !std::isfinite(glm::length(dpdv))) continue;
     for (int k = 0; k < 3; ++k) {
-      const dvec3 a = p[(k + 1) % 3] - p[k], c = p[(k + 2) % 3] - p[k];
-      // The corner's angle, from atan2 (accurate for slivers, unlike acos).
-      const double angle = std::atan2(glm::length(glm::cross(a, c)), glm::dot(a, c));
+      const double angle = corner_angle(p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
       // Each corner sees the derivatives in its own vertex's tangent plane,
       // as MikkTSpace does, so that a curved surface's corners agree.
       const dvec3 n(normals[tri[k]]);

@@ -1,5 +1,7 @@
 #include "debugtools/path_recorder.h"
 
+#include "core/light_sampler.h"
+
 #include <cstdio>
 #include <sstream>
 
@@ -29,19 +31,15 @@ const std::string& material_name(const Scene& scene, std::uint32_t m) {
 }
 
 // What a light event sampled: a delta light's own kind ("point", "spot",
-// "directional"; its index counts the scene's delta lights of non-zero
-// intensity, as the light sampler does), "area" or "environment".
+// "directional"), "area" or "environment".
 const char* light_kind(const Scene& scene, const LightEvent& e) {
   if (!e.delta) return e.infinite ? "environment" : "area";
-  std::uint32_t k = 0;
-  for (const DeltaLight& d : scene.delta_lights) {
-    if (is_black(d.intensity)) continue;
-    if (k++ != e.light) continue;
-    switch (d.kind) {
-      case DeltaLight::Kind::Point: return "point";
-      case DeltaLight::Kind::Spot: return "spot";
-      case DeltaLight::Kind::Directional: return "directional";
-    }
+  const std::vector<const DeltaLight*> lights = sampled_delta_lights(scene);
+  if (e.light >= lights.size()) return "point";
+  switch (lights[e.light]->kind) {
+    case DeltaLight::Kind::Point: return "point";
+    case DeltaLight::Kind::Spot: return "spot";
+    case DeltaLight::Kind::Directional: return "directional";
   }
   return "point";
 }

@@ -103,8 +103,7 @@ Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vert
   const Spectrum f = s.eval(ls->wi, wo);
   if (is_black(f)) return Spectrum(0.0f);
   ++path.rays;
-  // A directional light's shadow ray is unbounded (it must escape).
-  const Ray shadow = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, vec3(0.0f), -ls->wi);
+  const Ray shadow = shadow_ray(s, *ls);
   const bool visible = !scene_.occluded(shadow);
   const Spectrum L = visible ? f * ls->Le / ls->pdf : Spectrum(0.0f);
   if (path.observer)
@@ -122,7 +121,7 @@ Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int verte
   if (is_black(f)) return Spectrum(0.0f);
   const float w = light_sample_weight(settings_.strategy, ls->pdf, s.pdf(ls->wi, wo));
   ++path.rays;
-  const Ray shadow = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, ls->p_error, ls->n);
+  const Ray shadow = shadow_ray(s, *ls);
   const bool visible = !scene_.occluded(shadow);
   const Spectrum L = visible ? f * ls->Le * (w / ls->pdf) : Spectrum(0.0f);
   if (path.observer)

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -44,6 +45,13 @@ class TempDirTest : public ::testing::Test {
     dir_ = folder_->path();
   }
   void TearDown() override { folder_.reset(); }
+
+  // Writes `bytes` to the file `name` in dir_ and returns its path.
+  std::filesystem::path write(const std::string& name, const std::string& bytes) const {
+    const std::filesystem::path path = dir_ / name;
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path;
+  }
 
   std::filesystem::path dir_;
 

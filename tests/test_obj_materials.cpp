@@ -27,11 +27,6 @@ constexpr std::uint16_t kNone = TriangleMesh::kNoFileMaterial;
 
 class ObjMaterials : public test::TempDirTest {
  protected:
-  fs::path write(const std::string& name, const std::string& bytes) const {
-    const fs::path path = dir_ / name;
-    std::ofstream(path, std::ios::binary) << bytes;
-    return path;
-  }
   // A scene with materials white, red, wood and lamp, an environment light,
   // and `shapes` (and `extra` top-level keys).
   Scene scene(const std::string& shapes, const std::string& extra = "") const {

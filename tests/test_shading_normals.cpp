@@ -31,11 +31,6 @@ namespace fs = std::filesystem;
 
 class ShadingData : public test::TempDirTest {
  protected:
-  fs::path write(const std::string& name, const std::string& bytes) const {
-    const fs::path path = dir_ / name;
-    std::ofstream(path, std::ios::binary) << bytes;
-    return path;
-  }
   void expect_error(const std::string& name, const std::string& bytes, const std::string& message) const {
     try {
       (void)load_mesh(write(name, bytes));

@@ -367,7 +367,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
           if (obs) w.light[2 * i] = *ls;  // only the observer reads it back
           w.unoccluded[2 * i] = f * ls->Le / ls->pdf;
           w.light_weight[2 * i] = 1.0f;
-          w.shadow[2 * i] = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, vec3(0.0f), -ls->wi);
+          w.shadow[2 * i] = shadow_ray(s, *ls);
           w.shadow_state[2 * i] = 1;
         }
       }
@@ -381,7 +381,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
       if (obs) w.light[2 * i + 1] = *ls;
       w.unoccluded[2 * i + 1] = f * ls->Le * (lw / ls->pdf);
       w.light_weight[2 * i + 1] = lw;
-      w.shadow[2 * i + 1] = ls->infinite ? s.spawn(ls->wi) : s.spawn_to(ls->p, ls->p_error, ls->n);
+      w.shadow[2 * i + 1] = shadow_ray(s, *ls);
       w.shadow_state[2 * i + 1] = 1;
     }
   }
