@@ -4,8 +4,18 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <tuple>
 
 namespace pathlab {
+
+static_assert(sizeof(Sum1) == 16 && sizeof(Sum2) == 16);
+
+bool in_film_range(const Spectrum& L) {
+  // Also false for NaN: every comparison with it is.
+  for (int c = 0; c < 3; ++c)
+    if (!(std::abs(L[c]) < static_cast<float>(kFilmRadianceLimit))) return false;
+  return true;
+}
 
 Film::Film(int width, int height, FilterKind filter, FilmMoments moments)
     : width_(width),
@@ -13,21 +23,22 @@ Film::Film(int width, int height, FilterKind filter, FilmMoments moments)
       filter_(filter),
       moments_(moments),
       pixels_(static_cast<std::size_t>(width) * height),
-      sum_w2L2_(moments == FilmMoments::Mean ? 0 : static_cast<std::size_t>(width) * height),
+      moments_sums_(moments == FilmMoments::Mean ? 0 : static_cast<std::size_t>(width) * height),
       splat_(filter == FilterKind::Box ? 0 : static_cast<std::size_t>(width) * height) {
   // Zeroed in parallel: at 720p with the variance (52 MB) that takes 9-10 ms
   // on two threads, against 14 ms for the vectors zeroing them on one.
   parallel_for(0, pixels_.size(), std::size_t{1} << 16, [&](std::size_t b, std::size_t e) {
     const auto from = static_cast<std::ptrdiff_t>(b), to = static_cast<std::ptrdiff_t>(e);
     std::fill(pixels_.begin() + from, pixels_.begin() + to, Pixel{});
-    if (!sum_w2L2_.empty()) std::fill(sum_w2L2_.begin() + from, sum_w2L2_.begin() + to, dvec3(0.0));
+    if (!moments_sums_.empty()) std::fill(moments_sums_.begin() + from, moments_sums_.begin() + to, Moments{});
     if (!splat_.empty()) std::fill(splat_.begin() + from, splat_.begin() + to, SplatSums{});
   });
 }
 
 void Film::add_batch(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples) {
-  // One parallel pass over the rows; each pixel gathers its samples in a
-  // fixed order. NaN / Inf samples are left out and counted per row; a batch
+  // One parallel pass over the rows; each pixel gathers its samples (the
+  // order no longer matters to the sums, which are exact, but it keeps each
+  // pixel's memory on one thread). Bad samples are left out and counted per row; a batch
   // that had any is scanned again, serially, to report them in order. The
   // rows' rays are summed on the way.
   struct RowTally {
@@ -45,14 +56,15 @@ void Film::add_batch(std::uint32_t first, std::uint32_t count, std::span<const F
         if (filter_ == FilterKind::Box) {
           for (std::uint32_t j = 0; j < count; ++j) {
             const Spectrum& L = samples[own + j].L;
-            if (!is_finite(L)) {
+            if (!in_film_range(L)) {
               ++bad;
               continue;
             }
-            const dvec3 l(L);
             ++px.count;
-            px.sum_wL += l;
-            if (variance) sum_w2L2_[index(x, y)] += l * l;
+            for (int c = 0; c < 3; ++c) px.sum_wL[c].add(L[c]);
+            if (!variance) continue;
+            Moments& m = moments_sums_[index(x, y)];
+            for (int c = 0; c < 3; ++c) m.sum_w2L2[c].add(static_cast<double>(L[c]) * L[c]);
           }
           continue;
         }
@@ -61,25 +73,28 @@ void Film::add_batch(std::uint32_t first, std::uint32_t count, std::span<const F
         SplatSums& sp = splat_[index(x, y)];
         const float cx = static_cast<float>(x) + 0.5f, cy = static_cast<float>(y) + 0.5f;
         for (std::uint32_t j = 0; j < count; ++j) {
-          if (is_finite(samples[own + j].L))
+          if (in_film_range(samples[own + j].L))
             ++px.count;
           else
             ++bad;
           for (int sy = std::max(0, y - 1); sy <= std::min(height_ - 1, y + 1); ++sy) {
             for (int sx = std::max(0, x - 1); sx <= std::min(width_ - 1, x + 1); ++sx) {
               const FilmSample& s = samples[index(sx, sy) * count + j];
-              if (!is_finite(s.L)) continue;
+              if (!in_film_range(s.L)) continue;
               const float wx = 1.0f - std::abs(s.film.x - cx), wy = 1.0f - std::abs(s.film.y - cy);
               if (wx <= 0.0f || wy <= 0.0f) continue;
               const double w = static_cast<double>(wx) * wy;
               const dvec3 l(s.L);
-              sp.sum_w += w;
-              px.sum_wL += w * l;
+              sp.sum_w.add(w);
+              for (int c = 0; c < 3; ++c) px.sum_wL[c].add(w * l[c]);
               if (!variance) continue;
               const double w2 = w * w;
-              sp.sum_w2 += w2;
-              sp.sum_w2L += w2 * l;
-              sum_w2L2_[index(x, y)] += w2 * l * l;
+              sp.sum_w2.add(w2);
+              Moments& m = moments_sums_[index(x, y)];
+              for (int c = 0; c < 3; ++c) {
+                sp.sum_w2L[c].add(w2 * l[c]);
+                m.sum_w2L2[c].add(w2 * l[c] * l[c]);
+              }
             }
           }
         }
@@ -99,23 +114,88 @@ void Film::add_batch(std::uint32_t first, std::uint32_t count, std::span<const F
 }
 
 void Film::record_bad(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples) {
-  for (std::size_t i = 0; i < samples.size() && bad_kept_.size() < kMaxBadSamplesKept; ++i) {
-    if (is_finite(samples[i].L)) continue;
+  std::vector<BadSample> found;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (in_film_range(samples[i].L)) continue;
     const std::size_t pixel = i / count;
-    bad_kept_.push_back({static_cast<std::uint32_t>(pixel % width_), static_cast<std::uint32_t>(pixel / width_),
-                         first + static_cast<std::uint32_t>(i % count), samples[i].L});
+    found.push_back({static_cast<std::uint32_t>(pixel % width_), static_cast<std::uint32_t>(pixel / width_),
+                     first + static_cast<std::uint32_t>(i % count), samples[i].L});
   }
+  keep_bad(std::move(found));
 }
+
+// The bad samples kept are the first kMaxBadSamplesKept in the order (sample,
+// row, column): the same ones however the samples were split.
+void Film::keep_bad(std::vector<BadSample> more) {
+  bad_kept_.insert(bad_kept_.end(), more.begin(), more.end());
+  const auto key = [](const BadSample& b) { return std::tuple(b.sample, b.y, b.x); };
+  std::sort(bad_kept_.begin(), bad_kept_.end(), [&](const BadSample& a, const BadSample& b) { return key(a) < key(b); });
+  bad_kept_.erase(std::unique(bad_kept_.begin(), bad_kept_.end(),
+                              [&](const BadSample& a, const BadSample& b) { return key(a) == key(b); }),
+                  bad_kept_.end());
+  if (bad_kept_.size() > kMaxBadSamplesKept) bad_kept_.resize(kMaxBadSamplesKept);
+}
+
+void Film::add(const Film& o) {
+  if (o.width_ != width_ || o.height_ != height_ || o.filter_ != filter_ || o.moments_ != moments_)
+    throw std::invalid_argument("Film::add: the films differ in size, filter or moments");
+  parallel_for(0, pixels_.size(), std::size_t{1} << 14, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      for (int c = 0; c < 3; ++c) pixels_[i].sum_wL[c] += o.pixels_[i].sum_wL[c];
+      pixels_[i].count += o.pixels_[i].count;
+      if (!moments_sums_.empty())
+        for (int c = 0; c < 3; ++c) moments_sums_[i].sum_w2L2[c] += o.moments_sums_[i].sum_w2L2[c];
+      if (!splat_.empty()) {
+        splat_[i].sum_w += o.splat_[i].sum_w;
+        splat_[i].sum_w2 += o.splat_[i].sum_w2;
+        for (int c = 0; c < 3; ++c) splat_[i].sum_w2L[c] += o.splat_[i].sum_w2L[c];
+      }
+    }
+  });
+  bad_count_ += o.bad_count_;
+  rays_ += o.rays_;
+  keep_bad(o.bad_kept_);
+}
+
+Film::Words Film::words() {
+  static_assert(sizeof(Pixel) == kPixelWords * 8 && sizeof(Moments) == kMomentWords * 8 &&
+                sizeof(SplatSums) == kSplatWords * 8);
+  static_assert(alignof(Pixel) == 8 && alignof(Moments) == 8 && alignof(SplatSums) == 8);
+  const auto as_words = [](auto& v) {
+    return std::span<std::uint64_t>(reinterpret_cast<std::uint64_t*>(v.data()), v.size() * sizeof(v[0]) / 8);
+  };
+  return {as_words(pixels_), as_words(moments_sums_), as_words(splat_)};
+}
+
+Film::ConstWords Film::words() const {
+  const Words w = const_cast<Film*>(this)->words();
+  return {w.pixels, w.moments, w.splat};
+}
+
+void Film::restore_counts(std::uint64_t bad, std::uint64_t rays, std::vector<BadSample> kept) {
+  bad_count_ = bad;
+  rays_ = rays;
+  bad_kept_.clear();
+  keep_bad(std::move(kept));
+}
+
+namespace {
+template <class S>
+dvec3 value(const S (&sums)[3]) {
+  return {sums[0].value(), sums[1].value(), sums[2].value()};
+}
+}  // namespace
 
 Film::Sums Film::sums(int x, int y) const {
   const Pixel& p = pixels_[index(x, y)];
-  const dvec3 sum_w2L2 = keeps_variance() ? sum_w2L2_[index(x, y)] : dvec3(0.0);
+  const dvec3 sum_w2L2 = keeps_variance() ? value(moments_sums_[index(x, y)].sum_w2L2) : dvec3(0.0);
+  const dvec3 sum_wL = value(p.sum_wL);
   if (filter_ == FilterKind::Box) {
     const auto n = static_cast<double>(p.count);
-    return {n, n, p.sum_wL, p.sum_wL, sum_w2L2};
+    return {n, n, sum_wL, sum_wL, sum_w2L2};
   }
   const SplatSums& s = splat_[index(x, y)];
-  return {s.sum_w, s.sum_w2, p.sum_wL, s.sum_w2L, sum_w2L2};
+  return {s.sum_w.value(), s.sum_w2.value(), sum_wL, value(s.sum_w2L), sum_w2L2};
 }
 
 void Film::require_variance() const {
@@ -126,8 +206,8 @@ void Film::require_variance() const {
 Spectrum Film::mean(int x, int y) const {
   // sums(x, y) without the second moments, which image() need not read.
   const Pixel& p = pixels_[index(x, y)];
-  const double sum_w = filter_ == FilterKind::Box ? static_cast<double>(p.count) : splat_[index(x, y)].sum_w;
-  return sum_w > 0.0 ? Spectrum(p.sum_wL / sum_w) : Spectrum(0.0f);
+  const double sum_w = filter_ == FilterKind::Box ? static_cast<double>(p.count) : splat_[index(x, y)].sum_w.value();
+  return sum_w > 0.0 ? Spectrum(value(p.sum_wL) / sum_w) : Spectrum(0.0f);
 }
 
 Spectrum Film::variance_of_mean(int x, int y) const {

@@ -5,12 +5,18 @@
 // neighbour, so the sums - and the image bits - are the same for any number
 // of threads and any batch size.
 //
+// The sums are fixed-point (core/fixed_sum.h), so they do not depend on the
+// order samples arrive in either: a film rendered in pieces - resumed,
+// merged from sample ranges, reduced over processes (add()) - has the same
+// bits as one made in one go.
+//
 // A pixel's estimate is the weighted mean  I = sum(w L) / sum(w),  a ratio
 // estimator when the filter splats (bilinear); its variance is estimated by
 // the delta method,  Var(I) ~= sum(w^2 (L - I)^2) / (sum w)^2,  which reduces
 // to the usual  s^2 / n  for the box filter (w = 1).
 #pragma once
 
+#include "core/fixed_sum.h"
 #include "core/huge_pages.h"
 #include "core/image_io.h"
 #include "core/math.h"
@@ -30,11 +36,17 @@ struct FilmSample {
   std::uint32_t hits = 0;   // surfaces the path reached (its length in vertices)
 };
 
-// A sample left out of the image because its radiance was NaN or infinite.
+// A sample left out of the image because its radiance was NaN, infinite or
+// beyond the film's range (a component of magnitude kFilmRadianceLimit or
+// more: 2^32, about 4.3e9).
 struct BadSample {
   std::uint32_t x = 0, y = 0, sample = 0;
   Spectrum L{0.0f};
 };
+
+inline constexpr double kFilmRadianceLimit = Sum1::kLimit;
+// True if the film can add L: finite and every component below kFilmRadianceLimit.
+bool in_film_range(const Spectrum& L);
 
 // What a film keeps beyond each pixel's weighted mean.
 enum class FilmMoments : std::uint8_t {
@@ -57,10 +69,15 @@ class Film {
   FilterKind filter() const { return filter_; }
   bool keeps_variance() const { return moments_ == FilmMoments::MeanAndVariance; }
 
-  // Adds samples [first, first + count) of every pixel. NaN / Inf samples are
-  // left out, counted and remembered (the first kMaxBadSamplesKept); the
-  // rays of every sample, bad or not, are summed into rays_cast().
+  // Adds samples [first, first + count) of every pixel. Samples outside the
+  // film's range (NaN, Inf, huge: in_film_range) are left out, counted and
+  // remembered (the first kMaxBadSamplesKept by sample index, then row, then
+  // column); the rays of every sample, bad or not, are summed into rays_cast().
   void add_batch(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples);
+  // Adds another film of the same size, filter and moments, which holds
+  // other samples: the result has the bits of one film given both sets of
+  // samples. Throws std::invalid_argument if the films do not match.
+  void add(const Film& other);
 
   Image image() const;                  // the per-pixel weighted mean
   Spectrum mean(int x, int y) const;
@@ -78,21 +95,41 @@ class Film {
   const std::vector<BadSample>& bad_samples() const { return bad_kept_; }
   static constexpr std::size_t kMaxBadSamplesKept = 16;
 
+  // The film's whole state as arrays of 64-bit words, for the partial film
+  // file (core/partial_film.h): per pixel, 7 words of first sums (three
+  // Sum1 and the count), 6 of second moments (three Sum2; none for a
+  // FilmMoments::Mean film), 10 of splat sums (two Sum1 and three Sum1; none
+  // for the box filter).
+  static constexpr std::size_t kPixelWords = 7, kMomentWords = 6, kSplatWords = 10;
+  struct Words {
+    std::span<std::uint64_t> pixels, moments, splat;
+  };
+  struct ConstWords {
+    std::span<const std::uint64_t> pixels, moments, splat;
+  };
+  Words words();
+  ConstWords words() const;
+  // The counts a state restored into words() goes with.
+  void restore_counts(std::uint64_t bad, std::uint64_t rays, std::vector<BadSample> kept);
+
  private:
   // What every film keeps per pixel: sum(w L) and the count of its own
   // samples. With the box filter every weight is 1, so sum(w) and sum(w^2)
   // are the count and sum(w^2 L) is sum(w L).
   // (No member initialisers: the film zeroes its arrays in parallel.)
   struct Pixel {
-    dvec3 sum_wL;
+    Sum1 sum_wL[3];
     std::uint64_t count;
+  };
+  struct Moments {
+    Sum2 sum_w2L2[3];  // sum(w^2 L^2)
   };
   // What a splatting filter (w != 1) adds: sum(w), and for the variance
   // sum(w^2) and sum(w^2 L).
   struct SplatSums {
-    double sum_w;
-    double sum_w2;
-    dvec3 sum_w2L;
+    Sum1 sum_w;
+    Sum1 sum_w2;
+    Sum1 sum_w2L[3];
   };
   // A pixel's sums whatever the filter.
   struct Sums {
@@ -102,14 +139,16 @@ class Film {
   Sums sums(int x, int y) const;
   void require_variance() const;
   std::size_t index(int x, int y) const { return static_cast<std::size_t>(y) * width_ + x; }
-  // Records the batch's NaN / Inf samples in order (the rare path).
+  // Records the batch's bad samples, keeping the first kMaxBadSamplesKept
+  // in the canonical order (the rare path).
   void record_bad(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples);
+  void keep_bad(std::vector<BadSample> more);
 
   int width_, height_;
   FilterKind filter_;
   FilmMoments moments_;
   HugePageVector<Pixel> pixels_;
-  HugePageVector<dvec3> sum_w2L2_;   // sum(w^2 L^2) per pixel; empty for FilmMoments::Mean
+  HugePageVector<Moments> moments_sums_;  // empty for FilmMoments::Mean
   HugePageVector<SplatSums> splat_;  // empty for the box filter
   std::uint64_t bad_count_ = 0;
   std::uint64_t rays_ = 0;

@@ -67,7 +67,7 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
   return true;
 }
 
-tinygltf::Model parse(const fs::path& file) {
+tinygltf::Model parse(const fs::path& file, std::vector<fs::path>* external_files) {
   const gltf::Container container = gltf::read_container(file);
   // tinygltf reads "extras" and "extensions" recursively: a file nested
   // deeper than any real one is refused before it can exhaust the stack.
@@ -79,6 +79,7 @@ tinygltf::Model parse(const fs::path& file) {
   const nlohmann::json doc = nlohmann::json::parse(container.json_text, depth_limit, false);
   if (doc.is_discarded()) fail(file, "", "not valid JSON");
   Approved approved{gltf::validate(doc, file, container)};
+  external_files->assign(approved.files.begin(), approved.files.end());
 
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({&file_exists, &expand_path, &read_whole_file, &write_whole_file, &approved});
@@ -624,8 +625,11 @@ bool is_gltf_file(const fs::path& file) {
 }
 
 GltfContent load_gltf(const fs::path& file, const GltfOptions& options) {
-  const tinygltf::Model model = parse(file);
-  return Flattener(model, file, options).run();
+  std::vector<fs::path> external_files;
+  const tinygltf::Model model = parse(file, &external_files);
+  GltfContent content = Flattener(model, file, options).run();
+  content.external_files = std::move(external_files);
+  return content;
 }
 
 }  // namespace pathlab

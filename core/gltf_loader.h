@@ -57,6 +57,7 @@ struct GltfContent {
   std::vector<GltfCamera> cameras;         // perspective cameras, in node order
   std::vector<DeltaLight> delta_lights;    // KHR_lights_punctual point, spot and directional lights
   std::vector<std::string> warnings;       // one line each, naming the file
+  std::vector<std::filesystem::path> external_files;  // the buffers and images it names, read or not
 };
 
 struct GltfOptions {

@@ -82,6 +82,7 @@ Scene load_gltf_scene(const std::filesystem::path& file) {
   scene.name = file.stem().string();
   scene.film = FilmDesc{640, 480, FilterKind::Box};
   scene.warnings = content.warnings;
+  scene.input_files = content.external_files;
   append_gltf(scene, content);
   if (!content.cameras.empty()) {
     scene.camera = content.cameras.front().desc;

@@ -10,17 +10,18 @@ namespace {
 
 // pbrt-style firefly clamp: scale a finite sample down so that its largest
 // component is `limit`, keeping its colour. Biased: off unless asked for.
-// Non-finite samples pass through untouched (the film counts and locates them).
+// Samples outside the film's range pass through untouched (the film counts
+// and locates them).
 void clamp_samples(std::span<FilmSample> out, float limit, RenderStats& stats) {
   for (FilmSample& s : out) {
-    if (!is_finite(s.L)) continue;
+    if (!in_film_range(s.L)) continue;
     const double before = average(s.L);
-    stats.energy_total += before;
+    stats.energy_total.add(before);
     const float m = max_component(s.L);
     if (m > limit) {
       s.L *= limit / m;
       ++stats.clamped_samples;
-      stats.energy_clamped += before - average(s.L);
+      stats.energy_clamped.add(before - average(s.L));
     }
   }
 }
@@ -48,7 +49,7 @@ RenderStats render(const Tracer& tracer, Film& film, const ProgressFn& progress)
 }
 
 RenderStats render_samples(const Tracer& tracer, Film& film, std::uint32_t first, std::uint32_t last,
-                           const ProgressFn& progress) {
+                           const ProgressFn& progress, const BatchDoneFn& batch_done) {
   const auto start = std::chrono::steady_clock::now();
   RenderStats stats;
   if (last > first) {
@@ -66,6 +67,11 @@ RenderStats render_samples(const Tracer& tracer, Film& film, std::uint32_t first
       stats.rays += film.rays_cast() - rays_before;
       stats.samples += out.size();
       if (progress) progress(static_cast<double>(begin + count - first) / (last - first));
+      if (batch_done) {
+        stats.bad_samples = film.bad_sample_count();
+        stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (!batch_done(begin + count, stats)) break;
+      }
     }
   }
   stats.bad_samples = film.bad_sample_count();
@@ -83,24 +89,45 @@ double estimated_relmse(const Film& film) {
   return sum / (3.0 * film.width() * film.height());
 }
 
-UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule, const ProgressFn& progress) {
+UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule, const ProgressFn& progress,
+                         std::uint32_t start_spp, const BatchDoneFn& batch_done) {
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   const std::uint32_t max_spp = static_cast<std::uint32_t>(std::max(rule.max_spp, 1));
   const std::uint32_t pass = rule.pass_spp > 0 ? rule.pass_spp : batch_size(film.width(), film.height(), rule.max_spp);
   UntilResult r;
+  r.spp = start_spp;
+  // A resumed render decides as the uninterrupted one would have at this pass.
+  if (start_spp > 0 && rule.target_relmse > 0.0) r.estimated_relmse = estimated_relmse(film);
   while (r.spp < max_spp) {
-    if (r.passes > 0) {
+    if (r.passes > 0 || start_spp > 0) {
       const double now = elapsed();
-      if (rule.time_budget_seconds > 0.0 && now + now / r.passes > rule.time_budget_seconds) break;
+      if (r.passes > 0 && rule.time_budget_seconds > 0.0 && now + now / r.passes > rule.time_budget_seconds) break;
       if (rule.target_relmse > 0.0 && r.estimated_relmse < rule.target_relmse) break;
     }
-    const std::uint32_t last = std::min(max_spp, r.spp + pass);
-    const RenderStats s = render_samples(tracer, film, r.spp, last);
+    // On the grid of whole passes from 0, whatever spp a resume starts at.
+    const std::uint32_t last = std::min(max_spp, (r.spp / pass + 1) * pass);
+    const RenderStats base = r.stats;
+    bool go_on = true;
+    const auto done = [&](std::uint32_t end, const RenderStats& so_far) {
+      RenderStats all = base;
+      all += so_far;
+      all.seconds = elapsed();
+      return go_on = batch_done(end, all);
+    };
+    const RenderStats s = batch_done ? render_samples(tracer, film, r.spp, last, {}, done)
+                                     : render_samples(tracer, film, r.spp, last);
     r.stats += s;
     r.last_pass_seconds = s.seconds;
-    r.spp = last;
+    const auto pixels = static_cast<std::uint64_t>(film.width()) * film.height();
+    const std::uint32_t reached = r.spp + static_cast<std::uint32_t>(s.samples / std::max<std::uint64_t>(pixels, 1));
     ++r.passes;
+    if (!go_on) {
+      r.spp = reached;
+      r.stopped = true;
+      break;
+    }
+    r.spp = last;
     if (rule.target_relmse > 0.0) r.estimated_relmse = estimated_relmse(film);
     if (progress) {
       double f = static_cast<double>(r.spp) / max_spp;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/film.h"
+#include "core/fixed_sum.h"
 #include "core/tracer.h"
 
 #include <cstdint>
@@ -21,9 +22,13 @@ struct RenderStats {
   // Radiance clamping (RenderSettings::clamp): samples scaled down, and the
   // sum over all samples of the mean RGB radiance before clamping and of
   // what clamping removed (their ratio is the relative energy removed).
+  // Fixed-point, so that a render in pieces sums to the same bits.
   std::uint64_t clamped_samples = 0;
-  double energy_total = 0.0;
-  double energy_clamped = 0.0;
+  Sum1 energy_total;
+  Sum1 energy_clamped;
+  double relative_energy_clamped() const {
+    return energy_total.value() > 0.0 ? energy_clamped.value() / energy_total.value() : 0.0;
+  }
 
   // Adds the counts of another render of the same film (seconds and
   // bad_samples, which describe the whole film, are left to the caller).
@@ -39,6 +44,10 @@ struct RenderStats {
 
 // Called after each batch with the fraction done (0..1].
 using ProgressFn = std::function<void(double fraction)>;
+// Called after each batch, once the film holds samples [.., end) of every
+// pixel, with the stats of the render so far; returning false stops the
+// render there (at whole passes: a checkpoint, an interrupt).
+using BatchDoneFn = std::function<bool(std::uint32_t end, const RenderStats& so_far)>;
 
 // Renders settings.spp samples per pixel into `film` (which must match the
 // scene's resolution and filter): render_samples(tracer, film, 0, spp).
@@ -50,8 +59,10 @@ RenderStats render(const Tracer& tracer, Film& film, const ProgressFn& progress 
 // `last` samples per pixel. With settings.clamp > 0 each sample's radiance is
 // scaled so that its largest component is at most clamp (counted in
 // clamped_samples, energy_clamped).
+// `batch_done` may stop it early: RenderStats::samples then says how far it
+// got (samples / pixels passes).
 RenderStats render_samples(const Tracer& tracer, Film& film, std::uint32_t first, std::uint32_t last,
-                           const ProgressFn& progress = {});
+                           const ProgressFn& progress = {}, const BatchDoneFn& batch_done = {});
 
 // When render_until() stops. Zero fields are off; max_spp always applies.
 struct StopRule {
@@ -64,6 +75,7 @@ struct StopRule {
 struct UntilResult {
   RenderStats stats;
   std::uint32_t spp = 0;          // samples per pixel reached (whole passes)
+  bool stopped = false;           // batch_done stopped it
   std::uint32_t passes = 0;
   double estimated_relmse = 0.0;  // of the final film
   double last_pass_seconds = 0.0;
@@ -74,7 +86,11 @@ struct UntilResult {
 // so the render ends at most about one pass before the budget. It estimates
 // the film's error from its variance, so `film` must keep it
 // (FilmMoments::MeanAndVariance; a mean-only film throws std::logic_error).
-UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule, const ProgressFn& progress = {});
+// `start_spp`: the film already holds samples [0, start_spp) (a resumed
+// render), and the passes go on from there on the same grid as from 0.
+// `batch_done` as for render_samples.
+UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule, const ProgressFn& progress = {},
+                         std::uint32_t start_spp = 0, const BatchDoneFn& batch_done = {});
 
 // The relative error of the film's image estimated from its own per-pixel
 // variance: the mean over pixels and channels of Var(I) / (I + 0.01)^2,

@@ -142,6 +142,10 @@ struct Scene {
   std::vector<DeltaLight> delta_lights;  // point, spot and directional lights
   std::optional<Spectrum> environment;  // uniform radiance from every direction
   std::vector<std::string> warnings;    // non-fatal problems found while loading
+  // Every file the scene loaded besides its own (meshes, glTF files, ...),
+  // as resolved, in the order loaded: what a render's fingerprint hashes
+  // (core/partial_film.h).
+  std::vector<std::filesystem::path> input_files;
   // The closed-form model whose answer this scene has ("furnace", ...; see
   // analytic-scenes/), or empty. Only `pathlab check` reads it.
   std::string analytic;

@@ -415,6 +415,8 @@ void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path
   GltfContent content;
   try {
     content = load_gltf(path, options);
+    scene.input_files.push_back(path);
+    scene.input_files.insert(scene.input_files.end(), content.external_files.begin(), content.external_files.end());
   } catch (const InputError& e) {
     file.fail(e.what());
   }

@@ -76,6 +76,7 @@ std::vector<MeshPart> read_mesh_parts(const Node& node, Scene& scene, const std:
   TriangleMesh mesh;
   try {
     mesh = load_mesh(path, &report, options);
+    scene.input_files.push_back(path);
   } catch (const InputError& e) {
     file.fail(e.what());
   }

@@ -14,6 +14,7 @@ packages=(
   libtinyobjloader-dev    # OBJ meshes
   libtinygltf-dev         # glTF 2.0 files (header only: core/gltf_loader.cpp)
   zlib1g-dev              # .gz meshes
+  libxxhash-dev           # checksums and fingerprints of partial films (checkpoints)
   libcli11-dev            # the command line
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev        # Google Benchmark: bench/

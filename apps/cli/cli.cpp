@@ -18,7 +18,9 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
   DiffCommand diff;
   CheckCommand check;
   ConvergeCommand converge;
+  MergeCommand merge;
   render.add_to(app);
+  merge.add_to(app);
   check.add_to(app);
   diff.add_to(app);
   trace_pixel.add_to(app);
@@ -37,6 +39,7 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
 
   try {
     if (render.selected) return render.run(out, err);
+    if (merge.selected) return merge.run(out, err);
     if (trace_pixel.selected) return trace_pixel.run(out, err);
     if (diff.selected) return diff.run(out, err);
     if (check.selected) return check.run(out, err);

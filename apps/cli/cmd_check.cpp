@@ -84,7 +84,7 @@ int CheckCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     if (settings.clamp > 0.0f)
       err << "    clamp: " << stats.clamped_samples << " of " << stats.samples << " samples clamped ("
           << fmt("%.3g", 100.0 * static_cast<double>(stats.clamped_samples) / static_cast<double>(std::max<std::uint64_t>(stats.samples, 1)))
-          << " %), relative energy removed " << fmt("%.3g", stats.energy_total > 0.0 ? stats.energy_clamped / stats.energy_total : 0.0)
+          << " %), relative energy removed " << fmt("%.3g", stats.relative_energy_clamped())
           << "\n";
     err << "    measured bias vs the analytic image: " << fmt("%+.3g", wanted > 0.0 ? rendered / wanted - 1.0 : 0.0)
         << " relative (mean over the image)\n";

@@ -2,12 +2,16 @@
 //                [--max-depth D] [--rr-depth R] [--seed S] [--threads T]
 //                [--resolution WxH] [--aov albedo,normal,...] [--quiet]
 //                [--time SECONDS] [--target-relmse X]   (progressive: --spp is then the most it renders)
+//                [--checkpoint FILE [--checkpoint-every S]] [--resume FILE] [--passes A..B]
+//                (-o part.pfilm writes the partial film instead of an image: docs/overnight.md)
 #include "apps/cli/commands.h"
 
+#include "apps/cli/interrupt.h"
 #include "apps/cli/progress.h"
 #include "core/compiled_scene.h"
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/partial_film.h"
 #include "core/parallel.h"
 #include "core/render.h"
 #include "debugtools/aov.h"
@@ -15,6 +19,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <optional>
 #include <ostream>
@@ -37,30 +43,101 @@ void RenderCommand::add_to(CLI::App& app) {
   cmd->add_option("--target-relmse", target_relmse,
                   "Stop when the relative MSE estimated from per-pixel variance falls below X; --spp is then a cap")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--checkpoint", checkpoint,
+                  "Keep the render's state in FILE (a partial film), rewritten atomically every --checkpoint-every "
+                  "seconds, on Ctrl-C / SIGTERM and at the end; --resume FILE goes on from it");
+  cmd->add_option("--checkpoint-every", checkpoint_every, "Seconds between checkpoints (default 600)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--resume", resume, "Go on from this checkpoint (same scene, files and settings) to the same bits");
+  cmd->add_option("--passes", passes,
+                  "Render only sample passes A..B (sample indices A to B-1 of every pixel); with -o X.pfilm the "
+                  "partial film is written for 'pathlab merge'");
   cmd->add_flag("-q,--quiet", quiet, "Print only warnings and errors");
   cmd->callback([this] { selected = true; });
 }
+
+namespace {
+
+std::string lower_extension(const std::filesystem::path& p) {
+  std::string ext = p.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// "A..B" -> [A, B).
+PassRange parse_passes(const std::string& text) {
+  const std::size_t dots = text.find("..");
+  const auto number = [&](const std::string& part) -> std::optional<std::uint32_t> {
+    if (part.empty() || part.size() > 9 || part.find_first_not_of("0123456789") != std::string::npos) return {};
+    return static_cast<std::uint32_t>(std::stoul(part));
+  };
+  const auto a = dots == std::string::npos ? std::nullopt : number(text.substr(0, dots));
+  const auto b = dots == std::string::npos ? std::nullopt : number(text.substr(dots + 2));
+  if (!a || !b || *b <= *a)
+    throw InputError("--passes " + text + ": expected A..B with 0 <= A < B (sample passes A to B-1), e.g. 0..64");
+  return {*a, *b};
+}
+
+}  // namespace
 
 int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   Scene s = scene.load();
   for (const std::string& w : s.warnings) err << "pathlab: warning: " << w << "\n";
 
   std::filesystem::path exr = output.empty() ? std::filesystem::path("out") / (s.name + ".exr") : std::filesystem::path(output);
-  std::string ext = exr.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".exr") throw InputError(exr.string() + ": the output must be an .exr file (a .png is written beside it)");
+  // -o X.pfilm: the partial film itself, for `pathlab merge`, and no image.
+  const bool partial_output = lower_extension(exr) == ".pfilm";
+  if (!partial_output && lower_extension(exr) != ".exr")
+    throw InputError(exr.string() + ": the output must be an .exr file (a .png is written beside it), or a .pfilm "
+                     "partial film");
   std::filesystem::path png = exr;
   png.replace_extension(".png");
   ensure_writable(exr);
-  ensure_writable(png);
+  if (!partial_output) ensure_writable(png);
+  if (checkpoint) ensure_writable(*checkpoint);
+
+  const bool progressive = time_budget || target_relmse;
+  std::vector<Aov> layers;
+  for (const std::string& name : aovs) layers.push_back(*parse_aov(name));
+  const bool variance_aov = std::find(layers.begin(), layers.end(), Aov::Variance) != layers.end();
+  const bool pieces = checkpoint || resume || passes || partial_output;
+  if (pieces && std::any_of(layers.begin(), layers.end(), [](Aov a) { return a != Aov::Variance; }))
+    throw InputError("--aov: only the variance layer is kept in a partial film; the others cannot go with "
+                     "--checkpoint, --resume, --passes or a .pfilm output yet");
+  if (partial_output && !layers.empty()) throw InputError("--aov: a .pfilm output holds no image layers");
+  if (passes && progressive) throw InputError("--passes renders a fixed range of passes; --time and --target-relmse cannot go with it");
+  const std::uint32_t spp = static_cast<std::uint32_t>(std::max(s.render.spp, 0));
+  const PassRange range = passes ? parse_passes(*passes) : PassRange{0, spp};
+
+  // The fingerprint and the checkpoint are read before the scene is compiled,
+  // so that a mismatch is reported at once.
+  const Fingerprint fingerprint = render_fingerprint(s, scene.tracer);
+  std::optional<PartialFilm> resumed;
+  if (resume) {
+    resumed = read_partial_film(*resume);
+    const PartialFilmInfo& was = resumed->info;
+    if (!(was.fingerprint == fingerprint))
+      throw InputError(*resume + ": a checkpoint of another render; what differs:\n" +
+                       fingerprint_difference(was.fingerprint, fingerprint, "checkpoint", "this render"));
+    if (was.passes.begin != range.begin)
+      throw InputError(*resume + ": it holds passes " + std::to_string(was.passes.begin) + ".." +
+                       std::to_string(was.passes.end) + ", not a start of passes " + std::to_string(range.begin) +
+                       ".." + std::to_string(range.end));
+    if (!progressive && was.passes.end > range.end)
+      throw InputError(*resume + ": it already holds passes " + std::to_string(was.passes.begin) + ".." +
+                       std::to_string(was.passes.end) + ", beyond the " + std::to_string(range.end) +
+                       " asked for (--spp or --passes)");
+    const bool needs_variance = progressive || variance_aov;
+    if (needs_variance && !resumed->film.keeps_variance())
+      throw InputError(*resume + ": its film keeps no variance, which " +
+                       (progressive ? std::string("--time and --target-relmse need") : std::string("--aov variance is")));
+  }
 
   const ThreadLimit limit(threads);
   const RenderSettings settings = s.render;
   const CompiledScene compiled(std::move(s));
   const auto tracer = make_tracer(scene.tracer, compiled, settings);
   // With --aov the driver renders through a tracer that also fills the AOVs.
-  std::vector<Aov> layers;
-  for (const std::string& name : aovs) layers.push_back(*parse_aov(name));
   std::optional<AovAccumulator> aov_buffers;
   std::optional<AovTracer> aov_tracer;
   if (!layers.empty()) {
@@ -71,63 +148,123 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   if (const std::size_t n = compiled.lights().unsampled_light_count())
     err << "pathlab: warning: " << n << " light(s) are too dim next to the others ever to be picked for light "
         << "sampling; only rays that hit them count their light\n";
-  const bool progressive = time_budget || target_relmse;
   // The second moments only if something reads them: progressive rendering
-  // estimates its error from them, and the variance AOV is them.
-  const bool variance = progressive || std::find(layers.begin(), layers.end(), Aov::Variance) != layers.end();
-  Film film(sc.film.width, sc.film.height, sc.film.filter, variance ? FilmMoments::MeanAndVariance : FilmMoments::Mean);
+  // estimates its error from them, and the variance AOV is them. A resumed
+  // film keeps what it was made with.
+  const bool variance = progressive || variance_aov;
+  Film film = resumed ? std::move(resumed->film)
+                      : Film(sc.film.width, sc.film.height, sc.film.filter,
+                             variance ? FilmMoments::MeanAndVariance : FilmMoments::Mean);
+  PartialFilmInfo info;
+  if (resumed) {
+    info = resumed->info;
+    ++info.resumes;
+  } else {
+    info.passes = {range.begin, range.begin};
+    info.fingerprint = fingerprint;
+  }
+  info.target_spp = progressive && !scene.spp ? 1u << 24 : range.end;
+  const PartialFilmInfo before = info;
+  if (resumed && !quiet)
+    err << "pathlab: resuming " << *resume << ": passes " << info.passes.begin << ".." << info.passes.end
+        << " done, " << info.resumes - 1 << " resume(s) before\n";
+  const std::uint32_t start = info.passes.end;
+  // The partial film after this run's passes up to `end`, with its stats so far.
+  const auto info_at = [&](std::uint32_t end, const RenderStats& so_far) {
+    PartialFilmInfo i = before;
+    i.passes.end = end;
+    i.stats += so_far;
+    i.stats.seconds = before.stats.seconds + so_far.seconds;
+    i.stats.bad_samples = film.bad_sample_count();
+    return i;
+  };
+
+  const InterruptGuard interrupts;
+  auto last_checkpoint = std::chrono::steady_clock::now();
+  const BatchDoneFn batch_done = [&](std::uint32_t end, const RenderStats& so_far) {
+    if (InterruptGuard::received() != 0) return false;
+    const auto now = std::chrono::steady_clock::now();
+    if (checkpoint && std::chrono::duration<double>(now - last_checkpoint).count() >= checkpoint_every) {
+      write_partial_film(film, info_at(end, so_far), *checkpoint);
+      last_checkpoint = now;
+    }
+    return true;
+  };
 
   ProgressBar bar(err, "rendering", !quiet && stderr_is_terminal());
   const Tracer& driven = aov_tracer ? static_cast<const Tracer&>(*aov_tracer) : *tracer;
   std::optional<UntilResult> until;
+  RenderStats stats;
+  std::uint32_t end = start;
   if (progressive) {
     // Without an explicit --spp the budget or target decides alone.
     until = render_until(driven, film, {time_budget.value_or(0.0), target_relmse.value_or(0.0),
                                         scene.spp ? settings.spp : 1 << 24, 0},
-                         [&](double f) { bar.update(f); });
+                         [&](double f) { bar.update(f); }, start, batch_done);
+    stats = until->stats;
+    end = until->spp;
+  } else {
+    stats = render_samples(driven, film, start, range.end, [&](double f) { bar.update(f); }, batch_done);
+    const auto pixels = static_cast<std::uint64_t>(film.width()) * film.height();
+    end = start + static_cast<std::uint32_t>(stats.samples / std::max<std::uint64_t>(pixels, 1));
   }
-  const RenderStats stats = progressive ? until->stats : render(driven, film, [&](double f) { bar.update(f); });
-  const int spp_done = progressive ? static_cast<int>(until->spp) : settings.spp;
   bar.finish();
+  const int interrupted = InterruptGuard::received();
+  info = info_at(end, stats);
+  if (checkpoint) write_partial_film(film, info, *checkpoint);
+  if (partial_output) write_partial_film(film, info, exr);
+  const int spp_done = static_cast<int>(info.passes.count());
+  stats = info.stats;  // this render and the ones it resumed
 
-  const Image image = film.image();
-  char seconds[32];
-  std::snprintf(seconds, sizeof seconds, "%.3f", stats.seconds);
-  ImageMetadata meta = {
-      {"scene", sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string()},
-      {"tracer", std::string(tracer->name())},
-      {"strategy", strategy_name(settings.strategy)},
-      {"spp", std::to_string(spp_done)},
-      {"seed", std::to_string(settings.seed)},
-      {"max_depth", std::to_string(settings.max_depth)},
-      {"rr_depth", std::to_string(settings.rr_depth)},
-      {"filter", sc.film.filter == FilterKind::Box ? "box" : "bilinear"},
-      {"render_time_seconds", seconds},
-      {"bad_samples", std::to_string(stats.bad_samples)},
-      {"version", PATHLAB_VERSION},
-  };
-  if (progressive) {
-    char relmse[32];
-    std::snprintf(relmse, sizeof relmse, "%.6g", until->estimated_relmse);
-    meta.emplace_back("spp_reached", std::to_string(spp_done));
-    meta.emplace_back("estimated_relmse", relmse);
-    if (time_budget) meta.emplace_back("time_budget_seconds", std::to_string(*time_budget));
-    if (target_relmse) meta.emplace_back("target_relmse", std::to_string(*target_relmse));
+  if (!partial_output) {
+    const Image image = film.image();
+    char seconds[32];
+    std::snprintf(seconds, sizeof seconds, "%.3f", stats.seconds);
+    ImageMetadata meta = {
+        {"scene", sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string()},
+        {"tracer", std::string(tracer->name())},
+        {"strategy", strategy_name(settings.strategy)},
+        {"spp", std::to_string(spp_done)},
+        {"seed", std::to_string(settings.seed)},
+        {"max_depth", std::to_string(settings.max_depth)},
+        {"rr_depth", std::to_string(settings.rr_depth)},
+        {"filter", sc.film.filter == FilterKind::Box ? "box" : "bilinear"},
+        {"render_time_seconds", seconds},
+        {"bad_samples", std::to_string(stats.bad_samples)},
+        {"version", PATHLAB_VERSION},
+    };
+    for (auto& kv : partial_film_metadata(info)) meta.push_back(std::move(kv));
+    if (interrupted != 0) meta.emplace_back("interrupted", "yes");
+    if (progressive) {
+      char relmse[32];
+      std::snprintf(relmse, sizeof relmse, "%.6g", until->estimated_relmse);
+      meta.emplace_back("spp_reached", std::to_string(spp_done));
+      meta.emplace_back("estimated_relmse", relmse);
+      if (time_budget) meta.emplace_back("time_budget_seconds", std::to_string(*time_budget));
+      if (target_relmse) meta.emplace_back("target_relmse", std::to_string(*target_relmse));
+    }
+    if (layers.empty()) write_exr(exr, image, meta);
+    else write_exr_channels(exr, film.width(), film.height(), aov_channels(film, *aov_buffers, layers), meta);
+    try {
+      write_png(png, image, exposure);
+    } catch (...) {
+      // The two files are one result: do not leave the EXR without its PNG.
+      std::error_code ignored;
+      std::filesystem::remove(exr, ignored);
+      throw;
+    }
   }
-  if (layers.empty()) write_exr(exr, image, meta);
-  else write_exr_channels(exr, film.width(), film.height(), aov_channels(film, *aov_buffers, layers), meta);
-  try {
-    write_png(png, image, exposure);
-  } catch (...) {
-    // The two files are one result: do not leave the EXR without its PNG.
-    std::error_code ignored;
-    std::filesystem::remove(exr, ignored);
-    throw;
+  if (interrupted != 0) {
+    err << "pathlab: interrupted (" << (interrupted == SIGINT ? "SIGINT" : "SIGTERM") << ") after passes "
+        << info.passes.begin << ".." << info.passes.end << "; wrote " << exr.string()
+        << (checkpoint ? " and the checkpoint " + *checkpoint + " (go on with --resume " + *checkpoint + ")" : "")
+        << "\n";
   }
 
   if (stats.bad_samples > 0) {
     err << "pathlab: warning: " << stats.bad_samples
-        << " sample(s) had NaN or infinite radiance and were left out of the image. Replay them with:\n";
+        << " sample(s) had NaN, infinite or out-of-range (>= 2^32) radiance and were left out of the image. "
+           "Replay them with:\n";
     for (const BadSample& b : film.bad_samples())
       err << "  " << scene.trace_pixel_command(sc, b.x, b.y, b.sample) << "\n";
   }
@@ -136,7 +273,7 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     std::snprintf(line, sizeof line, "%.2f s, %.3g samples/s, %.3g rays/s", stats.seconds,
                   static_cast<double>(stats.samples) / std::max(stats.seconds, 1e-9),
                   static_cast<double>(stats.rays) / std::max(stats.seconds, 1e-9));
-    err << "pathlab: wrote " << exr.string() << " and " << png.string() << " (" << sc.film.width << "x"
+    err << "pathlab: wrote " << exr.string() << (partial_output ? "" : " and " + png.string()) << " (" << sc.film.width << "x"
         << sc.film.height << ", " << spp_done << " spp, " << tracer->name() << ", "
         << strategy_name(settings.strategy) << "): " << line << "\n";
     if (const auto* wf = dynamic_cast<const WavefrontTracer*>(tracer.get())) {
@@ -157,7 +294,8 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
       }
     }
   }
-  return 0;
+  // 128 + the signal, as a shell reports a process the signal ended.
+  return interrupted != 0 ? 128 + interrupted : 0;
 }
 
 }  // namespace pathlab::cli

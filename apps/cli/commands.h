@@ -22,6 +22,22 @@ struct RenderCommand {
   float exposure = 0.0f;
   std::optional<double> time_budget;    // --time SECONDS: stop at a whole pass before the budget
   std::optional<double> target_relmse;  // --target-relmse X: stop when the estimated relMSE < X
+  std::optional<std::string> checkpoint;  // --checkpoint FILE: the partial film, kept up to date
+  double checkpoint_every = 600.0;        // --checkpoint-every SECONDS
+  std::optional<std::string> resume;      // --resume FILE
+  std::optional<std::string> passes;      // --passes A..B
+  bool quiet = false;
+  bool selected = false;
+  void add_to(CLI::App& app);
+  int run(std::ostream& out, std::ostream& err) const;
+};
+
+// pathlab merge PART.pfilm... -o out.exr [--film merged.pfilm]
+struct MergeCommand {
+  std::vector<std::string> parts;
+  std::string output;
+  std::string film;  // also write the merged partial film here
+  float exposure = 0.0f;
   bool quiet = false;
   bool selected = false;
   void add_to(CLI::App& app);

@@ -1,0 +1,405 @@
+#include "core/partial_film.h"
+
+#include "core/error.h"
+
+#include <nlohmann/json.hpp>
+#include <xxhash.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cinttypes>
+#include <cstdio>
+#include <cstring>
+#include <fcntl.h>
+#include <fstream>
+#include <memory>
+#include <unistd.h>
+
+namespace pathlab {
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+constexpr char kMagic[8] = {'P', 'L', 'P', 'F', 'I', 'L', 'M', '1'};
+constexpr int kFormatVersion = 1;
+
+std::string hex128(const XXH128_hash_t& h) {
+  char text[33];
+  std::snprintf(text, sizeof text, "%016" PRIx64 "%016" PRIx64, static_cast<std::uint64_t>(h.high64),
+                static_cast<std::uint64_t>(h.low64));
+  return text;
+}
+
+std::string hex64(std::uint64_t v) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016" PRIx64, v);
+  return text;
+}
+
+// A float as C's "%a": exact, so that settings differing in the last bit differ.
+std::string exact(double v) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%a", v);
+  return text;
+}
+
+// XXH3-128 of a file's content, streamed.
+std::string hash_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot be read to fingerprint the render");
+  const std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), &XXH3_freeState);
+  XXH3_128bits_reset(state.get());
+  std::vector<char> buffer(std::size_t{1} << 20);
+  while (in) {
+    in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+    XXH3_128bits_update(state.get(), buffer.data(), static_cast<std::size_t>(in.gcount()));
+  }
+  if (in.bad()) throw InputError(path.string() + ": read failed while fingerprinting the render");
+  return hex128(XXH3_128bits_digest(state.get()));
+}
+
+const char* filter_name(FilterKind f) { return f == FilterKind::Box ? "box" : "bilinear"; }
+
+// ----------------------------------------------------------------- writing
+
+// A file written through a checksum: every byte written is hashed.
+class HashedWriter {
+ public:
+  HashedWriter(const fs::path& path, const fs::path& target) : path_(path), target_(target) {
+    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd_ < 0) fail("cannot create it");
+    XXH3_128bits_reset(state_.get());
+  }
+  ~HashedWriter() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  void write(const void* data, std::size_t n, bool hashed = true) {
+    if (hashed) XXH3_128bits_update(state_.get(), data, n);
+    const char* p = static_cast<const char*>(data);
+    while (n > 0) {
+      const ssize_t k = ::write(fd_, p, std::min<std::size_t>(n, std::size_t{1} << 30));
+      if (k < 0 && errno == EINTR) continue;
+      if (k <= 0) fail(std::strerror(errno));
+      p += k;
+      n -= static_cast<std::size_t>(k);
+    }
+  }
+  void write_u64(std::uint64_t v) {
+    unsigned char b[8];
+    for (int i = 0; i < 8; ++i) b[i] = static_cast<unsigned char>(v >> (8 * i));
+    write(b, 8);
+  }
+  XXH128_hash_t digest() const { return XXH3_128bits_digest(state_.get()); }
+  // Flushes to the disk and closes.
+  void finish() {
+    if (::fsync(fd_) != 0) fail(std::string("fsync: ") + std::strerror(errno));
+    if (::close(fd_) != 0) {
+      fd_ = -1;
+      fail(std::string("close: ") + std::strerror(errno));
+    }
+    fd_ = -1;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& why) const {
+    throw SystemError(target_.string() + ": could not write the partial film (" + path_.filename().string() +
+                      "): " + why);
+  }
+  fs::path path_, target_;
+  int fd_ = -1;
+  std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state_{XXH3_createState(), &XXH3_freeState};
+};
+
+json sum_json(const Sum1& s) { return json::array({hex64(s.low()), hex64(s.high())}); }
+
+// ----------------------------------------------------------------- reading
+
+class Reader {
+ public:
+  explicit Reader(const fs::path& path) : path_(path), in_(path, std::ios::binary) {
+    if (!in_) fail(fs::exists(path) ? "cannot be read" : "does not exist");
+    in_.seekg(0, std::ios::end);
+    size_ = static_cast<std::uint64_t>(in_.tellg());
+    in_.seekg(0);
+    XXH3_128bits_reset(state_.get());
+  }
+  std::uint64_t size() const { return size_; }
+  std::uint64_t position() const { return position_; }
+  void read(void* data, std::size_t n) {
+    if (position_ + n > size_) fail("truncated (it ends inside its data)");
+    in_.read(static_cast<char*>(data), static_cast<std::streamsize>(n));
+    if (!in_) fail("read failed");
+    XXH3_128bits_update(state_.get(), data, n);
+    position_ += n;
+  }
+  std::uint64_t read_u64() {
+    unsigned char b[8];
+    read(b, 8);
+    std::uint64_t v = 0;
+    for (int i = 0; i < 8; ++i) v |= static_cast<std::uint64_t>(b[i]) << (8 * i);
+    return v;
+  }
+  XXH128_hash_t digest() const { return XXH3_128bits_digest(state_.get()); }
+  // Reads the stored checksum (not hashed).
+  std::string read_checksum() {
+    if (position_ + 16 != size_) fail(position_ + 16 > size_ ? "truncated (its checksum is missing)" : "has bytes after its checksum");
+    unsigned char b[16];
+    in_.read(reinterpret_cast<char*>(b), 16);
+    if (!in_) fail("read failed");
+    XXH128_hash_t h;
+    h.low64 = 0;
+    h.high64 = 0;
+    for (int i = 0; i < 8; ++i) h.low64 |= static_cast<XXH64_hash_t>(b[i]) << (8 * i);
+    for (int i = 0; i < 8; ++i) h.high64 |= static_cast<XXH64_hash_t>(b[8 + i]) << (8 * i);
+    return hex128(h);
+  }
+  [[noreturn]] void fail(const std::string& why) const {
+    throw InputError(path_.string() + ": not a usable partial film: " + why);
+  }
+
+ private:
+  fs::path path_;
+  std::ifstream in_;
+  std::uint64_t size_ = 0, position_ = 0;
+  std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state_{XXH3_createState(), &XXH3_freeState};
+};
+
+std::uint64_t parse_hex64(const json& j) { return std::stoull(j.get<std::string>(), nullptr, 16); }
+Sum1 parse_sum(const json& j) { return Sum1::from_words(parse_hex64(j.at(0)), parse_hex64(j.at(1))); }
+
+}  // namespace
+
+// ------------------------------------------------------------- fingerprint
+
+Fingerprint render_fingerprint(const Scene& scene, std::string_view tracer) {
+  Fingerprint f;
+  f.lines.push_back(std::string("pathlab ") + PATHLAB_VERSION + " " + PATHLAB_GIT_COMMIT);
+  if (scene.file.empty())
+    f.lines.push_back("scene built-in " + scene.name);
+  else
+    f.lines.push_back("scene " + scene.file.filename().string() + " " + hash_file(scene.file));
+  // By name and content: the same data in another folder (another machine's
+  // data directory) is the same render.
+  for (const fs::path& p : scene.input_files) f.lines.push_back("file " + p.filename().string() + " " + hash_file(p));
+  const RenderSettings& r = scene.render;
+  f.lines.push_back("setting tracer " + std::string(tracer));
+  f.lines.push_back("setting resolution " + std::to_string(scene.film.width) + "x" + std::to_string(scene.film.height));
+  f.lines.push_back(std::string("setting filter ") + filter_name(scene.film.filter));
+  f.lines.push_back(std::string("setting strategy ") + strategy_name(r.strategy));
+  f.lines.push_back("setting max_depth " + std::to_string(r.max_depth));
+  f.lines.push_back("setting rr_depth " + std::to_string(r.rr_depth));
+  f.lines.push_back("setting seed " + std::to_string(r.seed));
+  f.lines.push_back(std::string("setting bsdf_sampling ") + bsdf_sampling_name(r.bsdf_sampling));
+  f.lines.push_back("setting clamp " + exact(r.clamp));
+  f.lines.push_back("setting min_pdf " + exact(r.min_pdf));
+  f.lines.push_back(std::string("setting general_shading ") + (r.force_general_shading ? "on" : "off"));
+  f.lines.push_back(std::string("setting bvh ") + (r.compact_bvh ? "compact" : "fast"));
+  std::string all;
+  for (const std::string& line : f.lines) all += line + "\n";
+  f.digest = hex128(XXH3_128bits(all.data(), all.size()));
+  return f;
+}
+
+std::string fingerprint_difference(const Fingerprint& was, const Fingerprint& now, std::string_view was_name,
+                                   std::string_view now_name) {
+  std::string out;
+  const auto missing_from = [](const std::vector<std::string>& lines, const std::vector<std::string>& other) {
+    std::vector<std::string> only;
+    for (const std::string& l : lines)
+      if (std::find(other.begin(), other.end(), l) == other.end()) only.push_back(l);
+    return only;
+  };
+  for (const std::string& l : missing_from(was.lines, now.lines)) out += "  " + std::string(was_name) + ": " + l + "\n";
+  for (const std::string& l : missing_from(now.lines, was.lines)) out += "  " + std::string(now_name) + ": " + l + "\n";
+  if (out.empty()) out = "  (the same lines in another order)\n";
+  out.pop_back();  // the last line's end is the message's
+  return out;
+}
+
+// ---------------------------------------------------------------- the file
+
+void write_partial_film(const Film& film, const PartialFilmInfo& pf, const fs::path& path) {
+  const Film::ConstWords words = film.words();
+  json bad = json::array();
+  for (const BadSample& b : film.bad_samples())
+    bad.push_back({{"x", b.x}, {"y", b.y}, {"sample", b.sample}, {"L", {exact(b.L.x), exact(b.L.y), exact(b.L.z)}}});
+  const json header = {
+      {"format", "pathlab partial film"},
+      {"format_version", kFormatVersion},
+      {"pathlab_version", PATHLAB_VERSION},
+      {"width", film.width()},
+      {"height", film.height()},
+      {"filter", filter_name(film.filter())},
+      {"moments", film.keeps_variance() ? "mean_and_variance" : "mean"},
+      {"passes", {pf.passes.begin, pf.passes.end}},
+      {"target_spp", pf.target_spp},
+      {"processes", pf.processes},
+      {"resumes", pf.resumes},
+      {"fingerprint", {{"digest", pf.fingerprint.digest}, {"lines", pf.fingerprint.lines}}},
+      {"stats",
+       {{"seconds", exact(pf.stats.seconds)},
+        {"samples", pf.stats.samples},
+        {"rays", pf.stats.rays},
+        {"clamped_samples", pf.stats.clamped_samples},
+        {"energy_total", sum_json(pf.stats.energy_total)},
+        {"energy_clamped", sum_json(pf.stats.energy_clamped)}}},
+      {"film_rays", film.rays_cast()},
+      {"bad_sample_count", film.bad_sample_count()},
+      {"bad_samples", bad},
+      {"words", {words.pixels.size(), words.moments.size(), words.splat.size()}},
+  };
+  const std::string text = header.dump(1);
+
+  // Beside the target, so that the rename stays within one file system.
+  fs::path tmp = path;
+  tmp += ".tmp-" + std::to_string(::getpid());
+  try {
+    HashedWriter w(tmp, path);
+    w.write(kMagic, sizeof kMagic);
+    w.write_u64(text.size());
+    w.write(text.data(), text.size());
+    // The arrays as they lie in memory: x86-64 is little-endian, as the format.
+    static_assert(std::endian::native == std::endian::little);
+    for (const std::span<const std::uint64_t> a : {words.pixels, words.moments, words.splat})
+      w.write(a.data(), a.size_bytes());
+    const XXH128_hash_t h = w.digest();
+    w.write_u64(h.low64);  // hashed too, harmlessly: the reader stops hashing before it
+    w.write_u64(h.high64);
+    w.finish();
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw;
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw SystemError(path.string() + ": could not replace it with the new partial film: " + ec.message());
+  }
+  // The rename itself reaches the disk with the folder's entry.
+  const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  if (const int dir = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
+  }
+}
+
+PartialFilm read_partial_film(const fs::path& path) {
+  Reader r(path);
+  if (r.size() < sizeof kMagic + 8 + 16) r.fail(r.size() == 0 ? "the file is empty" : "too short to be one");
+  char magic[sizeof kMagic];
+  r.read(magic, sizeof magic);
+  if (std::memcmp(magic, kMagic, sizeof kMagic) != 0) r.fail("it does not start with PLPFILM1 (not a pathlab partial film)");
+  const std::uint64_t header_size = r.read_u64();
+  if (header_size > r.size() - r.position()) r.fail("truncated (it ends inside its header)");
+  std::string text(header_size, '\0');
+  r.read(text.data(), text.size());
+  const json h = json::parse(text, nullptr, false);
+  if (h.is_discarded() || !h.is_object()) r.fail("its header is not JSON (corrupted)");
+
+  try {
+    if (h.at("format_version").get<int>() != kFormatVersion)
+      r.fail("format version " + h.at("format_version").dump() + ", this pathlab reads " + std::to_string(kFormatVersion));
+    const int width = h.at("width").get<int>(), height = h.at("height").get<int>();
+    if (width < 1 || height < 1 || width > 65536 || height > 65536) r.fail("its resolution is out of range");
+    const std::string filter = h.at("filter").get<std::string>(), moments = h.at("moments").get<std::string>();
+    if ((filter != "box" && filter != "bilinear") || (moments != "mean" && moments != "mean_and_variance"))
+      r.fail("unknown filter or moments in its header");
+    PartialFilm result{Film(width, height, filter == "box" ? FilterKind::Box : FilterKind::Bilinear,
+                            moments == "mean" ? FilmMoments::Mean : FilmMoments::MeanAndVariance),
+                       {}};
+    PartialFilmInfo& pf = result.info;
+    pf.passes = {h.at("passes").at(0).get<std::uint32_t>(), h.at("passes").at(1).get<std::uint32_t>()};
+    if (pf.passes.end < pf.passes.begin) r.fail("its pass range ends before it begins");
+    pf.target_spp = h.at("target_spp").get<std::uint32_t>();
+    pf.processes = h.at("processes").get<std::uint32_t>();
+    pf.resumes = h.at("resumes").get<std::uint32_t>();
+    pf.fingerprint.digest = h.at("fingerprint").at("digest").get<std::string>();
+    pf.fingerprint.lines = h.at("fingerprint").at("lines").get<std::vector<std::string>>();
+    const json& st = h.at("stats");
+    pf.stats.seconds = std::strtod(st.at("seconds").get<std::string>().c_str(), nullptr);
+    pf.stats.samples = st.at("samples").get<std::uint64_t>();
+    pf.stats.rays = st.at("rays").get<std::uint64_t>();
+    pf.stats.clamped_samples = st.at("clamped_samples").get<std::uint64_t>();
+    pf.stats.energy_total = parse_sum(st.at("energy_total"));
+    pf.stats.energy_clamped = parse_sum(st.at("energy_clamped"));
+    std::vector<BadSample> kept;
+    for (const json& b : h.at("bad_samples")) {
+      const json& L = b.at("L");
+      kept.push_back({b.at("x").get<std::uint32_t>(), b.at("y").get<std::uint32_t>(), b.at("sample").get<std::uint32_t>(),
+                      Spectrum(std::strtof(L.at(0).get<std::string>().c_str(), nullptr),
+                               std::strtof(L.at(1).get<std::string>().c_str(), nullptr),
+                               std::strtof(L.at(2).get<std::string>().c_str(), nullptr))});
+    }
+    result.film.restore_counts(h.at("bad_sample_count").get<std::uint64_t>(), h.at("film_rays").get<std::uint64_t>(),
+                               std::move(kept));
+    const Film::Words words = result.film.words();
+    const json& counts = h.at("words");
+    if (counts.at(0).get<std::uint64_t>() != words.pixels.size() ||
+        counts.at(1).get<std::uint64_t>() != words.moments.size() || counts.at(2).get<std::uint64_t>() != words.splat.size())
+      r.fail("its header's array sizes do not match its resolution, filter and moments");
+    for (const std::span<std::uint64_t> a : {words.pixels, words.moments, words.splat}) r.read(a.data(), a.size_bytes());
+    const std::string computed = hex128(r.digest());
+    if (r.read_checksum() != computed) r.fail("its checksum does not match its content (the file is corrupted)");
+    return result;
+  } catch (const json::exception& e) {
+    r.fail(std::string("its header is incomplete or malformed (") + e.what() + ")");
+  }
+}
+
+PartialFilm merge_partial_films(std::vector<PartialFilm> parts, const std::vector<fs::path>& names) {
+  if (parts.empty()) throw InputError("merge: no partial films given");
+  std::vector<std::size_t> order(parts.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  for (std::size_t i = 1; i < parts.size(); ++i)
+    if (!(parts[i].info.fingerprint == parts[0].info.fingerprint))
+      throw InputError("merge: " + names[i].string() + " is not a part of the same render as " + names[0].string() +
+                       ":\n" + fingerprint_difference(parts[0].info.fingerprint, parts[i].info.fingerprint,
+                                                      names[0].string(), names[i].string()));
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return parts[a].info.passes.begin < parts[b].info.passes.begin;
+  });
+  for (std::size_t k = 1; k < order.size(); ++k) {
+    const PartialFilmInfo& prev = parts[order[k - 1]].info;
+    const PartialFilmInfo& cur = parts[order[k]].info;
+    const auto range = [](const PartialFilmInfo& p) {
+      return std::to_string(p.passes.begin) + ".." + std::to_string(p.passes.end);
+    };
+    if (cur.passes.begin < prev.passes.end)
+      throw InputError("merge: " + names[order[k]].string() + " (passes " + range(cur) + ") overlaps " +
+                       names[order[k - 1]].string() + " (passes " + range(prev) + ")");
+    if (cur.passes.begin > prev.passes.end)
+      throw InputError("merge: passes " + std::to_string(prev.passes.end) + ".." + std::to_string(cur.passes.begin) +
+                       " are missing between " + names[order[k - 1]].string() + " and " + names[order[k]].string());
+  }
+  PartialFilm out = std::move(parts[order[0]]);
+  for (std::size_t k = 1; k < order.size(); ++k) {
+    PartialFilm& p = parts[order[k]];
+    if (p.film.width() != out.film.width() || p.film.height() != out.film.height() ||
+        p.film.filter() != out.film.filter() || p.film.keeps_variance() != out.film.keeps_variance())
+      throw InputError("merge: " + names[order[k]].string() + " holds a film of another size, filter or moments than " +
+                       names[order[0]].string());
+    out.film.add(p.film);
+    out.info.passes.end = p.info.passes.end;
+    out.info.target_spp = std::max(out.info.target_spp, p.info.target_spp);
+    out.info.stats += p.info.stats;
+    out.info.stats.seconds += p.info.stats.seconds;
+    out.info.processes += p.info.processes;
+    out.info.resumes += p.info.resumes;
+  }
+  out.info.stats.bad_samples = out.film.bad_sample_count();
+  return out;
+}
+
+std::vector<std::pair<std::string, std::string>> partial_film_metadata(const PartialFilmInfo& pf) {
+  return {{"passes", std::to_string(pf.passes.begin) + ".." + std::to_string(pf.passes.end)},
+          {"passes_spp", std::to_string(pf.passes.count())},
+          {"processes", std::to_string(pf.processes)},
+          {"resumes", std::to_string(pf.resumes)},
+          {"fingerprint", pf.fingerprint.digest}};
+}
+
+}  // namespace pathlab
