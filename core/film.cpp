@@ -136,21 +136,35 @@ void Film::keep_bad(std::vector<BadSample> more) {
   if (bad_kept_.size() > kMaxBadSamplesKept) bad_kept_.resize(kMaxBadSamplesKept);
 }
 
+void Film::add_pixel_words(const std::uint64_t* in, std::uint64_t* inout, std::size_t pixels) {
+  for (std::size_t i = 0; i < pixels; ++i, in += kPixelWords, inout += kPixelWords) {
+    add_sum_words(in, inout, 3);
+    inout[6] += in[6];  // the count
+  }
+}
+
+void Film::add_sum_words(const std::uint64_t* in, std::uint64_t* inout, std::size_t sums) {
+  for (std::size_t i = 0; i < 2 * sums; i += 2) {
+    Sum1 a = Sum1::from_words(inout[i], inout[i + 1]);
+    a += Sum1::from_words(in[i], in[i + 1]);
+    inout[i] = a.low();
+    inout[i + 1] = a.high();
+  }
+}
+
 void Film::add(const Film& o) {
   if (o.width_ != width_ || o.height_ != height_ || o.filter_ != filter_ || o.moments_ != moments_)
     throw std::invalid_argument("Film::add: the films differ in size, filter or moments");
+  const Words mine = words();
+  const ConstWords theirs = o.words();
+  // Every sum is a 128-bit integer (Sum2's units differ from Sum1's, but
+  // adding raw words is the same operation).
   parallel_for(0, pixels_.size(), std::size_t{1} << 14, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      for (int c = 0; c < 3; ++c) pixels_[i].sum_wL[c] += o.pixels_[i].sum_wL[c];
-      pixels_[i].count += o.pixels_[i].count;
-      if (!moments_sums_.empty())
-        for (int c = 0; c < 3; ++c) moments_sums_[i].sum_w2L2[c] += o.moments_sums_[i].sum_w2L2[c];
-      if (!splat_.empty()) {
-        splat_[i].sum_w += o.splat_[i].sum_w;
-        splat_[i].sum_w2 += o.splat_[i].sum_w2;
-        for (int c = 0; c < 3; ++c) splat_[i].sum_w2L[c] += o.splat_[i].sum_w2L[c];
-      }
-    }
+    add_pixel_words(theirs.pixels.data() + b * kPixelWords, mine.pixels.data() + b * kPixelWords, e - b);
+    if (!moments_sums_.empty())
+      add_sum_words(theirs.moments.data() + b * kMomentWords, mine.moments.data() + b * kMomentWords, 3 * (e - b));
+    if (!splat_.empty())
+      add_sum_words(theirs.splat.data() + b * kSplatWords, mine.splat.data() + b * kSplatWords, 5 * (e - b));
   });
   bad_count_ += o.bad_count_;
   rays_ += o.rays_;

@@ -55,8 +55,8 @@ enum class FilmMoments : std::uint8_t {
   // them).
   MeanAndVariance,
   // The image alone, for a render that writes nothing else: a box pixel is
-  // then 32 bytes instead of 56, which the film's pass over every batch
-  // reads and writes (at 720p a third less memory traffic).
+  // then 56 bytes instead of 104, which the film's pass over every batch
+  // reads and writes (at 720p about half the memory traffic).
   Mean,
 };
 
@@ -109,6 +109,11 @@ class Film {
   };
   Words words();
   ConstWords words() const;
+  // Adds arrays laid out as words() (what add() does, for code that moves
+  // films as words: the MPI reduction). `pixels` elements of kPixelWords
+  // words; `sums` 128-bit sums of two words (the moments and splat arrays).
+  static void add_pixel_words(const std::uint64_t* in, std::uint64_t* inout, std::size_t pixels);
+  static void add_sum_words(const std::uint64_t* in, std::uint64_t* inout, std::size_t sums);
   // The counts a state restored into words() goes with.
   void restore_counts(std::uint64_t bad, std::uint64_t rays, std::vector<BadSample> kept);
 

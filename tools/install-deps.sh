@@ -15,6 +15,7 @@ packages=(
   libtinygltf-dev         # glTF 2.0 files (header only: core/gltf_loader.cpp)
   zlib1g-dev              # .gz meshes
   libxxhash-dev           # checksums and fingerprints of partial films (checkpoints)
+  libopenmpi-dev openmpi-bin  # one render over the ranks of an MPI job (distributed/)
   libcli11-dev            # the command line
   libgtest-dev libgmock-dev  # tests
   libbenchmark-dev        # Google Benchmark: bench/

@@ -15,6 +15,7 @@
 #include "core/parallel.h"
 #include "core/render.h"
 #include "debugtools/aov.h"
+#include "distributed/mpi_job.h"
 #include "wavefront/wavefront_tracer.h"
 
 #include <algorithm>
@@ -81,8 +82,12 @@ PassRange parse_passes(const std::string& text) {
 }  // namespace
 
 int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
+  // Under mpirun: one render over every rank (distributed/mpi_job.h).
+  const MpiJob job;
+  const bool chatty = job.rank() == 0;  // the other ranks say nothing but errors
   Scene s = scene.load();
-  for (const std::string& w : s.warnings) err << "pathlab: warning: " << w << "\n";
+  if (chatty)
+    for (const std::string& w : s.warnings) err << "pathlab: warning: " << w << "\n";
 
   std::filesystem::path exr = output.empty() ? std::filesystem::path("out") / (s.name + ".exr") : std::filesystem::path(output);
   // -o X.pfilm: the partial film itself, for `pathlab merge`, and no image.
@@ -92,9 +97,11 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
                      "partial film");
   std::filesystem::path png = exr;
   png.replace_extension(".png");
-  ensure_writable(exr);
-  if (!partial_output) ensure_writable(png);
-  if (checkpoint) ensure_writable(*checkpoint);
+  if (chatty) {
+    ensure_writable(exr);
+    if (!partial_output) ensure_writable(png);
+    if (checkpoint) ensure_writable(*checkpoint);
+  }
 
   const bool progressive = time_budget || target_relmse;
   std::vector<Aov> layers;
@@ -106,6 +113,10 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
                      "--checkpoint, --resume, --passes or a .pfilm output yet");
   if (partial_output && !layers.empty()) throw InputError("--aov: a .pfilm output holds no image layers");
   if (passes && progressive) throw InputError("--passes renders a fixed range of passes; --time and --target-relmse cannot go with it");
+  if (job.distributed() && progressive)
+    throw InputError("--time and --target-relmse are not supported under mpirun yet; give --spp");
+  if (job.distributed() && !layers.empty())
+    throw InputError("--aov is not supported under mpirun yet (the AOV buffers are not reduced over ranks)");
   const std::uint32_t spp = static_cast<std::uint32_t>(std::max(s.render.spp, 0));
   const PassRange range = passes ? parse_passes(*passes) : PassRange{0, spp};
 
@@ -145,14 +156,14 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     aov_tracer.emplace(*tracer, *aov_buffers);
   }
   const Scene& sc = compiled.scene();
-  if (const std::size_t n = compiled.lights().unsampled_light_count())
+  if (const std::size_t n = compiled.lights().unsampled_light_count(); n > 0 && chatty)
     err << "pathlab: warning: " << n << " light(s) are too dim next to the others ever to be picked for light "
         << "sampling; only rays that hit them count their light\n";
   // The second moments only if something reads them: progressive rendering
   // estimates its error from them, and the variance AOV is them. A resumed
   // film keeps what it was made with.
   const bool variance = progressive || variance_aov;
-  Film film = resumed ? std::move(resumed->film)
+  Film film = resumed && job.rank() == 0 ? std::move(resumed->film)
                       : Film(sc.film.width, sc.film.height, sc.film.filter,
                              variance ? FilmMoments::MeanAndVariance : FilmMoments::Mean);
   PartialFilmInfo info;
@@ -165,19 +176,20 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   }
   info.target_spp = progressive && !scene.spp ? 1u << 24 : range.end;
   const PartialFilmInfo before = info;
-  if (resumed && !quiet)
+  if (resumed && !quiet && chatty)
     err << "pathlab: resuming " << *resume << ": passes " << info.passes.begin << ".." << info.passes.end
         << " done, " << info.resumes - 1 << " resume(s) before\n";
   const std::uint32_t start = info.passes.end;
-  // The partial film after this run's passes up to `end`, with its stats so far.
-  const auto info_at = [&](std::uint32_t end, const RenderStats& so_far) {
+  // The partial film `f` after this run's passes up to `end`, with its stats so far.
+  const auto info_of = [&](const Film& f, std::uint32_t end, const RenderStats& so_far) {
     PartialFilmInfo i = before;
     i.passes.end = end;
     i.stats += so_far;
     i.stats.seconds = before.stats.seconds + so_far.seconds;
-    i.stats.bad_samples = film.bad_sample_count();
+    i.stats.bad_samples = f.bad_sample_count();
     return i;
   };
+  const auto info_at = [&](std::uint32_t end, const RenderStats& so_far) { return info_of(film, end, so_far); };
 
   const InterruptGuard interrupts;
   auto last_checkpoint = std::chrono::steady_clock::now();
@@ -191,12 +203,38 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     return true;
   };
 
-  ProgressBar bar(err, "rendering", !quiet && stderr_is_terminal());
+  ProgressBar bar(err, "rendering", !quiet && chatty && stderr_is_terminal());
   const Tracer& driven = aov_tracer ? static_cast<const Tracer&>(*aov_tracer) : *tracer;
   std::optional<UntilResult> until;
   RenderStats stats;
   std::uint32_t end = start;
-  if (progressive) {
+  int interrupted = 0;
+  if (job.distributed()) {
+    // Every rank renders its blocks of passes into its own film; rank 0's
+    // also holds what a checkpoint it resumed from held, so the sum is the
+    // whole render. Rank 0 writes the checkpoints and the outputs.
+    const std::uint32_t block = batch_size(film.width(), film.height(), static_cast<int>(range.end - start));
+    const MpiJob::Result r = job.render(
+        driven, film, start, range.end, block, [] { return InterruptGuard::received() != 0; },
+        [&] {
+          const auto now = std::chrono::steady_clock::now();
+          if (!checkpoint || std::chrono::duration<double>(now - last_checkpoint).count() < checkpoint_every)
+            return false;
+          last_checkpoint = now;
+          return true;
+        },
+        [&](std::uint32_t reached, Film& sum, const RenderStats& total) {
+          stats = total;
+          info = info_of(sum, reached, total);
+          if (reached < range.end && checkpoint) write_partial_film(sum, info, *checkpoint);
+          film = std::move(sum);  // the last one is the job's film
+        },
+        [&](double f) { bar.update(f); });
+    bar.finish();
+    if (job.rank() != 0) return 0;
+    end = r.end;
+    interrupted = r.stopped ? (InterruptGuard::received() != 0 ? InterruptGuard::received() : SIGTERM) : 0;
+  } else if (progressive) {
     // Without an explicit --spp the budget or target decides alone.
     until = render_until(driven, film, {time_budget.value_or(0.0), target_relmse.value_or(0.0),
                                         scene.spp ? settings.spp : 1 << 24, 0},
@@ -209,7 +247,7 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     end = start + static_cast<std::uint32_t>(stats.samples / std::max<std::uint64_t>(pixels, 1));
   }
   bar.finish();
-  const int interrupted = InterruptGuard::received();
+  if (!job.distributed()) interrupted = InterruptGuard::received();
   info = info_at(end, stats);
   if (checkpoint) write_partial_film(film, info, *checkpoint);
   if (partial_output) write_partial_film(film, info, exr);

@@ -1,0 +1,85 @@
+// One render over the ranks of an MPI job equals one process, bit for bit
+// (distributed/mpi_job.h), and checkpoints move between rank counts. Runs the
+// real binary under mpirun (--oversubscribe: 3 ranks on 2 cores).
+#include "core/image_io.h"
+#include "core/partial_film.h"
+#include "tests/temp_dir.h"
+
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <string>
+#include <vector>
+
+namespace pathlab {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Runs `program args...`; its exit status (128 + signal if one ended it).
+int run(const std::string& program, const std::vector<std::string>& args) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::vector<char*> argv{const_cast<char*>(program.c_str())};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(program.c_str(), argv.data());
+    ::_exit(127);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : WEXITSTATUS(status);
+}
+
+std::vector<float> pixels_of(const fs::path& exr) {
+  const Image image = read_image(exr);
+  std::vector<float> out;
+  for (const vec3& s : image.pixels) out.insert(out.end(), {s.x, s.y, s.z});
+  return out;
+}
+
+class Mpi : public test::TempDirTest {
+ protected:
+  // pathlab render with the test's settings, under mpirun -n `ranks` (0: without mpirun).
+  int render(int ranks, const std::string& out, std::vector<std::string> extra, const std::string& spp = "12") {
+    std::vector<std::string> args{"render", "-o", (dir_ / out).string(), "--resolution", "40x30", "--spp", spp,
+                                  "--tracer", "wavefront", "--threads", "1", "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    if (ranks == 0) return run(PATHLAB_BINARY, args);
+    std::vector<std::string> mpi{"--oversubscribe", "--allow-run-as-root", "-n", std::to_string(ranks), PATHLAB_BINARY};
+    mpi.insert(mpi.end(), args.begin(), args.end());
+    return run(PATHLAB_MPIEXEC, mpi);
+  }
+};
+
+TEST_F(Mpi, OneTwoAndThreeRanksGiveTheBitsOfOneProcess) {
+  ASSERT_EQ(render(0, "one.exr", {}), 0);
+  const std::vector<float> one = pixels_of(dir_ / "one.exr");
+  for (const int ranks : {1, 2, 3}) {
+    const std::string out = "ranks" + std::to_string(ranks) + ".exr";
+    ASSERT_EQ(render(ranks, out, {}), 0) << ranks << " ranks";
+    EXPECT_EQ(pixels_of(dir_ / out), one) << ranks << " ranks";
+    ImageMetadata meta;
+    read_image(dir_ / out, &meta);
+    EXPECT_NE(std::find(meta.begin(), meta.end(), std::pair<std::string, std::string>("spp", "12")), meta.end());
+  }
+}
+
+TEST_F(Mpi, CheckpointsMoveBetweenRankCounts) {
+  ASSERT_EQ(render(0, "one.exr", {}), 0);
+  const std::vector<float> one = pixels_of(dir_ / "one.exr");
+  const std::string ck = (dir_ / "ck.pfilm").string();
+  // Passes 0..5 by 2 ranks, 5..9 by 3 resuming, 9..12 by one process.
+  ASSERT_EQ(render(2, "a.exr", {"--checkpoint", ck}, "5"), 0);
+  EXPECT_EQ(read_partial_film(ck).info.passes.end, 5u);
+  ASSERT_EQ(render(3, "b.exr", {"--checkpoint", ck, "--resume", ck}, "9"), 0);
+  EXPECT_EQ(read_partial_film(ck).info.passes.end, 9u);
+  ASSERT_EQ(render(0, "c.exr", {"--checkpoint", ck, "--resume", ck}), 0);
+  EXPECT_EQ(pixels_of(dir_ / "c.exr"), one);
+  EXPECT_EQ(read_partial_film(ck).info.resumes, 2u);
+}
+
+}  // namespace
+}  // namespace pathlab
