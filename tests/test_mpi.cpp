@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -44,9 +45,11 @@ class Mpi : public test::TempDirTest {
  protected:
   // pathlab render with the test's settings, under mpirun -n `ranks` (0: without mpirun).
   int render(int ranks, const std::string& out, std::vector<std::string> extra, const std::string& spp = "12") {
-    std::vector<std::string> args{"render", "-o", (dir_ / out).string(), "--resolution", "40x30", "--spp", spp,
-                                  "--tracer", "wavefront", "--threads", "1", "-q"};
+    std::vector<std::string> args{"render", "-o", (dir_ / out).string(), "--spp", spp, "--tracer", "wavefront",
+                                  "--threads", "1", "-q"};
     args.insert(args.end(), extra.begin(), extra.end());
+    if (std::find(extra.begin(), extra.end(), "--resolution") == extra.end())
+      args.insert(args.end(), {"--resolution", "40x30"});
     if (ranks == 0) return run(PATHLAB_BINARY, args);
     std::vector<std::string> mpi{"--oversubscribe", "--allow-run-as-root", "-n", std::to_string(ranks), PATHLAB_BINARY};
     mpi.insert(mpi.end(), args.begin(), args.end());
@@ -55,12 +58,23 @@ class Mpi : public test::TempDirTest {
 };
 
 TEST_F(Mpi, OneTwoAndThreeRanksGiveTheBitsOfOneProcess) {
-  ASSERT_EQ(render(0, "one.exr", {}), 0);
+  // 256x256: a block is 4 passes (2^18 samples), so 3 ranks share 12 passes.
+  const std::vector<std::string> big{"--resolution", "256x256"};
+  ASSERT_EQ(render(0, "one.exr", big), 0);
   const std::vector<float> one = pixels_of(dir_ / "one.exr");
   for (const int ranks : {1, 2, 3}) {
     const std::string out = "ranks" + std::to_string(ranks) + ".exr";
-    ASSERT_EQ(render(ranks, out, {}), 0) << ranks << " ranks";
+    const std::string ck = (dir_ / ("ranks" + std::to_string(ranks) + ".pfilm")).string();
+    std::vector<std::string> args = big;
+    args.insert(args.end(), {"--checkpoint", ck});
+    ASSERT_EQ(render(ranks, out, args), 0) << ranks << " ranks";
     EXPECT_EQ(pixels_of(dir_ / out), one) << ranks << " ranks";
+    // Every pass once: a rank tracing another's passes too would leave the
+    // mean alone but not the counts.
+    const PartialFilm pf = read_partial_film(ck);
+    EXPECT_EQ(pf.film.sample_count(0, 0), 12u);
+    EXPECT_EQ(pf.film.sample_count(255, 255), 12u);
+    EXPECT_EQ(pf.info.stats.samples, 12u * 256 * 256);
     ImageMetadata meta;
     read_image(dir_ / out, &meta);
     EXPECT_NE(std::find(meta.begin(), meta.end(), std::pair<std::string, std::string>("spp", "12")), meta.end());
