@@ -388,6 +388,35 @@ TEST_F(PiecesCli, ResumeRefusesAnotherSceneFileMeshSettingOrVersion) {
   EXPECT_FALSE(fs::exists(dir_ / "out.png") && fs::last_write_time(dir_ / "out.png") > fs::last_write_time(ck));
 }
 
+TEST_F(PiecesCli, ADamagedCheckpointIsRefusedWithExit2AndNothingWritten) {
+  const std::string ck = (dir_ / "ck.pfilm").string();
+  render("reference", {"--spp", "4", "--passes", "0..2", "--checkpoint", ck}, "part.pfilm");
+  std::string bytes;
+  {
+    std::ifstream in(ck, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  std::string flipped = bytes;
+  flipped[bytes.size() - 40] = static_cast<char>(flipped[bytes.size() - 40] ^ 0x04);
+  for (const auto& [content, problem] : std::vector<std::pair<std::string, std::string>>{
+           {bytes.substr(0, bytes.size() / 2), "truncated"}, {flipped, "checksum"}, {"", "empty"},
+           {"P3\n1 1\n255\n0 0 0\n", "too short"}}) {
+    std::ofstream(ck, std::ios::binary) << content;
+    std::vector<std::string> args{"render", "-o", (dir_ / "out.exr").string(), "--spp", "4", "--resume", ck,
+                                  "--checkpoint", ck};
+    for (const std::string& a : base("reference")) args.push_back(a);
+    const test::CliResult r = run_cli(args);
+    EXPECT_EQ(r.code, 2) << problem;
+    EXPECT_NE(r.err.find(ck), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(problem), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out.exr"));
+    EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+    // The damaged checkpoint is left as it was, for the user to look at.
+    std::ifstream in(ck, std::ios::binary);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), content) << problem;
+  }
+}
+
 // ------------------------------------------------------- Signals and kill -9
 
 // Runs the pathlab binary with `args`, sending it `signal` after `delay`
