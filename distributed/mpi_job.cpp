@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pathlab {
@@ -145,14 +147,19 @@ MpiJob::Result MpiJob::render(const Tracer& tracer, Film& film, std::uint32_t st
   RenderStats stats;  // this rank's
   Result result{start, false};
   const auto reduce_and_report = [&](std::uint32_t end) {
+    const auto t0 = std::chrono::steady_clock::now();
     std::unique_ptr<Film> sum;
     if (rank_ == 0)
       sum = std::make_unique<Film>(film.width(), film.height(), film.filter(),
                                    film.keeps_variance() ? FilmMoments::MeanAndVariance : FilmMoments::Mean);
     RenderStats total;
     reduce(film, stats, sum.get(), &total);
+    ++result.reductions;
+    result.reduce_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (rank_ == 0) reduced(end, *sum, total);
   };
+  const Film::ConstWords w = std::as_const(film).words();
+  result.film_bytes = 8 * (w.pixels.size() + w.moments.size() + w.splat.size());
   for (std::uint64_t round = 0;; ++round) {
     const std::uint64_t round_start = start + round * n * block;
     if (round_start >= last) break;

@@ -58,6 +58,9 @@ class MpiJob {
   struct Result {
     std::uint32_t end = 0;  // passes [start, end) were traced by the job
     bool stopped = false;   // a rank was interrupted
+    int reductions = 0;     // checkpoints and the final one
+    double reduce_seconds = 0.0;       // on this rank, in the reductions (waiting for slower ranks included)
+    std::uint64_t film_bytes = 0;      // one film's words, what each rank sends per reduction
   };
   // Renders passes [start, last) over the job's ranks into each rank's
   // `film` (same size, filter and moments everywhere), then reduces. The

@@ -233,6 +233,11 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     bar.finish();
     if (job.rank() != 0) return 0;
     end = r.end;
+    if (!quiet)
+      err << "pathlab: mpi: " << job.size() << " ranks, " << r.reductions << " reduction(s) of "
+          << r.film_bytes / (static_cast<std::uint64_t>(film.width()) * film.height()) << " bytes per pixel ("
+          << r.film_bytes / (1024 * 1024) << " MiB per rank), " << static_cast<int>(1000.0 * r.reduce_seconds)
+          << " ms in them on rank 0\n";
     interrupted = r.stopped ? (InterruptGuard::received() != 0 ? InterruptGuard::received() : SIGTERM) : 0;
   } else if (progressive) {
     // Without an explicit --spp the budget or target decides alone.
