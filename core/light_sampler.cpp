@@ -1,5 +1,6 @@
 #include "core/light_sampler.h"
 
+#include "core/environment_map.h"
 #include "core/faults.h"
 #include "core/geometry.h"
 #include "core/sampling.h"
@@ -109,6 +110,13 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&sce
     entries_.push_back({0, 0, 0.0f, {}});
     power.push_back(4.0 * kPi * kPi * double(scene_radius) * scene_radius * luminance(*scene.environment));
   }
+  // An image: pi r^2 times its luminance integrated over the sphere (the
+  // uniform case above is that for a constant map). A black map is no light.
+  if (scene.environment_map && scene.environment_map->luminance_integral() > 0.0) {
+    env_index_ = static_cast<std::int64_t>(entries_.size());
+    entries_.push_back({0, 0, 0.0f, {}});
+    power.push_back(kPi * double(scene_radius) * scene_radius * scene.environment_map->luminance_integral());
+  }
   build_distribution(power, &pmf_, &cdf_);
 
   // Delta lights by power (docs/scene-format.md, "How a light is picked"),
@@ -137,9 +145,17 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
   LightSample ls;
   ls.light = static_cast<std::uint32_t>(i);
   if (static_cast<std::int64_t>(i) == env_index_) {
-    ls.wi = square_to_uniform_sphere(u);
     ls.dist = kInfinity;
     ls.infinite = true;
+    if (const EnvironmentMap* map = scene_->environment_map.get()) {
+      const std::optional<EnvironmentMap::Sample> es = map->sample(u);
+      if (!es) return std::nullopt;
+      ls.wi = es->wi;
+      ls.Le = es->radiance;
+      ls.pdf = pmf_[i] * es->pdf;
+      return ls;
+    }
+    ls.wi = square_to_uniform_sphere(u);
     ls.Le = *scene_->environment;
     ls.pdf = pmf_[i] * kInv4Pi;
     return ls;
@@ -170,6 +186,17 @@ float LightSampler::pdf(const vec3& ref, const Surfel& hit) const {
   const vec3 d = hit.p - ref;
   const float dist = glm::length(d);
   return pmf_[i] * area_to_solid_angle(area_density(entries_[i]), faulty_distance(dist), glm::dot(hit.n, d) / dist);
+}
+
+float LightSampler::pdf_environment(const vec3& wi) const {
+  if (env_index_ < 0) return 0.0f;
+  const float pmf = pmf_[static_cast<std::size_t>(env_index_)];
+  return scene_->environment_map ? pmf * scene_->environment_map->pdf(wi) : pmf * kInv4Pi;
+}
+
+Spectrum LightSampler::environment(const vec3& dir) const {
+  if (scene_->environment_map) return scene_->environment_map->radiance(dir);
+  return scene_->environment.value_or(Spectrum(0.0f));
 }
 
 std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_choice) const {

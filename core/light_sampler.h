@@ -1,9 +1,10 @@
 // Light sampling for next-event estimation.
 //
-// Area lights are every emitting triangle and sphere, plus the uniform
-// environment; one is picked in proportion to its power, then a point on it
-// uniformly by area (a direction uniformly on the sphere, for the
-// environment). Densities are returned in solid angle as seen from the
+// Area lights are every emitting triangle and sphere, plus the environment
+// (uniform, or an image: core/environment_map.h); one is picked in
+// proportion to its power, then a point on it uniformly by area (for the
+// environment a direction: uniformly on the sphere, or by the image's
+// importance sampler). Densities are returned in solid angle as seen from the
 // shading point and include the probability of picking that light, so
 // `pdf()` of an emitter that a BSDF-sampled ray hits is directly comparable
 // with the BSDF's pdf (MIS).
@@ -56,7 +57,8 @@ std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene);
 class LightSampler {
  public:
   // `scene_radius`: radius of a sphere bounding the scene, for the power of
-  // the environment (pi * L * 4 pi r^2: the flux it sends through the scene).
+  // the environment (pi r^2 times the integral of Y(L) over the sphere, the
+  // flux it sends through the scene: pi * Y(L) * 4 pi r^2 when uniform).
   LightSampler(const Scene& scene, float scene_radius);
 
   std::size_t area_light_count() const { return entries_.size(); }
@@ -75,7 +77,10 @@ class LightSampler {
   float pdf(const vec3& ref, const Surfel& hit) const;
   // Density with which sample() would produce direction `wi` towards the
   // environment (0 without one).
-  float pdf_environment() const { return env_index_ < 0 ? 0.0f : pmf_[env_index_] * kInv4Pi; }
+  float pdf_environment(const vec3& wi) const;
+  // The radiance a ray with direction `dir` sees when it escapes the scene
+  // (black without an environment). Both tracers' escapes call this.
+  Spectrum environment(const vec3& dir) const;
 
   // A delta light picked in proportion to its power. Nothing if it sends no
   // light towards `ref` (outside a spot's cone, or at its position).

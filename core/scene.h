@@ -10,12 +10,15 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace pathlab {
+
+class EnvironmentMap;  // core/environment_map.h
 
 // How a sample's radiance reaches the pixels (the reconstruction filter).
 enum class FilterKind : std::uint8_t {
@@ -141,6 +144,9 @@ struct Scene {
   std::vector<Instance> instances;
   std::vector<DeltaLight> delta_lights;  // point, spot and directional lights
   std::optional<Spectrum> environment;  // uniform radiance from every direction
+  // Or a lat-long image of the radiance from each direction (shared by the
+  // copies of a scene; then `environment` is empty: there is one at most).
+  std::shared_ptr<const EnvironmentMap> environment_map;
   std::vector<std::string> warnings;    // non-fatal problems found while loading
   // The closed-form model whose answer this scene has ("furnace", ...; see
   // analytic-scenes/), or empty. Only `pathlab check` reads it.
