@@ -1,9 +1,18 @@
 // Model "environment-map": an environment image (core/environment_map.h)
-// seen directly, and optionally in one perfect mirror sphere (reflectance R,
-// the only shape). A camera ray that misses the sphere carries the map's
-// radiance in its direction; one that hits it carries R times the map's
-// radiance in the reflected direction (0 with a depth cap of 0 bounces):
-// the sphere is convex, so the reflected ray escapes.
+// seen directly, and at most one shape:
+//   - a perfect mirror sphere (reflectance R): a camera ray that hits it
+//     carries R times the map's radiance in the reflected direction (0 with a
+//     depth cap of 0 bounces): the sphere is convex, so the reflected ray
+//     escapes;
+//   - a planar diffuse mesh (albedo a) facing the map's up (+y turned by the
+//     map's transform), the camera above it: a point on it sees exactly the
+//     upper hemisphere of the map, whose rows are bands of polar angle
+//     [theta0, theta1) about that normal, so its irradiance is exactly
+//       E = sum over the upper rows and all columns of
+//           L(texel) (2 pi / width) (sin^2 theta1 - sin^2 theta0) / 2
+//     and it shows a E / pi (D >= 1). Light sampling, BSDF sampling and
+//     their MIS weights all meet the map there.
+// A ray that misses the shape carries the map's radiance in its direction.
 //
 // The map is piecewise constant, so the expected pixel values have edges
 // wherever a pixel straddles a texel boundary; expected_image() refines its
@@ -14,31 +23,57 @@
 #include "analytic-scenes/room.h"
 #include "core/environment_map.h"
 
+#include <array>
+#include <cmath>
 #include <sstream>
+#include <vector>
 
 namespace pathlab::analytic {
 namespace {
 
+// Irradiance on a surface whose normal is the map's up, from the upper
+// hemisphere (rows whose polar angle is below pi/2), exactly.
+dvec3 upper_hemisphere_irradiance(const EnvironmentMap& map) {
+  dvec3 E(0.0);
+  const int w = map.width(), h = map.height();
+  for (int y = 0; y < h / 2; ++y) {
+    const double s0 = std::sin(M_PI * y / h), s1 = std::sin(M_PI * (y + 1) / h);
+    const double band = (2.0 * M_PI / w) * 0.5 * (s1 * s1 - s0 * s0);
+    for (int x = 0; x < w; ++x) E += band * dvec3(map.texels().at(x, y));
+  }
+  return E;
+}
+
 class EnvironmentMapModel final : public AnalyticModel {
  public:
-  EnvironmentMapModel(std::shared_ptr<const EnvironmentMap> map, const Shape* sphere, Spectrum reflectance,
+  EnvironmentMapModel(std::shared_ptr<const EnvironmentMap> map, const Shape* shape, Spectrum surface,
                       std::string description)
-      : map_(std::move(map)), description_(std::move(description)), reflectance_(reflectance) {
-    if (sphere) {
+      : map_(std::move(map)), description_(std::move(description)), surface_(surface) {
+    if (shape && shape->kind == Shape::Kind::Sphere) {
       has_sphere_ = true;
-      center_ = sphere->center;
-      radius_ = sphere->radius;
+      center_ = shape->center;
+      radius_ = shape->radius;
+    } else if (shape) {
+      for (const glm::uvec3& t : shape->mesh.triangles)
+        plane_.push_back({dvec3(shape->mesh.positions[t.x]), dvec3(shape->mesh.positions[t.y]),
+                          dvec3(shape->mesh.positions[t.z])});
     }
   }
   std::string_view name() const override { return "environment-map"; }
   Spectrum radiance(const Ray& ray) const override {
+    if (!plane_.empty()) {
+      const dvec3 o(ray.origin), d(ray.dir);
+      for (const auto& t : plane_)
+        if (hit_triangle(o, d, t[0], t[1], t[2])) return surface_;
+      return map_->radiance(ray.dir);
+    }
     if (has_sphere_) {
       if (const std::optional<double> t = hit_sphere(center_, radius_, ray)) {
         // In double: the reflected direction of the exact hit point.
         const dvec3 o(ray.origin), d(ray.dir), c(center_);
         const dvec3 n = glm::normalize(o + *t * d - c);
         const dvec3 r = d - 2.0 * glm::dot(d, n) * n;
-        return reflectance_ * map_->radiance(vec3(glm::normalize(r)));
+        return surface_ * map_->radiance(vec3(glm::normalize(r)));
       }
     }
     return map_->radiance(ray.dir);
@@ -48,7 +83,8 @@ class EnvironmentMapModel final : public AnalyticModel {
  private:
   std::shared_ptr<const EnvironmentMap> map_;
   std::string description_;
-  Spectrum reflectance_{0.0f};
+  Spectrum surface_{0.0f};  // the sphere's reflectance, or the plane's radiance
+  std::vector<std::array<dvec3, 3>> plane_;  // the plane's triangles
   bool has_sphere_ = false;
   vec3 center_{0.0f};
   float radius_ = 0.0f;
@@ -60,25 +96,47 @@ std::unique_ptr<AnalyticModel> make_environment_map(const Scene& scene) {
   constexpr std::string_view kName = "environment-map";
   if (!scene.environment_map) refuse(scene, kName, "needs an environment image (a light with \"file\")");
   if (!scene.delta_lights.empty()) refuse(scene, kName, "delta lights (point, spot, directional) would light the sphere; remove them");
-  if (scene.shapes.size() > 1) refuse(scene, kName, "needs at most one shape, a mirror sphere; found " + std::to_string(scene.shapes.size()));
-  const Shape* sphere = nullptr;
-  Spectrum R(0.0f);
+  if (scene.shapes.size() > 1)
+    refuse(scene, kName, "needs at most one shape, a mirror sphere or a diffuse plane; found " + std::to_string(scene.shapes.size()));
+  const Shape* shape = nullptr;
+  Spectrum surface(0.0f);
+  const EnvironmentMap& map = *scene.environment_map;
   std::ostringstream d;
-  d << "environment " << scene.environment_map->source() << " (" << scene.environment_map->width() << " x "
-    << scene.environment_map->height() << ")";
+  d << "environment " << map.source() << " (" << map.width() << " x " << map.height() << ")";
   if (!scene.shapes.empty()) {
-    sphere = &scene.shapes[0];
-    const Material& m = scene.materials[sphere->material];
-    if (sphere->kind != Shape::Kind::Sphere || m.type != MaterialType::Mirror)
-      refuse(scene, kName, "the shape must be a mirror sphere");
-    if (m.emits()) refuse(scene, kName, "the mirror sphere must not emit");
-    // The camera is outside: a one-sided sphere facing in reflects nothing.
-    const bool faces_away = m.one_sided && sphere->flip_normals;
-    R = scene.render.max_depth == 0 || faces_away ? Spectrum(0.0f) : m.albedo;
-    d << ", mirror sphere '" << m.name << "' reflectance (" << R.x << ", " << R.y << ", " << R.z << ")";
+    shape = &scene.shapes[0];
+    const Material& m = scene.materials[shape->material];
+    if (m.emits()) refuse(scene, kName, "the shape must not emit");
+    const bool black = scene.render.max_depth == 0;
+    if (shape->kind == Shape::Kind::Sphere) {
+      if (m.type != MaterialType::Mirror) refuse(scene, kName, "a sphere must be a mirror");
+      // The camera is outside: a one-sided sphere facing in reflects nothing.
+      const bool faces_away = m.one_sided && shape->flip_normals;
+      surface = black || faces_away ? Spectrum(0.0f) : m.albedo;
+      d << ", mirror sphere '" << m.name << "' reflectance (" << surface.x << ", " << surface.y << ", " << surface.z << ")";
+    } else {
+      if (m.type != MaterialType::Diffuse || m.one_sided)
+        refuse(scene, kName, "a mesh must be a plane of a two-sided diffuse material");
+      const dvec3 up = glm::normalize(dvec3(map.to_world() * vec3(0.0f, 1.0f, 0.0f)));
+      const TriangleMesh& mesh = shape->mesh;
+      const double height = glm::dot(up, dvec3(mesh.positions[mesh.triangles[0].x]));
+      for (const glm::uvec3& t : mesh.triangles) {
+        const dvec3 p0(mesh.positions[t.x]), p1(mesh.positions[t.y]), p2(mesh.positions[t.z]);
+        const dvec3 n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+        if (std::abs(std::abs(glm::dot(n, up)) - 1.0) > 1e-6)
+          refuse(scene, kName, "the plane must face the environment's up (+y, turned by its transform)");
+        for (const dvec3& p : {p0, p1, p2})
+          if (std::abs(glm::dot(up, p) - height) > 1e-5 * (1.0 + std::abs(height)))
+            refuse(scene, kName, "the mesh must be planar");
+      }
+      if (!(glm::dot(up, dvec3(scene.camera.position)) > height)) refuse(scene, kName, "the camera must be above the plane");
+      const dvec3 E = upper_hemisphere_irradiance(map);
+      surface = black ? Spectrum(0.0f) : Spectrum(dvec3(m.albedo) * E / M_PI);
+      d << ", diffuse plane '" << m.name << "' irradiance (" << E.x << ", " << E.y << ", " << E.z << ")";
+    }
   }
   d << ", depth cap " << scene.render.max_depth;
-  return std::make_unique<EnvironmentMapModel>(scene.environment_map, sphere, R, d.str());
+  return std::make_unique<EnvironmentMapModel>(scene.environment_map, shape, surface, d.str());
 }
 
 }  // namespace pathlab::analytic

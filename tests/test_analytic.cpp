@@ -157,7 +157,10 @@ TEST(AnalyticRefusals, SphereAssumptions) {
 
 TEST(AnalyticRefusals, EnvironmentMapAssumptions) {
   expect_refused("envmap-mirror-sphere.json", [](Scene& s) { s.environment_map.reset(); }, "needs an environment image");
-  expect_refused("envmap-mirror-sphere.json", [](Scene& s) { s.materials[0].type = MaterialType::Diffuse; }, "mirror sphere");
+  expect_refused("envmap-mirror-sphere.json", [](Scene& s) { s.materials[0].type = MaterialType::Diffuse; }, "must be a mirror");
+  expect_refused("envmap-diffuse-plane.json", [](Scene& s) { s.shapes[0].mesh.positions[0].y += 0.5f; }, "face the environment's up");
+  expect_refused("envmap-diffuse-plane.json", [](Scene& s) { s.camera.position.y = -1.0f; }, "camera must be above");
+  expect_refused("envmap-diffuse-plane.json", [](Scene& s) { s.materials[0].type = MaterialType::Mirror; }, "two-sided diffuse");
   expect_refused("envmap-mirror-sphere.json", [](Scene& s) { s.shapes.push_back(s.shapes[0]); }, "at most one shape");
   expect_refused("envmap-mirror-sphere.json", [](Scene& s) { s.delta_lights.push_back({vec3(0.0f), Spectrum(1.0f)}); },
                  "delta lights");
