@@ -514,13 +514,15 @@ void read_lights(const Node& node, Scene* scene, const std::filesystem::path& fo
       spot.cos_inner = std::cos(glm::radians(inner));
       scene->delta_lights.push_back(spot);
     } else if (type == "directional") {
-      l.allow_only({"type", "direction", "irradiance"});
+      l.allow_only({"type", "direction", "irradiance", "angular_diameter"});
       DeltaLight sun;
       sun.kind = DeltaLight::Kind::Directional;
       sun.intensity = l.required("irradiance").color(false);
       const vec3 d = l.required("direction").vector3();
       if (!(glm::length(d) > 0.0f) || !is_finite(d)) l.child("direction").fail("direction must not be zero");
       sun.direction = glm::normalize(d);
+      // A sun disk (0.53 for the sun seen from the earth); 0 keeps a delta light.
+      sun.angular_radius = glm::radians(0.5f * unit_number(l, "angular_diameter", 0.0f, 0.0f, 90.0f));
       scene->delta_lights.push_back(sun);
     } else if (type == "environment") {
       l.allow_only({"type", "radiance", "file", "scale", "transform", "clamp_negative"});

@@ -169,6 +169,31 @@ TEST(AnalyticRefusals, EnvironmentMapAssumptions) {
   }, "environment");
 }
 
+TEST(AnalyticRefusals, PlaneUnderSunAssumptions) {
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.delta_lights[0].angular_radius = 0.0f; }, "angular_diameter");
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.environment = Spectrum(1.0f); }, "environment");
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.delta_lights[0].angular_radius = 1.2f; }, "whole sun disk");
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.camera.position.y = -1.0f; }, "sunny side");
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.materials[0].one_sided = true; }, "two-sided");
+  expect_refused("envmap-diffuse-plane.json", [](Scene& s) {
+    s.delta_lights.push_back({vec3(0.0f), Spectrum(1.0f), DeltaLight::Kind::Directional, vec3(0, -1, 0), 0.0f, 0.0f, 0.1f});
+  }, "delta lights");
+}
+
+// The sun's real size, 0.53 degrees: found by light sampling only (BSDF
+// sampling would hit it about once in 10^5 samples, so cosine and bsdf are
+// not run), the plane still shows a E cos theta / pi, in both tracers.
+TEST(AnalyticSunDisk, RealSunThroughLightSampling) {
+  for (Strategy strategy : {Strategy::Mis, Strategy::Light, Strategy::LightBsdf})
+    for (bool wavefront : {false, true}) {
+      Scene s = test::load_with_strategy("sun-disk-plane.json", strategy);
+      s.delta_lights[0].angular_radius = glm::radians(0.265f);
+      const CheckResult r = wavefront ? test::run_check<WavefrontTracer>(std::move(s)) : test::run_check(std::move(s));
+      EXPECT_TRUE(r.pass) << strategy_name(strategy) << (wavefront ? " wavefront" : " reference") << ": bias " << r.bias
+                          << " +- " << r.bias_se << ", " << r.failing << " pixel-channels fail";
+    }
+}
+
 // The expected image of a piecewise-constant map has edges wherever a pixel
 // straddles a texel boundary. Its midpoint quadrature (expected_image.h) must
 // be far more accurate there than the check's statistical tolerance (|z| up

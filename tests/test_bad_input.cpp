@@ -204,6 +204,10 @@ TEST_F(BadInput, BadSpotAndDirectionalLights) {
        "components must not be negative"},
       {R"({"type": "directional", "direction": [0, -1, 0], "intensity": 2})", "\"intensity\"", "unknown key 'intensity'"},
       {R"({"type": "directonal"})", "\"type\": \"directonal\"", "did you mean 'directional'"},
+      {R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1, "angular_diameter": 120})",
+       "\"angular_diameter\"", "angular_diameter must lie in [0, 90], found 120"},
+      {R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1, "angular_diameter": -0.5})",
+       "\"angular_diameter\"", "angular_diameter must lie in [0, 90], found -0.5"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.light);

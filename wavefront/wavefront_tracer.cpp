@@ -160,7 +160,7 @@ struct WavefrontTracer::VectorStages {
     // Only triangle area lights: no delta light, sphere light or environment.
     const LightSampler& lights = compiled.lights();
     if (lights.has_delta_lights()) return no("delta lights (point, spot, directional)");
-    if (lights.samples_environment()) return no("an environment light");
+    if (lights.samples_environment()) return no("an environment or sun disk light");
     for (const LightSampler::Entry& e : lights.entries()) {
       const Shape& shape = scene.shapes[e.shape];
       if (shape.kind != Shape::Kind::Triangles) return no("a sphere light (" + shape.description + ")");
