@@ -13,6 +13,10 @@
 //     and it shows a E / pi (D >= 1). Light sampling, BSDF sampling and
 //     their MIS weights all meet the map there.
 // A ray that misses the shape carries the map's radiance in its direction.
+// Sun disks (directional lights with an angular diameter) may join the map:
+// they add their radiance E / (pi sin^2 alpha) inside their cones, and to
+// the plane a E cos theta / pi each (exact when the whole disk is above the
+// plane, which the model requires).
 //
 // The map is piecewise constant, so the expected pixel values have edges
 // wherever a pixel straddles a texel boundary; expected_image() refines its
@@ -23,6 +27,7 @@
 #include "analytic-scenes/room.h"
 #include "core/environment_map.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <sstream>
@@ -44,11 +49,17 @@ dvec3 upper_hemisphere_irradiance(const EnvironmentMap& map) {
   return E;
 }
 
+struct Sun {
+  dvec3 to_sun;
+  double cos_alpha;
+  dvec3 radiance;
+};
+
 class EnvironmentMapModel final : public AnalyticModel {
  public:
-  EnvironmentMapModel(std::shared_ptr<const EnvironmentMap> map, const Shape* shape, Spectrum surface,
-                      std::string description)
-      : map_(std::move(map)), description_(std::move(description)), surface_(surface) {
+  EnvironmentMapModel(std::shared_ptr<const EnvironmentMap> map, std::vector<Sun> suns, const Shape* shape,
+                      Spectrum surface, std::string description)
+      : map_(std::move(map)), suns_(std::move(suns)), description_(std::move(description)), surface_(surface) {
     if (shape && shape->kind == Shape::Kind::Sphere) {
       has_sphere_ = true;
       center_ = shape->center;
@@ -65,7 +76,7 @@ class EnvironmentMapModel final : public AnalyticModel {
       const dvec3 o(ray.origin), d(ray.dir);
       for (const auto& t : plane_)
         if (hit_triangle(o, d, t[0], t[1], t[2])) return surface_;
-      return map_->radiance(ray.dir);
+      return sky(ray.dir);
     }
     if (has_sphere_) {
       if (const std::optional<double> t = hit_sphere(center_, radius_, ray)) {
@@ -73,15 +84,23 @@ class EnvironmentMapModel final : public AnalyticModel {
         const dvec3 o(ray.origin), d(ray.dir), c(center_);
         const dvec3 n = glm::normalize(o + *t * d - c);
         const dvec3 r = d - 2.0 * glm::dot(d, n) * n;
-        return surface_ * map_->radiance(vec3(glm::normalize(r)));
+        return surface_ * sky(vec3(glm::normalize(r)));
       }
     }
-    return map_->radiance(ray.dir);
+    return sky(ray.dir);
   }
   std::string describe() const override { return description_; }
 
  private:
+  Spectrum sky(const vec3& dir) const {
+    dvec3 L(map_->radiance(dir));
+    for (const Sun& sun : suns_)
+      if (glm::dot(glm::normalize(dvec3(dir)), sun.to_sun) >= sun.cos_alpha) L += sun.radiance;
+    return Spectrum(L);
+  }
+
   std::shared_ptr<const EnvironmentMap> map_;
+  std::vector<Sun> suns_;
   std::string description_;
   Spectrum surface_{0.0f};  // the sphere's reflectance, or the plane's radiance
   std::vector<std::array<dvec3, 3>> plane_;  // the plane's triangles
@@ -95,7 +114,14 @@ class EnvironmentMapModel final : public AnalyticModel {
 std::unique_ptr<AnalyticModel> make_environment_map(const Scene& scene) {
   constexpr std::string_view kName = "environment-map";
   if (!scene.environment_map) refuse(scene, kName, "needs an environment image (a light with \"file\")");
-  if (!scene.delta_lights.empty()) refuse(scene, kName, "delta lights (point, spot, directional) would light the sphere; remove them");
+  std::vector<Sun> suns;
+  for (const DeltaLight& dl : scene.delta_lights) {
+    if (!dl.is_sun_disk())
+      refuse(scene, kName, "delta lights (point, spot, directional without an angular_diameter) cannot be seen; remove them");
+    const double sin_alpha = std::sin(double(dl.angular_radius));
+    suns.push_back({-glm::normalize(dvec3(dl.direction)), std::cos(double(dl.angular_radius)),
+                    dvec3(dl.intensity) / (M_PI * sin_alpha * sin_alpha)});
+  }
   if (scene.shapes.size() > 1)
     refuse(scene, kName, "needs at most one shape, a mirror sphere or a diffuse plane; found " + std::to_string(scene.shapes.size()));
   const Shape* shape = nullptr;
@@ -130,13 +156,21 @@ std::unique_ptr<AnalyticModel> make_environment_map(const Scene& scene) {
             refuse(scene, kName, "the mesh must be planar");
       }
       if (!(glm::dot(up, dvec3(scene.camera.position)) > height)) refuse(scene, kName, "the camera must be above the plane");
-      const dvec3 E = upper_hemisphere_irradiance(map);
+      dvec3 E = upper_hemisphere_irradiance(map);
+      for (std::size_t i = 0; i < suns.size(); ++i) {
+        const DeltaLight& dl = scene.delta_lights[i];
+        const double cos_theta = glm::dot(suns[i].to_sun, up);
+        if (std::acos(std::clamp(cos_theta, -1.0, 1.0)) + double(dl.angular_radius) > 0.5 * M_PI + 1e-9)
+          refuse(scene, kName, "a sun disk must lie wholly above the plane");
+        E += dvec3(dl.intensity) * cos_theta;
+      }
       surface = black ? Spectrum(0.0f) : Spectrum(dvec3(m.albedo) * E / M_PI);
       d << ", diffuse plane '" << m.name << "' irradiance (" << E.x << ", " << E.y << ", " << E.z << ")";
     }
   }
   d << ", depth cap " << scene.render.max_depth;
-  return std::make_unique<EnvironmentMapModel>(scene.environment_map, shape, surface, d.str());
+  if (!suns.empty()) d << ", " << suns.size() << " sun disk(s)";
+  return std::make_unique<EnvironmentMapModel>(scene.environment_map, std::move(suns), shape, surface, d.str());
 }
 
 }  // namespace pathlab::analytic

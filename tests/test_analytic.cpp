@@ -175,9 +175,11 @@ TEST(AnalyticRefusals, PlaneUnderSunAssumptions) {
   expect_refused("sun-disk-plane.json", [](Scene& s) { s.delta_lights[0].angular_radius = 1.2f; }, "whole sun disk");
   expect_refused("sun-disk-plane.json", [](Scene& s) { s.camera.position.y = -1.0f; }, "sunny side");
   expect_refused("sun-disk-plane.json", [](Scene& s) { s.materials[0].one_sided = true; }, "two-sided");
-  expect_refused("envmap-diffuse-plane.json", [](Scene& s) {
-    s.delta_lights.push_back({vec3(0.0f), Spectrum(1.0f), DeltaLight::Kind::Directional, vec3(0, -1, 0), 0.0f, 0.0f, 0.1f});
-  }, "delta lights");
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.delta_lights.push_back({vec3(0.0f, 3.0f, 0.0f), Spectrum(1.0f)}); },
+                 "exactly one light");
+  expect_refused("envmap-sun-plane.json", [](Scene& s) { s.delta_lights[0].angular_radius = 0.0f; }, "delta lights");
+  expect_refused("envmap-sun-plane.json", [](Scene& s) { s.delta_lights[0].direction = vec3(0, 0.2f, -1); },
+                 "wholly above the plane");
 }
 
 // The sun's real size, 0.53 degrees: found by light sampling only (BSDF
