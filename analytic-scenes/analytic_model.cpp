@@ -19,6 +19,8 @@ constexpr Entry kModels[] = {
     {"penumbra", analytic::make_penumbra},
     {"rough-sphere-in-environment", analytic::make_rough_sphere_in_environment},
     {"glass-sphere-in-environment", analytic::make_glass_sphere_in_environment},
+    {"environment-map", analytic::make_environment_map},
+    {"plane-under-sun", analytic::make_plane_under_sun},
 };
 
 }  // namespace

@@ -164,7 +164,8 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
   }
   if (!model->emitter) refuse(scene, kName, "needs an emitting polygon");
   if (!model->ground) refuse(scene, kName, "needs a reflecting ground");
-  if (scene.environment && !is_black(*scene.environment)) refuse(scene, kName, "an environment would light the ground too; remove it");
+  if ((scene.environment && !is_black(*scene.environment)) || scene.environment_map)
+    refuse(scene, kName, "an environment would light the ground too; remove it");
   if (!scene.delta_lights.empty()) refuse(scene, kName, "delta lights (point, spot, directional) would light the ground too; remove them");
 
   const Material& em = scene.materials[model->emitter->material];

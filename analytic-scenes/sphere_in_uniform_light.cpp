@@ -1,7 +1,8 @@
 // Model "sphere-in-uniform-light": one sphere, Lambert (albedo a) or mirror
 // (reflectance R), surrounded by light of uniform radiance L_s, which is
 // either
-//   - a uniform environment (then the sphere must be the only shape), or
+//   - a uniform environment, or an environment image whose texels are all
+//     equal (then the sphere must be the only shape), or
 //   - a closed room around the camera and the sphere whose walls emit Le
 //     towards the inside and reflect nothing (material "emissive"): L_s = Le,
 //   - or such a room with Lambert walls of albedo rho emitting Le, when the
@@ -13,6 +14,7 @@
 // of at least one bounce (0 otherwise); any other ray carries L_s.
 #include "analytic-scenes/models.h"
 #include "analytic-scenes/room.h"
+#include "core/environment_map.h"
 
 #include <sstream>
 
@@ -66,11 +68,20 @@ std::unique_ptr<AnalyticModel> make_sphere_in_uniform_light(const Scene& scene) 
   Spectrum surround;
   std::string what;
   if (!room) {
-    if (!scene.environment) refuse(scene, kName, "needs a uniform environment or a closed emitting room around the sphere");
-    surround = *scene.environment;
-    what = "environment " + fmt(surround);
+    // An environment image whose texels are all equal is uniform too (its
+    // lookup and importance sampling differ from the uniform light's, its
+    // radiance does not).
+    std::optional<Spectrum> uniform = scene.environment;
+    if (!uniform && scene.environment_map) uniform = scene.environment_map->constant();
+    if (!uniform)
+      refuse(scene, kName,
+             scene.environment_map ? "the environment image is not constant: its radiance is not uniform"
+                                   : "needs a uniform environment or a closed emitting room around the sphere");
+    surround = *uniform;
+    what = (scene.environment ? "environment " : "constant environment image ") + fmt(surround);
   } else {
-    if (scene.environment && !is_black(*scene.environment))
+    if ((scene.environment && !is_black(*scene.environment)) ||
+        (scene.environment_map && !scene.environment_map->is_black()))
       refuse(scene, kName, "give either an environment or a room, not both");
     const Material& rm = scene.materials[room->material];
     if (!rm.emits()) refuse(scene, kName, "the room must emit");

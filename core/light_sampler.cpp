@@ -1,5 +1,6 @@
 #include "core/light_sampler.h"
 
+#include "core/environment_map.h"
 #include "core/faults.h"
 #include "core/geometry.h"
 #include "core/sampling.h"
@@ -74,7 +75,7 @@ Ray shadow_ray(const Surfel& s, const LightSample& ls) {
 std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene) {
   std::vector<const DeltaLight*> out;
   for (const DeltaLight& dl : scene.delta_lights)
-    if (!is_black(dl.intensity)) out.push_back(&dl);
+    if (!is_black(dl.intensity) && !dl.is_sun_disk()) out.push_back(&dl);
   return out;
 }
 
@@ -109,6 +110,30 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&sce
     entries_.push_back({0, 0, 0.0f, {}});
     power.push_back(4.0 * kPi * kPi * double(scene_radius) * scene_radius * luminance(*scene.environment));
   }
+  // An image: pi r^2 times its luminance integrated over the sphere (the
+  // uniform case above is that for a constant map). A black map is no light.
+  if (scene.environment_map && scene.environment_map->luminance_integral() > 0.0) {
+    env_index_ = static_cast<std::int64_t>(entries_.size());
+    entries_.push_back({0, 0, 0.0f, {}});
+    power.push_back(kPi * double(scene_radius) * scene_radius * scene.environment_map->luminance_integral());
+  }
+  // Sun disks: pi r^2 Y(E), as a delta directional light. The cone's size in
+  // double: 1 - cos alpha of the sun (about 1e-5) would keep two digits in float.
+  for (const DeltaLight& dl : scene.delta_lights) {
+    if (!dl.is_sun_disk() || is_black(dl.intensity)) continue;
+    const double alpha = dl.angular_radius, sin_alpha = std::sin(alpha);
+    const double one_minus_cos = 2.0 * std::sin(0.5 * alpha) * std::sin(0.5 * alpha);
+    SunDisk sun;
+    sun.frame = Frame(-dl.direction);
+    sun.one_minus_cos = static_cast<float>(one_minus_cos);
+    sun.sin2 = static_cast<float>(sin_alpha * sin_alpha);
+    sun.cone_pdf = static_cast<float>(1.0 / (2.0 * double(kPi) * one_minus_cos));
+    sun.Le = Spectrum(dvec3(dl.intensity) / (double(kPi) * sin_alpha * sin_alpha));
+    sun.entry = static_cast<std::int64_t>(entries_.size());
+    suns_.push_back(sun);
+    entries_.push_back({0, 0, 0.0f, {}});
+    power.push_back(kPi * double(scene_radius) * scene_radius * luminance(dl.intensity));
+  }
   build_distribution(power, &pmf_, &cdf_);
 
   // Delta lights by power (docs/scene-format.md, "How a light is picked"),
@@ -137,11 +162,39 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
   LightSample ls;
   ls.light = static_cast<std::uint32_t>(i);
   if (static_cast<std::int64_t>(i) == env_index_) {
-    ls.wi = square_to_uniform_sphere(u);
     ls.dist = kInfinity;
     ls.infinite = true;
-    ls.Le = *scene_->environment;
-    ls.pdf = pmf_[i] * kInv4Pi;
+    if (const EnvironmentMap* map = scene_->environment_map.get()) {
+      const std::optional<EnvironmentMap::Sample> es = map->sample(u);
+      if (!es) return std::nullopt;
+      ls.wi = es->wi;
+      ls.Le = es->radiance;
+      ls.pdf = pmf_[i] * es->pdf;
+    } else {
+      ls.wi = square_to_uniform_sphere(u);
+      ls.Le = *scene_->environment;
+      ls.pdf = pmf_[i] * kInv4Pi;
+    }
+    // A sun disk in the same direction: the sample stands for every infinite
+    // light there (their radiance summed, their densities summed: one
+    // technique for the sky as a whole, as the escape weighs it).
+    if (!suns_.empty()) add_suns(ls.wi, &ls.Le, &ls.pdf);
+    return ls;
+  }
+  if (const auto sun = std::find_if(suns_.begin(), suns_.end(), [&](const SunDisk& d) { return d.entry == std::int64_t(i); });
+      sun != suns_.end()) {
+    // Uniform in the cone, by 1 - cos theta = u.x (1 - cos alpha): sin theta
+    // from that difference keeps the disk's size exact for a tiny sun.
+    const float one_minus_cos = u.x * sun->one_minus_cos;
+    const float sin_theta = std::sqrt(std::max(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
+    const float phi = 2.0f * kPi * u.y;
+    const vec3 local(sin_theta * std::cos(phi), sin_theta * std::sin(phi), 1.0f - one_minus_cos);
+    ls.wi = glm::normalize(sun->frame.s * local.x + sun->frame.t * local.y + sun->frame.n * local.z);
+    ls.dist = kInfinity;
+    ls.infinite = true;
+    ls.Le = environment(ls.wi);
+    ls.pdf = pdf_environment(ls.wi);
+    if (!(ls.pdf > 0.0f) || is_black(ls.Le)) return std::nullopt;  // rounded out of the cone
     return ls;
   }
   const Entry& e = entries_[i];
@@ -170,6 +223,45 @@ float LightSampler::pdf(const vec3& ref, const Surfel& hit) const {
   const vec3 d = hit.p - ref;
   const float dist = glm::length(d);
   return pmf_[i] * area_to_solid_angle(area_density(entries_[i]), faulty_distance(dist), glm::dot(hit.n, d) / dist);
+}
+
+bool LightSampler::SunDisk::contains(const vec3& dir) const {
+  // By the sine: the cosine of a 0.27 degree cone is 1 - 1.1e-5, which float
+  // resolves only to about 0.5 %; the cross product keeps full precision.
+  if (!(glm::dot(dir, frame.n) > 0.0f)) return false;
+  const vec3 c = glm::cross(dir, frame.n);
+  return glm::dot(c, c) <= sin2;
+}
+
+void LightSampler::add_suns(const vec3& dir, Spectrum* Le, float* pdf) const {
+  for (const SunDisk& sun : suns_)
+    if (sun.contains(dir)) {
+      *Le += sun.Le;
+      *pdf += pmf_[static_cast<std::size_t>(sun.entry)] * sun.cone_pdf;
+    }
+}
+
+float LightSampler::pdf_environment(const vec3& wi) const {
+  float pdf = 0.0f;
+  if (env_index_ >= 0) {
+    const float pmf = pmf_[static_cast<std::size_t>(env_index_)];
+    pdf = scene_->environment_map ? pmf * scene_->environment_map->pdf(wi) : pmf * kInv4Pi;
+  }
+  if (!suns_.empty()) {
+    Spectrum unused(0.0f);
+    add_suns(wi, &unused, &pdf);
+  }
+  return pdf;
+}
+
+Spectrum LightSampler::environment(const vec3& dir) const {
+  Spectrum L = scene_->environment_map ? scene_->environment_map->radiance(dir)
+                                       : scene_->environment.value_or(Spectrum(0.0f));
+  if (!suns_.empty()) {
+    float unused = 0.0f;
+    add_suns(dir, &L, &unused);
+  }
+  return L;
 }
 
 std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_choice) const {

@@ -1,12 +1,20 @@
 // Light sampling for next-event estimation.
 //
-// Area lights are every emitting triangle and sphere, plus the uniform
-// environment; one is picked in proportion to its power, then a point on it
-// uniformly by area (a direction uniformly on the sphere, for the
-// environment). Densities are returned in solid angle as seen from the
+// Area lights are every emitting triangle and sphere, plus the environment
+// (uniform, or an image: core/environment_map.h); one is picked in
+// proportion to its power, then a point on it uniformly by area (for the
+// environment a direction: uniformly on the sphere, or by the image's
+// importance sampler). Densities are returned in solid angle as seen from the
 // shading point and include the probability of picking that light, so
 // `pdf()` of an emitter that a BSDF-sampled ray hits is directly comparable
 // with the BSDF's pdf (MIS).
+//
+// A directional light with an angular diameter is a sun disk: uniform
+// radiance in a cone that escaping rays can hit, sampled uniformly in the
+// cone, picked like the environment (power pi r^2 Y(E)). The environment and
+// the sun disks are one sky to the estimators: environment(dir) and
+// pdf_environment(dir) sum them all, and a sample of any of them carries
+// those sums, so MIS weighs the sky as one light.
 //
 // Point, spot and directional lights are delta lights: no ray can hit them,
 // so they live in a separate list that every strategy samples explicitly
@@ -56,7 +64,8 @@ std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene);
 class LightSampler {
  public:
   // `scene_radius`: radius of a sphere bounding the scene, for the power of
-  // the environment (pi * L * 4 pi r^2: the flux it sends through the scene).
+  // the environment (pi r^2 times the integral of Y(L) over the sphere, the
+  // flux it sends through the scene: pi * Y(L) * 4 pi r^2 when uniform).
   LightSampler(const Scene& scene, float scene_radius);
 
   std::size_t area_light_count() const { return entries_.size(); }
@@ -74,8 +83,12 @@ class LightSampler {
   // (reached from `ref`), in solid angle; 0 if `hit` is not on a light.
   float pdf(const vec3& ref, const Surfel& hit) const;
   // Density with which sample() would produce direction `wi` towards the
-  // environment (0 without one).
-  float pdf_environment() const { return env_index_ < 0 ? 0.0f : pmf_[env_index_] * kInv4Pi; }
+  // environment or a sun disk (0 without them): the sum over those lights.
+  float pdf_environment(const vec3& wi) const;
+  // The radiance a ray with direction `dir` sees when it escapes the scene:
+  // the environment's plus that of every sun disk it points into (black
+  // without them). Both tracers' escapes call this.
+  Spectrum environment(const vec3& dir) const;
 
   // A delta light picked in proportion to its power. Nothing if it sends no
   // light towards `ref` (outside a spot's cone, or at its position).
@@ -98,7 +111,8 @@ class LightSampler {
   std::span<const Entry> entries() const { return entries_; }
   std::span<const float> cdf() const { return cdf_; }
   std::span<const float> pmf() const { return pmf_; }
-  bool samples_environment() const { return env_index_ >= 0; }
+  // True if an environment or a sun disk is sampled (a light escaping rays find).
+  bool samples_environment() const { return env_index_ >= 0 || !suns_.empty(); }
   // The entry of shape `shape`'s triangle 0 (its triangle k is entry
   // first_entry + k), or -1 if the shape is not sampled as a light.
   std::int64_t first_entry(std::uint32_t shape) const { return first_entry_[shape]; }
@@ -107,8 +121,24 @@ class LightSampler {
   static std::size_t pick(const std::vector<float>& cdf, float u);
   static float area_density(const Entry& e);  // 1 / area
 
+  // A sun disk: radiance Le within the cone of half-angle alpha about frame.n
+  // (the direction towards the sun).
+  struct SunDisk {
+    Frame frame;
+    float one_minus_cos = 0.0f;  // 1 - cos alpha, computed as 2 sin^2(alpha / 2)
+    float sin2 = 0.0f;           // sin^2 alpha
+    float cone_pdf = 0.0f;       // 1 / (2 pi (1 - cos alpha))
+    Spectrum Le{0.0f};           // E / (pi sin^2 alpha)
+    std::int64_t entry = -1;     // its entry in entries_
+    bool contains(const vec3& dir) const;
+  };
+  // Adds the radiance and density (with its pick probability) of every sun
+  // disk whose cone holds `dir`.
+  void add_suns(const vec3& dir, Spectrum* Le, float* pdf) const;
+
   const Scene* scene_;
-  std::vector<Entry> entries_;           // area lights, then the environment
+  std::vector<Entry> entries_;           // area lights, then the environment, then the sun disks
+  std::vector<SunDisk> suns_;
   std::vector<float> pmf_, cdf_;         // over entries_
   std::vector<std::int64_t> first_entry_;  // per shape: index of its prim 0, or -1
   std::int64_t env_index_ = -1;

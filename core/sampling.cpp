@@ -1,5 +1,8 @@
 #include "core/sampling.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace pathlab {
 
 SinCos sin_cos_quarter(float x) {
@@ -82,6 +85,59 @@ vec2 uniform_triangle_to_square(vec2 b) {
   // above 1: clamp to the square the forward warp reads.
   const float s = 1.0f - b.y;
   return glm::clamp(vec2(s * s, s > 0.0f ? b.x / s : 0.0f), vec2(0.0f), vec2(kOneMinusEpsilon));
+}
+
+Distribution1D::Distribution1D(std::span<const float> weights) : n_(weights.size()), cdf_(weights.size() + 1, 0.0f) {
+  double running = 0.0;
+  for (std::size_t i = 0; i < n_; ++i) {
+    running += weights[i];
+    cdf_[i + 1] = static_cast<float>(running);
+  }
+  total_ = running;
+  if (!(total_ > 0.0)) {
+    total_ = 0.0;
+    std::fill(cdf_.begin(), cdf_.end(), 0.0f);
+    return;
+  }
+  // Normalised from the double sums, so that the cdf is non-decreasing and
+  // ends at exactly 1.
+  running = 0.0;
+  for (std::size_t i = 0; i < n_; ++i) {
+    running += weights[i];
+    cdf_[i + 1] = std::min(1.0f, static_cast<float>(running / total_));
+  }
+  cdf_[n_] = 1.0f;
+}
+
+Distribution1D::Sample Distribution1D::sample(float u) const {
+  if (!(total_ > 0.0)) return {};
+  // The last i with cdf[i] <= u: a zero-width cell j has cdf[j] == cdf[j + 1],
+  // so whenever cdf[j] <= u the search moves past it. u < 1 = cdf[n].
+  const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
+  const std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - cdf_.begin()) - 1, n_ - 1);
+  const float width = cdf_[i + 1] - cdf_[i];
+  const float t = width > 0.0f ? std::clamp((u - cdf_[i]) / width, 0.0f, 1.0f) : 0.0f;
+  // Kept inside the cell: (i + t) / n may round up to its upper edge.
+  const float upper = std::nextafter(static_cast<float>(i + 1) / static_cast<float>(n_), 0.0f);
+  const float x = std::min((static_cast<float>(i) + t) / static_cast<float>(n_), upper);
+  return {x, pdf(i), i};
+}
+
+Distribution2D::Distribution2D(std::span<const float> weights, std::size_t width, std::size_t height) {
+  std::vector<float> row_sums(height);
+  conditional_.reserve(height);
+  for (std::size_t y = 0; y < height; ++y) {
+    conditional_.emplace_back(weights.subspan(y * width, width));
+    row_sums[y] = static_cast<float>(conditional_.back().total());
+  }
+  marginal_ = Distribution1D(row_sums);
+}
+
+Distribution2D::Sample Distribution2D::sample(vec2 u) const {
+  const Distribution1D::Sample row = marginal_.sample(u.y);
+  if (!(row.pdf > 0.0f)) return {};
+  const Distribution1D::Sample col = conditional_[row.cell].sample(u.x);
+  return {vec2(col.x, row.x), row.pdf * col.pdf, col.cell, row.cell};
 }
 
 }  // namespace pathlab

@@ -5,6 +5,10 @@
 
 #include "core/math.h"
 
+#include <cstddef>
+#include <span>
+#include <vector>
+
 namespace pathlab {
 
 // sin and cos of x for |x| <= pi/4, by fixed polynomials in plain float
@@ -55,5 +59,63 @@ inline float area_to_solid_angle(float pdf_area, float dist, float cos_light) {
   const float c = std::abs(cos_light);
   return c > 0.0f ? pdf_area * dist * dist / c : 0.0f;
 }
+
+// A piecewise-constant density on [0, 1) over n equal cells, proportional
+// to non-negative weights (pbrt-v4's PiecewiseConstant1D). The density of a
+// cell is read from the cdf as stored (float), not from the weights, so it is
+// exactly the probability with which sample() lands there (for a continuous
+// u): a cell whose weight is lost to rounding has density 0 and is never
+// sampled. All weights 0: no density at all (sample() gives pdf 0).
+class Distribution1D {
+ public:
+  Distribution1D() = default;
+  explicit Distribution1D(std::span<const float> weights);
+
+  std::size_t size() const { return n_; }
+  // Sum of the weights (in double), 0 for a distribution with no density.
+  double total() const { return total_; }
+  // Probability of cell i, and the density on [0, 1) inside it.
+  float pmf(std::size_t i) const { return cdf_[i + 1] - cdf_[i]; }
+  float pdf(std::size_t i) const { return pmf(i) * static_cast<float>(n_); }
+
+  struct Sample {
+    float x = 0.0f;       // in [0, 1), uniform inside its cell
+    float pdf = 0.0f;     // density at x
+    std::size_t cell = 0;
+  };
+  // The cell i with cdf[i] <= u < cdf[i + 1] (zero-width cells skipped),
+  // and x placed in it by where u falls between the two.
+  Sample sample(float u) const;
+
+ private:
+  std::size_t n_ = 0;
+  double total_ = 0.0;
+  std::vector<float> cdf_;  // n + 1 entries, 0 ... 1
+};
+
+// A piecewise-constant density on [0, 1)^2 over a grid of width x height
+// cells, row-major weights: the rows by their sums (the marginal), then a
+// column of the row (its conditional), as pbrt-v4's PiecewiseConstant2D.
+class Distribution2D {
+ public:
+  Distribution2D() = default;
+  Distribution2D(std::span<const float> weights, std::size_t width, std::size_t height);
+
+  double total() const { return marginal_.total(); }
+  // Density on [0, 1)^2 in cell (x, y).
+  float pdf(std::size_t x, std::size_t y) const { return marginal_.pdf(y) * conditional_[y].pdf(x); }
+
+  struct Sample {
+    vec2 p{0.0f};  // in [0, 1)^2
+    float pdf = 0.0f;
+    std::size_t x = 0, y = 0;  // its cell
+  };
+  // u.y picks the row, u.x the column within it.
+  Sample sample(vec2 u) const;
+
+ private:
+  Distribution1D marginal_;
+  std::vector<Distribution1D> conditional_;
+};
 
 }  // namespace pathlab

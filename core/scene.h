@@ -10,12 +10,15 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace pathlab {
+
+class EnvironmentMap;  // core/environment_map.h
 
 // How a sample's radiance reaches the pixels (the reconstruction filter).
 enum class FilterKind : std::uint8_t {
@@ -112,7 +115,11 @@ inline constexpr std::uint32_t kNoInstance = 0xffffffffu;
 //                SpotLight): 1 inside the inner cone, 0 outside the outer.
 //   Directional: `intensity` is the irradiance E (W/m^2 per channel) on a
 //                surface facing the light; `direction` (unit) is the way the
-//                light travels. `position` unused.
+//                light travels. `position` unused. With an angular_radius
+//                alpha > 0 it is no delta light but a sun disk: uniform
+//                radiance E / (pi sin^2 alpha) from the cone of half-angle
+//                alpha about -direction, which rays can hit; LightSampler
+//                samples it with the area lights and the environment.
 struct DeltaLight {
   enum class Kind : std::uint8_t { Point, Spot, Directional };
   vec3 position{0.0f};
@@ -121,6 +128,8 @@ struct DeltaLight {
   vec3 direction{0.0f, 0.0f, -1.0f};
   float cos_outer = 0.0f;  // spot: cosine of the outer half-angle (cone_angle)
   float cos_inner = 0.0f;  // spot: cosine of the inner half-angle (falloff_start)
+  float angular_radius = 0.0f;  // directional: half the angular diameter, radians (0: a delta light)
+  bool is_sun_disk() const { return kind == Kind::Directional && angular_radius > 0.0f; }
 };
 // The spot profile: 1 for cos_theta >= cos_inner, 0 for cos_theta <= cos_outer,
 // a smoothstep in cos theta between.
@@ -139,8 +148,11 @@ struct Scene {
   std::vector<Shape> shapes;
   std::vector<ShapeGroup> groups;
   std::vector<Instance> instances;
-  std::vector<DeltaLight> delta_lights;  // point, spot and directional lights
+  std::vector<DeltaLight> delta_lights;  // point, spot and directional lights (and sun disks)
   std::optional<Spectrum> environment;  // uniform radiance from every direction
+  // Or a lat-long image of the radiance from each direction (shared by the
+  // copies of a scene; then `environment` is empty: there is one at most).
+  std::shared_ptr<const EnvironmentMap> environment_map;
   std::vector<std::string> warnings;    // non-fatal problems found while loading
   // Every file the scene loaded besides its own (meshes, glTF files, ...),
   // as resolved, in the order loaded: what a render's fingerprint hashes

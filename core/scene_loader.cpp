@@ -1,6 +1,7 @@
 #include "core/scene_loader.h"
 
 #include "core/data_dir.h"
+#include "core/environment_map.h"
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/gltf_loader.h"
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <span>
 #include <sstream>
@@ -441,7 +443,48 @@ void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path
   if (scene.shapes.size() == before) file.fail(path.string() + ": the file's scene holds no triangles");
 }
 
-void read_lights(const Node& node, Scene* scene) {
+// {"type": "environment", "file": ..., "scale": s, "transform": rotations,
+//  "clamp_negative": bool}.
+std::shared_ptr<const EnvironmentMap> read_environment_map(const Node& l, const std::filesystem::path& folder,
+                                                           Scene* scene) {
+  const Node file = l.required("file");
+  if (file.string().empty()) file.fail("the image file name is empty");
+  const std::filesystem::path path = resolve_scene_path(folder, file.string());
+  if (names_data_file(file.string()) && !std::filesystem::exists(path))
+    file.fail(file.string() + ": " + path.string() + " does not exist; " + data_directory_hint());
+  float scale = 1.0f;
+  if (l.has("scale")) {
+    scale = static_cast<float>(l.child("scale").number());
+    if (!(scale >= 0.0f)) l.child("scale").fail("scale must be >= 0, found " + l.child("scale").value().dump());
+  }
+  // Directions only: a rotation (a mirror too) keeps solid angles, so the
+  // map's density stays a density; a scale or shear would not, and a
+  // translation means nothing at infinity.
+  mat3 to_world(1.0f);
+  if (l.has("transform")) {
+    const Node t = l.child("transform");
+    const mat4 m = read_transform(t);
+    to_world = mat3(m);
+    const mat3 gram = glm::transpose(to_world) * to_world;
+    float off = 0.0f;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) off = std::max(off, std::abs(gram[i][j] - (i == j ? 1.0f : 0.0f)));
+    if (!(off <= 1e-4f)) t.fail("an environment's transform may only rotate (no scale or shear)");
+    if (m[3][0] != 0.0f || m[3][1] != 0.0f || m[3][2] != 0.0f)
+      t.fail("an environment's transform may only rotate (a translation means nothing at infinity)");
+  }
+  const bool clamp_negative = l.boolean_or("clamp_negative", false);
+  std::string warning;
+  try {
+    auto map = std::make_shared<const EnvironmentMap>(load_environment_map(path, scale, to_world, clamp_negative, &warning));
+    if (!warning.empty()) scene->warnings.push_back(file.message(warning));
+    return map;
+  } catch (const InputError& e) {
+    file.fail(e.what());
+  }
+}
+
+void read_lights(const Node& node, Scene* scene, const std::filesystem::path& folder) {
   if (!node.value().is_array()) node.fail("expected an array of lights");
   for (std::size_t i = 0; i < node.value().size(); ++i) {
     const Node l = node.child(i);
@@ -473,18 +516,28 @@ void read_lights(const Node& node, Scene* scene) {
       spot.cos_inner = std::cos(glm::radians(inner));
       scene->delta_lights.push_back(spot);
     } else if (type == "directional") {
-      l.allow_only({"type", "direction", "irradiance"});
+      l.allow_only({"type", "direction", "irradiance", "angular_diameter"});
       DeltaLight sun;
       sun.kind = DeltaLight::Kind::Directional;
       sun.intensity = l.required("irradiance").color(false);
       const vec3 d = l.required("direction").vector3();
       if (!(glm::length(d) > 0.0f) || !is_finite(d)) l.child("direction").fail("direction must not be zero");
       sun.direction = glm::normalize(d);
+      // A sun disk (0.53 for the sun seen from the earth); 0 keeps a delta light.
+      sun.angular_radius = glm::radians(0.5f * unit_number(l, "angular_diameter", 0.0f, 0.0f, 90.0f));
       scene->delta_lights.push_back(sun);
     } else if (type == "environment") {
-      l.allow_only({"type", "radiance"});
-      if (scene->environment) l.fail("only one environment light is allowed");
-      scene->environment = l.required("radiance").color(false);
+      l.allow_only({"type", "radiance", "file", "scale", "transform", "clamp_negative"});
+      if (scene->environment || scene->environment_map) l.fail("only one environment light is allowed");
+      if (l.has("radiance") == l.has("file"))
+        l.fail("an environment needs exactly one of 'radiance' (uniform) and 'file' (a lat-long image)");
+      if (l.has("radiance")) {
+        for (const char* key : {"scale", "transform", "clamp_negative"})
+          if (l.has(key)) l.child(key).fail(std::string(key) + " applies to an environment image ('file') only");
+        scene->environment = l.required("radiance").color(false);
+      } else {
+        scene->environment_map = read_environment_map(l, folder, scene);
+      }
     } else {
       const std::array<std::string_view, 4> types{"point", "spot", "directional", "environment"};
       const std::string near = suggestion(type, types);
@@ -543,11 +596,12 @@ Scene read_scene(const JsonDocument& doc) {
       scene.warnings.push_back(root.child("groups").child(scene.groups[g].name).message(
           "group " + in_quotes(scene.groups[g].name) + " is never placed (no instance names it)"));
 
-  if (root.has("lights")) read_lights(root.child("lights"), &scene);
+  if (root.has("lights")) read_lights(root.child("lights"), &scene, folder);
   // Tangents for the meshes whose material needs them (core/tangents.h).
   add_needed_tangents(&scene);
 
-  bool any_light = scene.environment && !is_black(*scene.environment);
+  bool any_light = (scene.environment && !is_black(*scene.environment)) ||
+                   (scene.environment_map && !scene.environment_map->is_black());
   for (const DeltaLight& p : scene.delta_lights) any_light = any_light || !is_black(p.intensity);
   for (const Shape& s : scene.shapes) any_light = any_light || scene.materials[s.material].emits();
   if (!any_light) scene.warnings.push_back(doc.file().string() + ": the scene has no light; it will render black");

@@ -23,8 +23,8 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
   Surfel s;
   ++path.rays;
   if (!scene.intersect(ray, &s)) {
-    const Spectrum Le = scene.scene().environment.value_or(Spectrum(0.0f));
-    const float w = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, scene.lights().pdf_environment());
+    const Spectrum Le = scene.lights().environment(ray.dir);
+    const float w = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, scene.lights().pdf_environment(ray.dir));
     if (path.observer) {
       path.observer->on_escape({vertex, Le, w, beta * w * Le});
       path.observer->on_end({vertex, PathEnd::Escaped});

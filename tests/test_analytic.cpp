@@ -149,6 +149,85 @@ TEST(AnalyticRefusals, SphereAssumptions) {
   expect_refused("mirror-sphere-gray-room.json", [](Scene& s) { s.render.max_depth = 5; }, "perfect mirror");
   expect_refused("mirror-sphere-gray-room.json", [](Scene& s) { s.materials[0].albedo = Spectrum(0.9f); }, "perfect mirror");
   expect_refused("sphere-in-environment.json", [](Scene& s) { s.environment.reset(); }, "environment or a closed");
+  // An environment image is uniform only when constant.
+  expect_refused("white-sphere-constant-envmap.json", [](Scene& s) {
+    s.environment_map = load_scene(test::analytic_scene("envmap-direct.json")).environment_map;
+  }, "not constant");
+}
+
+TEST(AnalyticRefusals, EnvironmentMapAssumptions) {
+  expect_refused("envmap-mirror-sphere.json", [](Scene& s) { s.environment_map.reset(); }, "needs an environment image");
+  expect_refused("envmap-mirror-sphere.json", [](Scene& s) { s.materials[0].type = MaterialType::Diffuse; }, "must be a mirror");
+  expect_refused("envmap-diffuse-plane.json", [](Scene& s) { s.shapes[0].mesh.positions[0].y += 0.5f; }, "face the environment's up");
+  expect_refused("envmap-diffuse-plane.json", [](Scene& s) { s.camera.position.y = -1.0f; }, "camera must be above");
+  expect_refused("envmap-diffuse-plane.json", [](Scene& s) { s.materials[0].type = MaterialType::Mirror; }, "two-sided diffuse");
+  expect_refused("envmap-mirror-sphere.json", [](Scene& s) { s.shapes.push_back(s.shapes[0]); }, "at most one shape");
+  expect_refused("envmap-mirror-sphere.json", [](Scene& s) { s.delta_lights.push_back({vec3(0.0f), Spectrum(1.0f)}); },
+                 "delta lights");
+  expect_refused("penumbra-box.json", [](Scene& s) {
+    s.environment_map = load_scene(test::analytic_scene("envmap-direct.json")).environment_map;
+  }, "environment");
+}
+
+TEST(AnalyticRefusals, PlaneUnderSunAssumptions) {
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.delta_lights[0].angular_radius = 0.0f; }, "angular_diameter");
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.environment = Spectrum(1.0f); }, "environment");
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.delta_lights[0].angular_radius = 1.2f; }, "whole sun disk");
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.camera.position.y = -1.0f; }, "sunny side");
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.materials[0].one_sided = true; }, "two-sided");
+  expect_refused("sun-disk-plane.json", [](Scene& s) { s.delta_lights.push_back({vec3(0.0f, 3.0f, 0.0f), Spectrum(1.0f)}); },
+                 "exactly one light");
+  expect_refused("envmap-sun-plane.json", [](Scene& s) { s.delta_lights[0].angular_radius = 0.0f; }, "delta lights");
+  expect_refused("envmap-sun-plane.json", [](Scene& s) { s.delta_lights[0].direction = vec3(0, 0.2f, -1); },
+                 "wholly above the plane");
+}
+
+// The sun's real size, 0.53 degrees: found by light sampling only (BSDF
+// sampling would hit it about once in 10^5 samples, so cosine and bsdf are
+// not run), the plane still shows a E cos theta / pi, in both tracers.
+TEST(AnalyticSunDisk, RealSunThroughLightSampling) {
+  for (Strategy strategy : {Strategy::Mis, Strategy::Light, Strategy::LightBsdf})
+    for (bool wavefront : {false, true}) {
+      Scene s = test::load_with_strategy("sun-disk-plane.json", strategy);
+      s.delta_lights[0].angular_radius = glm::radians(0.265f);
+      const CheckResult r = wavefront ? test::run_check<WavefrontTracer>(std::move(s)) : test::run_check(std::move(s));
+      EXPECT_TRUE(r.pass) << strategy_name(strategy) << (wavefront ? " wavefront" : " reference") << ": bias " << r.bias
+                          << " +- " << r.bias_se << ", " << r.failing << " pixel-channels fail";
+    }
+}
+
+// The expected image of a piecewise-constant map has edges wherever a pixel
+// straddles a texel boundary. Its midpoint quadrature (expected_image.h) must
+// be far more accurate there than the check's statistical tolerance (|z| up
+// to the Sidak threshold times the pixel's noise), or the check would lose
+// its power on those pixels: the reported quadrature error stays below a
+// tenth of that tolerance, everywhere (noise: the render's own variance of
+// the mean, or the footprint's floor where that is larger, as check.h does).
+TEST(AnalyticEnvironmentMap, QuadratureFarBelowTheNoise) {
+  for (const char* name : {"envmap-direct.json", "envmap-mirror-sphere.json"}) {
+    const Scene scene = load_scene(test::analytic_scene(name));
+    const auto model = make_analytic_model(scene);
+    const RenderSettings settings = scene.render;
+    const CompiledScene compiled{Scene(scene)};
+    const ReferenceTracer tracer(compiled, settings);
+    Film film(scene.film.width, scene.film.height, scene.film.filter, FilmMoments::MeanAndVariance);
+    render(tracer, film);
+    const ExpectedImage expected = expected_image(*model, compiled.camera(), scene.film);
+    const Image variance = film.variance_of_mean();
+    const double n = 3.0 * scene.film.width * scene.film.height;
+    const double tolerance = normal_two_sided_quantile(-std::expm1(std::log1p(-CheckOptions{}.alpha) / n));
+    double worst = 0.0;
+    for (int y = 0; y < scene.film.height; ++y)
+      for (int x = 0; x < scene.film.width; ++x)
+        for (int c = 0; c < 3; ++c) {
+          const double noise = std::sqrt(std::max(double(variance.at(x, y)[c]),
+                                                  double(expected.footprint_variance.at(x, y)[c]) / settings.spp));
+          if (noise > 0.0) worst = std::max(worst, double(expected.quadrature_error.at(x, y)[c]) / (tolerance * noise));
+          else  // the whole footprint in one texel: nothing to miss but rounding
+            EXPECT_LE(expected.quadrature_error.at(x, y)[c], 1e-6f * expected.mean.at(x, y)[c]) << name << " " << x << "," << y;
+        }
+    EXPECT_LT(worst, 0.1) << name;
+  }
 }
 
 }  // namespace

