@@ -150,12 +150,13 @@ EnvironmentMap load_environment_map(const std::filesystem::path& file, float sca
   if (negatives > 0) {
     // Out-of-gamut colours of an HDR photograph, typically: tiny negative
     // components left by a colour-space conversion. Radiance cannot be
-    // negative, so they are refused unless the scene asks to read them as 0.
+    // negative: they are read as 0 with a warning (the scene's default), or
+    // refused when the scene says "clamp_negative": false.
     std::ostringstream m;
     m << name << ": " << negatives << " texel component(s) are negative, the most " << where_most << " ("
       << most_negative << ")";
-    if (!clamp_negative) throw InputError(m.str() + "; set \"clamp_negative\": true to read them as 0");
-    if (warning) *warning = m.str() + "; read as 0 (clamp_negative)";
+    if (!clamp_negative) throw InputError(m.str() + "; \"clamp_negative\": true (the default) reads them as 0");
+    if (warning) *warning = m.str() + "; read as 0";
   }
   return EnvironmentMap(std::move(image), to_world, name);
 }

@@ -6,7 +6,8 @@
 // Scene keys (docs/scene-format.md, Lights): "file" (an EXR or HDR image,
 // 2:1, RGB or one grey channel), "scale" (default 1, multiplies every texel),
 // "transform" (rotations only; default none), "clamp_negative" (default
-// false: negative texel components are refused; true reads them as 0).
+// true: negative texel components are read as 0, with a warning; false
+// refuses them).
 //
 // Lat-long convention (Mitsuba 3's): +y is up. In the map's own frame a
 // texel's centre (u, v) in [0, 1)^2, u = (column + 1/2) / width and

@@ -473,11 +473,12 @@ std::shared_ptr<const EnvironmentMap> read_environment_map(const Node& l, const 
     if (m[3][0] != 0.0f || m[3][1] != 0.0f || m[3][2] != 0.0f)
       t.fail("an environment's transform may only rotate (a translation means nothing at infinity)");
   }
-  const bool clamp_negative = l.boolean_or("clamp_negative", false);
+  const bool clamp_negative = l.boolean_or("clamp_negative", true);
   std::string warning;
   try {
     auto map = std::make_shared<const EnvironmentMap>(load_environment_map(path, scale, to_world, clamp_negative, &warning));
     if (!warning.empty()) scene->warnings.push_back(file.message(warning));
+    scene->input_files.push_back(path);
     return map;
   } catch (const InputError& e) {
     file.fail(e.what());

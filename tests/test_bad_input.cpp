@@ -245,9 +245,9 @@ TEST_F(BadInput, BadEnvironmentImages) {
        "square.exr: an environment map must be twice as wide as high (latitude-longitude); the image is 8 x 8"},
       {R"({"type": "environment", "file": "nowhere.exr"})", "\"file\"", "nowhere.exr: cannot read image: no such file"},
       {R"({"type": "environment", "file": "nan.exr"})", "\"file\"", "nan.exr: texel (column 3, row 1) channel G is NaN"},
-      {R"({"type": "environment", "file": "negative.exr"})", "\"file\"",
+      {R"({"type": "environment", "file": "negative.exr", "clamp_negative": false})", "\"file\"",
        "negative.exr: 1 texel component(s) are negative, the most texel (column 7, row 2) channel B (-0.25); "
-       "set \"clamp_negative\": true to read them as 0"},
+       "\"clamp_negative\": true (the default) reads them as 0"},
       {R"({"type": "environment", "file": "infinite.exr"})", "\"file\"",
        "infinite.exr: texel (column 0, row 3) channel R is infinite"},
       {R"({"type": "environment", "file": "rgba.exr"})", "\"file\"",

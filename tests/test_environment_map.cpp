@@ -178,15 +178,15 @@ TEST_F(EnvironmentMapFile, OneGreyChannelIsGrey) {
   EXPECT_EQ(s.environment_map->radiance(vec3(1, 0, 0)), Spectrum(2.0f));  // column 2 of 8
 }
 
-// Negative components are refused, or read as 0 with a warning that says
-// how many and where the worst one is.
+// Negative components are read as 0 with a warning that says how many and
+// where the worst one is (the default), or refused with clamp_negative false.
 TEST_F(EnvironmentMapFile, ClampNegativeReadsThemAsZeroAndWarns) {
   Image image = numbered(8, 4);
   image.at(5, 2) = Spectrum(1.0f, -0.5f, 2.0f);
   image.at(6, 3).z = -0.01f;
   write_exr(dir_ / "map.exr", image, {});
-  EXPECT_THROW(load(R"({"type": "environment", "file": "map.exr"})"), InputError);
-  const Scene s = load(R"({"type": "environment", "file": "map.exr", "clamp_negative": true})");
+  EXPECT_THROW(load(R"({"type": "environment", "file": "map.exr", "clamp_negative": false})"), InputError);
+  const Scene s = load(R"({"type": "environment", "file": "map.exr"})");
   ASSERT_EQ(s.warnings.size(), 1u);
   EXPECT_NE(s.warnings[0].find("2 texel component(s) are negative, the most texel (column 5, row 2) channel G (-0.5)"),
             std::string::npos) << s.warnings[0];
