@@ -170,8 +170,8 @@ struct Material {
   // Parameters read from textures (each overrides the constant above), and
   // the normal map; both empty for an untextured material, whose hits read
   // the constants and pay nothing for textures.
-  std::vector<TexturedParam> textured;
-  std::optional<NormalMap> normal_map;
+  std::vector<TexturedParam> textured{};
+  std::optional<NormalMap> normal_map{};
   bool emission_textured = false;  // `textured` holds Emission (kept by set_texture)
   bool is_textured() const { return !textured.empty(); }
   const TexturedParam* texture_of(MaterialParam p) const;

@@ -32,6 +32,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
             : c.scene == "instanced" ? test::cornell_with_instances()
             : c.scene == "delta"     ? test::cornell_with_delta_lights()
+            : c.scene == "textured"  ? test::cornell_with_textures()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -91,6 +92,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("smooth");     // the Cornell box with a smooth-shaded sphere (test_scenes.h)
   scenes.push_back("instanced");  // the Cornell box with a group placed three times (test_scenes.h)
   scenes.push_back("delta");      // the Cornell box with point, spot and directional lights (test_scenes.h)
+  scenes.push_back("textured");   // the Cornell box reading textures everywhere (test_scenes.h)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
@@ -121,6 +123,34 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
               c = render_image(2, 17);
   EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
   EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
+}
+
+// A textured scene (texture lookups, cones, normal maps, textured emission)
+// renders the same bits with one and two threads and any wave size, in both
+// tracers.
+TEST(Wavefront, TexturedSceneSameBitsForOneAndTwoThreads) {
+  Scene scene = test::cornell_with_textures();
+  scene.film.width = scene.film.height = 16;
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  auto render_image = [&](bool wavefront, int threads, std::size_t wave) {
+    const ThreadLimit limit(threads);
+    Film film(16, 16, FilterKind::Box);
+    if (wavefront) {
+      const WavefrontTracer tracer(compiled, settings, wave);
+      EXPECT_FALSE(tracer.vectorised());
+      render(tracer, film);
+    } else {
+      const ReferenceTracer tracer(compiled, settings);
+      render(tracer, film);
+    }
+    return film.image();
+  };
+  for (const bool wavefront : {false, true}) {
+    const Image a = render_image(wavefront, 1, WavefrontTracer::kDefaultWaveSize),
+                b = render_image(wavefront, 2, wavefront ? 17 : WavefrontTracer::kDefaultWaveSize);
+    EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0) << wavefront;
+  }
 }
 
 // The render driver hands tracers a SampleBuffer nobody has written, so a
