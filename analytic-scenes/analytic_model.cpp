@@ -21,6 +21,7 @@ constexpr Entry kModels[] = {
     {"glass-sphere-in-environment", analytic::make_glass_sphere_in_environment},
     {"environment-map", analytic::make_environment_map},
     {"plane-under-sun", analytic::make_plane_under_sun},
+    {"textured-room", analytic::make_textured_room},
 };
 
 }  // namespace

@@ -12,6 +12,7 @@ std::unique_ptr<AnalyticModel> make_rough_sphere_in_environment(const Scene& sce
 std::unique_ptr<AnalyticModel> make_glass_sphere_in_environment(const Scene& scene);
 std::unique_ptr<AnalyticModel> make_environment_map(const Scene& scene);
 std::unique_ptr<AnalyticModel> make_plane_under_sun(const Scene& scene);
+std::unique_ptr<AnalyticModel> make_textured_room(const Scene& scene);
 
 // Radiance reaching the eye inside a closed Lambert room of albedo rho that
 // emits Le everywhere, counting paths of at most `max_depth` bounces

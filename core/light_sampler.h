@@ -66,7 +66,12 @@ class LightSampler {
   // `scene_radius`: radius of a sphere bounding the scene, for the power of
   // the environment (pi r^2 times the integral of Y(L) over the sphere, the
   // flux it sends through the scene: pi * Y(L) * 4 pi r^2 when uniform).
-  LightSampler(const Scene& scene, float scene_radius);
+  // `textures`: the scene's, for emission read from a texture (null if it
+  // has none). A textured emitter is picked by the power of its texture's
+  // mean (over the whole image, not the part a triangle maps: an estimate;
+  // any positive weight keeps the estimator unbiased), and each sample's Le
+  // is read at the point's uv, unfiltered, as a ray that hits it reads it.
+  LightSampler(const Scene& scene, float scene_radius, const Textures* textures = nullptr);
 
   std::size_t area_light_count() const { return entries_.size(); }
   // Area lights (or the environment) too dim, next to the others, ever to be
@@ -137,6 +142,7 @@ class LightSampler {
   void add_suns(const vec3& dir, Spectrum* Le, float* pdf) const;
 
   const Scene* scene_;
+  const Textures* textures_;
   std::vector<Entry> entries_;           // area lights, then the environment, then the sun disks
   std::vector<SunDisk> suns_;
   std::vector<float> pmf_, cdf_;         // over entries_

@@ -54,6 +54,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "instanced" ? test::cornell_with_instances()
             : c.scene == "delta"     ? test::cornell_with_delta_lights()
             : c.scene == "envmap"    ? envmap_scene()
+            : c.scene == "textured"  ? test::cornell_with_textures()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -114,6 +115,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("instanced");  // the Cornell box with a group placed three times (test_scenes.h)
   scenes.push_back("delta");      // the Cornell box with point, spot and directional lights (test_scenes.h)
   scenes.push_back("envmap");     // an environment image over a diffuse sphere and a metal ground (above)
+  scenes.push_back("textured");   // the Cornell box reading textures everywhere (test_scenes.h)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
@@ -146,29 +148,46 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
   EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
 }
 
-// An environment image: both tracers give the same bits for one thread and
-// two (and the wavefront for any wave size).
+// Both tracers give the same bits for one thread and two, and the wavefront
+// for any wave size, on a scene the vectorised stages leave to the scalar ones.
+void expect_same_bits_for_one_and_two_threads(Scene scene) {
+  const int width = scene.film.width, height = scene.film.height;
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  auto render_image = [&](bool wavefront, int threads, std::size_t wave) {
+    const ThreadLimit limit(threads);
+    Film film(width, height, FilterKind::Box);
+    if (wavefront) {
+      const WavefrontTracer tracer(compiled, settings, wave);
+      EXPECT_FALSE(tracer.vectorised());
+      render(tracer, film);
+    } else {
+      const ReferenceTracer tracer(compiled, settings);
+      render(tracer, film);
+    }
+    return film.image();
+  };
+  for (const bool wavefront : {false, true}) {
+    const Image a = render_image(wavefront, 1, WavefrontTracer::kDefaultWaveSize),
+                b = render_image(wavefront, 2, wavefront ? 17 : WavefrontTracer::kDefaultWaveSize);
+    EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0) << wavefront;
+  }
+}
+
+// An environment image.
 TEST(Wavefront, EnvironmentMapSameBitsForOneAndTwoThreads) {
   Scene scene = envmap_scene();
   scene.film.width = 16;
   scene.film.height = 12;
   scene.render.spp = 4;
-  const RenderSettings settings = scene.render;
-  const CompiledScene compiled(std::move(scene));
-  auto render_image = [&](bool wavefront, int threads, std::size_t wave) {
-    const ThreadLimit limit(threads);
-    const ReferenceTracer reference(compiled, settings);
-    const WavefrontTracer front(compiled, settings, wave);
-    Film film(16, 12, FilterKind::Box);
-    if (wavefront) render(front, film);
-    else render(reference, film);
-    return film.image();
-  };
-  for (bool wavefront : {false, true}) {
-    const Image a = render_image(wavefront, 1, WavefrontTracer::kDefaultWaveSize);
-    const Image b = render_image(wavefront, 2, wavefront ? 17 : WavefrontTracer::kDefaultWaveSize);
-    EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0) << wavefront;
-  }
+  expect_same_bits_for_one_and_two_threads(std::move(scene));
+}
+
+// A textured scene (texture lookups, cones, normal maps, textured emission).
+TEST(Wavefront, TexturedSceneSameBitsForOneAndTwoThreads) {
+  Scene scene = test::cornell_with_textures();
+  scene.film.width = scene.film.height = 16;
+  expect_same_bits_for_one_and_two_threads(std::move(scene));
 }
 
 // The render driver hands tracers a SampleBuffer nobody has written, so a
