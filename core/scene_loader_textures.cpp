@@ -7,6 +7,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <sstream>
 
 namespace pathlab::scene_detail {
