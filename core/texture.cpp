@@ -166,6 +166,11 @@ Textures::~Textures() {
 
 void Textures::lookup(std::uint32_t image, TextureWrap wrap, int first, int n, const TextureFootprint& at,
                       float* out) const {
+  // Debian's OpenImageIO keeps its assertions: channels past the image's
+  // would abort the process inside OIIO, so callers map them first.
+  if (first < 0 || first + n > images_[image].channels)
+    throw std::logic_error("Textures::lookup: channels " + std::to_string(first) + ".." + std::to_string(first + n) +
+                           " of an image with " + std::to_string(images_[image].channels));
   OIIO::TextureSystem& ts = *oiio_->ts;
   OIIO::TextureOpt opt;
   opt.firstchannel = first;
@@ -181,7 +186,7 @@ void Textures::lookup(std::uint32_t image, TextureWrap wrap, int first, int n, c
 Spectrum Textures::color(const TextureRef& ref, const TextureFootprint& at) const {
   float v[3];
   if (images_[ref.image].channels < 3) {
-    lookup(ref.image, ref.wrap, ref.channel, 1, at, v);
+    lookup(ref.image, ref.wrap, 0, 1, at, v);
     v[1] = v[2] = v[0];
   } else {
     lookup(ref.image, ref.wrap, ref.channel, 3, at, v);
@@ -189,15 +194,27 @@ Spectrum Textures::color(const TextureRef& ref, const TextureFootprint& at) cons
   return ref.scale * Spectrum(v[0], v[1], v[2]) + ref.offset;
 }
 
+// Channel c of a grey image (one channel, or grey and alpha) as an RGBA
+// image would have it, as glTF reads such images: R = G = B = grey, and
+// alpha the second channel or 1. -1: the constant 1.
+int Textures::stored_channel(std::uint32_t image, int c) const {
+  const int channels = images_[image].channels;
+  if (c < channels && channels >= 3) return c;
+  if (channels >= 3) return -1;  // alpha of an RGB image
+  if (c < 3) return 0;
+  return channels == 2 ? 1 : -1;
+}
+
 float Textures::number(const TextureRef& ref, const TextureFootprint& at) const {
-  float v = 0.0f;
-  lookup(ref.image, ref.wrap, ref.channel, 1, at, &v);
+  const int c = stored_channel(ref.image, ref.channel);
+  float v = 1.0f;
+  if (c >= 0) lookup(ref.image, ref.wrap, c, 1, at, &v);
   return ref.scale.x * v + ref.offset.x;
 }
 
 Spectrum Textures::mean_color(const TextureRef& ref) const {
   const Image& im = images_[ref.image];
-  const Spectrum m = im.channels < 3 ? Spectrum(im.mean[ref.channel])
+  const Spectrum m = im.channels < 3 ? Spectrum(im.mean[0])
                                      : Spectrum(im.mean[ref.channel], im.mean[ref.channel + 1], im.mean[ref.channel + 2]);
   return ref.scale * m + ref.offset;
 }

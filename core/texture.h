@@ -116,6 +116,10 @@ class Textures {
 
   std::size_t size() const { return images_.size(); }
   int channels(std::uint32_t image) const { return images_[image].channels; }
+  // Where channel `c` (0..3: R, G, B, A) of `image` is stored: a grey image
+  // (one channel, or grey and alpha) reads as R = G = B = grey, as glTF
+  // reads it; -1 for an alpha the image does not have (the constant 1).
+  int stored_channel(std::uint32_t image, int c) const;
   // The mean of channel `c` over every texel of the finest level, decoded.
   float mean(std::uint32_t image, int c) const { return images_[image].mean[c]; }
 
