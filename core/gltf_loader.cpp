@@ -492,6 +492,7 @@ std::uint32_t Flattener::material(int index) {
   p.specular_tint = 0.0f;
   p.sheen = 0.0f;
   Spectrum emission(0.0f);
+  float coverage = 1.0f;  // Material::alpha
   if (index < 0) {
     // glTF's default material: base colour 1, metallic 1, roughness 1.
     p.base_color = Spectrum(1.0f);
@@ -525,8 +526,19 @@ std::uint32_t Flattener::material(int index) {
         ignored_.insert("extension " + name);
       }
     }
-    if (alpha < 1.0f || m.alphaMode == "BLEND" || m.alphaMode == "MASK") ignored_.insert("alpha (rendered opaque)");
+    // alphaMode (glTF 2.0, 3.9.4) onto the material's coverage: OPAQUE
+    // ignores alpha, MASK keeps the surface where alpha >= alphaCutoff and
+    // cuts it elsewhere, BLEND is stochastic coverage. The factor alone:
+    // the texture's alpha is not read (neither is its colour).
+    if (m.alphaMode == "MASK") {
+      if (!(m.alphaCutoff >= 0.0)) fail(file_, at + "/alphaCutoff", "must not be negative");
+      coverage = alpha >= static_cast<float>(m.alphaCutoff) ? 1.0f : 0.0f;
+    } else if (m.alphaMode == "BLEND") {
+      coverage = alpha;
+    }
     if (pbr.baseColorTexture.index >= 0) ignored_.insert("baseColorTexture");
+    if (pbr.baseColorTexture.index >= 0 && m.alphaMode != "OPAQUE")
+      ignored_.insert("baseColorTexture's alpha (the factor alone gives the coverage)");
     if (pbr.metallicRoughnessTexture.index >= 0) ignored_.insert("metallicRoughnessTexture");
     if (m.normalTexture.index >= 0) ignored_.insert("normalTexture");
     if (m.emissiveTexture.index >= 0) ignored_.insert("emissiveTexture");
@@ -539,6 +551,7 @@ std::uint32_t Flattener::material(int index) {
   out.material = disney_material(p);
   out.material.name = name;
   out.material.emission = emission;
+  out.material.alpha = coverage;
   // Single-sided: the back neither reflects nor emits (Material::one_sided).
   // glTF's back-face culling, which makes the back invisible in a
   // rasteriser, is not modelled: the back still occludes.

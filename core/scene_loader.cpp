@@ -149,6 +149,20 @@ float unit_number(const Node& node, const char* key, float fallback, float lo = 
   return v;
 }
 
+// "alpha": the material's coverage (core/alpha.h), a number in [0, 1]. A
+// light may not have it: the light sampler would aim at points that its
+// shadow rays may pass through.
+float read_alpha(const Node& node, const Material& m) {
+  if (!node.has("alpha")) return 1.0f;
+  const Node a = node.child("alpha");
+  if (a.value().is_string()) a.fail("alpha must be a number in [0, 1] (alpha textures are not supported yet)");
+  const float alpha = unit_number(node, "alpha", 1.0f);
+  if (alpha < 1.0f && m.emits() && m.sampled_as_light)
+    a.fail("alpha on a light: light sampling does not model coverage; give the material \"light\": false, or "
+           "make it opaque");
+  return alpha;
+}
+
 // A key that belongs to another material type gets a pointed message, not
 // only "unknown key": {key used, what to say}.
 void reject_misplaced(const Node& node, const std::string& type,
@@ -169,7 +183,7 @@ Material read_material(const Node& node, const std::string& name) {
                      {{type == "diffuse" ? "reflectance" : "albedo",
                        type == "diffuse" ? "its colour is 'albedo'" : "its colour is 'reflectance'"},
                       {"radiance", "emitted light is 'emission'"}});
-    node.allow_only({"type", refl, "emission", "two_sided", "light", "one_sided"});
+    node.allow_only({"type", refl, "emission", "two_sided", "light", "one_sided", "alpha"});
     m.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
     m.albedo = node.has(refl) ? node.child(refl).color(true) : Spectrum(type == "diffuse" ? 0.5f : 1.0f);
     if (node.has("emission")) m.emission = node.child("emission").color(false);
@@ -179,7 +193,7 @@ Material read_material(const Node& node, const std::string& name) {
                       {"albedo", "it reflects nothing (use type diffuse with 'emission' for a surface that does both)"},
                       {"reflectance", "it reflects nothing"},
                       {"one_sided", "it reflects nothing; the sides it emits from are set by 'two_sided'"}});
-    node.allow_only({"type", "radiance", "two_sided", "light"});
+    node.allow_only({"type", "radiance", "two_sided", "light", "alpha"});
     m.type = MaterialType::Emissive;
     m.albedo = Spectrum(0.0f);
     m.emission = node.required("radiance").color(false);
@@ -190,7 +204,7 @@ Material read_material(const Node& node, const std::string& name) {
                       {"radiance", "emitted light is 'emission'"}});
     node.allow_only({"type", "base_color", "metallic", "subsurface", "specular", "specular_tint", "roughness",
                      "anisotropic", "sheen", "sheen_tint", "clearcoat", "clearcoat_gloss", "energy_compensation", "emission",
-                     "two_sided", "light", "one_sided"});
+                     "two_sided", "light", "one_sided", "alpha"});
     DisneyParams p;
     if (node.has("base_color")) p.base_color = node.child("base_color").color(true);
     p.metallic = unit_number(node, "metallic", p.metallic);
@@ -215,7 +229,7 @@ Material read_material(const Node& node, const std::string& name) {
                       {"eta", "the index of refraction is 'ior'"},
                       {"emission", "glass does not emit"},
                       {"one_sided", "glass has an inside and an outside: both sides scatter"}});
-    node.allow_only({"type", "ior", "reflectance", "transmittance"});
+    node.allow_only({"type", "ior", "reflectance", "transmittance", "alpha"});
     DielectricParams p;
     p.ior = unit_number(node, "ior", p.ior, 1.0f, 10.0f);
     if (node.has("reflectance")) p.reflectance = node.child("reflectance").color(true);
@@ -233,6 +247,7 @@ Material read_material(const Node& node, const std::string& name) {
   m.two_sided_emission = node.boolean_or("two_sided", false);
   m.sampled_as_light = node.boolean_or("light", true);
   m.one_sided = node.boolean_or("one_sided", false);
+  m.alpha = read_alpha(node, m);
   return m;
 }
 
@@ -437,6 +452,13 @@ void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path
     file.fail(e.what());
   }
   if (scene.shapes.size() == before) file.fail(path.string() + ": the file's scene holds no triangles");
+  for (std::size_t k = before; k < scene.shapes.size(); ++k) {
+    const Material& m = scene.materials[scene.shapes[k].material];
+    if (m.has_alpha() && m.emits() && m.sampled_as_light)
+      file.fail(scene.shapes[k].description + ": material " + in_quotes(m.name) +
+                " has alpha (alphaMode MASK or BLEND) on a light: light sampling does not model coverage; override "
+                "it with a scene material in 'materials'");
+  }
 }
 
 void read_lights(const Node& node, Scene* scene) {

@@ -205,6 +205,10 @@ void read_shape(const Node& node, Scene& scene, const std::filesystem::path& fol
 
   if (type == "sphere") {
     shape.kind = Shape::Kind::Sphere;
+    if (scene.materials[shape.material].has_alpha())
+      node.child("material").fail("material " + in_quotes(scene.materials[shape.material].name) +
+                                  " has alpha, which spheres do not support (a ray crosses a sphere twice at one "
+                                  "primitive, and both crossings would share one decision); use a mesh");
     shape.center = node.has("center") ? node.child("center").vector3() : vec3(0.0f);
     shape.radius = static_cast<float>(node.number_or("radius", 1.0));
     if (!(shape.radius > 0.0f)) node.child("radius").fail("radius must be positive");

@@ -23,7 +23,7 @@ namespace pathlab {
 namespace {
 
 struct SameSeedCase {
-  std::string scene;  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" (test_scenes.h), else a file in analytic-scenes/
+  std::string scene;  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" / "alpha" (test_scenes.h), else a file in analytic-scenes/
   Strategy strategy;
 };
 
@@ -32,6 +32,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
             : c.scene == "instanced" ? test::cornell_with_instances()
             : c.scene == "delta"     ? test::cornell_with_delta_lights()
+            : c.scene == "alpha"     ? test::cornell_with_alpha()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -91,6 +92,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("smooth");     // the Cornell box with a smooth-shaded sphere (test_scenes.h)
   scenes.push_back("instanced");  // the Cornell box with a group placed three times (test_scenes.h)
   scenes.push_back("delta");      // the Cornell box with point, spot and directional lights (test_scenes.h)
+  scenes.push_back("alpha");      // the instanced Cornell box with partial coverage (test_scenes.h)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});

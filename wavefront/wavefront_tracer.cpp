@@ -154,6 +154,9 @@ struct WavefrontTracer::VectorStages {
     }
     if (diffuse) sc.min_pdf = diffuse->shading.min_pdf;
     if (!scene.instances.empty()) return no("instances");
+    // Alpha is decided inside Embree by the rays' keys, which Lanes do not carry.
+    for (const Material& m : scene.materials)
+      if (m.has_alpha()) return no("material '" + m.name + "' has alpha (partial coverage)");
     // Flat triangles only: the stages shade with the geometric normal.
     for (const Shape& shape : scene.shapes)
       if (shape.mesh.has_normals()) return no(shape.description + " has vertex normals (smooth shading)");
@@ -368,6 +371,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
           w.unoccluded[2 * i] = f * ls->Le / ls->pdf;
           w.light_weight[2 * i] = 1.0f;
           w.shadow[2 * i] = shadow_ray(s, *ls);
+          w.shadow[2 * i].alpha_key = scene_.alpha_key(w.rng[i], w.vertex[i]);
           w.shadow_state[2 * i] = 1;
         }
       }
@@ -382,6 +386,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
       w.unoccluded[2 * i + 1] = f * ls->Le * (lw / ls->pdf);
       w.light_weight[2 * i + 1] = lw;
       w.shadow[2 * i + 1] = shadow_ray(s, *ls);
+      w.shadow[2 * i + 1].alpha_key = scene_.alpha_key(w.rng[i], w.vertex[i]);
       w.shadow_state[2 * i + 1] = 1;
     }
   }
@@ -453,7 +458,8 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
       weight /= survival;
     }
     w.beta[i] *= weight;
-    const Ray next = s.spawn(bs->wi);
+    Ray next = s.spawn(bs->wi);
+    next.alpha_key = scene_.alpha_key(w.rng[i], v);
     if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i], next});
     w.prev[i] = PreviousVertex{s.p, bs->pdf, bs->impulse,
                                !(strategy == Strategy::LightBsdf && w.u(i, Dim::Technique) < 0.5f)};
@@ -489,6 +495,7 @@ void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
     w.vertex[i] = 0;  // the camera's random numbers are those of vertex 0
     w.film[i] = vec2(static_cast<float>(w.x[i]) + w.u(i, Dim::FilmX), static_cast<float>(w.y[i]) + w.u(i, Dim::FilmY));
     w.ray[i] = camera.generate_ray(w.film[i], vec2(w.u(i, Dim::LensX), w.u(i, Dim::LensY)));
+    w.ray[i].alpha_key = scene_.alpha_key(w.rng[i], 0);
     w.beta[i] = Spectrum(1.0f);
     w.L[i] = Spectrum(0.0f);
     w.prev[i] = PreviousVertex{};
