@@ -19,6 +19,7 @@ constexpr Entry kModels[] = {
     {"penumbra", analytic::make_penumbra},
     {"rough-sphere-in-environment", analytic::make_rough_sphere_in_environment},
     {"glass-sphere-in-environment", analytic::make_glass_sphere_in_environment},
+    {"textured-room", analytic::make_textured_room},
 };
 
 }  // namespace

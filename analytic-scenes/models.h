@@ -10,6 +10,7 @@ std::unique_ptr<AnalyticModel> make_sphere_in_uniform_light(const Scene& scene);
 std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene);
 std::unique_ptr<AnalyticModel> make_rough_sphere_in_environment(const Scene& scene);
 std::unique_ptr<AnalyticModel> make_glass_sphere_in_environment(const Scene& scene);
+std::unique_ptr<AnalyticModel> make_textured_room(const Scene& scene);
 
 // Radiance reaching the eye inside a closed Lambert room of albedo rho that
 // emits Le everywhere, counting paths of at most `max_depth` bounces

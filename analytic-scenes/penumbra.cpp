@@ -223,6 +223,8 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
     }
     if (occ->kind != Shape::Kind::Triangles || !(convex_polygon || (is_closed(*occ) && is_convex(*occ))))
       refuse(scene, kName, "the occluder must be a closed convex mesh (a box) or a planar convex polygon (a quad)");
+    if (scene.materials[occ->material].alpha_texture)
+      refuse(scene, kName, "the occluder's alpha must be a number (an alpha texture is not modelled)");
     const double a = scene.materials[occ->material].alpha;
     model->opacity = convex_polygon ? a : 1.0 - (1.0 - a) * (1.0 - a);
     // Strictly between the emitter's plane and the whole ground, so that from

@@ -5,6 +5,7 @@
 #include "core/parallel.h"
 #include "core/tangents.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace pathlab {
@@ -91,8 +92,10 @@ CompiledScene::CompiledScene(Scene scene)
     p.emplace_back(0.0f);
     p.pop_back();
   }
+  // The images first: alpha textures are read during traversal.
+  if (!scene_.textures.empty()) textures_ = std::make_unique<Textures>(scene_.textures, scene_.render.texture_cache_mb);
   accel_ = std::make_unique<EmbreeAccel>(scene_.shapes, scene_.groups, scene_.instances, scene_.render.compact_bvh,
-                                         scene_.materials);
+                                         scene_.materials, textures_.get());
   first_triangle_.resize(scene_.shapes.size() + 1, 0);
   for (std::size_t i = 0; i < scene_.shapes.size(); ++i) {
     const Shape& shape = scene_.shapes[i];
@@ -107,13 +110,13 @@ CompiledScene::CompiledScene(Scene scene)
       for (std::size_t t = b; t < e; ++t) out[t] = make_triangle(shape, static_cast<std::uint32_t>(t));
     });
   }
-  lights_ = std::make_unique<LightSampler>(scene_, bounds_radius_);
+  lights_ = std::make_unique<LightSampler>(scene_, bounds_radius_, textures_.get());
 }
 
-bool CompiledScene::intersect(const Ray& ray, Surfel* s) const {
+bool CompiledScene::intersect(const Ray& ray, Surfel* s, const RayCone& cone, SurfaceParams* params) const {
   RayHit hit;
   if (!accel_->intersect(ray, &hit)) return false;
-  resolve(ray, hit, s);
+  resolve(ray, hit, s, cone, params);
   return true;
 }
 
@@ -148,7 +151,8 @@ void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const v
   }
 }
 
-void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const {
+void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s, const RayCone& cone,
+                            SurfaceParams* params) const {
   const Shape& shape = scene_.shapes[hit.shape];
   const bool interpolated = shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals();
   vec3 ns_sum;  // read only when `interpolated`
@@ -178,9 +182,75 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s) const 
     s->frame = Frame(ns);
   }
   s->material = &scene_.materials[shape.material];
+  s->params = nullptr;
   s->shape = hit.shape;
   s->prim = hit.prim;
   s->instance = hit.instance;
+  if (textures_ && (s->material->is_textured() || s->material->normal_map)) read_textures(shape, ray, hit, cone, params, s);
+}
+
+void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayHit& hit, const RayCone& cone,
+                                  SurfaceParams* params, Surfel* s) const {
+  const Material& m = *s->material;
+  // Texture coordinates and the uv-to-world area ratio that turns the cone's
+  // width into a footprint in uv (core/ray_cone.h).
+  float uv_per_area = 0.0f;
+  if (shape.kind == Shape::Kind::Sphere) {
+    // pbrt's (phi, theta) parametrisation about the z axis, in the shape's
+    // own space: u = phi / 2 pi, v = 1 - theta / pi (v = 1 at +z).
+    const vec3 p_local = hit.instance == kNoInstance ? s->p : vec3(placements_[hit.instance].to_local * vec4(s->p, 1.0f));
+    const vec3 d = (p_local - shape.center) / shape.radius;
+    s->uv = sphere_uv(d);
+    const float theta = (1.0f - s->uv.y) * kPi;
+    // dA = r^2 sin(theta) dtheta dphi = 2 pi^2 r^2 sin(theta) du dv.
+    const float sin_theta = std::max(std::sin(theta), 1e-4f);
+    uv_per_area = 1.0f / (2.0f * kPi * kPi * shape.radius * shape.radius * sin_theta);
+  } else {
+    const Triangle& t = triangles_[first_triangle_[hit.shape] + hit.prim];
+    vec3 e1 = t.p1 - t.p0, e2 = t.p2 - t.p0;
+    if (hit.instance != kNoInstance) {
+      const mat3 l(placements_[hit.instance].to_world);
+      e1 = l * e1, e2 = l * e2;
+    }
+    float uv_area = 0.5f;  // barycentrics
+    if (shape.mesh.has_uvs()) {
+      const glm::uvec3 v = shape.mesh.triangles[hit.prim];
+      const vec2 a = shape.mesh.uvs[v.y] - shape.mesh.uvs[v.x], b = shape.mesh.uvs[v.z] - shape.mesh.uvs[v.x];
+      uv_area = 0.5f * std::abs(a.x * b.y - a.y * b.x);
+    }
+    const float area = 0.5f * glm::length(glm::cross(e1, e2));
+    uv_per_area = area > 0.0f ? uv_area / area : 0.0f;
+  }
+  const float width = uv_footprint(cone.width_at(glm::length(s->p - ray.origin)), glm::dot(ray.dir, s->n), uv_per_area);
+  const TextureFootprint at{s->uv, std::isfinite(width) ? width : 0.0f};
+  if (m.normal_map) {
+    // Tangent space as glTF has it: x along the tangent (dP/du), y along the
+    // bitangent (dP/dv, "+y up"), z the shading normal; n = 2 c - 1, x and y
+    // times the map's scale.
+    const vec3 c = vec3(textures_->color(m.normal_map->texture, at));
+    vec3 nt = 2.0f * c - 1.0f;
+    nt.x *= m.normal_map->scale;
+    nt.y *= m.normal_map->scale;
+    const Frame& f = s->frame;
+    const vec3 sum = nt.x * f.s + nt.y * f.t + nt.z * f.n;
+    // The shading-normal policy applies to the tilted normal: turned to the
+    // geometric side, and a tilt below ~0.08 degrees leaves the frame as it
+    // was (a flat map changes no bit).
+    const float length = glm::length(sum);
+    if (length > 1e-20f && std::isfinite(length) && glm::dot(sum / length, f.n) < 1.0f - 1e-6f) {
+      const vec3 ns = shading_normal(s->n, sum);
+      // Keep s along the tangent: Gram-Schmidt against the new normal.
+      const vec3 t = f.s - glm::dot(f.s, ns) * ns;
+      const float tl = glm::length(t);
+      const float handed = glm::dot(glm::cross(f.n, f.s), f.t) < 0.0f ? -1.0f : 1.0f;
+      s->frame = tl > 1e-4f ? Frame(ns, t / tl, handed) : Frame(ns);
+      s->shading_normal = ns != s->n;
+    }
+  }
+  if (m.is_textured() && params != nullptr) {
+    evaluate_textured(m, *textures_, at, TextureFootprint{s->uv, 0.0f}, params);
+    s->params = params;
+  }
 }
 
 }  // namespace pathlab

@@ -9,8 +9,10 @@
 #include "core/geometry.h"
 #include "core/huge_pages.h"
 #include "core/light_sampler.h"
+#include "core/ray_cone.h"
 #include "core/scene.h"
 #include "core/surfel.h"
+#include "core/texture.h"
 
 #include <memory>
 #include <span>
@@ -44,9 +46,21 @@ class CompiledScene {
   vec3 bounds_center() const { return bounds_center_; }
   float bounds_radius() const { return bounds_radius_; }
 
+  // The scene's textures, or null for a scene that reads none (then no
+  // texture system exists and no hit pays for one).
+  const Textures* textures() const { return textures_.get(); }
+  bool has_textures() const { return textures_ != nullptr; }
+  // The cone a camera ray starts with (core/ray_cone.h): one pixel's spread
+  // when the scene has textures and `filter` is cone; zero otherwise (the
+  // finest level, and no cone arithmetic).
+  RayCone camera_cone(TextureFilter filter) const {
+    if (!textures_ || filter != TextureFilter::Cone) return {};
+    return {0.0f, pixel_spread_angle(scene_.camera.fov_y_degrees, scene_.film.height)};
+  }
+
   // The first surface along `ray`, resolved into a Surfel. False if the ray
-  // escapes.
-  bool intersect(const Ray& ray, Surfel* surfel) const;
+  // escapes. `cone` and `params`: see resolve().
+  bool intersect(const Ray& ray, Surfel* surfel, const RayCone& cone = {}, SurfaceParams* params = nullptr) const;
   bool occluded(const Ray& ray) const { return accel_->occluded(ray); }
 
   // Many rays at once (see EmbreeAccel::intersect_batch for `mode` and
@@ -71,7 +85,14 @@ class CompiledScene {
   }
   // The Surfel of a hit `ray` found, in world space (a hit on a shape in a
   // group is resolved in the group's space, then placed by its instance).
-  void resolve(const Ray& ray, const RayHit& hit, Surfel* surfel) const;
+  // A hit on a material that reads textures reads them here, with the
+  // footprint of `cone` (the cone `ray` carries from its origin; a zero cone
+  // reads the finest level): a normal map tilts the shading frame, and
+  // textured parameters are evaluated into `*params`, which the Surfel then
+  // points to (Surfel::params; the caller keeps it alive as long as the
+  // Surfel). Without `params` the Surfel reads the material's constants.
+  void resolve(const Ray& ray, const RayHit& hit, Surfel* surfel, const RayCone& cone = {},
+               SurfaceParams* params = nullptr) const;
   // Every shape's triangles as resolve() reads them, one shape after the
   // other: triangle k of shape s is triangles()[first_triangle(s) + k]
   // (a sphere has none). A shape in a group has its triangles in the
@@ -102,11 +123,15 @@ class CompiledScene {
   // inverse transpose; null for a shape placed in world space) first.
   void resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, const mat3* to_normal, Surfel* s,
                      vec3* ns_sum) const;
+  // resolve()'s texture reads for a material with textures or a normal map.
+  void read_textures(const Shape& shape, const Ray& ray, const RayHit& hit, const RayCone& cone,
+                     SurfaceParams* params, Surfel* s) const;
 
   Scene scene_;
   std::vector<Placement> placements_;  // per instance
   Camera camera_;
   std::unique_ptr<EmbreeAccel> accel_;
+  std::unique_ptr<Textures> textures_;  // before lights_, which reads emission textures
   std::unique_ptr<LightSampler> lights_;
   HugePageVector<Triangle> triangles_;        // every shape's, in shape order (read at random: huge pages)
   std::vector<std::size_t> first_triangle_;  // per shape, and one past the last

@@ -2,6 +2,7 @@
 
 #include "core/alpha.h"
 #include "core/error.h"
+#include "core/texture.h"
 
 #include <embree3/rtcore.h>
 
@@ -43,6 +44,23 @@ struct AlphaGeometry {
   float alpha = 1.0f;
   std::uint32_t shape = 0;           // index into Scene::shapes
   std::uint32_t first_instance = 0;  // geometry ID of instance 0 in the top scene
+  // A textured coverage (else null): the texture, its images, and the mesh
+  // whose texture coordinates (or, without them, the barycentrics, as
+  // CompiledScene::resolve reads them) say where.
+  const TextureRef* texture = nullptr;
+  const Textures* textures = nullptr;
+  const TriangleMesh* mesh = nullptr;
+
+  // The coverage at barycentrics (b1, b2) of triangle `prim`.
+  float at(unsigned prim, float b1, float b2) const {
+    if (!texture) return alpha;
+    vec2 uv(b1, b2);
+    if (mesh->has_uvs()) {
+      const glm::uvec3 v = mesh->triangles[prim];
+      uv = (1.0f - b1 - b2) * mesh->uvs[v.x] + b1 * mesh->uvs[v.y] + b2 * mesh->uvs[v.z];
+    }
+    return std::clamp(textures->nearest_number(*texture, uv), 0.0f, 1.0f);
+  }
 };
 
 // Embree's intersection and occlusion filter for a geometry with alpha: a
@@ -57,7 +75,8 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
     const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
     const std::uint32_t instance = inst == RTC_INVALID_GEOMETRY_ID ? kNoInstance : inst - g->first_instance;
-    if (!alpha_stops(g->alpha, alpha_uniform(key, g->shape, prim, instance))) args->valid[i] = 0;
+    const float alpha = g->at(prim, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+    if (!alpha_stops(alpha, alpha_uniform(key, g->shape, prim, instance))) args->valid[i] = 0;
   }
 }
 
@@ -75,6 +94,7 @@ struct EmbreeAccel::Impl {
   std::vector<std::uint32_t> instance_group;  // per instance; empty for a scene without instances
   bool compact = false;
   std::span<const Material> materials;  // read while building only; empty: every shape opaque
+  const Textures* textures = nullptr;   // for alpha textures
   // The alpha filters' user data, one per shape with alpha (a group's shape
   // once, whatever places it); Embree holds pointers to them.
   std::vector<std::unique_ptr<AlphaGeometry>> alpha_geometries;
@@ -106,10 +126,12 @@ struct EmbreeAccel::Impl {
 };
 
 EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups,
-                         std::span<const Instance> instances, bool compact, std::span<const Material> materials)
+                         std::span<const Instance> instances, bool compact, std::span<const Material> materials,
+                         const Textures* textures)
     : impl_(std::make_unique<Impl>()) {
   impl_->compact = compact;
   impl_->materials = materials;
+  impl_->textures = textures;
   // Set before any shape is attached: the filters read it.
   impl_->first_instance = static_cast<std::uint32_t>(shapes.size());
   impl_->device = rtcNewDevice(nullptr);
@@ -157,8 +179,11 @@ EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const Shape
 }
 
 void EmbreeAccel::Impl::attach(RTCScene target, const Shape& shape, std::uint32_t index, std::uint32_t id) {
-  const float alpha = materials.empty() ? 1.0f : materials[shape.material].alpha;
-  if (alpha < 1.0f && shape.kind != Shape::Kind::Triangles)
+  const Material* material = materials.empty() ? nullptr : &materials[shape.material];
+  const bool has_alpha = material && material->has_alpha();
+  if (has_alpha && material->alpha_texture && !textures)
+    throw InputError(shape.description + ": an alpha texture, but the scene's textures were not given");
+  if (has_alpha && shape.kind != Shape::Kind::Triangles)
     throw InputError(shape.description + ": alpha on a sphere is not supported (a ray crosses it twice at one "
                      "primitive, so the two crossings cannot be decided apart); use a mesh");
   RTCGeometry geom = nullptr;
@@ -191,10 +216,12 @@ void EmbreeAccel::Impl::attach(RTCScene target, const Shape& shape, std::uint32_
     }
   }
   errors.check(shape.description.c_str());
-  if (alpha < 1.0f) {
+  if (has_alpha) {
     // Only the geometries with alpha get filters: Embree calls none on the
     // others, which trace as fast as in a scene without alpha.
-    alpha_geometries.push_back(std::make_unique<AlphaGeometry>(AlphaGeometry{alpha, index, first_instance}));
+    alpha_geometries.push_back(std::make_unique<AlphaGeometry>(AlphaGeometry{
+        material->alpha, index, first_instance, material->alpha_texture ? &*material->alpha_texture : nullptr,
+        textures, &shape.mesh}));
     rtcSetGeometryUserData(geom, alpha_geometries.back().get());
     rtcSetGeometryIntersectFilterFunction(geom, &alpha_filter);
     rtcSetGeometryOccludedFilterFunction(geom, &alpha_filter);

@@ -5,7 +5,7 @@
 // scene's shape index), and each of the scene's instances places it through
 // an Embree instance (geometry ID shapes.size() + instance index in the top
 // scene).
-// Shapes whose material has alpha (Material::alpha < 1) get intersection
+// Shapes whose material has alpha (Material::has_alpha) get intersection
 // and occlusion filters that let a ray through with probability 1 - alpha,
 // decided by the ray's alpha_key and the surface (core/alpha.h); every other
 // geometry has none, so a scene without alpha traces as before.
@@ -21,6 +21,8 @@
 #include <string>
 
 namespace pathlab {
+
+class Textures;
 
 struct RayHit {
   float t = 0.0f;
@@ -63,10 +65,11 @@ class EmbreeAccel {
   // `compact`: RenderSettings::compact_bvh. `materials`: the table
   // Shape::material indexes, read for alpha (empty: every shape opaque);
   // throws InputError for alpha on a sphere, whose two crossings of one
-  // ray would share a decision.
+  // ray would share a decision. `textures`: the scene's images, which
+  // alpha textures read (must outlive the accel; null if it has none).
   explicit EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups = {},
                        std::span<const Instance> instances = {}, bool compact = false,
-                       std::span<const Material> materials = {});
+                       std::span<const Material> materials = {}, const Textures* textures = nullptr);
   ~EmbreeAccel();
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;

@@ -25,6 +25,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstring>
@@ -32,6 +33,8 @@
 #include <optional>
 #include <set>
 #include <utility>
+
+#include <unistd.h>
 
 namespace pathlab {
 namespace {
@@ -62,9 +65,33 @@ bool write_whole_file(std::string* err, const std::string&, const std::vector<un
   *err = "pathlab does not write glTF files";
   return false;
 }
-// Images are kept undecoded: no textures yet.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+// Images are not decoded here: an embedded image's bytes (a data URI or a
+// buffer view) are kept as they are, for OpenImageIO to read from a file
+// (Flattener::texture); an external one keeps its uri.
+bool keep_image_bytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                      const unsigned char* bytes, int size, void*) {
+  image->image.assign(bytes, bytes + size);
   return true;
+}
+
+// The folder embedded images are written to, one per process, removed at
+// exit (the scene's textures name these files).
+const fs::path& embedded_image_dir() {
+  struct Dir {
+    fs::path path;
+    Dir() {
+      path = fs::temp_directory_path() / ("pathlab-gltf-images-" + std::to_string(::getpid()));
+      std::error_code ec;
+      fs::create_directories(path, ec);
+      if (ec) throw SystemError("cannot create " + path.string() + " for glTF's embedded images: " + ec.message());
+    }
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
 }
 
 tinygltf::Model parse(const fs::path& file) {
@@ -82,7 +109,7 @@ tinygltf::Model parse(const fs::path& file) {
 
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({&file_exists, &expand_path, &read_whole_file, &write_whole_file, &approved});
-  loader.SetImageLoader(&skip_image, nullptr);
+  loader.SetImageLoader(&keep_image_bytes, nullptr);
   tinygltf::Model model;
   std::string err, warn;  // tinygltf's warnings repeat what pathlab reports itself
   const std::string base = file.parent_path().string();
@@ -168,6 +195,11 @@ class Flattener {
   void place_mesh(std::size_t mesh, const mat4& world, std::size_t node);
   void place_node(std::size_t node, const mat4& world);
   std::uint32_t material(int index);
+  // The TextureRef of a material's textureInfo (its image added to
+  // out_.images once per colour space), or nothing (with a warning) for a
+  // texture pathlab cannot read as the file means it.
+  std::optional<TextureRef> texture(int texture, int tex_coord, const tinygltf::ExtensionMap& extensions,
+                                    TextureColorSpace space, const std::string& at);
   void warn_once(const std::string& key, const std::string& text) {
     if (warned_.insert(key).second) out_.warnings.push_back(file_.string() + ": " + text);
   }
@@ -177,6 +209,7 @@ class Flattener {
   const GltfOptions& options_;
   GltfContent out_;
   std::map<int, std::uint32_t> materials_;  // glTF material (-1: default) -> out_.materials
+  std::map<std::pair<int, TextureColorSpace>, std::uint32_t> images_;  // (glTF image, colour space) -> out_.images
   std::map<std::pair<std::size_t, std::size_t>, TriangleMesh> meshes_;  // primitives read once, copied per node
   std::vector<bool> instanced_;  // per glTF mesh: placed by instances of a group
   std::map<std::size_t, std::optional<std::uint32_t>> groups_;  // glTF mesh -> out_.groups (none: no triangles)
@@ -493,6 +526,9 @@ std::uint32_t Flattener::material(int index) {
   p.sheen = 0.0f;
   Spectrum emission(0.0f);
   float coverage = 1.0f;  // Material::alpha
+  std::vector<TexturedParam> textures;
+  std::optional<NormalMap> normal_map;
+  std::optional<TextureRef> emission_texture;
   if (index < 0) {
     // glTF's default material: base colour 1, metallic 1, roughness 1.
     p.base_color = Spectrum(1.0f);
@@ -529,20 +565,44 @@ std::uint32_t Flattener::material(int index) {
     // alphaMode (glTF 2.0, 3.9.4) onto the material's coverage: OPAQUE
     // ignores alpha, MASK keeps the surface where alpha >= alphaCutoff and
     // cuts it elsewhere, BLEND is stochastic coverage. The factor alone:
-    // the texture's alpha is not read (neither is its colour).
+    // the base colour texture's alpha is not read.
     if (m.alphaMode == "MASK") {
       if (!(m.alphaCutoff >= 0.0)) fail(file_, at + "/alphaCutoff", "must not be negative");
       coverage = alpha >= static_cast<float>(m.alphaCutoff) ? 1.0f : 0.0f;
     } else if (m.alphaMode == "BLEND") {
       coverage = alpha;
     }
-    if (pbr.baseColorTexture.index >= 0) ignored_.insert("baseColorTexture");
+    // Textures multiply their factors (glTF 2.0, 3.9): the factor is the
+    // TextureRef's scale.
     if (pbr.baseColorTexture.index >= 0 && m.alphaMode != "OPAQUE")
       ignored_.insert("baseColorTexture's alpha (the factor alone gives the coverage)");
-    if (pbr.metallicRoughnessTexture.index >= 0) ignored_.insert("metallicRoughnessTexture");
-    if (m.normalTexture.index >= 0) ignored_.insert("normalTexture");
-    if (m.emissiveTexture.index >= 0) ignored_.insert("emissiveTexture");
-    if (m.occlusionTexture.index >= 0) ignored_.insert("occlusion");
+    if (pbr.baseColorTexture.index >= 0)
+      if (auto t = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions,
+                           TextureColorSpace::Srgb, at + "/pbrMetallicRoughness/baseColorTexture")) {
+        t->scale = p.base_color;
+        textures.push_back({MaterialParam::BaseColor, *t});
+      }
+    if (pbr.metallicRoughnessTexture.index >= 0)
+      if (auto t = texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+                           pbr.metallicRoughnessTexture.extensions, TextureColorSpace::Linear,
+                           at + "/pbrMetallicRoughness/metallicRoughnessTexture")) {
+        // Blue is metallic, green roughness.
+        t->channel = 2;
+        t->scale = Spectrum(p.metallic);
+        textures.push_back({MaterialParam::Metallic, *t});
+        t->channel = 1;
+        t->scale = Spectrum(p.roughness);
+        textures.push_back({MaterialParam::Roughness, *t});
+      }
+    if (m.normalTexture.index >= 0)
+      if (auto t = texture(m.normalTexture.index, m.normalTexture.texCoord, m.normalTexture.extensions,
+                           TextureColorSpace::Linear, at + "/normalTexture"))
+        normal_map = NormalMap{*t, static_cast<float>(m.normalTexture.scale)};
+    if (m.emissiveTexture.index >= 0)
+      if (auto t = texture(m.emissiveTexture.index, m.emissiveTexture.texCoord, m.emissiveTexture.extensions,
+                           TextureColorSpace::Srgb, at + "/emissiveTexture"))
+        emission_texture = t;
+    if (m.occlusionTexture.index >= 0) ignored_.insert("occlusionTexture");
     out.gltf_name = m.name;
     out.double_sided = m.doubleSided;
     out.material.name = label + (m.name.empty() ? "#" + std::to_string(index) : m.name);
@@ -552,6 +612,12 @@ std::uint32_t Flattener::material(int index) {
   out.material.name = name;
   out.material.emission = emission;
   out.material.alpha = coverage;
+  for (const TexturedParam& t : textures) out.material.set_texture(t.param, t.texture);
+  if (emission_texture && !is_black(emission)) {
+    emission_texture->scale = emission;
+    out.material.set_texture(MaterialParam::Emission, *emission_texture);
+  }
+  out.material.normal_map = normal_map;
   // Single-sided: the back neither reflects nor emits (Material::one_sided).
   // glTF's back-face culling, which makes the back invisible in a
   // rasteriser, is not modelled: the back still occludes.
@@ -564,6 +630,61 @@ std::uint32_t Flattener::material(int index) {
   out_.materials.push_back(std::move(out));
   materials_[index] = at;
   return at;
+}
+
+std::optional<TextureRef> Flattener::texture(int index, int tex_coord, const tinygltf::ExtensionMap& extensions,
+                                             TextureColorSpace space, const std::string& at) {
+  if (tex_coord != 0) {
+    warn_once("texcoord", "textures read through TEXCOORD_1 or later ignored (only TEXCOORD_0 is read), first at " + at);
+    return std::nullopt;
+  }
+  if (extensions.count("KHR_texture_transform") > 0)
+    warn_once("transform", "KHR_texture_transform ignored (textures read untransformed), first at " + at);
+  if (index < 0 || static_cast<std::size_t>(index) >= model_.textures.size())
+    fail(file_, at + "/index", "no texture " + std::to_string(index));
+  const tinygltf::Texture& tex = model_.textures[static_cast<std::size_t>(index)];
+  if (tex.source < 0 || static_cast<std::size_t>(tex.source) >= model_.images.size()) {
+    warn_once("nosource", "a texture without an image (or with only an extension's image) ignored, first at " + at);
+    return std::nullopt;
+  }
+  TextureRef ref;
+  if (tex.sampler >= 0 && static_cast<std::size_t>(tex.sampler) < model_.samplers.size()) {
+    const tinygltf::Sampler& sm = model_.samplers[static_cast<std::size_t>(tex.sampler)];
+    const auto wrap = [](int mode) {
+      return mode == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE     ? TextureWrap::Clamp
+             : mode == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT ? TextureWrap::Mirror
+                                                             : TextureWrap::Repeat;
+    };
+    ref.wrap = wrap(sm.wrapS);
+    if (sm.wrapT != sm.wrapS)
+      warn_once("wrap", "a sampler whose wrapT differs from wrapS reads both with wrapS's mode, first at " + at);
+  }
+  const auto key = std::make_pair(tex.source, space);
+  if (const auto it = images_.find(key); it != images_.end()) {
+    ref.image = it->second;
+    return ref;
+  }
+  const tinygltf::Image& image = model_.images[static_cast<std::size_t>(tex.source)];
+  const std::string image_at = "/images/" + std::to_string(tex.source);
+  fs::path path;
+  if (!image.image.empty()) {
+    // Embedded: written out once per image for OpenImageIO to read.
+    static std::atomic<unsigned> counter{0};
+    const std::string ext = image.mimeType == "image/jpeg" ? ".jpg" : image.mimeType == "image/png" ? ".png" : ".img";
+    path = embedded_image_dir() / (file_.stem().string() + "-" + std::to_string(counter++) + ext);
+    std::ofstream out(path, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(image.image.data()), static_cast<std::streamsize>(image.image.size()));
+    if (!out) throw SystemError(path.string() + ": cannot write glTF's embedded image " + image_at);
+  } else if (!image.uri.empty()) {
+    path = (file_.parent_path() / image.uri).lexically_normal();
+    if (!fs::is_regular_file(path)) fail(file_, image_at + "/uri", "the image " + path.string() + " does not exist");
+  } else {
+    fail(file_, image_at, "the image has neither data nor a uri");
+  }
+  ref.image = static_cast<std::uint32_t>(out_.images.size());
+  out_.images.push_back({path, space, file_.string() + ": " + image_at});
+  images_[key] = ref.image;
+  return ref;
 }
 
 // The default scene's root nodes (`scene`, else scene 0, else every node
@@ -603,7 +724,6 @@ GltfContent Flattener::run() {
         std::end(gltf::kSupportedExtensions))
       ignored_.insert("extension " + ext);
   if (!model_.animations.empty()) ignored_.insert("animations");
-  if (!model_.textures.empty()) ignored_.insert("textures");
   // The file's materials in file order, used or not, so that names can be
   // overridden whatever the scene shows.
   for (std::size_t m = 0; m < model_.materials.size(); ++m) material(static_cast<int>(m));

@@ -56,6 +56,10 @@ struct GltfContent {
   std::vector<Instance> instances;
   std::vector<GltfCamera> cameras;         // perspective cameras, in node order
   std::vector<DeltaLight> delta_lights;    // KHR_lights_punctual point, spot and directional lights
+  // The images the materials' textures read (TextureRef::image indexes
+  // this list): external files where the glTF names them, embedded ones
+  // (data URIs, buffer views) written to a temporary folder removed at exit.
+  std::vector<TextureImage> images;
   std::vector<std::string> warnings;       // one line each, naming the file
 };
 

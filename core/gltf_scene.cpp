@@ -31,6 +31,19 @@ void append_gltf(Scene& scene, const GltfContent& content, const std::vector<std
     std::optional<std::uint32_t>& m = index[i];
     if (!m) {
       Material added = content.materials[i].material;
+      // Its textures' images into the scene's list (once per file and colour space).
+      const auto image = [&](TextureRef& ref) {
+        const TextureImage& im = content.images[ref.image];
+        for (std::uint32_t k = 0; k < scene.textures.size(); ++k)
+          if (scene.textures[k].file == im.file && scene.textures[k].colorspace == im.colorspace) {
+            ref.image = k;
+            return;
+          }
+        ref.image = static_cast<std::uint32_t>(scene.textures.size());
+        scene.textures.push_back(im);
+      };
+      for (TexturedParam& t : added.textured) image(t.texture);
+      if (added.normal_map) image(added.normal_map->texture);
       added.name = unique_name(added.name, [&](const std::string& name) {
         return std::any_of(scene.materials.begin(), scene.materials.end(), [&](const Material& x) { return x.name == name; });
       });

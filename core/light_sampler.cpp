@@ -80,7 +80,8 @@ std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene) {
 
 float LightSampler::area_density(const Entry& e) { return PATHLAB_FAULT(LightPdfWithoutArea) ? 1.0f : 1.0f / e.area; }
 
-LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&scene) {
+LightSampler::LightSampler(const Scene& scene, float scene_radius, const Textures* textures)
+    : scene_(&scene), textures_(textures) {
   std::vector<double> power;
   first_entry_.assign(scene.shapes.size(), -1);
   for (std::uint32_t s = 0; s < scene.shapes.size(); ++s) {
@@ -90,7 +91,9 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius) : scene_(&sce
     // unless their material says "light": false.
     if (!m.emits() || !m.sampled_as_light || shape.in_group) continue;
     // Flux of a Lambertian emitter: pi * L * area per emitting side.
-    const double per_area = kPi * luminance(m.emission) * (m.two_sided_emission ? 2.0 : 1.0);
+    const TexturedParam* tex = textures ? m.texture_of(MaterialParam::Emission) : nullptr;
+    const Spectrum mean_emission = tex ? glm::max(textures->mean_color(tex->texture), Spectrum(0.0f)) : m.emission;
+    const double per_area = kPi * luminance(mean_emission) * (m.two_sided_emission ? 2.0 : 1.0);
     first_entry_[s] = static_cast<std::int64_t>(entries_.size());
     if (shape.kind == Shape::Kind::Sphere) {
       const float area = 4.0f * kPi * shape.radius * shape.radius;
@@ -146,7 +149,18 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
   }
   const Entry& e = entries_[i];
   const Shape& shape = scene_->shapes[e.shape];
-  const SurfacePoint sp = shape.kind == Shape::Kind::Sphere ? sample_sphere(shape, u) : sample_triangle(e.triangle, u);
+  const Material& m = scene_->materials[shape.material];
+  const bool textured = textures_ && m.emission_textured;
+  vec2 b(0.0f);  // the triangle point's barycentrics (b1, b2), for a textured emitter
+  SurfacePoint sp;
+  if (shape.kind == Shape::Kind::Sphere) {
+    sp = sample_sphere(shape, u);
+  } else if (!textured) {
+    sp = sample_triangle(e.triangle, u);
+  } else {
+    b = square_to_uniform_triangle(u);  // what sample_triangle does, keeping b
+    sp = triangle_point(e.triangle, b);
+  }
   ls.p = sp.p;
   ls.p_error = sp.p_error;
   ls.n = sp.n;
@@ -154,12 +168,23 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
   ls.dist = glm::length(d);
   if (!(ls.dist > 0.0f)) return std::nullopt;
   ls.wi = d / ls.dist;
-  const Material& m = scene_->materials[shape.material];
   const float cos_light = glm::dot(ls.n, -ls.wi);
   if (!m.two_sided_emission && cos_light <= 0.0f) return std::nullopt;  // back of a one-sided emitter
   ls.pdf = pmf_[i] * area_to_solid_angle(area_density(e), faulty_distance(ls.dist), cos_light);
   if (!(ls.pdf > 0.0f) || std::isinf(ls.pdf)) return std::nullopt;  // seen edge-on
-  ls.Le = m.emission;
+  if (!textured) {
+    ls.Le = m.emission;
+    return ls;
+  }
+  // The texture at the point's uv, as CompiledScene::resolve gives a hit there.
+  vec2 uv = b;
+  if (shape.kind == Shape::Kind::Sphere) {
+    uv = sphere_uv((ls.p - shape.center) / shape.radius);
+  } else if (shape.mesh.has_uvs()) {
+    const glm::uvec3 v = shape.mesh.triangles[e.prim];
+    uv = (1.0f - b.x - b.y) * shape.mesh.uvs[v.x] + b.x * shape.mesh.uvs[v.y] + b.y * shape.mesh.uvs[v.z];
+  }
+  ls.Le = emission_at(m, textures_, uv);
   return ls;
 }
 

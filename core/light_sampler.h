@@ -57,7 +57,12 @@ class LightSampler {
  public:
   // `scene_radius`: radius of a sphere bounding the scene, for the power of
   // the environment (pi * L * 4 pi r^2: the flux it sends through the scene).
-  LightSampler(const Scene& scene, float scene_radius);
+  // `textures`: the scene's, for emission read from a texture (null if it
+  // has none). A textured emitter is picked by the power of its texture's
+  // mean (over the whole image, not the part a triangle maps: an estimate;
+  // any positive weight keeps the estimator unbiased), and each sample's Le
+  // is read at the point's uv, unfiltered, as a ray that hits it reads it.
+  LightSampler(const Scene& scene, float scene_radius, const Textures* textures = nullptr);
 
   std::size_t area_light_count() const { return entries_.size(); }
   // Area lights (or the environment) too dim, next to the others, ever to be
@@ -108,6 +113,7 @@ class LightSampler {
   static float area_density(const Entry& e);  // 1 / area
 
   const Scene* scene_;
+  const Textures* textures_;
   std::vector<Entry> entries_;           // area lights, then the environment
   std::vector<float> pmf_, cdf_;         // over entries_
   std::vector<std::int64_t> first_entry_;  // per shape: index of its prim 0, or -1

@@ -2,6 +2,8 @@
 
 #include "core/scene.h"
 
+#include <algorithm>
+
 namespace pathlab {
 
 const char* lobe_name(Lobe lobe) {
@@ -51,12 +53,31 @@ const char* shading_path_name(ShadingPath p) {
 bool Material::scatters() const {
   switch (type) {
     case MaterialType::Diffuse:
-    case MaterialType::Mirror: return !is_black(albedo);
+    case MaterialType::Mirror: return !is_black(albedo) || texture_of(MaterialParam::Albedo) != nullptr;
     case MaterialType::Emissive: return false;
     case MaterialType::Disney: return true;  // Schlick Fresnel reflects at grazing angles whatever the colours
-    case MaterialType::Dielectric: return !is_black(glass.reflectance) || !is_black(glass.transmittance);
+    case MaterialType::Dielectric:
+      return !is_black(glass.reflectance) || !is_black(glass.transmittance) ||
+             texture_of(MaterialParam::GlassReflectance) != nullptr ||
+             texture_of(MaterialParam::GlassTransmittance) != nullptr;
   }
   return false;
+}
+
+void Material::set_texture(MaterialParam p, const TextureRef& texture) {
+  for (TexturedParam& t : textured)
+    if (t.param == p) {
+      t.texture = texture;
+      return;
+    }
+  textured.push_back({p, texture});
+  if (p == MaterialParam::Emission) emission_textured = true;
+}
+
+const TexturedParam* Material::texture_of(MaterialParam p) const {
+  for (const TexturedParam& t : textured)
+    if (t.param == p) return &t;
+  return nullptr;
 }
 
 LobeMask Material::lobes() const {
@@ -65,10 +86,12 @@ LobeMask Material::lobes() const {
     case MaterialType::Mirror: return lobe_bit(Lobe::MirrorImpulse);
     case MaterialType::Emissive: return 0;
     case MaterialType::Disney: {
+      // A textured parameter may take any value: count the lobe it may switch on.
+      const bool metallic_below_1 = disney.metallic < 1.0f || texture_of(MaterialParam::Metallic);
       LobeMask m = lobe_bit(Lobe::Specular);
-      if (disney.metallic < 1.0f) m |= lobe_bit(Lobe::DisneyDiffuse);
-      if (disney.metallic < 1.0f && disney.sheen > 0.0f) m |= lobe_bit(Lobe::Sheen);
-      if (disney.clearcoat > 0.0f) m |= lobe_bit(Lobe::Clearcoat);
+      if (metallic_below_1) m |= lobe_bit(Lobe::DisneyDiffuse);
+      if (metallic_below_1 && (disney.sheen > 0.0f || texture_of(MaterialParam::Sheen))) m |= lobe_bit(Lobe::Sheen);
+      if (disney.clearcoat > 0.0f || texture_of(MaterialParam::Clearcoat)) m |= lobe_bit(Lobe::Clearcoat);
       return m;
     }
     case MaterialType::Dielectric:
@@ -100,6 +123,51 @@ Material dielectric_material(const DielectricParams& params) {
   m.type = MaterialType::Dielectric;
   m.glass = params;
   return m;
+}
+
+namespace {
+
+float clamp01(float v) { return std::clamp(v, 0.0f, 1.0f); }
+Spectrum clamp01(const Spectrum& c) { return glm::clamp(c, Spectrum(0.0f), Spectrum(1.0f)); }
+
+}  // namespace
+
+void evaluate_textured(const Material& m, const Textures& textures, const TextureFootprint& at,
+                       const TextureFootprint& emission_at, SurfaceParams* out) {
+  out->albedo = m.albedo;
+  out->emission = m.emission;
+  out->glass = m.glass;
+  DisneyParams p = m.disney;
+  for (const TexturedParam& t : m.textured) {
+    const TextureRef& r = t.texture;
+    switch (t.param) {
+      case MaterialParam::Albedo: out->albedo = clamp01(textures.color(r, at)); break;
+      case MaterialParam::Emission: out->emission = glm::max(textures.color(r, emission_at), Spectrum(0.0f)); break;
+      case MaterialParam::GlassReflectance: out->glass.reflectance = clamp01(textures.color(r, at)); break;
+      case MaterialParam::GlassTransmittance: out->glass.transmittance = clamp01(textures.color(r, at)); break;
+      case MaterialParam::BaseColor: p.base_color = clamp01(textures.color(r, at)); break;
+      case MaterialParam::Metallic: p.metallic = clamp01(textures.number(r, at)); break;
+      case MaterialParam::Subsurface: p.subsurface = clamp01(textures.number(r, at)); break;
+      case MaterialParam::Specular: p.specular = clamp01(textures.number(r, at)); break;
+      case MaterialParam::SpecularTint: p.specular_tint = clamp01(textures.number(r, at)); break;
+      case MaterialParam::Roughness: p.roughness = clamp01(textures.number(r, at)); break;
+      case MaterialParam::Anisotropic: p.anisotropic = clamp01(textures.number(r, at)); break;
+      case MaterialParam::Sheen: p.sheen = clamp01(textures.number(r, at)); break;
+      case MaterialParam::SheenTint: p.sheen_tint = clamp01(textures.number(r, at)); break;
+      case MaterialParam::Clearcoat: p.clearcoat = clamp01(textures.number(r, at)); break;
+      case MaterialParam::ClearcoatGloss: p.clearcoat_gloss = clamp01(textures.number(r, at)); break;
+    }
+  }
+  // The closure from the evaluated parameters, as configure_shading()
+  // builds an untextured material's (energy compensation is refused with
+  // textures at load: its tables are built per material, not per hit).
+  out->closure = m.type == MaterialType::Disney ? disney::make_closure(p) : disney::lambert_closure(out->albedo);
+}
+
+Spectrum emission_at(const Material& m, const Textures* textures, vec2 uv) {
+  if (textures == nullptr) return m.emission;
+  const TexturedParam* t = m.texture_of(MaterialParam::Emission);
+  return t == nullptr ? m.emission : glm::max(textures->color(t->texture, TextureFootprint{uv, 0.0f}), Spectrum(0.0f));
 }
 
 ShadingPath shading_path_for(LobeMask lobes, bool force_general) {

@@ -57,8 +57,9 @@
 //
 // Every type:
 //     alpha         number in [0, 1]   coverage: a ray meets the   default 1
-//                                      surface with this probability and passes through it
-//                                      otherwise (core/alpha.h); an error on a light and on a sphere
+//                   or texture         surface with this probability and passes through it
+//                                      otherwise (core/alpha.h); an error on a light and on a sphere;
+//                                      a texture is read at its nearest texel, one channel, linear
 //
 // Emission leaves the front side of a surface: the side its geometric normal
 // points to (see each shape's "flip_normals"), or both sides if two_sided.
@@ -70,9 +71,12 @@
 #include "core/bsdf/closure.h"
 #include "core/math.h"
 #include "core/shading.h"
+#include "core/texture.h"
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace pathlab {
 
@@ -104,6 +108,45 @@ struct DielectricParams {
   Spectrum transmittance{1.0f};
 };
 
+// The parameters a scene may texture (docs/scene-format.md, "Textures").
+enum class MaterialParam : std::uint8_t {
+  Albedo,              // diffuse albedo, mirror reflectance
+  Emission,            // emission ("radiance" of an emissive)
+  GlassReflectance,
+  GlassTransmittance,
+  BaseColor,           // the Disney parameters from here on
+  Metallic,
+  Subsurface,
+  Specular,
+  SpecularTint,
+  Roughness,
+  Anisotropic,
+  Sheen,
+  SheenTint,
+  Clearcoat,
+  ClearcoatGloss,
+};
+struct TexturedParam {
+  MaterialParam param;
+  TextureRef texture;
+};
+// A tangent-space normal map (glTF's convention: +y up, n = 2 c - 1 with
+// x and y times `scale`).
+struct NormalMap {
+  TextureRef texture;
+  float scale = 1.0f;
+};
+
+// A material's parameters at one point of its surface: what a textured
+// material evaluates per hit (CompiledScene::resolve) and Surfel reads
+// instead of the Material's own.
+struct SurfaceParams {
+  Spectrum albedo{0.0f};    // Material::albedo
+  Spectrum emission{0.0f};  // Material::emission
+  DielectricParams glass{};
+  disney::Closure closure{};
+};
+
 struct Material {
   std::string name;
   MaterialType type = MaterialType::Diffuse;
@@ -113,18 +156,21 @@ struct Material {
   bool sampled_as_light = true;  // false: only rays that hit it find its emission
   bool one_sided = false;      // reflects on its front side only; the back is black
   // Coverage in [0, 1]: a ray meets the surface with this probability and
-  // passes through it otherwise (core/alpha.h). 1: opaque.
+  // passes through it otherwise (core/alpha.h). 1: opaque. A texture, when
+  // there is one, replaces the number: its nearest texel at the hit's
+  // texture coordinates, clamped to [0, 1] (Textures::nearest_number).
   float alpha = 1.0f;
+  std::optional<TextureRef> alpha_texture{};
   DisneyParams disney{};       // type Disney
   DielectricParams glass{};    // type Dielectric
   // Derived from `disney` (or, for the general path, from `albedo`) by the
   // factories below and configure_shading().
   disney::Closure closure{};
 
-  bool emits() const { return !is_black(emission); }
+  bool emits() const { return !is_black(emission) || emission_textured; }
   // True if rays may pass through the surface (EmbreeAccel then registers
   // its alpha filter on the material's shapes, and only then).
-  bool has_alpha() const { return alpha < 1.0f; }
+  bool has_alpha() const { return alpha < 1.0f || alpha_texture.has_value(); }
   // True if the material scatters light at all (an "emissive" does not).
   bool scatters() const;
   // True if every way this material scatters is an impulse: next-event
@@ -135,7 +181,28 @@ struct Material {
   // Set by configure_shading() when a scene is compiled; the default suits
   // a material used on its own (tests).
   ShadingConfig shading{};
+
+  // Parameters read from textures (each overrides the constant above), and
+  // the normal map; both empty for an untextured material, whose hits read
+  // the constants and pay nothing for textures.
+  std::vector<TexturedParam> textured{};
+  std::optional<NormalMap> normal_map{};
+  bool emission_textured = false;  // `textured` holds Emission (kept by set_texture)
+  bool is_textured() const { return !textured.empty(); }
+  const TexturedParam* texture_of(MaterialParam p) const;
+  // Reads parameter `p` from `texture` from now on.
+  void set_texture(MaterialParam p, const TextureRef& texture);
 };
+
+// The parameters of `m` at a point: `at` for reflection, `emission_at` for
+// emission (emission is read without filtering: see docs/scene-format.md).
+// Disney parameters are clamped to their ranges, colours to >= 0 and
+// reflectances to <= 1.
+void evaluate_textured(const Material& m, const Textures& textures, const TextureFootprint& at,
+                       const TextureFootprint& emission_at, SurfaceParams* out);
+// The emission of `m` at a point (its constant, or its texture read without
+// filtering); for light sampling.
+Spectrum emission_at(const Material& m, const Textures* textures, vec2 uv);
 
 // Materials of each type with the given parameters (and no emission).
 Material diffuse_material(const Spectrum& albedo);

@@ -70,6 +70,9 @@ struct RenderSettings {
   // a fifth less memory for a large mesh, about 10 % slower; the same hits,
   // so the same image). Measured in docs/performance.md.
   bool compact_bvh = false;
+  // Textures: how lookups are filtered, and OIIO's tile cache (MB).
+  TextureFilter texture_filter = TextureFilter::Cone;
+  float texture_cache_mb = 256.0f;
 };
 inline constexpr int kMaxVerticesUncapped = 1000;
 
@@ -140,6 +143,7 @@ struct Scene {
   std::vector<ShapeGroup> groups;
   std::vector<Instance> instances;
   std::vector<DeltaLight> delta_lights;  // point, spot and directional lights
+  std::vector<TextureImage> textures;    // the images materials read (TextureRef::image)
   std::optional<Spectrum> environment;  // uniform radiance from every direction
   std::vector<std::string> warnings;    // non-fatal problems found while loading
   // The closed-form model whose answer this scene has ("furnace", ...; see

@@ -73,7 +73,8 @@ FilmDesc read_film(const Node& node) {
 }
 
 RenderSettings read_render(const Node& node) {
-  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh"});
+  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh",
+                   "texture_filter", "texture_cache_mb"});
   RenderSettings r;
   if (node.has("spp")) {
     const std::int64_t spp = node.child("spp").integer();
@@ -126,6 +127,16 @@ RenderSettings read_render(const Node& node) {
     if (name != "fast" && name != "compact") node.child("bvh").fail("unknown bvh " + in_quotes(name) + " (expected fast or compact)");
     r.compact_bvh = name == "compact";
   }
+  if (node.has("texture_filter")) {
+    const std::string name = node.child("texture_filter").string();
+    const auto f = parse_texture_filter(name);
+    if (!f) node.child("texture_filter").fail("unknown texture_filter " + in_quotes(name) + " (expected cone or point)");
+    r.texture_filter = *f;
+  }
+  if (node.has("texture_cache_mb")) {
+    r.texture_cache_mb = static_cast<float>(node.child("texture_cache_mb").number());
+    if (!(r.texture_cache_mb >= 1.0f)) node.child("texture_cache_mb").fail("texture_cache_mb must be at least 1 (megabytes)");
+  }
   if (node.has("clamp")) {
     r.clamp = static_cast<float>(node.child("clamp").number());
     if (r.clamp < 0.0f) node.child("clamp").fail("clamp must not be negative (0 turns clamping off)");
@@ -149,18 +160,21 @@ float unit_number(const Node& node, const char* key, float fallback, float lo = 
   return v;
 }
 
-// "alpha": the material's coverage (core/alpha.h), a number in [0, 1]. A
+// "alpha": the material's coverage (core/alpha.h), a number in [0, 1] or a
+// texture (one channel, linear by default, read at the nearest texel). A
 // light may not have it: the light sampler would aim at points that its
 // shadow rays may pass through.
-float read_alpha(const Node& node, const Material& m) {
-  if (!node.has("alpha")) return 1.0f;
+void read_alpha(const Node& node, Material& m, Scene& scene) {
+  if (!node.has("alpha")) return;
   const Node a = node.child("alpha");
-  if (a.value().is_string()) a.fail("alpha must be a number in [0, 1] (alpha textures are not supported yet)");
-  const float alpha = unit_number(node, "alpha", 1.0f);
-  if (alpha < 1.0f && m.emits() && m.sampled_as_light)
-    a.fail("alpha on a light: light sampling does not model coverage; give the material \"light\": false, or "
-           "make it opaque");
-  return alpha;
+  const bool textured = is_texture(a);
+  if (textured) m.alpha_texture = read_texture(a, scene, TextureUse::Number, TextureColorSpace::Linear);
+  else if (!a.value().is_number()) a.fail("alpha must be a number in [0, 1] or a texture {\"texture\": \"file.png\", ...}, found " + describe(a.value()));
+  else m.alpha = unit_number(node, "alpha", 1.0f);
+  if (m.has_alpha() && m.emits() && m.sampled_as_light)
+    a.fail(std::string(textured ? "an alpha texture" : "alpha") +
+           " on a light: light sampling does not model coverage; give the material \"light\": false, or make it "
+           "opaque");
 }
 
 // A key that belongs to another material type gets a pointed message, not
@@ -172,21 +186,46 @@ void reject_misplaced(const Node& node, const std::string& type,
       node.child(key).fail((type == "emissive" ? "an " : "a ") + type + " material has no '" + key + "'; " + advice);
 }
 
-Material read_material(const Node& node, const std::string& name) {
+// A material's textured parameters, read before the constants are (a
+// Disney material is rebuilt from its parameters, so they are applied last).
+struct MaterialTextures {
+  const Node& node;
+  Scene& scene;
+  std::vector<TexturedParam> found;
+  // True (and the texture noted) if `key` holds a texture.
+  bool take(const char* key, MaterialParam param, TextureUse use) {
+    if (!node.has(key) || !is_texture(node.child(key))) return false;
+    found.push_back({param, read_texture(node.child(key), scene,
+                                         use, use == TextureUse::Color ? TextureColorSpace::Srgb : TextureColorSpace::Linear)});
+    return true;
+  }
+};
+
+Material read_material(const Node& node, const std::string& name, Scene& scene) {
   node.expect_object();
   const std::string type = node.required("type").string();
   Material m;
   m.name = name;
+  MaterialTextures tex{node, scene, {}};
+  // A colour or number, or a texture in its place (then the constant keeps its default).
+  auto colour = [&](const char* key, MaterialParam param, bool max_one, Spectrum fallback) {
+    if (tex.take(key, param, TextureUse::Color) || !node.has(key)) return fallback;
+    return node.child(key).color(max_one);
+  };
+  auto number = [&](const char* key, MaterialParam param, float fallback) {
+    if (tex.take(key, param, TextureUse::Number)) return fallback;
+    return unit_number(node, key, fallback);
+  };
   if (type == "diffuse" || type == "mirror") {
     const char* refl = type == "diffuse" ? "albedo" : "reflectance";
     reject_misplaced(node, type,
                      {{type == "diffuse" ? "reflectance" : "albedo",
                        type == "diffuse" ? "its colour is 'albedo'" : "its colour is 'reflectance'"},
                       {"radiance", "emitted light is 'emission'"}});
-    node.allow_only({"type", refl, "emission", "two_sided", "light", "one_sided", "alpha"});
+    node.allow_only({"type", refl, "emission", "two_sided", "light", "one_sided", "normal_map", "alpha"});
     m.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
-    m.albedo = node.has(refl) ? node.child(refl).color(true) : Spectrum(type == "diffuse" ? 0.5f : 1.0f);
-    if (node.has("emission")) m.emission = node.child("emission").color(false);
+    m.albedo = colour(refl, MaterialParam::Albedo, true, Spectrum(type == "diffuse" ? 0.5f : 1.0f));
+    m.emission = colour("emission", MaterialParam::Emission, false, Spectrum(0.0f));
   } else if (type == "emissive") {
     reject_misplaced(node, type,
                      {{"emission", "its emitted light is 'radiance'"},
@@ -196,7 +235,8 @@ Material read_material(const Node& node, const std::string& name) {
     node.allow_only({"type", "radiance", "two_sided", "light", "alpha"});
     m.type = MaterialType::Emissive;
     m.albedo = Spectrum(0.0f);
-    m.emission = node.required("radiance").color(false);
+    node.required("radiance");
+    m.emission = colour("radiance", MaterialParam::Emission, false, Spectrum(0.0f));
   } else if (type == "disney") {
     reject_misplaced(node, type,
                      {{"albedo", "its colour is 'base_color'"},
@@ -204,36 +244,41 @@ Material read_material(const Node& node, const std::string& name) {
                       {"radiance", "emitted light is 'emission'"}});
     node.allow_only({"type", "base_color", "metallic", "subsurface", "specular", "specular_tint", "roughness",
                      "anisotropic", "sheen", "sheen_tint", "clearcoat", "clearcoat_gloss", "energy_compensation", "emission",
-                     "two_sided", "light", "one_sided", "alpha"});
+                     "two_sided", "light", "one_sided", "normal_map", "alpha"});
     DisneyParams p;
-    if (node.has("base_color")) p.base_color = node.child("base_color").color(true);
-    p.metallic = unit_number(node, "metallic", p.metallic);
-    p.subsurface = unit_number(node, "subsurface", p.subsurface);
-    p.specular = unit_number(node, "specular", p.specular);
-    p.specular_tint = unit_number(node, "specular_tint", p.specular_tint);
-    p.roughness = unit_number(node, "roughness", p.roughness);
+    p.base_color = colour("base_color", MaterialParam::BaseColor, true, p.base_color);
+    p.metallic = number("metallic", MaterialParam::Metallic, p.metallic);
+    p.subsurface = number("subsurface", MaterialParam::Subsurface, p.subsurface);
+    p.specular = number("specular", MaterialParam::Specular, p.specular);
+    p.specular_tint = number("specular_tint", MaterialParam::SpecularTint, p.specular_tint);
+    p.roughness = number("roughness", MaterialParam::Roughness, p.roughness);
     // 0.9 * 1 would leave an aspect of sqrt(0.1); the range stops at 1.
-    p.anisotropic = unit_number(node, "anisotropic", p.anisotropic);
-    p.sheen = unit_number(node, "sheen", p.sheen);
-    p.sheen_tint = unit_number(node, "sheen_tint", p.sheen_tint);
-    p.clearcoat = unit_number(node, "clearcoat", p.clearcoat);
-    p.clearcoat_gloss = unit_number(node, "clearcoat_gloss", p.clearcoat_gloss);
+    p.anisotropic = number("anisotropic", MaterialParam::Anisotropic, p.anisotropic);
+    p.sheen = number("sheen", MaterialParam::Sheen, p.sheen);
+    p.sheen_tint = number("sheen_tint", MaterialParam::SheenTint, p.sheen_tint);
+    p.clearcoat = number("clearcoat", MaterialParam::Clearcoat, p.clearcoat);
+    p.clearcoat_gloss = number("clearcoat_gloss", MaterialParam::ClearcoatGloss, p.clearcoat_gloss);
     p.energy_compensation = node.boolean_or("energy_compensation", false);
+    const bool textured_lobes =
+        std::any_of(tex.found.begin(), tex.found.end(), [](const TexturedParam& t) { return t.param != MaterialParam::Emission; });
+    if (p.energy_compensation && textured_lobes)
+      node.child("energy_compensation")
+          .fail("energy_compensation cannot be combined with textured parameters (its tables are built once per material)");
     const std::string keep = m.name;
     m = disney_material(p);
     m.name = keep;
-    if (node.has("emission")) m.emission = node.child("emission").color(false);
+    m.emission = colour("emission", MaterialParam::Emission, false, Spectrum(0.0f));
   } else if (type == "dielectric") {
     reject_misplaced(node, type,
                      {{"albedo", "its tints are 'reflectance' and 'transmittance'"},
                       {"eta", "the index of refraction is 'ior'"},
                       {"emission", "glass does not emit"},
                       {"one_sided", "glass has an inside and an outside: both sides scatter"}});
-    node.allow_only({"type", "ior", "reflectance", "transmittance", "alpha"});
+    node.allow_only({"type", "ior", "reflectance", "transmittance", "normal_map", "alpha"});
     DielectricParams p;
     p.ior = unit_number(node, "ior", p.ior, 1.0f, 10.0f);
-    if (node.has("reflectance")) p.reflectance = node.child("reflectance").color(true);
-    if (node.has("transmittance")) p.transmittance = node.child("transmittance").color(true);
+    p.reflectance = colour("reflectance", MaterialParam::GlassReflectance, true, p.reflectance);
+    p.transmittance = colour("transmittance", MaterialParam::GlassTransmittance, true, p.transmittance);
     const std::string keep = m.name;
     m = dielectric_material(p);
     m.name = keep;
@@ -244,10 +289,19 @@ Material read_material(const Node& node, const std::string& name) {
     node.child("type").fail("unknown material type " + in_quotes(type) +
                             (near.empty() ? " (expected diffuse, mirror, emissive, disney or dielectric)" : near));
   }
+  for (const TexturedParam& t : tex.found) m.set_texture(t.param, t.texture);
+  if (node.has("normal_map")) {
+    const Node nm = node.child("normal_map");
+    if (!is_texture(nm)) nm.fail("expected a texture: {\"texture\": \"file.png\", ...}, found " + describe(nm.value()));
+    NormalMap map{read_texture(nm, scene, TextureUse::NormalMap, TextureColorSpace::Linear), 1.0f};
+    map.scale = map.texture.scale.x;
+    map.texture.scale = Spectrum(1.0f);
+    m.normal_map = map;
+  }
   m.two_sided_emission = node.boolean_or("two_sided", false);
   m.sampled_as_light = node.boolean_or("light", true);
   m.one_sided = node.boolean_or("one_sided", false);
-  m.alpha = read_alpha(node, m);
+  read_alpha(node, m, scene);
   return m;
 }
 
@@ -543,7 +597,7 @@ Scene read_scene(const JsonDocument& doc) {
   mats.expect_object();
   for (const auto& [name, unused] : mats.value().items()) {
     materials[name] = static_cast<std::uint32_t>(scene.materials.size());
-    scene.materials.push_back(read_material(mats.child(name), name));
+    scene.materials.push_back(read_material(mats.child(name), name, scene));
   }
 
   const Node shapes = root.required("shapes");

@@ -174,4 +174,16 @@ std::uint32_t material_index(const Node& node, const std::map<std::string, std::
 void read_shape(const Node& node, Scene& scene, const std::filesystem::path& folder,
                 const std::map<std::string, std::uint32_t>& materials, const std::string& label);
 
+// Textured parameters (scene_loader_textures.cpp). A value is a texture
+// when it is an object with a "texture" key.
+enum class TextureUse : std::uint8_t { Color, Number, NormalMap };
+bool is_texture(const Node& node);
+// The texture entry at `node`, its image added to scene.textures (once per
+// file and colour space; files are relative to the scene's folder). The
+// header is read here, so a missing or unreadable file, or a channel out of
+// range, is reported at the key; the texels are scanned when the scene is
+// compiled (core/texture.h). For a NormalMap, `scale` is glTF's normal scale
+// (any sign) and comes back in TextureRef::scale.x.
+TextureRef read_texture(const Node& node, Scene& scene, TextureUse use, TextureColorSpace default_space);
+
 }  // namespace pathlab::scene_detail

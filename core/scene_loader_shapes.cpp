@@ -12,14 +12,17 @@
 namespace pathlab::scene_detail {
 namespace {
 
-TriangleMesh unit_rectangle() {
+// `uvs`: texture coordinates (each face's square onto [0, 1]^2), given only
+// to a shape whose material reads textures.
+TriangleMesh unit_rectangle(bool uvs) {
   TriangleMesh m;
   m.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
   m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  if (uvs) m.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
   return m;
 }
 
-TriangleMesh unit_box() {
+TriangleMesh unit_box(bool uvs) {
   TriangleMesh m;
   // Six faces, each with its own four corners, wound counter-clockwise seen
   // from outside.
@@ -27,8 +30,10 @@ TriangleMesh unit_box() {
   for (const vec3& normal : n) {
     const Frame f(normal);
     const auto base = static_cast<unsigned>(m.positions.size());
-    for (const vec2 c : {vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, 1)})
+    for (const vec2 c : {vec2(-1, -1), vec2(1, -1), vec2(1, 1), vec2(-1, 1)}) {
       m.positions.push_back(normal + c.x * f.s + c.y * f.t);
+      if (uvs) m.uvs.push_back(0.5f * (c + 1.0f));
+    }
     // (s, t, n) is right-handed, so s -> t is counter-clockwise about n.
     m.triangles.push_back({base, base + 1, base + 2});
     m.triangles.push_back({base, base + 2, base + 3});
@@ -236,7 +241,9 @@ void read_shape(const Node& node, Scene& scene, const std::filesystem::path& fol
   if (type == "mesh") {
     parts = read_mesh_parts(node, scene, folder, materials, label);
   } else {
-    parts.push_back({type == "rectangle" ? unit_rectangle() : unit_box(), shape.material, shape.description});
+    const Material& m = scene.materials[shape.material];
+    const bool uvs = m.is_textured() || m.normal_map.has_value() || m.alpha_texture.has_value();
+    parts.push_back({type == "rectangle" ? unit_rectangle(uvs) : unit_box(uvs), shape.material, shape.description});
   }
   for (MeshPart& part : parts) {
     Shape added = shape;

@@ -23,6 +23,21 @@ LocalDirs to_local_upper(const Frame& frame, const vec3& wo, const vec3& wi) {
   return d;
 }
 
+// What shading reads of a material: its own constants, or the parameters
+// a textured material has at this point (Surfel::params). The same names as
+// Material's fields, so the code below reads either.
+struct MaterialView {
+  MaterialType type;
+  const ShadingConfig& shading;
+  const Spectrum& albedo;
+  const disney::Closure& closure;
+  const DielectricParams& glass;
+};
+MaterialView view_of(const Material& m, const SurfaceParams* p) {
+  if (p == nullptr) return {m.type, m.shading, m.albedo, m.closure, m.glass};
+  return {m.type, m.shading, p->albedo, p->closure, p->glass};
+}
+
 using disney::kClearcoat;
 using disney::kDisneyLobes;
 using disney::kGeneral;
@@ -30,13 +45,13 @@ using disney::kGeneral;
 // Shading specialised to a feature set (disney::Features); 0 = the
 // Lambert-only path, which contains no Disney code at all. In the general
 // path a "diffuse" material goes through the closure too.
-template <unsigned F> bool via_closure(const Material& m) {
+template <unsigned F> bool via_closure(const MaterialView& m) {
   if constexpr (F == 0) return false;
   else if constexpr ((F & disney::kLambertLobe) != 0) return m.type == MaterialType::Disney || m.type == MaterialType::Diffuse;
   else return m.type == MaterialType::Disney;
 }
 
-template <unsigned F> Spectrum eval_as(const Material& m, const LocalDirs& d) {
+template <unsigned F> Spectrum eval_as(const MaterialView& m, const LocalDirs& d) {
   if constexpr (F != 0) {
     if (via_closure<F>(m)) return disney::eval<F>(m.closure, d.wo, d.wi);
   }
@@ -45,7 +60,7 @@ template <unsigned F> Spectrum eval_as(const Material& m, const LocalDirs& d) {
   return lambert::eval(m.albedo, d.wi);
 }
 
-template <unsigned F> float pdf_as(const Material& m, const LocalDirs& d) {
+template <unsigned F> float pdf_as(const MaterialView& m, const LocalDirs& d) {
   if constexpr (F != 0) {
     if (via_closure<F>(m)) return disney::pdf<F>(m.closure, d.wo, d.wi, m.shading.sampling);
   }
@@ -55,7 +70,7 @@ template <unsigned F> float pdf_as(const Material& m, const LocalDirs& d) {
 }
 
 template <unsigned F>
-std::optional<BsdfSample> scatter_closure(const Material& m, const Frame& frame, const vec3& wo_local, float side,
+std::optional<BsdfSample> scatter_closure(const MaterialView& m, const Frame& frame, const vec3& wo_local, float side,
                                           float u_lobe, vec2 u) {
   const std::optional<disney::DirectionSample> ds = disney::sample<F>(m.closure, wo_local, u_lobe, u, m.shading.sampling);
   if (!ds) return std::nullopt;
@@ -69,7 +84,7 @@ std::optional<BsdfSample> scatter_closure(const Material& m, const Frame& frame,
   return BsdfSample{frame.to_world(wi), f / pdf, pdf, ds->lobe, false};
 }
 
-std::optional<BsdfSample> scatter_dielectric(const Material& m, const Frame& frame, const vec3& wo, float u_lobe) {
+std::optional<BsdfSample> scatter_dielectric(const MaterialView& m, const Frame& frame, const vec3& wo, float u_lobe) {
   // The geometric normal's side is the outside: entering or leaving decides
   // eta (dielectric.h).
   const vec3 wo_local = frame.to_local(wo);
@@ -93,7 +108,7 @@ std::optional<BsdfSample> scatter_dielectric(const Material& m, const Frame& fra
 
 Spectrum Surfel::emitted(const vec3& wo) const {
   if (!material->emits()) return Spectrum(0.0f);
-  if (material->two_sided_emission || glm::dot(n, wo) > 0.0f) return material->emission;
+  if (material->two_sided_emission || glm::dot(n, wo) > 0.0f) return params ? params->emission : material->emission;
   return Spectrum(0.0f);
 }
 
@@ -107,9 +122,9 @@ bool geometric_side_ok(const vec3& n, const vec3& wi, const vec3& wo, bool trans
 }
 
 Spectrum Surfel::eval(const vec3& wi, const vec3& wo) const {
-  const Material& m = *material;
-  if (m.is_pure_impulse() || m.type == MaterialType::Emissive) return Spectrum(0.0f);
-  if (m.one_sided && !(on_front(wo) && on_front(wi))) return Spectrum(0.0f);
+  if (material->is_pure_impulse() || material->type == MaterialType::Emissive) return Spectrum(0.0f);
+  if (material->one_sided && !(on_front(wo) && on_front(wi))) return Spectrum(0.0f);
+  const MaterialView m = view_of(*material, params);
   if (shading_normal && !geometric_side_ok(n, wi, wo, false)) return Spectrum(0.0f);
   const LocalDirs d = to_local_upper(frame, wo, wi);
   switch (m.shading.path) {
@@ -122,9 +137,9 @@ Spectrum Surfel::eval(const vec3& wi, const vec3& wo) const {
 }
 
 float Surfel::pdf(const vec3& wi, const vec3& wo) const {
-  const Material& m = *material;
-  if (m.is_pure_impulse() || m.type == MaterialType::Emissive) return 0.0f;
-  if (m.one_sided && !on_front(wo)) return 0.0f;  // scatter() samples nothing there
+  if (material->is_pure_impulse() || material->type == MaterialType::Emissive) return 0.0f;
+  if (material->one_sided && !on_front(wo)) return 0.0f;  // scatter() samples nothing there
+  const MaterialView m = view_of(*material, params);
   const LocalDirs d = to_local_upper(frame, wo, wi);
   switch (m.shading.path) {
     case ShadingPath::LambertOnly: return pdf_as<0>(m, d);
@@ -148,7 +163,7 @@ std::optional<BsdfSample> Surfel::scatter(const vec3& wo, float u_lobe, vec2 u) 
 }
 
 std::optional<BsdfSample> Surfel::scatter_in_frame(const vec3& wo, float u_lobe, vec2 u) const {
-  const Material& m = *material;
+  const MaterialView m = view_of(*material, params);
   if (m.type == MaterialType::Dielectric) return scatter_dielectric(m, frame, wo, u_lobe);
   vec3 wo_local = frame.to_local(wo);
   const float side = wo_local.z < 0.0f ? -1.0f : 1.0f;

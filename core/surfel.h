@@ -38,6 +38,10 @@ struct Surfel {
   // side are absorbed, and eval() is 0 there.
   bool shading_normal = false;
   const Material* material = nullptr;
+  // The material's parameters at this point when it reads textures
+  // (CompiledScene::resolve evaluates them into storage the caller owns);
+  // null: the material's own constants.
+  const SurfaceParams* params = nullptr;
   std::uint32_t shape = 0;      // index into Scene::shapes
   std::uint32_t prim = 0;       // triangle index within the shape (0 for a sphere)
   std::uint32_t instance = kNoInstance;  // index into Scene::instances for a shape in a group

@@ -56,8 +56,10 @@ std::vector<vec4> compute_tangents(const TriangleMesh& mesh) {
 }
 
 bool needs_tangents(const Shape& shape, const Material& material) {
+  const bool anisotropic = material.type == MaterialType::Disney &&
+                           (material.disney.anisotropic > 0.0f || material.texture_of(MaterialParam::Anisotropic));
   return shape.kind == Shape::Kind::Triangles && shape.mesh.has_uvs() && shape.mesh.tangents.empty() &&
-         material.type == MaterialType::Disney && material.disney.anisotropic > 0.0f;
+         (anisotropic || material.normal_map.has_value());
 }
 
 void add_needed_tangents(Scene* scene) {

@@ -54,7 +54,8 @@ namespace pathlab {
 std::vector<vec4> compute_tangents(const TriangleMesh& mesh);
 
 // True when `shape` needs computed tangents: a triangle mesh with texture
-// coordinates, no tangents of its own, and an anisotropic material.
+// coordinates, no tangents of its own, and an anisotropic material (or one
+// whose anisotropy is textured) or a normal map.
 bool needs_tangents(const Shape& shape, const Material& material);
 // Computes the tangents of every shape of `scene` that needs_tangents(); the
 // scene loader calls it once every shape is read.

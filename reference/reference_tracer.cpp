@@ -14,6 +14,11 @@ struct ReferenceTracer::Path {
   PathObserver* observer;
   std::uint32_t rays = 0;
   std::uint32_t hits = 0;
+  // Textured scenes only: the cone the current ray carries, and where its
+  // hit's evaluated parameters go (one suffices: a vertex is done with its
+  // Surfel before the path goes on).
+  RayCone cone{};
+  SurfaceParams* params = nullptr;
   float u(int vertex, Dim dim) const { return rng.get(static_cast<std::uint32_t>(vertex), dim); }
   // The key of the rays leaving `vertex` (core/alpha.h).
   std::uint32_t alpha_key(const CompiledScene& scene, int vertex) const {
@@ -26,7 +31,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
   const CompiledScene& scene = scene_;
   Surfel s;
   ++path.rays;
-  if (!scene.intersect(ray, &s)) {
+  if (!scene.intersect(ray, &s, path.cone, path.params)) {
     const Spectrum Le = scene.scene().environment.value_or(Spectrum(0.0f));
     const float w = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, scene.lights().pdf_environment());
     if (path.observer) {
@@ -96,6 +101,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
         {vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, beta_next, next_ray});
 
   const PreviousVertex next{s.p, bs->pdf, bs->impulse, !(strategy == Strategy::LightBsdf && u_technique < 0.5f)};
+  if (path.params) path.cone = scattered_cone(path.cone, glm::length(s.p - ray.origin), bs->impulse, bs->pdf);
   return L + weight * Li(next_ray, vertex + 1, next, beta_next, path);
 }
 
@@ -141,6 +147,12 @@ FilmSample ReferenceTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::
                                          PathObserver* observer) const {
   const std::uint32_t pixel = y * static_cast<std::uint32_t>(scene_.scene().film.width) + x;
   Path path{SampleStream(settings_.seed, pixel, sample), observer};
+  std::optional<SurfaceParams> params;
+  if (scene_.has_textures()) {
+    params.emplace();
+    path.params = &*params;
+    path.cone = scene_.camera_cone(settings_.texture_filter);
+  }
   FilmSample fs;
   fs.film = vec2(static_cast<float>(x) + path.u(0, Dim::FilmX), static_cast<float>(y) + path.u(0, Dim::FilmY));
   Ray ray = scene_.camera().generate_ray(fs.film, vec2(path.u(0, Dim::LensX), path.u(0, Dim::LensY)));

@@ -14,13 +14,16 @@
 #include "core/scene_loader.h"
 #include "reference/reference_tracer.h"
 #include "tests/stat_util.h"
+#include "tests/temp_dir.h"
 #include "tests/test_scenes.h"
+#include "tests/texture_util.h"
 #include "wavefront/wavefront_tracer.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -50,7 +53,8 @@ std::vector<FilmSample> samples(const Tracer& tracer) {
 // (z = 0, -0.25, ...; as shapes, or as instances of one group) at an
 // emitter of radiance 1 at z = -2 that fills the view. With a depth cap of 0
 // a sample is 1 if its camera ray reached the emitter, else 0.
-Scene layers(int count, float alpha, bool instanced) {
+Scene layers(int count, float alpha, bool instanced, const std::string& alpha_json = "",
+             const std::filesystem::path& file = "layers.json") {
   std::string quads, groups;
   for (int k = 0; k < count; ++k) {
     const std::string z = std::to_string(-0.25 * k);
@@ -70,11 +74,12 @@ Scene layers(int count, float alpha, bool instanced) {
     "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0], "fov_y": 30},
     "film": {"resolution": [32, 32]},
     "render": {"spp": 16, "max_depth": 0, "strategy": "bsdf", "seed": 7},
-    "materials": {"leaf": {"type": "diffuse", "albedo": 0, "alpha": )" + std::to_string(alpha) + R"(},
+    "materials": {"leaf": {"type": "diffuse", "albedo": 0, "alpha": )" +
+                         (alpha_json.empty() ? std::to_string(alpha) : alpha_json) + R"(},
                   "lamp": {"type": "emissive", "radiance": 1}},
     "shapes": [{"type": "rectangle", "material": "lamp", "transform": [{"scale": 10}, {"translate": [0, 0, -2]}]})" +
                          quads + "]" + groups + "}",
-                     "layers.json");
+                     file);
 }
 
 // The camera rays that pass every layer, counted in both tracers, which
@@ -121,6 +126,39 @@ TEST(Alpha, CoverageZeroAndOne) {
   const CompiledScene compiled(std::move(opaque));
   EXPECT_FALSE(compiled.has_alpha());
   for (const FilmSample& s : samples(ReferenceTracer(compiled, settings))) EXPECT_EQ(s.L.x, 0.0f);
+}
+
+class AlphaTexture : public test::TempDirTest {};
+
+// A cut-out: a 2x1 alpha texture, opaque on the left texel and clear on the
+// right, on the quad that fills the view (u = (x + 4) / 8). Read at the
+// nearest texel, it stops every camera ray of the image's left half and
+// none of the right half, in both tracers.
+TEST_F(AlphaTexture, CutsOutTheClearTexels) {
+  test::write_image(dir_ / "cut.exr", 2, 1, 1, {1.0f, 0.0f});
+  const std::filesystem::path file = dir_ / "cut.json";
+  Scene scene = layers(1, 1.0f, false, R"({"texture": "cut.exr"})", file);
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  ASSERT_TRUE(compiled.has_alpha());
+  const std::vector<FilmSample> a = samples(ReferenceTracer(compiled, settings));
+  const std::vector<FilmSample> b = samples(WavefrontTracer(compiled, settings, 997));
+  const auto count = static_cast<std::size_t>(settings.spp);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::size_t x = (i / count) % 32;
+    ASSERT_EQ(a[i].L.x, x < 16 ? 0.0f : 1.0f) << "sample " << i << ", pixel column " << x;
+    ASSERT_EQ(b[i].L, a[i].L) << "sample " << i;
+  }
+}
+
+// A texture of 0.25 everywhere (one channel, linear by default: an sRGB
+// decode would make it 0.05): 3/4 of the camera rays pass.
+TEST_F(AlphaTexture, GreyTextureIsCoverageReadLinear) {
+  test::write_image(dir_ / "grey.png", 2, 2, 1, {0.25f, 0.25f, 0.25f, 0.25f}, OIIO::TypeDesc::UINT8);
+  const float texel = std::round(0.25f * 255.0f) / 255.0f;  // what the PNG holds
+  std::size_t n = 0;
+  const std::size_t k = passed(layers(1, 1.0f, false, R"({"texture": "grey.png"})", dir_ / "grey.json"), &n);
+  EXPECT_LT(std::abs(binomial_z(k, n, 1.0 - texel)), kZ) << k << " of " << n;
 }
 
 // Shadow rays honour alpha. A directional light of irradiance E, travelling

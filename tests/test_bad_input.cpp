@@ -5,6 +5,7 @@
 #include "tests/cli_util.h"
 #include "tests/gltf_writer.h"
 #include "tests/temp_dir.h"
+#include "tests/texture_util.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -304,6 +305,12 @@ TEST_F(BadInput, AlphaOutOfRangeOnALightOrOnASphere) {
                                   "    {\"type\": \"rectangle\", \"material\": \"lamp\"}");
   expect_rejected(render(write("light.json", light)),
                   {"light.json:" + where_in(light, "\"alpha\""), "/materials/lamp/alpha", "alpha on a light", "\"light\": false"});
+  test::write_image(dir_ / "mask.exr", 1, 1, 1, {0.5f});
+  inputs_.insert("mask.exr");
+  const std::string textured = scene("    \"lamp\": {\"type\": \"emissive\", \"radiance\": 2, \"alpha\": {\"texture\": \"mask.exr\"}}",
+                                     "    {\"type\": \"rectangle\", \"material\": \"lamp\"}");
+  expect_rejected(render(write("textured.json", textured)),
+                  {"textured.json:", "/materials/lamp/alpha", "an alpha texture on a light"});
   const std::string sphere =
       scene(kMaterials + ",\n    \"leaf\": {\"type\": \"diffuse\", \"alpha\": 0.5}",
             "    {\"type\": \"sphere\", \"material\": \"leaf\"},\n" + kLamp);
@@ -318,6 +325,65 @@ TEST_F(BadInput, UnknownBsdfSamplingAndNegativeFireflyControls) {
                   {"flavour.json:", "/render/bsdf_sampling", "unknown BSDF sampling 'vndff' (did you mean 'vndf'?)"});
   const std::string clamp = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"clamp\": -1}");
   expect_rejected(render(write("clamp.json", clamp)), {"clamp.json:", "/render/clamp", "clamp must not be negative"});
+}
+
+// ------------------------------------------------------------ textures
+
+// A diffuse material "tex" whose albedo is `texture` (the JSON object's
+// inside), on the sphere.
+std::string textured_scene(const std::string& texture, const std::string& extra = "") {
+  return scene("    \"tex\": {\"type\": \"diffuse\", \"albedo\": {" + texture + "}},\n" + kMaterials,
+               "    {\"type\": \"sphere\", \"material\": \"tex\", \"radius\": 0.5},\n" + kLamp, extra);
+}
+
+TEST_F(BadInput, TextureFileMissingOrUnreadable) {
+  const std::string missing = textured_scene("\"texture\": \"nope.png\"");
+  expect_rejected(render(write("missing.json", missing)),
+                  {"missing.json:" + where_in(missing, "\"texture\""), "/materials/tex/albedo/texture", "nope.png does not exist"});
+  write("garbage.png", "this is not a PNG");
+  const std::string garbage = textured_scene("\"texture\": \"garbage.png\"");
+  expect_rejected(render(write("garbage.json", garbage)),
+                  {"garbage.json:" + where_in(garbage, "\"texture\""), "garbage.png: cannot read it"});
+}
+
+TEST_F(BadInput, TextureWithUnsupportedChannelsOrChannelOutOfRange) {
+  test::write_image(dir_ / "five.exr", 1, 1, 5, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f});
+  inputs_.insert("five.exr");
+  const std::string five = textured_scene("\"texture\": \"five.exr\"");
+  expect_rejected(render(write("five.json", five)), {"five.json:", "five.exr has 5 channels (1 to 4 are supported"});
+  test::write_image(dir_ / "rgb.exr", 1, 1, 3, {0.1f, 0.2f, 0.3f});
+  inputs_.insert("rgb.exr");
+  const std::string channel = textured_scene("\"texture\": \"rgb.exr\", \"channel\": 1");
+  expect_rejected(render(write("channel.json", channel)),
+                  {"channel.json:" + where_in(channel, "\"channel\""), "/materials/tex/albedo/channel", "channel 1 is out of range"});
+}
+
+TEST_F(BadInput, NonFiniteTexelNamesFileAndTexel) {
+  test::write_image(dir_ / "nan.exr", 2, 2, 3,
+                    {0.1f, 0.2f, 0.3f, 0.1f, 0.2f, 0.3f, 0.1f, std::numeric_limits<float>::quiet_NaN(), 0.3f, 0.1f, 0.2f, 0.3f});
+  inputs_.insert("nan.exr");
+  const std::string text = textured_scene("\"texture\": \"nan.exr\", \"colorspace\": \"linear\"");
+  expect_rejected(render(write("nan-texel.json", text)),
+                  {"nan-texel.json:" + where_in(text, "\"texture\""), "nan.exr", "texel (0, 1) channel 1 is NaN"});
+}
+
+TEST_F(BadInput, BadTextureKeys) {
+  test::write_image(dir_ / "rgb.exr", 1, 1, 3, {0.1f, 0.2f, 0.3f});
+  inputs_.insert("rgb.exr");
+  const std::string scale = textured_scene("\"texture\": \"rgb.exr\", \"scale\": -1");
+  expect_rejected(render(write("scale.json", scale)),
+                  {"scale.json:" + where_in(scale, "\"scale\""), "/materials/tex/albedo/scale", "scale must not be negative"});
+  const std::string wrap = textured_scene("\"texture\": \"rgb.exr\", \"wrap\": \"repaet\"");
+  expect_rejected(render(write("wrap.json", wrap)),
+                  {"wrap.json:" + where_in(wrap, "\"wrap\""), "unknown wrap mode 'repaet' (did you mean 'repeat'?)"});
+  const std::string space = textured_scene("\"texture\": \"rgb.exr\", \"colorspace\": \"aces\"");
+  expect_rejected(render(write("space.json", space)),
+                  {"space.json:" + where_in(space, "\"colorspace\""), "unknown colorspace 'aces' (expected srgb or linear)"});
+  const std::string key = textured_scene("\"texture\": \"rgb.exr\", \"wrapp\": \"clamp\"");
+  expect_rejected(render(write("key.json", key)), {"key.json:", "unknown key 'wrapp' (did you mean 'wrap'?)"});
+  const std::string filter = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"texture_filter\": \"trilinear\"}");
+  expect_rejected(render(write("filter.json", filter)),
+                  {"filter.json:", "/render/texture_filter", "unknown texture_filter 'trilinear' (expected cone or point)"});
 }
 
 TEST_F(BadInput, AlbedoAboveOne) {

@@ -3,6 +3,8 @@
 
 #include "core/scene.h"
 #include "core/scene_loader.h"
+#include "tests/temp_dir.h"
+#include "tests/texture_util.h"
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -10,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -181,5 +184,56 @@ inline std::string strategy_test_name(const testing::TestParamInfo<Strategy>& p)
 }
 
 using pathlab::kAllStrategies;
+
+// A Cornell box that reads textures everywhere it can: sRGB noise on the
+// walls (cone-filtered, wrapped), a Disney box with textured base colour,
+// roughness and metallic, a normal-mapped floor, a textured mirror, a
+// textured emissive light and a textured diffuse sphere. Its images live in
+// a folder that lasts as long as the test process.
+inline Scene cornell_with_textures() {
+  static const ScopedTempDir dir("textured-scenes");
+  const std::filesystem::path& d = dir.path();
+  if (!std::filesystem::exists(d / "noise.png")) {
+    std::mt19937 gen(3);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<float> noise(64 * 64 * 3), data(32 * 32 * 4), normals(32 * 32 * 3), light(8 * 8 * 3);
+    for (float& v : noise) v = u(gen);
+    for (float& v : data) v = u(gen);
+    for (std::size_t i = 0; i < 32 * 32; ++i) {  // tilts up to ~35 degrees
+      const float x = 0.3f * (u(gen) - 0.5f), y = 0.3f * (u(gen) - 0.5f);
+      normals[3 * i] = 0.5f + x, normals[3 * i + 1] = 0.5f + y, normals[3 * i + 2] = 0.5f + 0.5f * std::sqrt(1.0f - 4.0f * (x * x + y * y));
+    }
+    for (float& v : light) v = 0.2f + u(gen);
+    write_image(d / "noise.png", 64, 64, 3, noise, OIIO::TypeDesc::UINT8);
+    write_image(d / "data.png", 32, 32, 4, data, OIIO::TypeDesc::UINT8);
+    write_image(d / "normals.exr", 32, 32, 3, normals);
+    write_image(d / "light.exr", 8, 8, 3, light);
+  }
+  const std::string text = R"({"pathlab_scene": 1,
+  "camera": {"position": [0, 0, 3.75], "look_at": [0, 0, 0], "fov_y": 40},
+  "film": {"resolution": [32, 32]},
+  "render": {"spp": 4, "max_depth": 6, "rr_depth": 3},
+  "materials": {
+    "walls": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": 0.9, "wrap": "mirror"}},
+    "floor": {"type": "diffuse", "albedo": [0.7, 0.7, 0.6], "normal_map": {"texture": "normals.exr", "scale": 0.8}},
+    "red": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": [0.8, 0.1, 0.1]}},
+    "disney": {"type": "disney", "base_color": {"texture": "noise.png"}, "roughness": {"texture": "data.png", "channel": 1},
+               "metallic": {"texture": "data.png", "channel": 2}, "clearcoat": {"texture": "data.png", "channel": 3, "scale": 0.5}},
+    "mirror": {"type": "mirror", "reflectance": {"texture": "noise.png", "offset": 0.2, "scale": 0.7}},
+    "ball": {"type": "diffuse", "albedo": {"texture": "noise.png", "wrap": "clamp"}},
+    "light": {"type": "emissive", "radiance": {"texture": "light.exr", "scale": [17, 12, 4], "colorspace": "linear"}}
+  },
+  "shapes": [
+    {"type": "rectangle", "material": "floor", "transform": [{"rotate": {"axis": [1, 0, 0], "angle": -90}}, {"translate": [0, -1, 0]}]},
+    {"type": "rectangle", "material": "walls", "transform": [{"rotate": {"axis": [1, 0, 0], "angle": 90}}, {"translate": [0, 1, 0]}]},
+    {"type": "rectangle", "material": "walls", "transform": [{"scale": 1.0}, {"translate": [0, 0, -1]}]},
+    {"type": "rectangle", "material": "red", "transform": [{"rotate": {"axis": [0, 1, 0], "angle": 90}}, {"translate": [-1, 0, 0]}]},
+    {"type": "rectangle", "material": "mirror", "transform": [{"rotate": {"axis": [0, 1, 0], "angle": -90}}, {"translate": [1, 0, 0]}]},
+    {"type": "box", "material": "disney", "transform": [{"scale": 0.3}, {"rotate": {"axis": [0, 1, 0], "angle": -17}}, {"translate": [0.35, -0.7, 0.35]}]},
+    {"type": "sphere", "material": "ball", "center": [-0.4, -0.5, -0.2], "radius": 0.45},
+    {"type": "rectangle", "material": "light", "transform": [{"scale": [0.25, 0.2, 1]}, {"rotate": {"axis": [1, 0, 0], "angle": 90}}, {"translate": [0, 0.998, 0]}]}
+  ]})";
+  return parse_scene(text, d / "textured-cornell.json");
+}
 
 }  // namespace pathlab::test

@@ -23,7 +23,7 @@ namespace pathlab {
 namespace {
 
 struct SameSeedCase {
-  std::string scene;  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" / "alpha" (test_scenes.h), else a file in analytic-scenes/
+  std::string scene;  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" / "alpha" / "textured" (test_scenes.h), else a file in analytic-scenes/
   Strategy strategy;
 };
 
@@ -33,6 +33,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "instanced" ? test::cornell_with_instances()
             : c.scene == "delta"     ? test::cornell_with_delta_lights()
             : c.scene == "alpha"     ? test::cornell_with_alpha()
+            : c.scene == "textured"  ? test::cornell_with_textures()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -93,6 +94,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("instanced");  // the Cornell box with a group placed three times (test_scenes.h)
   scenes.push_back("delta");      // the Cornell box with point, spot and directional lights (test_scenes.h)
   scenes.push_back("alpha");      // the instanced Cornell box with partial coverage (test_scenes.h)
+  scenes.push_back("textured");   // the Cornell box reading textures everywhere (test_scenes.h)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
@@ -123,6 +125,34 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
               c = render_image(2, 17);
   EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
   EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
+}
+
+// A textured scene (texture lookups, cones, normal maps, textured emission)
+// renders the same bits with one and two threads and any wave size, in both
+// tracers.
+TEST(Wavefront, TexturedSceneSameBitsForOneAndTwoThreads) {
+  Scene scene = test::cornell_with_textures();
+  scene.film.width = scene.film.height = 16;
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  auto render_image = [&](bool wavefront, int threads, std::size_t wave) {
+    const ThreadLimit limit(threads);
+    Film film(16, 16, FilterKind::Box);
+    if (wavefront) {
+      const WavefrontTracer tracer(compiled, settings, wave);
+      EXPECT_FALSE(tracer.vectorised());
+      render(tracer, film);
+    } else {
+      const ReferenceTracer tracer(compiled, settings);
+      render(tracer, film);
+    }
+    return film.image();
+  };
+  for (const bool wavefront : {false, true}) {
+    const Image a = render_image(wavefront, 1, WavefrontTracer::kDefaultWaveSize),
+                b = render_image(wavefront, 2, wavefront ? 17 : WavefrontTracer::kDefaultWaveSize);
+    EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0) << wavefront;
+  }
 }
 
 // The render driver hands tracers a SampleBuffer nobody has written, so a

@@ -43,6 +43,10 @@ struct WavefrontTracer::Wave {
   std::vector<PreviousVertex> prev;
   std::vector<std::int32_t> vertex;  // the vertex the current ray will reach
   std::vector<std::uint32_t> rays;
+  // Textured scenes only (sized by textured()): the ray's cone, moved with
+  // the path, and the hit's evaluated parameters, this bounce only.
+  std::vector<RayCone> cone;
+  std::vector<SurfaceParams> params;
   // This bounce only.
   std::vector<std::uint8_t> alive;
   std::vector<Surfel> surfel;
@@ -79,8 +83,14 @@ struct WavefrontTracer::Wave {
   void move(std::size_t from, std::size_t to) {
     out_index[to] = out_index[from], rng[to] = rng[from], film[to] = film[from], ray[to] = ray[from];
     beta[to] = beta[from], L[to] = L[from], prev[to] = prev[from], vertex[to] = vertex[from], rays[to] = rays[from];
+    if (!cone.empty()) cone[to] = cone[from];
   }
   std::size_t capacity() const { return out_index.size(); }
+  // Room for the texture state too (the thread's wave may have served an
+  // untextured scene before).
+  void textured(std::size_t size) {
+    if (cone.size() < size) cone.resize(size), params.resize(size);
+  }
   float u(std::size_t i, Dim dim) const { return rng[i].get(static_cast<std::uint32_t>(vertex[i]), dim); }
 };
 
@@ -157,6 +167,7 @@ struct WavefrontTracer::VectorStages {
     // Alpha is decided inside Embree by the rays' keys, which Lanes do not carry.
     for (const Material& m : scene.materials)
       if (m.has_alpha()) return no("material '" + m.name + "' has alpha (partial coverage)");
+    if (compiled.has_textures()) return no("textures");
     // Flat triangles only: the stages shade with the geometric normal.
     for (const Shape& shape : scene.shapes)
       if (shape.mesh.has_normals()) return no(shape.description + " has vertex normals (smooth shading)");
@@ -310,6 +321,13 @@ void WavefrontTracer::intersect(Wave& w) const {
   w.clock.batch(camera_rays ? kCameraQueries : kBounceQueries, t0, n);
   for (std::size_t i = 0; i < n; ++i)
     if (found[i]) scene_.prefetch(hits[i]);
+  if (scene_.has_textures()) {
+    for (std::size_t i = 0; i < n; ++i) {
+      ++w.rays[i];
+      if (found[i]) scene_.resolve(rays[i], hits[i], &w.surfel[i], w.cone[i], &w.params[i]);
+    }
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     ++w.rays[i];
     if (found[i]) scene_.resolve(rays[i], hits[i], &w.surfel[i]);
@@ -430,6 +448,7 @@ void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
 // Stage: sample the continuation, apply Russian roulette, spawn the next ray.
 void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
   const Strategy strategy = settings_.strategy;
+  const bool textured = scene_.has_textures();
   for (std::size_t i = 0; i < w.n; ++i) {
     if (!w.alive[i]) continue;
     const Surfel& s = w.surfel[i];
@@ -463,6 +482,7 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
     if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i], next});
     w.prev[i] = PreviousVertex{s.p, bs->pdf, bs->impulse,
                                !(strategy == Strategy::LightBsdf && w.u(i, Dim::Technique) < 0.5f)};
+    if (textured) w.cone[i] = scattered_cone(w.cone[i], glm::length(s.p - w.ray[i].origin), bs->impulse, bs->pdf);
     w.ray[i] = next;
     w.vertex[i] = v + 1;
   }
@@ -491,6 +511,10 @@ void WavefrontTracer::compact(Wave& w, std::span<FilmSample> out) {
 // Stage: one camera ray per path.
 void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
   const Camera& camera = scene_.camera();
+  if (scene_.has_textures()) {
+    w.textured(w.capacity());
+    std::fill_n(w.cone.begin(), w.n, scene_.camera_cone(settings_.texture_filter));
+  }
   for (std::size_t i = 0; i < w.n; ++i) {
     w.vertex[i] = 0;  // the camera's random numbers are those of vertex 0
     w.film[i] = vec2(static_cast<float>(w.x[i]) + w.u(i, Dim::FilmX), static_cast<float>(w.y[i]) + w.u(i, Dim::FilmY));

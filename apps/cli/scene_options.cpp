@@ -35,6 +35,11 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
       ->check(CLI::Range(0.0f, 3.4e38f));
   cmd.add_option("--bvh", bvh, "Embree's BVH: fast, or compact (less memory, slower; the same image)")
       ->check(CLI::IsMember({"fast", "compact"}));
+  cmd.add_option("--texture-filter", texture_filter,
+                 "Texture lookups: cone (filtered over the ray cone's footprint) or point (the finest level)")
+      ->check(CLI::IsMember({"cone", "point"}));
+  cmd.add_option("--texture-cache-mb", texture_cache_mb, "OpenImageIO's texture tile cache, in MB")
+      ->check(CLI::Range(1.0f, 1.0e6f));
   cmd.add_flag("--general-shading", general_shading,
                "Shade every material through the general Disney-capable code instead of code specialised to the "
                "scene's lobes (same image, slower)");
@@ -52,6 +57,8 @@ Scene SceneOptions::load() const {
   if (min_pdf) r.min_pdf = *min_pdf;
   if (general_shading) r.force_general_shading = true;
   if (bvh) r.compact_bvh = *bvh == "compact";
+  if (texture_filter) r.texture_filter = *parse_texture_filter(*texture_filter);
+  if (texture_cache_mb) r.texture_cache_mb = *texture_cache_mb;
   if (seed) {
     std::uint64_t value = 0;
     const char* end = seed->data() + seed->size();
@@ -85,6 +92,7 @@ std::string SceneOptions::trace_pixel_command(const Scene& scene, std::uint32_t 
   if (scene.render.bsdf_sampling != BsdfSampling::Vndf) cmd << " --bsdf-sampling " << bsdf_sampling_name(scene.render.bsdf_sampling);
   if (scene.render.min_pdf > 0.0f) cmd << " --min-pdf " << scene.render.min_pdf;
   if (scene.render.force_general_shading) cmd << " --general-shading";
+  if (scene.render.texture_filter != TextureFilter::Cone) cmd << " --texture-filter " << texture_filter_name(scene.render.texture_filter);
   return cmd.str();
 }
 

@@ -1,0 +1,218 @@
+#include "core/texture.h"
+
+#include "core/error.h"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+#include <OpenImageIO/texture.h>
+
+#include <atomic>
+#include <cmath>
+#include <sstream>
+#include <unistd.h>
+
+namespace pathlab {
+
+const char* texture_wrap_name(TextureWrap wrap) {
+  switch (wrap) {
+    case TextureWrap::Repeat: return "repeat";
+    case TextureWrap::Clamp: return "clamp";
+    case TextureWrap::Black: return "black";
+    case TextureWrap::Mirror: return "mirror";
+  }
+  return "?";
+}
+
+std::optional<TextureWrap> parse_texture_wrap(std::string_view name) {
+  if (name == "repeat" || name == "periodic") return TextureWrap::Repeat;
+  if (name == "clamp") return TextureWrap::Clamp;
+  if (name == "black") return TextureWrap::Black;
+  if (name == "mirror") return TextureWrap::Mirror;
+  return std::nullopt;
+}
+
+const char* texture_color_space_name(TextureColorSpace space) {
+  return space == TextureColorSpace::Srgb ? "srgb" : "linear";
+}
+
+std::optional<TextureColorSpace> parse_texture_color_space(std::string_view name) {
+  if (name == "srgb") return TextureColorSpace::Srgb;
+  if (name == "linear") return TextureColorSpace::Linear;
+  return std::nullopt;
+}
+
+const char* texture_filter_name(TextureFilter filter) { return filter == TextureFilter::Cone ? "cone" : "point"; }
+
+std::optional<TextureFilter> parse_texture_filter(std::string_view name) {
+  if (name == "cone") return TextureFilter::Cone;
+  if (name == "point") return TextureFilter::Point;
+  return std::nullopt;
+}
+
+namespace {
+
+// The sRGB transfer curve's inverse (IEC 61966-2-1), in double so that
+// every 8-bit code decodes to the float nearest the exact value.
+float srgb_to_linear(float c) {
+  const double v = c;
+  return static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+}
+
+OIIO::TextureOpt::Wrap oiio_wrap(TextureWrap wrap) {
+  switch (wrap) {
+    case TextureWrap::Repeat: return OIIO::TextureOpt::WrapPeriodic;
+    case TextureWrap::Clamp: return OIIO::TextureOpt::WrapClamp;
+    case TextureWrap::Black: return OIIO::TextureOpt::WrapBlack;
+    case TextureWrap::Mirror: return OIIO::TextureOpt::WrapMirror;
+  }
+  return OIIO::TextureOpt::WrapPeriodic;
+}
+
+// A fresh folder for one Textures object's decoded images.
+std::filesystem::path make_temp_dir() {
+  static std::atomic<unsigned> counter{0};
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("pathlab-textures-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw SystemError("cannot create the folder " + dir.string() + " for decoded textures: " + ec.message());
+  return dir;
+}
+
+}  // namespace
+
+struct Textures::Oiio {
+  OIIO::TextureSystem* ts = nullptr;
+  ~Oiio() {
+    if (ts) OIIO::TextureSystem::destroy(ts);
+  }
+};
+
+Textures::Textures(std::span<const TextureImage> images, float cache_mb) : oiio_(std::make_unique<Oiio>()) {
+  oiio_->ts = OIIO::TextureSystem::create(false);  // our own cache, not OIIO's process-wide one
+  OIIO::TextureSystem& ts = *oiio_->ts;
+  ts.attribute("max_memory_MB", cache_mb);
+  ts.attribute("automip", 1);          // MIP-map untiled images on first read
+  ts.attribute("unassociatedalpha", 1);  // texels as stored: never premultiplied by alpha
+  for (const TextureImage& image : images) {
+    const std::string name = image.file.string();
+    auto fail = [&](const std::string& problem) -> void {
+      throw InputError(image.where + ": texture " + name + ": " + problem);
+    };
+    if (!std::filesystem::is_regular_file(image.file)) fail("no such file");
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(name, &config);
+    if (!in) fail("cannot read it (" + OIIO::geterror() + ")");
+    const OIIO::ImageSpec spec = in->spec();
+    if (spec.nchannels < 1 || spec.nchannels > 4)
+      fail("has " + std::to_string(spec.nchannels) + " channels (1 to 4 are supported: grey, grey+alpha, RGB, RGBA)");
+    if (spec.depth > 1) fail("is a volume (3D) image");
+    const std::size_t w = static_cast<std::size_t>(spec.width), h = static_cast<std::size_t>(spec.height);
+    const std::size_t nc = static_cast<std::size_t>(spec.nchannels);
+    std::vector<float> texels(w * h * nc);
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, texels.data()))
+      fail("cannot read its pixels (" + in->geterror() + ")");
+    in->close();
+    // Refuse what no filter could average: the first texel that is not a
+    // finite number, named (x, y from the top left, channel).
+    for (std::size_t i = 0; i < texels.size(); ++i)
+      if (!std::isfinite(texels[i])) {
+        std::ostringstream m;
+        const std::size_t px = i / nc;
+        m << "texel (" << px % w << ", " << px / w << ") channel " << i % nc << " is "
+          << (std::isnan(texels[i]) ? "NaN" : "infinite") << " (x, y from the top-left corner)";
+        fail(m.str());
+      }
+    // Colour channels: the first three, or the one grey channel; alpha is
+    // always linear.
+    const std::size_t colour = nc >= 3 ? 3 : 1;
+    if (image.colorspace == TextureColorSpace::Srgb)
+      for (std::size_t i = 0; i < texels.size(); ++i)
+        if (i % nc < colour) texels[i] = srgb_to_linear(texels[i]);
+    Image out;
+    out.channels = spec.nchannels;
+    double sum[4] = {};
+    for (std::size_t i = 0; i < texels.size(); ++i) sum[i % nc] += texels[i];
+    for (std::size_t c = 0; c < nc; ++c) out.mean[c] = static_cast<float>(sum[c] / static_cast<double>(w * h));
+
+    std::string source = name;
+    if (image.colorspace == TextureColorSpace::Srgb) {
+      if (temp_dir_.empty()) temp_dir_ = make_temp_dir();
+      source = (temp_dir_ / (std::to_string(images_.size()) + ".tx")).string();
+      OIIO::ImageSpec decoded(spec.width, spec.height, spec.nchannels, OIIO::TypeDesc::FLOAT);
+      const OIIO::ImageBuf buf(decoded, texels.data());
+      OIIO::ImageSpec tx;
+      tx.format = OIIO::TypeDesc::FLOAT;
+      if (!OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, buf, source, tx))
+        throw SystemError(image.where + ": texture " + name + ": cannot write its decoded copy " + source + ": " +
+                          OIIO::geterror());
+    }
+    out.handle = ts.get_texture_handle(OIIO::ustring(source));
+    if (out.handle == nullptr || !ts.good(static_cast<OIIO::TextureSystem::TextureHandle*>(out.handle)))
+      fail("OpenImageIO's texture system cannot open it (" + ts.geterror() + ")");
+    images_.push_back(out);
+  }
+}
+
+Textures::~Textures() {
+  oiio_.reset();  // closes the files before they go
+  if (!temp_dir_.empty()) {
+    std::error_code ec;
+    std::filesystem::remove_all(temp_dir_, ec);
+  }
+}
+
+void Textures::lookup(std::uint32_t image, TextureWrap wrap, int first, int n, const TextureFootprint& at,
+                      float* out) const {
+  OIIO::TextureSystem& ts = *oiio_->ts;
+  OIIO::TextureOpt opt;
+  opt.firstchannel = first;
+  opt.swrap = opt.twrap = oiio_wrap(wrap);
+  opt.interpmode = OIIO::TextureOpt::InterpBilinear;  // not OIIO's default "smart bicubic": the same kernel at every level
+  opt.fill = 0.0f;
+  // An isotropic footprint: the cone's width along both image axes.
+  const float d = at.width;
+  ts.texture(static_cast<OIIO::TextureSystem::TextureHandle*>(images_[image].handle), ts.get_perthread_info(), opt,
+             at.uv.x, 1.0f - at.uv.y, d, 0.0f, 0.0f, d, n, out);
+}
+
+Spectrum Textures::color(const TextureRef& ref, const TextureFootprint& at) const {
+  float v[3];
+  if (images_[ref.image].channels < 3) {
+    lookup(ref.image, ref.wrap, ref.channel, 1, at, v);
+    v[1] = v[2] = v[0];
+  } else {
+    lookup(ref.image, ref.wrap, ref.channel, 3, at, v);
+  }
+  return ref.scale * Spectrum(v[0], v[1], v[2]) + ref.offset;
+}
+
+float Textures::number(const TextureRef& ref, const TextureFootprint& at) const {
+  float v = 0.0f;
+  lookup(ref.image, ref.wrap, ref.channel, 1, at, &v);
+  return ref.scale.x * v + ref.offset.x;
+}
+
+float Textures::nearest_number(const TextureRef& ref, vec2 uv) const {
+  OIIO::TextureSystem& ts = *oiio_->ts;
+  OIIO::TextureOpt opt;
+  opt.firstchannel = ref.channel;
+  opt.swrap = opt.twrap = oiio_wrap(ref.wrap);
+  opt.interpmode = OIIO::TextureOpt::InterpClosest;
+  opt.fill = 0.0f;
+  float v = 0.0f;
+  ts.texture(static_cast<OIIO::TextureSystem::TextureHandle*>(images_[ref.image].handle), ts.get_perthread_info(), opt,
+             uv.x, 1.0f - uv.y, 0.0f, 0.0f, 0.0f, 0.0f, 1, &v);
+  return ref.scale.x * v + ref.offset.x;
+}
+
+Spectrum Textures::mean_color(const TextureRef& ref) const {
+  const Image& im = images_[ref.image];
+  const Spectrum m = im.channels < 3 ? Spectrum(im.mean[ref.channel])
+                                     : Spectrum(im.mean[ref.channel], im.mean[ref.channel + 1], im.mean[ref.channel + 2]);
+  return ref.scale * m + ref.offset;
+}
+
+}  // namespace pathlab
