@@ -161,7 +161,11 @@ void evaluate_textured(const Material& m, const Textures& textures, const Textur
   // The closure from the evaluated parameters, as configure_shading()
   // builds an untextured material's (energy compensation is refused with
   // textures at load: its tables are built per material, not per hit).
-  out->closure = m.type == MaterialType::Disney ? disney::make_closure(p) : disney::lambert_closure(out->albedo);
+  // Only the code that reads it pays for it: a Lambert material's closure is
+  // read by the general shading path alone (the closure holds the energy
+  // tables, some 500 bytes, so building it per hit is not free).
+  if (m.type == MaterialType::Disney) out->closure = disney::make_closure(p);
+  else if (m.shading.path == ShadingPath::General) out->closure = disney::lambert_closure(out->albedo);
 }
 
 Spectrum emission_at(const Material& m, const Textures* textures, vec2 uv) {

@@ -1,10 +1,11 @@
-// Tangents: the direction in a mesh's surface that anisotropic shading (and,
-// from the next issue on, normal maps) measures angles from.
+// Tangents: the direction in a mesh's surface that anisotropic shading and
+// normal maps measure angles from.
 //
 // Where they come from. A mesh keeps the tangents its file gave (glTF
 // TANGENT). Otherwise the scene loader computes them only when something
 // needs them ("model only what a scene requires"): a triangle shape with
-// texture coordinates whose material is anisotropic (Disney anisotropic > 0).
+// texture coordinates whose material is anisotropic (Disney anisotropic > 0,
+// or textured) or has a normal map.
 // Every other mesh has none, and its hits keep the frame built from the
 // shading normal alone (Frame(ns)), bit for bit as before tangents existed.
 //
@@ -32,10 +33,11 @@
 // An anisotropic highlight depends only on the tangent's direction up to its
 // sign, so these differences move no highlight on a mesh with a continuous
 // UV layout. A normal map is less forgiving: it must be decoded in exactly
-// the frame it was baked in, so the next issue (normal maps) should compare
-// these tangents against MikkTSpace-baked glTF tangents and, where they
-// differ, prefer the file's (which the loader already keeps). Debian ships
-// no MikkTSpace package, hence this implementation.
+// the frame it was baked in, so a mesh that brings its own (MikkTSpace-baked
+// glTF TANGENT) keeps them and they are used; these computed ones may tilt a
+// baked map's normals slightly differently at seams and on curved meshes
+// (not yet compared against MikkTSpace). Debian ships no MikkTSpace
+// package, hence this implementation.
 #pragma once
 
 #include "core/math.h"

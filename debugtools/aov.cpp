@@ -10,11 +10,17 @@ namespace pathlab {
 namespace {
 // The colour the albedo AOV shows for a material: the parameter a user
 // thinks of as its colour.
-Spectrum surface_colour(const Material& m) {
+// A textured material's colour is the one its hit read (`s.params`; the
+// Disney base colour looked up there, unfiltered).
+Spectrum surface_colour(const Surfel& s, const Textures* textures) {
+  const Material& m = *s.material;
   switch (m.type) {
-    case MaterialType::Disney: return m.disney.base_color;
-    case MaterialType::Dielectric: return m.glass.transmittance;
-    default: return m.albedo;
+    case MaterialType::Disney:
+      if (const TexturedParam* t = m.texture_of(MaterialParam::BaseColor); t && textures)
+        return glm::clamp(textures->color(t->texture, {s.uv, 0.0f}), Spectrum(0.0f), Spectrum(1.0f));
+      return m.disney.base_color;
+    case MaterialType::Dielectric: return s.params ? s.params->glass.transmittance : m.glass.transmittance;
+    default: return s.params ? s.params->albedo : m.albedo;
   }
 }
 }  // namespace
@@ -46,7 +52,9 @@ AovAccumulator::AovAccumulator(const CompiledScene& scene, const RenderSettings&
 
 void AovAccumulator::add_batch(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples) {
   const Camera& camera = scene_.camera();
+  const RayCone cone = scene_.camera_cone(settings_.texture_filter);
   parallel_for(0, static_cast<std::size_t>(height_), 1, [&](std::size_t y0, std::size_t y1) {
+    SurfaceParams params;  // a textured material's parameters at a hit, read with the camera's cone
     for (std::size_t y = y0; y < y1; ++y) {
       for (int x = 0; x < width_; ++x) {
         const std::size_t index = y * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
@@ -62,11 +70,11 @@ void AovAccumulator::add_batch(std::uint32_t first, std::uint32_t count, std::sp
           Ray ray = camera.generate_ray(film, vec2(u.get(0, Dim::LensX), u.get(0, Dim::LensY)));
           ray.alpha_key = scene_.alpha_key(u, 0);  // sees through what the render saw through
           Surfel s;
-          const bool hit = scene_.intersect(ray, &s);
+          const bool hit = scene_.intersect(ray, &s, cone, &params);
           if (first + j == 0) px.material = hit ? static_cast<int>(s.material - scene_.scene().materials.data()) : -1;
           if (!hit) continue;
           ++px.surface_hits;
-          if (s.material->scatters()) px.albedo += dvec3(surface_colour(*s.material));
+          if (s.material->scatters()) px.albedo += dvec3(surface_colour(s, scene_.textures()));
           px.normal += dvec3(s.frame.n);
           px.depth += static_cast<double>(glm::length(s.p - ray.origin));
         }

@@ -9,6 +9,7 @@
 #include "core/render.h"
 #include "core/scene_loader.h"
 #include "core/tangents.h"
+#include "debugtools/aov.h"
 #include "reference/reference_tracer.h"
 #include "tests/stat_util.h"
 #include "tests/temp_dir.h"
@@ -243,6 +244,20 @@ TEST_F(TexturesTest, FlatNormalMapRendersTheBitsOfNoMap) {
   };
   const Image a = image(true), b = image(false);
   EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
+}
+
+// The albedo AOV shows what a textured surface's hits read, not the
+// material's constant.
+TEST_F(TexturesTest, AlbedoAovReadsTheTexture) {
+  write_image(dir_ / "c.exr", 1, 1, 3, {0.3f, 0.6f, 0.9f});
+  // A large rectangle filling the view.
+  const CompiledScene compiled(parse_scene(plane_scene("c.exr", 2.0f, 0.0f, 5.0f, 8, "cone"), dir_ / "s.json"));
+  const ReferenceTracer tracer(compiled, compiled.scene().render);
+  AovAccumulator aovs(compiled, compiled.scene().render);
+  Film film(8, 8, FilterKind::Box);
+  render(AovTracer(tracer, aovs), film);
+  const Image albedo = aovs.albedo();
+  for (const vec3& p : albedo.pixels) expect_near(p, Spectrum(0.3f, 0.6f, 0.9f), 1e-6f, "albedo AOV");
 }
 
 // ------------------------------------------------------------ textured emission

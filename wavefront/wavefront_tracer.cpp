@@ -301,7 +301,9 @@ std::string WavefrontTracer::stages_description() const {
 }
 
 std::size_t WavefrontTracer::bytes_per_path() const {
-  return vector_ ? Lanes::bytes_per_path() : scalar_bytes_per_path();
+  if (vector_) return Lanes::bytes_per_path();
+  // A textured scene's paths also carry their cone and their hit's parameters.
+  return scalar_bytes_per_path() + (scene_.has_textures() ? sizeof(RayCone) + sizeof(SurfaceParams) : 0);
 }
 
 // Stage: the first surface along each live path's ray. The rays go to
