@@ -71,6 +71,10 @@ struct WavefrontTracer::Wave {
     shadow.resize(2 * size), light.resize(2 * size), unoccluded.resize(2 * size), light_weight.resize(2 * size);
     shadow_state.resize(2 * size);
     query.resize(2 * size), query_slot.resize(2 * size), query_result.resize(2 * size);
+    // A thread's wave that once served a textured scene keeps its cones, and
+    // move() copies them whenever there are any: they must grow with the rest
+    // (a textured render, then a larger untextured one, wrote past them).
+    if (!cone.empty()) textured(size);
   }
   // A finished path's sample. Its last ray reached vertex `vertex` unless it
   // found nothing.
