@@ -1,20 +1,28 @@
 // Model "penumbra": a planar convex emitter of radiance Le (one-sided unless
 // two_sided), a planar Lambert ground of albedo rho (black from behind if its
-// material is one_sided), and at most one black,
-// closed, convex occluder (a box) strictly between the emitter's plane and
-// the ground. Nothing else reflects, so a ground point x receives direct
-// light only:
+// material is one_sided), and at most one black occluder strictly between
+// the emitter's plane and the ground: a closed convex mesh (a box) or a
+// planar convex polygon (a quad), of coverage alpha (core/alpha.h; 1 if its
+// material has none). Nothing else reflects, so a ground point x receives
+// direct light only:
 //   L(x) = rho / pi * Le * FF(x),
-//   FF(x) = F(emitter) - F(emitter ∩ shadow(x)),
+//   FF(x) = F(emitter) - o F(emitter ∩ shadow(x)),
 // with F the cosine-weighted solid angle of a polygon seen from x (Lambert's
-// formula after clipping to x's horizon, polygon_irradiance.h), and
-// shadow(x) the occluder projected from x onto the emitter's plane: convex,
-// because the occluder is, and exactly the set of emitter points x cannot
-// see. Umbra (FF = 0), penumbra and fully lit points are all exact.
+// formula after clipping to x's horizon, polygon_irradiance.h), shadow(x)
+// the occluder projected from x onto the emitter's plane: convex, because
+// the occluder is, and exactly the set of emitter points whose segment to x
+// meets it; and o the probability that such a segment is stopped: alpha
+// for a polygon, which the segment crosses once, 1 - (1 - alpha)^2 for a
+// closed mesh, which it crosses twice, each crossing decided independently.
+// With alpha = 1, o = 1: umbra (FF = 0), penumbra and fully lit points are
+// all exact; with alpha < 1 the irradiance is E_unoccluded - o (E_unoccluded
+// - E_occluded), as exact.
 //
 // A camera ray carries: Le where it meets the emitter's front, 0 on the
 // occluder or the emitter's back or when it escapes, and L(x) on the ground
-// (0 with a depth cap of 0). The same model serves the emitter registered
+// (0 with a depth cap of 0); a ray that meets the occluder passes it with
+// probability 1 - o and carries what lies behind, so its expected radiance
+// is (1 - o) times that. The same model serves the emitter registered
 // as a light and, with "light": false in its material, as a plain emissive
 // surface only BSDF sampling finds.
 #include "analytic-scenes/models.h"
@@ -87,6 +95,7 @@ class Penumbra final : public AnalyticModel {
   const Shape* emitter = nullptr;
   const Shape* ground = nullptr;
   const Shape* occluder = nullptr;  // may be null
+  double opacity = 1.0;              // o: the probability that a segment through the occluder is stopped
   Plane emitter_plane, ground_plane;
   dvec3 eu, ev;                      // basis of the emitter's plane
   std::vector<glm::dvec2> emitter_2d;  // convex, counter-clockwise
@@ -120,7 +129,7 @@ class Penumbra final : public AnalyticModel {
       if (!hidden.empty()) {
         std::vector<dvec3> hidden_3d;
         for (const glm::dvec2& p : hidden) hidden_3d.push_back(to_3d(p));
-        ff -= polygon_form_factor(hidden_3d, x, n);
+        ff -= opacity * polygon_form_factor(hidden_3d, x, n);
       }
     }
     return std::max(0.0, ff);
@@ -129,18 +138,26 @@ class Penumbra final : public AnalyticModel {
   Spectrum radiance(const Ray& ray) const override {
     std::vector<const Shape*> shapes{emitter, ground};
     if (occluder) shapes.push_back(occluder);
-    const auto hit = nearest_hit(shapes, ray);
-    if (!hit) return Spectrum(0.0f);
+    auto hit = nearest_hit(shapes, ray);
+    // The occluder is black: it stops a ray with probability o and gives 0;
+    // otherwise the ray goes on to what lies behind it.
+    float through = 1.0f;
+    if (hit && hit->first == 2) {
+      through = static_cast<float>(1.0 - opacity);
+      shapes.pop_back();
+      hit = nearest_hit(shapes, ray);
+    }
+    if (!hit || through == 0.0f) return Spectrum(0.0f);
     const dvec3 d = glm::normalize(dvec3(ray.dir));
     const dvec3 x = dvec3(ray.origin) + hit->second * d;
-    if (hit->first == 0) return (two_sided || glm::dot(d, emitter_plane.normal) < 0.0) ? Le : Spectrum(0.0f);
-    if (hit->first == 2 || max_depth == 0) return Spectrum(0.0f);
+    if (hit->first == 0) return (two_sided || glm::dot(d, emitter_plane.normal) < 0.0) ? through * Le : Spectrum(0.0f);
+    if (max_depth == 0) return Spectrum(0.0f);
     // A two-sided Lambert ground shades on the camera's side; a one-sided
     // one is black from behind.
     const bool front = glm::dot(d, ground_plane.normal) < 0.0;
     if (ground_one_sided && !front) return Spectrum(0.0f);
     const dvec3 n = front ? ground_plane.normal : -ground_plane.normal;
-    return rho * Le * static_cast<float>(visible_form_factor(x, n) / kPi);
+    return through * rho * Le * static_cast<float>(visible_form_factor(x, n) / kPi);
   }
 };
 
@@ -170,6 +187,7 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
 
   const Material& em = scene.materials[model->emitter->material];
   const Material& gm = scene.materials[model->ground->material];
+  if (gm.has_alpha()) refuse(scene, kName, "only the occluder may have alpha (the ground has)");
   if (em.scatters()) refuse(scene, kName, "the emitter must reflect nothing (material type \"emissive\")");
   if (gm.type != MaterialType::Diffuse) refuse(scene, kName, "the ground must be diffuse (Lambert)");
   const auto ep = plane_of(*model->emitter);
@@ -192,8 +210,24 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
   for (const glm::dvec2& p : model->emitter_2d) model->emitter_3d.push_back(model->to_3d(p));
 
   if (const Shape* occ = model->occluder) {
-    if (occ->kind != Shape::Kind::Triangles || !is_closed(*occ) || !is_convex(*occ))
-      refuse(scene, kName, "the occluder must be a closed convex mesh (a box)");
+    // A closed convex mesh, or a planar convex polygon (its hull in its
+    // plane has the mesh's own area).
+    const auto planar = occ->kind == Shape::Kind::Triangles ? plane_of(*occ) : std::nullopt;
+    bool convex_polygon = false;
+    if (planar) {
+      const Frame pf{vec3(planar->normal)};
+      std::vector<glm::dvec2> hull;
+      for (const vec3& v : occ->mesh.positions)
+        hull.emplace_back(glm::dot(dvec3(v) - planar->point, dvec3(pf.s)), glm::dot(dvec3(v) - planar->point, dvec3(pf.t)));
+      hull = convex_hull(std::move(hull));
+      convex_polygon = std::abs(signed_area(hull) - mesh_area(*occ)) <= 1e-5 * mesh_area(*occ);
+    }
+    if (occ->kind != Shape::Kind::Triangles || !(convex_polygon || (is_closed(*occ) && is_convex(*occ))))
+      refuse(scene, kName, "the occluder must be a closed convex mesh (a box) or a planar convex polygon (a quad)");
+    if (scene.materials[occ->material].alpha_texture)
+      refuse(scene, kName, "the occluder's alpha must be a number (an alpha texture is not modelled)");
+    const double a = scene.materials[occ->material].alpha;
+    model->opacity = convex_polygon ? a : 1.0 - (1.0 - a) * (1.0 - a);
     // Strictly between the emitter's plane and the whole ground, so that from
     // every ground point it projects onto the emitter's plane.
     double ground_near = kInfinity;
@@ -214,7 +248,11 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
     << (em.sampled_as_light ? " as a light" : " not a light (BSDF sampling only)") << ", ground '" << gm.name
     << "' albedo (" << gm.albedo.x << ", " << gm.albedo.y << ", " << gm.albedo.z << ")"
     << (gm.one_sided ? " one-sided" : "")
-    << (model->occluder ? ", one occluder" : ", no occluder") << ", depth cap " << model->max_depth;
+    << (model->occluder ? ", one occluder" : ", no occluder");
+  if (model->occluder && scene.materials[model->occluder->material].has_alpha())
+    d << " of alpha " << scene.materials[model->occluder->material].alpha << " (stops " << model->opacity
+      << " of the segments through it)";
+  d << ", depth cap " << model->max_depth;
   model->description = d.str();
   return model;
 }

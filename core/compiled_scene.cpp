@@ -44,16 +44,29 @@ void check_instancing(const Scene& scene) {
   }
 }
 
+// The loaders refuse alpha on a light; a scene built in code gets the same
+// check: the light sampler would aim at points that rays may pass through.
+void check_alpha(const Scene& scene) {
+  for (const Shape& shape : scene.shapes) {
+    const Material& m = scene.materials[shape.material];
+    if (m.has_alpha() && m.emits() && m.sampled_as_light)
+      throw InputError(shape.description + ": material '" + m.name +
+                       "' has alpha on a light (light sampling does not model coverage; give it \"light\": false)");
+  }
+}
+
 }  // namespace
 
 CompiledScene::CompiledScene(Scene scene)
     : scene_(std::move(scene)), camera_(scene_.camera, scene_.film.width, scene_.film.height) {
   check_instancing(scene_);
+  check_alpha(scene_);
   configure_shading(scene_);  // materials: shading path for the scene's lobes, sampling flavour, min pdf
   Box box;
   for (const Shape& shape : scene_.shapes) {
     if (!shape.in_group) box.add(bounds(shape));
     lobes_ |= scene_.materials[shape.material].lobes();
+    has_alpha_ = has_alpha_ || scene_.materials[shape.material].has_alpha();
   }
   // An instance's bounds: the corners of its group's box, placed.
   std::vector<Box> group_boxes;
@@ -79,7 +92,10 @@ CompiledScene::CompiledScene(Scene scene)
     p.emplace_back(0.0f);
     p.pop_back();
   }
-  accel_ = std::make_unique<EmbreeAccel>(scene_.shapes, scene_.groups, scene_.instances, scene_.render.compact_bvh);
+  // The images first: alpha textures are read during traversal.
+  if (!scene_.textures.empty()) textures_ = std::make_unique<Textures>(scene_.textures, scene_.render.texture_cache_mb);
+  accel_ = std::make_unique<EmbreeAccel>(scene_.shapes, scene_.groups, scene_.instances, scene_.render.compact_bvh,
+                                         scene_.materials, textures_.get());
   first_triangle_.resize(scene_.shapes.size() + 1, 0);
   for (std::size_t i = 0; i < scene_.shapes.size(); ++i) {
     const Shape& shape = scene_.shapes[i];
@@ -94,7 +110,6 @@ CompiledScene::CompiledScene(Scene scene)
       for (std::size_t t = b; t < e; ++t) out[t] = make_triangle(shape, static_cast<std::uint32_t>(t));
     });
   }
-  if (!scene_.textures.empty()) textures_ = std::make_unique<Textures>(scene_.textures, scene_.render.texture_cache_mb);
   lights_ = std::make_unique<LightSampler>(scene_, bounds_radius_, textures_.get());
 }
 

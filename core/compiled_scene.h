@@ -3,6 +3,7 @@
 // thread of every tracer.
 #pragma once
 
+#include "core/alpha.h"
 #include "core/camera.h"
 #include "core/embree_accel.h"
 #include "core/geometry.h"
@@ -33,6 +34,14 @@ class CompiledScene {
   // Every lobe any material of the scene uses ("model only what a scene
   // requires": shading may skip the rest).
   LobeMask lobes() const { return lobes_; }
+  // True if some shape's material has alpha (Material::has_alpha).
+  bool has_alpha() const { return has_alpha_; }
+  // The alpha key of the rays leaving `vertex` of the sample `rng` draws for
+  // (core/alpha.h), the one both tracers give their camera, continuation and
+  // shadow rays; 0 in a scene without alpha, where no filter reads it.
+  std::uint32_t alpha_key(const SampleStream& rng, int vertex) const {
+    return has_alpha_ ? pathlab::alpha_key(rng, static_cast<std::uint32_t>(vertex)) : 0u;
+  }
   // Centre and radius of a sphere bounding all finite geometry.
   vec3 bounds_center() const { return bounds_center_; }
   float bounds_radius() const { return bounds_radius_; }
@@ -127,6 +136,7 @@ class CompiledScene {
   HugePageVector<Triangle> triangles_;        // every shape's, in shape order (read at random: huge pages)
   std::vector<std::size_t> first_triangle_;  // per shape, and one past the last
   LobeMask lobes_ = 0;
+  bool has_alpha_ = false;
   vec3 bounds_center_{0.0f};
   float bounds_radius_ = 1.0f;
 };

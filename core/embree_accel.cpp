@@ -1,6 +1,8 @@
 #include "core/embree_accel.h"
 
+#include "core/alpha.h"
 #include "core/error.h"
+#include "core/texture.h"
 
 #include <embree3/rtcore.h>
 
@@ -35,6 +37,49 @@ struct ErrorSink {
   }
 };
 
+// What the alpha filter of one geometry reads (its user data): the shape's
+// coverage, and what turns Embree's IDs into the scene's shape and instance
+// indices that the decision hashes (core/alpha.h).
+struct AlphaGeometry {
+  float alpha = 1.0f;
+  std::uint32_t shape = 0;           // index into Scene::shapes
+  std::uint32_t first_instance = 0;  // geometry ID of instance 0 in the top scene
+  // A textured coverage (else null): the texture, its images, and the mesh
+  // whose texture coordinates (or, without them, the barycentrics, as
+  // CompiledScene::resolve reads them) say where.
+  const TextureRef* texture = nullptr;
+  const Textures* textures = nullptr;
+  const TriangleMesh* mesh = nullptr;
+
+  // The coverage at barycentrics (b1, b2) of triangle `prim`.
+  float at(unsigned prim, float b1, float b2) const {
+    if (!texture) return alpha;
+    vec2 uv(b1, b2);
+    if (mesh->has_uvs()) {
+      const glm::uvec3 v = mesh->triangles[prim];
+      uv = (1.0f - b1 - b2) * mesh->uvs[v.x] + b1 * mesh->uvs[v.y] + b2 * mesh->uvs[v.z];
+    }
+    return std::clamp(textures->nearest_number(*texture, uv), 0.0f, 1.0f);
+  }
+};
+
+// Embree's intersection and occlusion filter for a geometry with alpha: a
+// hit the alpha test rejects is made invalid, and traversal goes on past it.
+// A pure function of (ray key, shape, triangle, instance), so Embree may
+// call it for the same triangle any number of times, in any order.
+void alpha_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* g = static_cast<const AlphaGeometry*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const unsigned key = RTCRayN_id(args->ray, args->N, i);
+    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    const unsigned inst = RTCHitN_instID(args->hit, args->N, i, 0);
+    const std::uint32_t instance = inst == RTC_INVALID_GEOMETRY_ID ? kNoInstance : inst - g->first_instance;
+    const float alpha = g->at(prim, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+    if (!alpha_stops(alpha, alpha_uniform(key, g->shape, prim, instance))) args->valid[i] = 0;
+  }
+}
+
 }  // namespace
 
 struct EmbreeAccel::Impl {
@@ -48,6 +93,11 @@ struct EmbreeAccel::Impl {
   std::vector<std::vector<std::uint32_t>> group_shapes;
   std::vector<std::uint32_t> instance_group;  // per instance; empty for a scene without instances
   bool compact = false;
+  std::span<const Material> materials;  // read while building only; empty: every shape opaque
+  const Textures* textures = nullptr;   // for alpha textures
+  // The alpha filters' user data, one per shape with alpha (a group's shape
+  // once, whatever places it); Embree holds pointers to them.
+  std::vector<std::unique_ptr<AlphaGeometry>> alpha_geometries;
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
@@ -60,7 +110,9 @@ struct EmbreeAccel::Impl {
     rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
     return s;
   }
-  void attach(RTCScene target, const Shape& shape, std::uint32_t id);
+  // Attaches `shape` (the scene's shape `index`) to `target` with geometry
+  // ID `id`.
+  void attach(RTCScene target, const Shape& shape, std::uint32_t index, std::uint32_t id);
   // The instance ID Embree reports, as RayHit::instance.
   std::uint32_t instance_of(unsigned inst_id) const {
     return inst_id == RTC_INVALID_GEOMETRY_ID ? kNoInstance : inst_id - first_instance;
@@ -74,9 +126,14 @@ struct EmbreeAccel::Impl {
 };
 
 EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups,
-                         std::span<const Instance> instances, bool compact)
+                         std::span<const Instance> instances, bool compact, std::span<const Material> materials,
+                         const Textures* textures)
     : impl_(std::make_unique<Impl>()) {
   impl_->compact = compact;
+  impl_->materials = materials;
+  impl_->textures = textures;
+  // Set before any shape is attached: the filters read it.
+  impl_->first_instance = static_cast<std::uint32_t>(shapes.size());
   impl_->device = rtcNewDevice(nullptr);
   if (!impl_->device)
     throw SystemError(std::string("Embree: cannot create device: error ") +
@@ -85,7 +142,7 @@ EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const Shape
 
   impl_->scene = impl_->new_scene();
   for (std::uint32_t id = 0; id < shapes.size(); ++id)
-    if (!shapes[id].in_group) impl_->attach(impl_->scene, shapes[id], id);
+    if (!shapes[id].in_group) impl_->attach(impl_->scene, shapes[id], id, id);
 
   // Each group's BVH is built once, its shapes numbered from 0 in it.
   struct GroupScenes {  // released however the constructor ends: the instances hold their own references
@@ -97,12 +154,11 @@ EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const Shape
   for (const ShapeGroup& group : groups) {
     group_scenes.scenes.push_back(impl_->new_scene());
     for (std::uint32_t k = 0; k < group.shapes.size(); ++k)
-      impl_->attach(group_scenes.scenes.back(), shapes[group.shapes[k]], k);
+      impl_->attach(group_scenes.scenes.back(), shapes[group.shapes[k]], group.shapes[k], k);
     impl_->group_shapes.push_back(group.shapes);
     rtcCommitScene(group_scenes.scenes.back());
     impl_->errors.check(("building the BVH of group " + group.name).c_str());
   }
-  impl_->first_instance = static_cast<std::uint32_t>(shapes.size());
   for (std::uint32_t i = 0; i < instances.size(); ++i) {
     const Instance& inst = instances[i];
     RTCGeometry geom = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_INSTANCE);
@@ -122,7 +178,14 @@ EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const Shape
   impl_->errors.check("building the BVH");
 }
 
-void EmbreeAccel::Impl::attach(RTCScene target, const Shape& shape, std::uint32_t id) {
+void EmbreeAccel::Impl::attach(RTCScene target, const Shape& shape, std::uint32_t index, std::uint32_t id) {
+  const Material* material = materials.empty() ? nullptr : &materials[shape.material];
+  const bool has_alpha = material && material->has_alpha();
+  if (has_alpha && material->alpha_texture && !textures)
+    throw InputError(shape.description + ": an alpha texture, but the scene's textures were not given");
+  if (has_alpha && shape.kind != Shape::Kind::Triangles)
+    throw InputError(shape.description + ": alpha on a sphere is not supported (a ray crosses it twice at one "
+                     "primitive, so the two crossings cannot be decided apart); use a mesh");
   RTCGeometry geom = nullptr;
   if (shape.kind == Shape::Kind::Triangles) {
     geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
@@ -153,6 +216,16 @@ void EmbreeAccel::Impl::attach(RTCScene target, const Shape& shape, std::uint32_
     }
   }
   errors.check(shape.description.c_str());
+  if (has_alpha) {
+    // Only the geometries with alpha get filters: Embree calls none on the
+    // others, which trace as fast as in a scene without alpha.
+    alpha_geometries.push_back(std::make_unique<AlphaGeometry>(AlphaGeometry{
+        material->alpha, index, first_instance, material->alpha_texture ? &*material->alpha_texture : nullptr,
+        textures, &shape.mesh}));
+    rtcSetGeometryUserData(geom, alpha_geometries.back().get());
+    rtcSetGeometryIntersectFilterFunction(geom, &alpha_filter);
+    rtcSetGeometryOccludedFilterFunction(geom, &alpha_filter);
+  }
   rtcCommitGeometry(geom);
   rtcAttachGeometryByID(target, geom, id);
   rtcReleaseGeometry(geom);
@@ -174,7 +247,7 @@ void fill(RTCRay& r, const Ray& ray) {
   r.tfar = ray.tmax;
   r.time = 0.0f;
   r.mask = 0xffffffffu;
-  r.id = 0;
+  r.id = ray.alpha_key;
   r.flags = 0;
 }
 
@@ -238,7 +311,7 @@ void fill_lane(Packet& r, int k, const Ray& ray) {
   r.tfar[k] = ray.tmax;
   r.time[k] = 0.0f;
   r.mask[k] = 0xffffffffu;
-  r.id[k] = 0;
+  r.id[k] = ray.alpha_key;
   r.flags[k] = 0;
 }
 
@@ -373,7 +446,8 @@ namespace {
 
 // Ray i of `rays` in the one-ray form.
 Ray ray_at(const RayArrays& r, std::size_t i) {
-  return Ray{vec3(r.ox[i], r.oy[i], r.oz[i]), vec3(r.dx[i], r.dy[i], r.dz[i]), r.tmax[i]};
+  return Ray{vec3(r.ox[i], r.oy[i], r.oz[i]), vec3(r.dx[i], r.dy[i], r.dz[i]), r.tmax[i],
+             r.alpha_key ? r.alpha_key[i] : 0u};
 }
 
 // Lanes [b, b + n) of `rays` as a 16-wide packet.
@@ -391,14 +465,15 @@ void fill_packet(Packet& p, const RayArrays& rays, std::size_t b, std::size_t n)
     p.tnear[k] = 0.0f;
     p.time[k] = 0.0f;
     p.mask[k] = 0xffffffffu;
-    p.id[k] = 0;
+    p.id[k] = rays.alpha_key ? rays.alpha_key[b + k] : 0u;
     p.flags[k] = 0;
   }
   disable_lanes(p, n);
 }
 
 // The per-ray inputs of a pointer-SoA stream that the arrays do not hold:
-// tnear 0, time 0, every mask bit, id and flags 0; and tfar to be written.
+// tnear 0, time 0, every mask bit, flags 0, id 0 unless the arrays hold
+// alpha keys; and tfar to be written.
 struct StreamScratch {
   std::vector<float> zeros, tfar, ng, u, v;
   std::vector<unsigned> mask, zero_ids, geom, prim, inst;
@@ -418,7 +493,8 @@ struct StreamScratch {
   RTCRayNp ray(const RayArrays& r) {
     return RTCRayNp{const_cast<float*>(r.ox), const_cast<float*>(r.oy), const_cast<float*>(r.oz), zeros.data(),
                     const_cast<float*>(r.dx), const_cast<float*>(r.dy), const_cast<float*>(r.dz), zeros.data(),
-                    tfar.data(), mask.data(), zero_ids.data(), zero_ids.data()};
+                    tfar.data(), mask.data(),
+                    r.alpha_key ? const_cast<unsigned*>(r.alpha_key) : zero_ids.data(), zero_ids.data()};
   }
 };
 

@@ -5,6 +5,10 @@
 // scene's shape index), and each of the scene's instances places it through
 // an Embree instance (geometry ID shapes.size() + instance index in the top
 // scene).
+// Shapes whose material has alpha (Material::has_alpha) get intersection
+// and occlusion filters that let a ray through with probability 1 - alpha,
+// decided by the ray's alpha_key and the surface (core/alpha.h); every other
+// geometry has none, so a scene without alpha traces as before.
 // This is the only file that includes Embree.
 #pragma once
 
@@ -17,6 +21,8 @@
 #include <string>
 
 namespace pathlab {
+
+class Textures;
 
 struct RayHit {
   float t = 0.0f;
@@ -40,6 +46,7 @@ inline constexpr RayBatchMode kAllRayBatchModes[] = {RayBatchMode::Single, RayBa
 // the wavefront's vectorised stages keep their paths in.
 struct RayArrays {
   const float *ox, *oy, *oz, *dx, *dy, *dz, *tmax;
+  const std::uint32_t* alpha_key = nullptr;  // as Ray::alpha_key; null: every key 0
 };
 struct HitArrays {
   float *t, *u, *v;               // distance; Embree's barycentrics (b1, b2) for a triangle
@@ -55,9 +62,14 @@ class EmbreeAccel {
   // their vertex arrays too where they have capacity for one more vertex
   // (CompiledScene reserves it): `shapes` must outlive the accel and keep
   // those arrays unchanged. Groups and instances are copied.
-  // `compact`: RenderSettings::compact_bvh.
+  // `compact`: RenderSettings::compact_bvh. `materials`: the table
+  // Shape::material indexes, read for alpha (empty: every shape opaque);
+  // throws InputError for alpha on a sphere, whose two crossings of one
+  // ray would share a decision. `textures`: the scene's images, which
+  // alpha textures read (must outlive the accel; null if it has none).
   explicit EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups = {},
-                       std::span<const Instance> instances = {}, bool compact = false);
+                       std::span<const Instance> instances = {}, bool compact = false,
+                       std::span<const Material> materials = {}, const Textures* textures = nullptr);
   ~EmbreeAccel();
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;

@@ -26,6 +26,7 @@ enum class Fault {
   CoatNotCoupled,         // bsdf/disney.cpp: energy compensation forgets to dim what lies under the clearcoat
   DiffuseNotCoupled,      // bsdf/disney.cpp: energy compensation forgets to dim the diffuse under the specular layer
   DielectricFresnelIgnored,// surfel.cpp: glass always refracts (Fresnel reflection dropped, TIR kept)
+  AlphaKeysNotSet,        // reference: every ray keeps alpha key 0, so each triangle decides once for all rays
 };
 
 #ifdef PATHLAB_FAULT_INJECTION

@@ -526,6 +526,7 @@ std::uint32_t Flattener::material(int index) {
   p.specular_tint = 0.0f;
   p.sheen = 0.0f;
   Spectrum emission(0.0f);
+  float coverage = 1.0f;  // Material::alpha
   std::vector<TexturedParam> textures;
   std::optional<NormalMap> normal_map;
   std::optional<TextureRef> emission_texture;
@@ -562,9 +563,20 @@ std::uint32_t Flattener::material(int index) {
         ignored_.insert("extension " + name);
       }
     }
-    if (alpha < 1.0f || m.alphaMode == "BLEND" || m.alphaMode == "MASK") ignored_.insert("alpha (rendered opaque)");
+    // alphaMode (glTF 2.0, 3.9.4) onto the material's coverage: OPAQUE
+    // ignores alpha, MASK keeps the surface where alpha >= alphaCutoff and
+    // cuts it elsewhere, BLEND is stochastic coverage. The factor alone:
+    // the base colour texture's alpha is not read.
+    if (m.alphaMode == "MASK") {
+      if (!(m.alphaCutoff >= 0.0)) fail(file_, at + "/alphaCutoff", "must not be negative");
+      coverage = alpha >= static_cast<float>(m.alphaCutoff) ? 1.0f : 0.0f;
+    } else if (m.alphaMode == "BLEND") {
+      coverage = alpha;
+    }
     // Textures multiply their factors (glTF 2.0, 3.9): the factor is the
     // TextureRef's scale.
+    if (pbr.baseColorTexture.index >= 0 && m.alphaMode != "OPAQUE")
+      ignored_.insert("baseColorTexture's alpha (the factor alone gives the coverage)");
     if (pbr.baseColorTexture.index >= 0)
       if (auto t = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions,
                            TextureColorSpace::Srgb, at + "/pbrMetallicRoughness/baseColorTexture")) {
@@ -600,6 +612,7 @@ std::uint32_t Flattener::material(int index) {
   out.material = disney_material(p);
   out.material.name = name;
   out.material.emission = emission;
+  out.material.alpha = coverage;
   for (const TexturedParam& t : textures) out.material.set_texture(t.param, t.texture);
   if (emission_texture && !is_black(emission)) {
     emission_texture->scale = emission;

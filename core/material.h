@@ -55,6 +55,12 @@
 //     radiance      [r,g,b] >= 0       emitted radiance            required
 //     two_sided, light                  as for "diffuse"
 //
+// Every type:
+//     alpha         number in [0, 1]   coverage: a ray meets the   default 1
+//                   or texture         surface with this probability and passes through it
+//                                      otherwise (core/alpha.h); an error on a light and on a sphere;
+//                                      a texture is read at its nearest texel, one channel, linear
+//
 // Emission leaves the front side of a surface: the side its geometric normal
 // points to (see each shape's "flip_normals"), or both sides if two_sided.
 // Reflection happens on both sides unless one_sided: then a path that meets
@@ -149,6 +155,12 @@ struct Material {
   bool two_sided_emission = false;
   bool sampled_as_light = true;  // false: only rays that hit it find its emission
   bool one_sided = false;      // reflects on its front side only; the back is black
+  // Coverage in [0, 1]: a ray meets the surface with this probability and
+  // passes through it otherwise (core/alpha.h). 1: opaque. A texture, when
+  // there is one, replaces the number: its nearest texel at the hit's
+  // texture coordinates, clamped to [0, 1] (Textures::nearest_number).
+  float alpha = 1.0f;
+  std::optional<TextureRef> alpha_texture{};
   DisneyParams disney{};       // type Disney
   DielectricParams glass{};    // type Dielectric
   // Derived from `disney` (or, for the general path, from `albedo`) by the
@@ -156,6 +168,9 @@ struct Material {
   disney::Closure closure{};
 
   bool emits() const { return !is_black(emission) || emission_textured; }
+  // True if rays may pass through the surface (EmbreeAccel then registers
+  // its alpha filter on the material's shapes, and only then).
+  bool has_alpha() const { return alpha < 1.0f || alpha_texture.has_value(); }
   // True if the material scatters light at all (an "emissive" does not).
   bool scatters() const;
   // True if every way this material scatters is an impulse: next-event

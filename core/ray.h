@@ -14,6 +14,9 @@ struct Ray {
   vec3 origin;
   vec3 dir;           // unit length
   float tmax = kInfinity;
+  // Decides the surfaces of partial coverage the ray meets (core/alpha.h);
+  // Embree carries it in its ray's `id`.
+  std::uint32_t alpha_key = 0;
 };
 
 // Moves `p` off its surface along `n` (pointing to the side the new ray

@@ -35,9 +35,11 @@ class SampleStream {
   // key() is mix64(seed_key(seed) ^ (pixel << 32 | sample)).
   static constexpr std::uint64_t seed_key(std::uint64_t seed) { return mix64(seed + 0x9e3779b97f4a7c15ull); }
 
-  constexpr float get(std::uint32_t bounce, Dim dim) const {
-    return to_unit_float(
-        mix64(key_ ^ ((static_cast<std::uint64_t>(bounce) << 32) | static_cast<std::uint32_t>(dim))));
+  constexpr float get(std::uint32_t bounce, Dim dim) const { return to_unit_float(bits(bounce, dim)); }
+  // The whole 64-bit hash get() takes its top 24 bits from, for a decision
+  // that needs more than one float's worth (a ray's alpha key, core/alpha.h).
+  constexpr std::uint64_t bits(std::uint32_t bounce, Dim dim) const {
+    return mix64(key_ ^ ((static_cast<std::uint64_t>(bounce) << 32) | static_cast<std::uint32_t>(dim)));
   }
   // The hashed (seed, pixel, sample): get() is to_unit_float(mix64(key() ^
   // (bounce << 32 | dim))), for code that draws many streams' numbers at once.

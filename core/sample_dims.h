@@ -29,6 +29,11 @@ enum class Dim : std::uint32_t {
   DirectionY,
   Roulette,          // Russian roulette survival
 
+  // --- any bounce: the rays that leave it ----------------------------------------
+  Alpha,             // the key of every ray leaving this vertex (the camera ray at bounce 0, the
+                     // continuation and the shadow rays at k >= 1): stochastic alpha decides each
+                     // surface the ray meets by a hash of this key and the surface (core/alpha.h)
+
   Count
 };
 

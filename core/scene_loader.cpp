@@ -162,6 +162,23 @@ float unit_number(const Node& node, const char* key, float fallback, float lo = 
   return v;
 }
 
+// "alpha": the material's coverage (core/alpha.h), a number in [0, 1] or a
+// texture (one channel, linear by default, read at the nearest texel). A
+// light may not have it: the light sampler would aim at points that its
+// shadow rays may pass through.
+void read_alpha(const Node& node, Material& m, Scene& scene) {
+  if (!node.has("alpha")) return;
+  const Node a = node.child("alpha");
+  const bool textured = is_texture(a);
+  if (textured) m.alpha_texture = read_texture(a, scene, TextureUse::Number, TextureColorSpace::Linear);
+  else if (!a.value().is_number()) a.fail("alpha must be a number in [0, 1] or a texture {\"texture\": \"file.png\", ...}, found " + describe(a.value()));
+  else m.alpha = unit_number(node, "alpha", 1.0f);
+  if (m.has_alpha() && m.emits() && m.sampled_as_light)
+    a.fail(std::string(textured ? "an alpha texture" : "alpha") +
+           " on a light: light sampling does not model coverage; give the material \"light\": false, or make it "
+           "opaque");
+}
+
 // A key that belongs to another material type gets a pointed message, not
 // only "unknown key": {key used, what to say}.
 void reject_misplaced(const Node& node, const std::string& type,
@@ -207,7 +224,7 @@ Material read_material(const Node& node, const std::string& name, Scene& scene) 
                      {{type == "diffuse" ? "reflectance" : "albedo",
                        type == "diffuse" ? "its colour is 'albedo'" : "its colour is 'reflectance'"},
                       {"radiance", "emitted light is 'emission'"}});
-    node.allow_only({"type", refl, "emission", "two_sided", "light", "one_sided", "normal_map"});
+    node.allow_only({"type", refl, "emission", "two_sided", "light", "one_sided", "normal_map", "alpha"});
     m.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
     m.albedo = colour(refl, MaterialParam::Albedo, true, Spectrum(type == "diffuse" ? 0.5f : 1.0f));
     m.emission = colour("emission", MaterialParam::Emission, false, Spectrum(0.0f));
@@ -217,7 +234,7 @@ Material read_material(const Node& node, const std::string& name, Scene& scene) 
                       {"albedo", "it reflects nothing (use type diffuse with 'emission' for a surface that does both)"},
                       {"reflectance", "it reflects nothing"},
                       {"one_sided", "it reflects nothing; the sides it emits from are set by 'two_sided'"}});
-    node.allow_only({"type", "radiance", "two_sided", "light"});
+    node.allow_only({"type", "radiance", "two_sided", "light", "alpha"});
     m.type = MaterialType::Emissive;
     m.albedo = Spectrum(0.0f);
     node.required("radiance");
@@ -229,7 +246,7 @@ Material read_material(const Node& node, const std::string& name, Scene& scene) 
                       {"radiance", "emitted light is 'emission'"}});
     node.allow_only({"type", "base_color", "metallic", "subsurface", "specular", "specular_tint", "roughness",
                      "anisotropic", "sheen", "sheen_tint", "clearcoat", "clearcoat_gloss", "energy_compensation", "emission",
-                     "two_sided", "light", "one_sided", "normal_map"});
+                     "two_sided", "light", "one_sided", "normal_map", "alpha"});
     DisneyParams p;
     p.base_color = colour("base_color", MaterialParam::BaseColor, true, p.base_color);
     p.metallic = number("metallic", MaterialParam::Metallic, p.metallic);
@@ -259,7 +276,7 @@ Material read_material(const Node& node, const std::string& name, Scene& scene) 
                       {"eta", "the index of refraction is 'ior'"},
                       {"emission", "glass does not emit"},
                       {"one_sided", "glass has an inside and an outside: both sides scatter"}});
-    node.allow_only({"type", "ior", "reflectance", "transmittance", "normal_map"});
+    node.allow_only({"type", "ior", "reflectance", "transmittance", "normal_map", "alpha"});
     DielectricParams p;
     p.ior = unit_number(node, "ior", p.ior, 1.0f, 10.0f);
     p.reflectance = colour("reflectance", MaterialParam::GlassReflectance, true, p.reflectance);
@@ -286,6 +303,7 @@ Material read_material(const Node& node, const std::string& name, Scene& scene) 
   m.two_sided_emission = node.boolean_or("two_sided", false);
   m.sampled_as_light = node.boolean_or("light", true);
   m.one_sided = node.boolean_or("one_sided", false);
+  read_alpha(node, m, scene);
   return m;
 }
 
@@ -492,6 +510,13 @@ void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path
     file.fail(e.what());
   }
   if (scene.shapes.size() == before) file.fail(path.string() + ": the file's scene holds no triangles");
+  for (std::size_t k = before; k < scene.shapes.size(); ++k) {
+    const Material& m = scene.materials[scene.shapes[k].material];
+    if (m.has_alpha() && m.emits() && m.sampled_as_light)
+      file.fail(scene.shapes[k].description + ": material " + in_quotes(m.name) +
+                " has alpha (alphaMode MASK or BLEND) on a light: light sampling does not model coverage; override "
+                "it with a scene material in 'materials'");
+  }
 }
 
 // {"type": "environment", "file": ..., "scale": s, "transform": rotations,

@@ -211,6 +211,10 @@ void read_shape(const Node& node, Scene& scene, const std::filesystem::path& fol
 
   if (type == "sphere") {
     shape.kind = Shape::Kind::Sphere;
+    if (scene.materials[shape.material].has_alpha())
+      node.child("material").fail("material " + in_quotes(scene.materials[shape.material].name) +
+                                  " has alpha, which spheres do not support (a ray crosses a sphere twice at one "
+                                  "primitive, and both crossings would share one decision); use a mesh");
     shape.center = node.has("center") ? node.child("center").vector3() : vec3(0.0f);
     shape.radius = static_cast<float>(node.number_or("radius", 1.0));
     if (!(shape.radius > 0.0f)) node.child("radius").fail("radius must be positive");
@@ -239,7 +243,7 @@ void read_shape(const Node& node, Scene& scene, const std::filesystem::path& fol
     parts = read_mesh_parts(node, scene, folder, materials, label);
   } else {
     const Material& m = scene.materials[shape.material];
-    const bool uvs = m.is_textured() || m.normal_map.has_value();
+    const bool uvs = m.is_textured() || m.normal_map.has_value() || m.alpha_texture.has_value();
     parts.push_back({type == "rectangle" ? unit_rectangle(uvs) : unit_box(uvs), shape.material, shape.description});
   }
   for (MeshPart& part : parts) {

@@ -212,6 +212,19 @@ float Textures::number(const TextureRef& ref, const TextureFootprint& at) const 
   return ref.scale.x * v + ref.offset.x;
 }
 
+float Textures::nearest_number(const TextureRef& ref, vec2 uv) const {
+  OIIO::TextureSystem& ts = *oiio_->ts;
+  OIIO::TextureOpt opt;
+  opt.firstchannel = ref.channel;
+  opt.swrap = opt.twrap = oiio_wrap(ref.wrap);
+  opt.interpmode = OIIO::TextureOpt::InterpClosest;
+  opt.fill = 0.0f;
+  float v = 0.0f;
+  ts.texture(static_cast<OIIO::TextureSystem::TextureHandle*>(images_[ref.image].handle), ts.get_perthread_info(), opt,
+             uv.x, 1.0f - uv.y, 0.0f, 0.0f, 0.0f, 0.0f, 1, &v);
+  return ref.scale.x * v + ref.offset.x;
+}
+
 Spectrum Textures::mean_color(const TextureRef& ref) const {
   const Image& im = images_[ref.image];
   const Spectrum m = im.channels < 3 ? Spectrum(im.mean[0])

@@ -126,6 +126,11 @@ class Textures {
   // scale * texel + offset, as a colour / as one number.
   Spectrum color(const TextureRef& ref, const TextureFootprint& at) const;
   float number(const TextureRef& ref, const TextureFootprint& at) const;
+  // scale * texel + offset of the texel of the finest level that holds
+  // `uv` (no filtering): alpha cut-outs (core/alpha.h), whose decision must
+  // not depend on a footprint the BVH traversal does not know, and whose
+  // edges stay where the texels put them.
+  float nearest_number(const TextureRef& ref, vec2 uv) const;
   // The mean of color(ref, .) over the image's finest level.
   Spectrum mean_color(const TextureRef& ref) const;
 

@@ -67,7 +67,8 @@ void AovAccumulator::add_batch(std::uint32_t first, std::uint32_t count, std::sp
           // The camera ray of this sample, as both tracers draw it.
           const SampleStream u(settings_.seed, static_cast<std::uint32_t>(index), first + j);
           const vec2 film(static_cast<float>(x) + u.get(0, Dim::FilmX), static_cast<float>(y) + u.get(0, Dim::FilmY));
-          const Ray ray = camera.generate_ray(film, vec2(u.get(0, Dim::LensX), u.get(0, Dim::LensY)));
+          Ray ray = camera.generate_ray(film, vec2(u.get(0, Dim::LensX), u.get(0, Dim::LensY)));
+          ray.alpha_key = scene_.alpha_key(u, 0);  // sees through what the render saw through
           Surfel s;
           const bool hit = scene_.intersect(ray, &s, cone, &params);
           if (first + j == 0) px.material = hit ? static_cast<int>(s.material - scene_.scene().materials.data()) : -1;

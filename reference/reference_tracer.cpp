@@ -20,6 +20,10 @@ struct ReferenceTracer::Path {
   RayCone cone{};
   SurfaceParams* params = nullptr;
   float u(int vertex, Dim dim) const { return rng.get(static_cast<std::uint32_t>(vertex), dim); }
+  // The key of the rays leaving `vertex` (core/alpha.h).
+  std::uint32_t alpha_key(const CompiledScene& scene, int vertex) const {
+    return PATHLAB_FAULT(AlphaKeysNotSet) ? 0u : scene.alpha_key(rng, vertex);
+  }
 };
 
 Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& prev, const Spectrum& beta,
@@ -90,7 +94,8 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
     if (!PATHLAB_FAULT(RouletteNotReweighted)) weight /= survival;
   }
   const Spectrum beta_next = beta * weight;
-  const Ray next_ray = s.spawn(bs->wi);
+  Ray next_ray = s.spawn(bs->wi);
+  next_ray.alpha_key = path.alpha_key(scene_, vertex);
   if (path.observer)
     path.observer->on_scatter(
         {vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, beta_next, next_ray});
@@ -109,7 +114,8 @@ Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vert
   const Spectrum f = s.eval(ls->wi, wo);
   if (is_black(f)) return Spectrum(0.0f);
   ++path.rays;
-  const Ray shadow = shadow_ray(s, *ls);
+  Ray shadow = shadow_ray(s, *ls);
+  shadow.alpha_key = path.alpha_key(scene_, vertex);
   const bool visible = !scene_.occluded(shadow);
   const Spectrum L = visible ? f * ls->Le / ls->pdf : Spectrum(0.0f);
   if (path.observer)
@@ -127,7 +133,8 @@ Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int verte
   if (is_black(f)) return Spectrum(0.0f);
   const float w = light_sample_weight(settings_.strategy, ls->pdf, s.pdf(ls->wi, wo));
   ++path.rays;
-  const Ray shadow = shadow_ray(s, *ls);
+  Ray shadow = shadow_ray(s, *ls);
+  shadow.alpha_key = path.alpha_key(scene_, vertex);
   const bool visible = !scene_.occluded(shadow);
   const Spectrum L = visible ? f * ls->Le * (w / ls->pdf) : Spectrum(0.0f);
   if (path.observer)
@@ -148,7 +155,8 @@ FilmSample ReferenceTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::
   }
   FilmSample fs;
   fs.film = vec2(static_cast<float>(x) + path.u(0, Dim::FilmX), static_cast<float>(y) + path.u(0, Dim::FilmY));
-  const Ray ray = scene_.camera().generate_ray(fs.film, vec2(path.u(0, Dim::LensX), path.u(0, Dim::LensY)));
+  Ray ray = scene_.camera().generate_ray(fs.film, vec2(path.u(0, Dim::LensX), path.u(0, Dim::LensY)));
+  ray.alpha_key = path.alpha_key(scene_, 0);
   if (observer) observer->on_camera({x, y, sample, fs.film, ray.origin, ray.dir});
   fs.L = Li(ray, 1, PreviousVertex{}, Spectrum(1.0f), path);
   fs.rays = path.rays;

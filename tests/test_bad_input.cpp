@@ -355,6 +355,34 @@ TEST_F(BadInput, DielectricParameterOutOfRange) {
   expect_rejected(render(write("eta.json", eta)), {"eta.json:", "/materials/white/eta", "the index of refraction is 'ior'"});
 }
 
+// Alpha (coverage): out of range, a texture name while only numbers are
+// read, on a light (the light sampler would aim through it), on a sphere
+// (its two crossings of one ray share a primitive, so one decision).
+TEST_F(BadInput, AlphaOutOfRangeOnALightOrOnASphere) {
+  const std::string kQuad = "    {\"type\": \"rectangle\", \"material\": \"white\"}";
+  const std::string text = scene("    \"white\": {\"type\": \"diffuse\", \"alpha\": 1.5}", kQuad);
+  expect_rejected(render(write("alpha.json", text)),
+                  {"alpha.json:" + where_in(text, "\"alpha\""), "/materials/white/alpha", "alpha must lie in [0, 1], found 1.5"});
+  const std::string named = scene("    \"white\": {\"type\": \"diffuse\", \"alpha\": \"leaf.png\"}", kQuad);
+  expect_rejected(render(write("named.json", named)), {"named.json:", "/materials/white/alpha", "alpha must be a number"});
+  const std::string light = scene("    \"lamp\": {\"type\": \"emissive\", \"radiance\": 2, \"alpha\": 0.5}",
+                                  "    {\"type\": \"rectangle\", \"material\": \"lamp\"}");
+  expect_rejected(render(write("light.json", light)),
+                  {"light.json:" + where_in(light, "\"alpha\""), "/materials/lamp/alpha", "alpha on a light", "\"light\": false"});
+  test::write_image(dir_ / "mask.exr", 1, 1, 1, {0.5f});
+  inputs_.insert("mask.exr");
+  const std::string textured = scene("    \"lamp\": {\"type\": \"emissive\", \"radiance\": 2, \"alpha\": {\"texture\": \"mask.exr\"}}",
+                                     "    {\"type\": \"rectangle\", \"material\": \"lamp\"}");
+  expect_rejected(render(write("textured.json", textured)),
+                  {"textured.json:", "/materials/lamp/alpha", "an alpha texture on a light"});
+  const std::string sphere =
+      scene(kMaterials + ",\n    \"leaf\": {\"type\": \"diffuse\", \"alpha\": 0.5}",
+            "    {\"type\": \"sphere\", \"material\": \"leaf\"},\n" + kLamp);
+  expect_rejected(render(write("sphere.json", sphere)),
+                  {"sphere.json:" + where_in(sphere, "\"material\": \"leaf\"") , "/shapes/0/material",
+                   "material 'leaf' has alpha, which spheres do not support"});
+}
+
 TEST_F(BadInput, UnknownBsdfSamplingAndNegativeFireflyControls) {
   const std::string text = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"bsdf_sampling\": \"vndff\"}");
   expect_rejected(render(write("flavour.json", text)),
@@ -710,6 +738,18 @@ TEST_F(BadInput, GltfBufferUris) {
   doc["buffers"][0]["byteLength"] = 2147483648u;
   expect_rejected(render(write("huge-data.gltf", doc.dump())),
                   {"huge-data.gltf: /buffers/0/byteLength: byteLength is 2147483648 but the data URI has"});
+}
+
+// A glTF emitter with alphaMode BLEND would be a light with alpha.
+TEST_F(BadInput, GltfAlphaOnALight) {
+  test::GltfWriter w = gltf_quad();
+  w.doc["materials"] = {{{"emissiveFactor", {1, 1, 1}}, {"alphaMode", "BLEND"},
+                         {"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 0.5}}}}}};
+  w.doc["meshes"][0]["primitives"][0]["material"] = 0;
+  write("lamp.gltf", w.embedded());
+  const std::string text = scene(kMaterials, "    {\"type\": \"gltf\", \"file\": \"lamp.gltf\"}");
+  expect_rejected(render(write("gltf.json", text)), {"gltf.json:" + where_in(text, "\"file\""), "/shapes/0/file",
+                                                     "has alpha (alphaMode MASK or BLEND) on a light"});
 }
 
 TEST_F(BadInput, GltfUnsupportedRequiredExtension) {

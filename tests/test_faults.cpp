@@ -56,6 +56,7 @@ const FaultCase kCases[] = {
     {Fault::RouletteNotReweighted, "roulette_not_reweighted_cosine", "furnace-box.json", Strategy::Cosine},
     {Fault::RouletteNotReweighted, "roulette_not_reweighted_mis", "mirror-sphere-gray-room.json", Strategy::Mis},
     {Fault::DielectricFresnelIgnored, "dielectric_fresnel_ignored_mis", "glass-sphere-tinted.json", Strategy::Mis},
+    {Fault::AlphaKeysNotSet, "alpha_keys_not_set_mis", "penumbra-alpha.json", Strategy::Mis},
 };
 
 INSTANTIATE_TEST_SUITE_P(Checker, PlantedFault, testing::ValuesIn(kCases),

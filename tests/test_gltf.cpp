@@ -227,7 +227,40 @@ TEST_F(Gltf, MaterialsMapOntoDisney) {
   EXPECT_FALSE(plain.material.two_sided_emission);
   std::string all;
   for (const std::string& line : c.warnings) all += line + "\n";
-  EXPECT_NE(all.find("ignored (not supported yet): alpha (rendered opaque)"), std::string::npos) << all;
+  // alphaMode OPAQUE (the default) ignores the factor's alpha.
+  EXPECT_EQ(gold.material.alpha, 1.0f);
+  EXPECT_EQ(all.find("alpha"), std::string::npos) << all;
+}
+
+// alphaMode onto the material's coverage (core/alpha.h): MASK cuts at
+// alphaCutoff (0.5 by default), BLEND is the alpha itself, OPAQUE ignores it.
+// The factor alone: a base colour texture's alpha is said to be ignored.
+TEST_F(Gltf, AlphaModesMapOntoCoverage) {
+  GltfWriter w = quad(test::kGltfShort);
+  const json first = w.doc["meshes"][0]["primitives"][0];
+  const auto factor = [](double a) { return json{{"baseColorFactor", {1, 1, 1, a}}}; };
+  w.doc["materials"] = json::array({{{"alphaMode", "MASK"}, {"pbrMetallicRoughness", factor(0.5)}},
+                                    {{"alphaMode", "MASK"}, {"alphaCutoff", 0.6}, {"pbrMetallicRoughness", factor(0.5)}},
+                                    {{"alphaMode", "BLEND"}, {"pbrMetallicRoughness", factor(0.25)}},
+                                    {{"alphaMode", "OPAQUE"}, {"pbrMetallicRoughness", factor(0.25)}},
+                                    {{"alphaMode", "BLEND"},
+                                     {"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 0.5}}, {"baseColorTexture", {{"index", 0}}}}}}});
+  w.doc["meshes"][0]["primitives"] = json::array();
+  for (int m = 0; m < 5; ++m) {
+    json p = first;
+    p["material"] = m;
+    w.doc["meshes"][0]["primitives"].push_back(p);
+  }
+  test::write_image(dir_ / "base.png", 1, 1, 4, {1.0f, 1.0f, 1.0f, 0.5f}, OIIO::TypeDesc::UINT8);
+  w.doc["images"] = json::array({{{"uri", "base.png"}}});
+  w.doc["textures"] = json::array({{{"source", 0}}});
+  const GltfContent c = load_all(w, "alpha");
+  ASSERT_EQ(c.primitives.size(), 5u);
+  const float expected[] = {1.0f, 0.0f, 0.25f, 1.0f, 0.5f};
+  for (int m = 0; m < 5; ++m) EXPECT_EQ(c.materials[c.primitives[static_cast<std::size_t>(m)].material].material.alpha, expected[m]) << m;
+  std::string all;
+  for (const std::string& line : c.warnings) all += line + "\n";
+  EXPECT_NE(all.find("baseColorTexture's alpha (the factor alone gives the coverage)"), std::string::npos) << all;
 }
 
 // Textures: base colour (an external PNG), metallic-roughness (a PNG in a

@@ -157,6 +157,24 @@ inline Scene cornell_with_instances() {
   return scene;
 }
 
+// cornell_with_instances() with partial coverage (core/alpha.h): the
+// group's UV sphere at alpha 0.5 (so inside three instances) and the tall
+// box, placed in world space, at alpha 0.3; the group's true sphere stays
+// opaque (spheres take no alpha). The alpha scene of the same-path tests.
+inline Scene cornell_with_alpha() {
+  Scene scene = cornell_with_instances();
+  const auto add = [&](const char* name, float alpha) {
+    Material m = scene.materials[scene.shapes.front().material];
+    m.name = name;
+    m.alpha = alpha;
+    scene.materials.push_back(m);
+    return static_cast<std::uint32_t>(scene.materials.size() - 1);
+  };
+  scene.shapes[scene.groups[0].shapes[0]].material = add("leaf", 0.5f);
+  scene.shapes[6].material = add("lace", 0.3f);  // the tall box
+  return scene;
+}
+
 // A GoogleTest parameter name for a strategy ("light+bsdf" -> "light_bsdf").
 inline std::string strategy_test_name(const testing::TestParamInfo<Strategy>& p) {
   std::string s = strategy_name(p.param);

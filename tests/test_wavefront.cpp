@@ -23,8 +23,9 @@ namespace pathlab {
 namespace {
 
 struct SameSeedCase {
-  std::string scene;  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" (test_scenes.h), "envmap"
-                      // (below), else a file in analytic-scenes/
+  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" / "alpha" / "textured" (test_scenes.h),
+  // "envmap" (below), else a file in analytic-scenes/
+  std::string scene;
   Strategy strategy;
 };
 
@@ -54,6 +55,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "instanced" ? test::cornell_with_instances()
             : c.scene == "delta"     ? test::cornell_with_delta_lights()
             : c.scene == "envmap"    ? envmap_scene()
+            : c.scene == "alpha"     ? test::cornell_with_alpha()
             : c.scene == "textured"  ? test::cornell_with_textures()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
@@ -115,6 +117,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("instanced");  // the Cornell box with a group placed three times (test_scenes.h)
   scenes.push_back("delta");      // the Cornell box with point, spot and directional lights (test_scenes.h)
   scenes.push_back("envmap");     // an environment image over a diffuse sphere and a metal ground (above)
+  scenes.push_back("alpha");      // the instanced Cornell box with partial coverage (test_scenes.h)
   scenes.push_back("textured");   // the Cornell box reading textures everywhere (test_scenes.h)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)

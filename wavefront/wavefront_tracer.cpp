@@ -71,6 +71,10 @@ struct WavefrontTracer::Wave {
     shadow.resize(2 * size), light.resize(2 * size), unoccluded.resize(2 * size), light_weight.resize(2 * size);
     shadow_state.resize(2 * size);
     query.resize(2 * size), query_slot.resize(2 * size), query_result.resize(2 * size);
+    // A thread's wave that once served a textured scene keeps its cones, and
+    // move() copies them whenever there are any: they must grow with the rest
+    // (a textured render, then a larger untextured one, wrote past them).
+    if (!cone.empty()) textured(size);
   }
   // A finished path's sample. Its last ray reached vertex `vertex` unless it
   // found nothing.
@@ -164,6 +168,9 @@ struct WavefrontTracer::VectorStages {
     }
     if (diffuse) sc.min_pdf = diffuse->shading.min_pdf;
     if (!scene.instances.empty()) return no("instances");
+    // Alpha is decided inside Embree by the rays' keys, which Lanes do not carry.
+    for (const Material& m : scene.materials)
+      if (m.has_alpha()) return no("material '" + m.name + "' has alpha (partial coverage)");
     if (compiled.has_textures()) return no("textures");
     // Flat triangles only: the stages shade with the geometric normal.
     for (const Shape& shape : scene.shapes)
@@ -389,6 +396,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
           w.unoccluded[2 * i] = f * ls->Le / ls->pdf;
           w.light_weight[2 * i] = 1.0f;
           w.shadow[2 * i] = shadow_ray(s, *ls);
+          w.shadow[2 * i].alpha_key = scene_.alpha_key(w.rng[i], w.vertex[i]);
           w.shadow_state[2 * i] = 1;
         }
       }
@@ -403,6 +411,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
       w.unoccluded[2 * i + 1] = f * ls->Le * (lw / ls->pdf);
       w.light_weight[2 * i + 1] = lw;
       w.shadow[2 * i + 1] = shadow_ray(s, *ls);
+      w.shadow[2 * i + 1].alpha_key = scene_.alpha_key(w.rng[i], w.vertex[i]);
       w.shadow_state[2 * i + 1] = 1;
     }
   }
@@ -475,7 +484,8 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
       weight /= survival;
     }
     w.beta[i] *= weight;
-    const Ray next = s.spawn(bs->wi);
+    Ray next = s.spawn(bs->wi);
+    next.alpha_key = scene_.alpha_key(w.rng[i], v);
     if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i], next});
     w.prev[i] = PreviousVertex{s.p, bs->pdf, bs->impulse,
                                !(strategy == Strategy::LightBsdf && w.u(i, Dim::Technique) < 0.5f)};
@@ -516,6 +526,7 @@ void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
     w.vertex[i] = 0;  // the camera's random numbers are those of vertex 0
     w.film[i] = vec2(static_cast<float>(w.x[i]) + w.u(i, Dim::FilmX), static_cast<float>(w.y[i]) + w.u(i, Dim::FilmY));
     w.ray[i] = camera.generate_ray(w.film[i], vec2(w.u(i, Dim::LensX), w.u(i, Dim::LensY)));
+    w.ray[i].alpha_key = scene_.alpha_key(w.rng[i], 0);
     w.beta[i] = Spectrum(1.0f);
     w.L[i] = Spectrum(0.0f);
     w.prev[i] = PreviousVertex{};
