@@ -75,6 +75,39 @@ TEST_F(TexturesTest, PointLookupsReadTheTexelsAndWrapAsAsked) {
   EXPECT_NEAR(tx.mean(0, 0), (0.1f + 0.4f + 0.7f + 1.0f) / 4.0f, 1e-6f);
 }
 
+// A grey image (one channel, or grey and alpha) reads as R = G = B = grey,
+// as glTF reads it (a grey metallic-roughness JPEG's G and B), and alpha 1
+// where it has none; never a channel past the image's (which Debian's OIIO
+// answers with an assertion that aborts the process).
+TEST_F(TexturesTest, GreyImagesReadAsRgbWithAlphaOne) {
+  write_image(dir_ / "grey.exr", 2, 1, 1, {0.25f, 0.75f});
+  write_image(dir_ / "grey-alpha.exr", 2, 1, 2, {0.25f, 0.5f, 0.75f, 1.0f});
+  write_image(dir_ / "rgb.exr", 2, 1, 3, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f});
+  const std::vector<TextureImage> images{{dir_ / "grey.exr", TextureColorSpace::Linear, "test"},
+                                         {dir_ / "grey-alpha.exr", TextureColorSpace::Linear, "test"},
+                                         {dir_ / "rgb.exr", TextureColorSpace::Linear, "test"}};
+  const Textures tx(images, 16.0f);
+  const TextureFootprint left{vec2(0.25f, 0.5f), 0.0f};
+  TextureRef ref;
+  for (std::uint8_t c = 0; c < 3; ++c) {
+    ref.channel = c;
+    ref.image = 0;
+    EXPECT_EQ(tx.number(ref, left), 0.25f) << int(c);
+    ref.image = 1;
+    EXPECT_EQ(tx.number(ref, left), 0.25f) << int(c);
+  }
+  ref.channel = 3;  // alpha
+  ref.image = 0;
+  EXPECT_EQ(tx.number(ref, left), 1.0f);
+  ref.image = 1;
+  EXPECT_EQ(tx.number(ref, left), 0.5f);
+  ref.image = 2;
+  EXPECT_EQ(tx.number(ref, left), 1.0f);
+  ref.channel = 0;
+  ref.image = 1;
+  expect_near(tx.color(ref, left), Spectrum(0.25f), 0.0f, "grey+alpha as a colour");
+}
+
 // The sRGB curve (IEC 61966-2-1), in double.
 double srgb(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
 
