@@ -1,10 +1,12 @@
-// Every scene shipped in scenes/ loads without a warning, compiles, and
-// traces a sample to a finite radiance; the benchmark scenes in bench/scenes/
+// Every scene shipped in scenes/ loads without a warning but those its data
+// earns (below), compiles, and traces samples to a finite radiance in both
+// tracers, the same path in each; the benchmark scenes in bench/scenes/
 // load. Some read fetched data ("$data/..."), so these run after the
 // pathlab_data fixture.
 #include "core/compiled_scene.h"
 #include "core/scene_loader.h"
 #include "reference/reference_tracer.h"
+#include "wavefront/wavefront_tracer.h"
 
 #include <gtest/gtest.h>
 
@@ -22,13 +24,26 @@ TEST(ExampleScenes, LoadCompileAndTrace) {
     if (entry.path().extension() != ".json") continue;
     SCOPED_TRACE(entry.path().string());
     Scene scene = load_scene(entry.path());
-    EXPECT_TRUE(scene.warnings.empty()) << scene.warnings.front();
+    // What the fetched data earns: the webxr controller's occlusion map
+    // (glTF's occlusion is not modelled) and the few slightly negative
+    // texels of every HDRI Haven map (read as 0).
+    for (const std::string& w : scene.warnings)
+      EXPECT_TRUE(w.find("ignored (not supported yet): occlusionTexture") != std::string::npos ||
+                  w.find("texel component(s) are negative") != std::string::npos)
+          << w;
     const RenderSettings settings = scene.render;
     const CompiledScene compiled(std::move(scene));
-    const ReferenceTracer tracer(compiled, settings);
+    const ReferenceTracer reference(compiled, settings);
+    const WavefrontTracer wavefront(compiled, settings);
     const auto w = static_cast<std::uint32_t>(compiled.scene().film.width);
     const auto h = static_cast<std::uint32_t>(compiled.scene().film.height);
-    for (std::uint32_t s = 0; s < 16; ++s) EXPECT_TRUE(is_finite(tracer.trace_sample(w / 2, h / 2, s, nullptr).L));
+    for (std::uint32_t s = 0; s < 16; ++s) {
+      const FilmSample a = reference.trace_sample(w / 2, h / 2, s, nullptr);
+      const FilmSample b = wavefront.trace_sample(w / 2, h / 2, s, nullptr);
+      EXPECT_TRUE(is_finite(a.L));
+      EXPECT_EQ(a.hits, b.hits) << "sample " << s;
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(a.L[c], b.L[c], 1e-4f * (1.0f + a.L[c])) << "sample " << s;
+    }
     ++count;
   }
   EXPECT_GE(count, 3);
