@@ -93,7 +93,6 @@ Textures::Textures(std::span<const TextureImage> images, float cache_mb) : oiio_
   oiio_->ts = OIIO::TextureSystem::create(false);  // our own cache, not OIIO's process-wide one
   OIIO::TextureSystem& ts = *oiio_->ts;
   ts.attribute("max_memory_MB", cache_mb);
-  ts.attribute("automip", 1);          // MIP-map untiled images on first read
   ts.attribute("unassociatedalpha", 1);  // texels as stored: never premultiplied by alpha
   for (const TextureImage& image : images) {
     const std::string name = image.file.string();
@@ -109,6 +108,13 @@ Textures::Textures(std::span<const TextureImage> images, float cache_mb) : oiio_
     if (spec.nchannels < 1 || spec.nchannels > 4)
       fail("has " + std::to_string(spec.nchannels) + " channels (1 to 4 are supported: grey, grey+alpha, RGB, RGBA)");
     if (spec.depth > 1) fail("is a volume (3D) image");
+    // A tiled, MIP-mapped file (a .tx from maketx) is read in place, a tile
+    // at a time, however large. Anything else is converted once, below: an
+    // untiled image would enter OpenImageIO's cache whole, and one larger
+    // than ten times the cache trips an assertion that aborts the process
+    // in Debian's build (ImageCache::check_max_mem).
+    const bool tiled_mipmap = spec.tile_width > 0 && in->seek_subimage(0, 1);
+    if (!in->seek_subimage(0, 0)) fail("cannot read it (" + in->geterror() + ")");
     const std::size_t w = static_cast<std::size_t>(spec.width), h = static_cast<std::size_t>(spec.height);
     const std::size_t nc = static_cast<std::size_t>(spec.nchannels);
     std::vector<float> texels(w * h * nc);
@@ -138,7 +144,7 @@ Textures::Textures(std::span<const TextureImage> images, float cache_mb) : oiio_
     for (std::size_t c = 0; c < nc; ++c) out.mean[c] = static_cast<float>(sum[c] / static_cast<double>(w * h));
 
     std::string source = name;
-    if (image.colorspace == TextureColorSpace::Srgb) {
+    if (image.colorspace == TextureColorSpace::Srgb || !tiled_mipmap) {
       if (temp_dir_.empty()) temp_dir_ = make_temp_dir();
       source = (temp_dir_ / (std::to_string(images_.size()) + ".tx")).string();
       OIIO::ImageSpec decoded(spec.width, spec.height, spec.nchannels, OIIO::TypeDesc::FLOAT);
@@ -146,7 +152,7 @@ Textures::Textures(std::span<const TextureImage> images, float cache_mb) : oiio_
       OIIO::ImageSpec tx;
       tx.format = OIIO::TypeDesc::FLOAT;
       if (!OIIO::ImageBufAlgo::make_texture(OIIO::ImageBufAlgo::MakeTxTexture, buf, source, tx))
-        throw SystemError(image.where + ": texture " + name + ": cannot write its decoded copy " + source + ": " +
+        throw SystemError(image.where + ": texture " + name + ": cannot write its tiled, MIP-mapped copy " + source + ": " +
                           OIIO::geterror());
     }
     out.handle = ts.get_texture_handle(OIIO::ustring(source));

@@ -21,12 +21,13 @@
 // decoded once at load (IEC 61966-2-1, exactly, to 32-bit float, alpha left
 // alone) and written as a tiled, MIP-mapped TX file in a temporary folder the
 // Textures object removes again; the TextureSystem reads that, and every
-// MIP level and filtered lookup is in linear space. A "linear" image is read
-// in place: a TX file (maketx) as it is, any other format MIP-mapped by OIIO
-// when first read ("automip"), which holds the whole image in OIIO's cache.
-// TX files read as linear are therefore what scales beyond memory (their
-// tiles come and go within `cache_mb`); the load-time scan still reads the
-// finest level once.
+// MIP level and filtered lookup is in linear space. A "linear" image that is
+// already tiled and MIP-mapped (a TX file from maketx) is read in place; any
+// other is converted the same way, without the decoding. So every texture
+// reaches the TextureSystem as tiles, which come and go within `cache_mb`
+// however large the images are (an untiled image would enter the cache
+// whole, and Debian's OIIO aborts when that exceeds ten times the cache).
+// The load-time scan still reads each finest level once.
 //
 // Coordinates. pathlab's uv has its origin at the bottom left, v up
 // (core/mesh.h); OIIO's t runs down the image, so a lookup reads t = 1 - v.
