@@ -256,4 +256,15 @@ float srgb_to_linear(float v) {
   return static_cast<float>(std::pow((x + 0.055) / 1.055, 2.4));
 }
 
+void write_png_beside(const std::filesystem::path& exr, const std::filesystem::path& png, const Image& image,
+                      float exposure) {
+  try {
+    write_png(png, image, exposure);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(exr, ignored);
+    throw;
+  }
+}
+
 }  // namespace pathlab

@@ -65,6 +65,11 @@ void write_exr_channels(const std::filesystem::path& file, int width, int height
 // encoded with the sRGB transfer curve. NaN pixels become magenta so that
 // they cannot hide (the renderer never produces them; diff inputs might).
 void write_png(const std::filesystem::path& file, const Image& image, float exposure = 0.0f);
+// write_png for the PNG that goes beside the EXR `exr` already written: the
+// two are one result, so if the PNG cannot be written the EXR is removed
+// before the error goes on.
+void write_png_beside(const std::filesystem::path& exr, const std::filesystem::path& png, const Image& image,
+                      float exposure);
 
 // Writes 8-bit RGB bytes (already encoded, row-major, top row first) as a
 // PNG, e.g. a screenshot.

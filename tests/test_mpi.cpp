@@ -3,12 +3,10 @@
 // real binary under mpirun (--oversubscribe: 3 ranks on 2 cores).
 #include "core/image_io.h"
 #include "core/partial_film.h"
+#include "tests/process_util.h"
 #include "tests/temp_dir.h"
 
 #include <gtest/gtest.h>
-
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <string>
@@ -19,28 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Runs `program args...`; its exit status (128 + signal if one ended it).
-int run(const std::string& program, const std::vector<std::string>& args) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    std::vector<char*> argv{const_cast<char*>(program.c_str())};
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(program.c_str(), argv.data());
-    ::_exit(127);
-  }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : WEXITSTATUS(status);
-}
-
-std::vector<float> pixels_of(const fs::path& exr) {
-  const Image image = read_image(exr);
-  std::vector<float> out;
-  for (const vec3& s : image.pixels) out.insert(out.end(), {s.x, s.y, s.z});
-  return out;
-}
-
 class Mpi : public test::TempDirTest {
  protected:
   // pathlab render with the test's settings, under mpirun -n `ranks` (0: without mpirun).
@@ -50,10 +26,10 @@ class Mpi : public test::TempDirTest {
     args.insert(args.end(), extra.begin(), extra.end());
     if (std::find(extra.begin(), extra.end(), "--resolution") == extra.end())
       args.insert(args.end(), {"--resolution", "40x30"});
-    if (ranks == 0) return run(PATHLAB_BINARY, args);
+    if (ranks == 0) return test::run_process(PATHLAB_BINARY, args);
     std::vector<std::string> mpi{"--oversubscribe", "--allow-run-as-root", "-n", std::to_string(ranks), PATHLAB_BINARY};
     mpi.insert(mpi.end(), args.begin(), args.end());
-    return run(PATHLAB_MPIEXEC, mpi);
+    return test::run_process(PATHLAB_MPIEXEC, mpi);
   }
 };
 
@@ -61,14 +37,14 @@ TEST_F(Mpi, OneTwoAndThreeRanksGiveTheBitsOfOneProcess) {
   // 256x256: a block is 4 passes (2^18 samples), so 3 ranks share 12 passes.
   const std::vector<std::string> big{"--resolution", "256x256"};
   ASSERT_EQ(render(0, "one.exr", big), 0);
-  const std::vector<float> one = pixels_of(dir_ / "one.exr");
+  const std::vector<float> one = test::pixel_floats(dir_ / "one.exr");
   for (const int ranks : {1, 2, 3}) {
     const std::string out = "ranks" + std::to_string(ranks) + ".exr";
     const std::string ck = (dir_ / ("ranks" + std::to_string(ranks) + ".pfilm")).string();
     std::vector<std::string> args = big;
     args.insert(args.end(), {"--checkpoint", ck});
     ASSERT_EQ(render(ranks, out, args), 0) << ranks << " ranks";
-    EXPECT_EQ(pixels_of(dir_ / out), one) << ranks << " ranks";
+    EXPECT_EQ(test::pixel_floats(dir_ / out), one) << ranks << " ranks";
     // Every pass once: a rank tracing another's passes too would leave the
     // mean alone but not the counts.
     const PartialFilm pf = read_partial_film(ck);
@@ -83,7 +59,7 @@ TEST_F(Mpi, OneTwoAndThreeRanksGiveTheBitsOfOneProcess) {
 
 TEST_F(Mpi, CheckpointsMoveBetweenRankCounts) {
   ASSERT_EQ(render(0, "one.exr", {}), 0);
-  const std::vector<float> one = pixels_of(dir_ / "one.exr");
+  const std::vector<float> one = test::pixel_floats(dir_ / "one.exr");
   const std::string ck = (dir_ / "ck.pfilm").string();
   // Passes 0..5 by 2 ranks, 5..9 by 3 resuming, 9..12 by one process.
   ASSERT_EQ(render(2, "a.exr", {"--checkpoint", ck}, "5"), 0);
@@ -91,7 +67,7 @@ TEST_F(Mpi, CheckpointsMoveBetweenRankCounts) {
   ASSERT_EQ(render(3, "b.exr", {"--checkpoint", ck, "--resume", ck}, "9"), 0);
   EXPECT_EQ(read_partial_film(ck).info.passes.end, 9u);
   ASSERT_EQ(render(0, "c.exr", {"--checkpoint", ck, "--resume", ck}), 0);
-  EXPECT_EQ(pixels_of(dir_ / "c.exr"), one);
+  EXPECT_EQ(test::pixel_floats(dir_ / "c.exr"), one);
   EXPECT_EQ(read_partial_film(ck).info.resumes, 2u);
 }
 

@@ -9,6 +9,7 @@
 #include "core/partial_film.h"
 #include "core/rng.h"
 #include "tests/cli_util.h"
+#include "tests/process_util.h"
 #include "tests/temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -272,14 +273,6 @@ TEST_F(PartialFilmFile, MergeRefusesOverlapsGapsAndOtherRenders) {
 
 // ---------------------------------------------------------------- The CLI
 
-// The image of an EXR pathlab wrote, bit for bit.
-std::vector<float> pixels_of(const fs::path& exr) {
-  const Image image = read_image(exr);
-  std::vector<float> out;
-  for (const Spectrum& s : image.pixels) out.insert(out.end(), {s.x, s.y, s.z});
-  return out;
-}
-
 class PiecesCli : public test::TempDirTest {
  protected:
   std::vector<std::string> base(const std::string& tracer) {
@@ -297,14 +290,14 @@ class PiecesCli : public test::TempDirTest {
 
 TEST_F(PiecesCli, AnySplitMergedIsBitIdenticalToOneRender) {
   for (const std::string tracer : {"reference", "wavefront"}) {
-    const std::vector<float> whole = pixels_of(render(tracer, {"--spp", "8"}, "whole.exr"));
+    const std::vector<float> whole = test::pixel_floats(render(tracer, {"--spp", "8"}, "whole.exr"));
     const std::vector<std::vector<std::string>> splits = {
         {"0..1", "1..2"}, {"0..3", "3..8"}, {"0..1", "1..2", "2..3", "3..4", "4..5", "5..6", "6..7", "7..8"}};
     for (const auto& split : splits) {
       // 1+1 is a 2-spp render; the others make up the 8 of `whole`.
       const std::uint32_t total = split.size() == 2 && split[1] == "1..2" ? 2 : 8;
       const std::vector<float> expected =
-          total == 8 ? whole : pixels_of(render(tracer, {"--spp", std::to_string(total)}, "two.exr"));
+          total == 8 ? whole : test::pixel_floats(render(tracer, {"--spp", std::to_string(total)}, "two.exr"));
       std::vector<std::string> merge{"merge", "-o", (dir_ / "merged.exr").string(), "-q"};
       for (std::size_t i = 0; i < split.size(); ++i) {
         const std::string part = "part" + std::to_string(i) + ".pfilm";
@@ -314,19 +307,19 @@ TEST_F(PiecesCli, AnySplitMergedIsBitIdenticalToOneRender) {
       std::reverse(merge.begin() + 4, merge.end());  // the order given does not matter
       const test::CliResult r = run_cli(merge);
       ASSERT_EQ(r.code, 0) << r.err;
-      EXPECT_EQ(pixels_of(dir_ / "merged.exr"), expected) << tracer << ", " << split.size() << " parts";
+      EXPECT_EQ(test::pixel_floats(dir_ / "merged.exr"), expected) << tracer << ", " << split.size() << " parts";
     }
   }
 }
 
 TEST_F(PiecesCli, AResumedRenderIsBitIdenticalAndRecordsItsHistory) {
-  const std::vector<float> whole = pixels_of(render("reference", {"--spp", "6"}, "whole.exr"));
+  const std::vector<float> whole = test::pixel_floats(render("reference", {"--spp", "6"}, "whole.exr"));
   const std::string ck = (dir_ / "ck.pfilm").string();
   // A checkpoint of passes 0..2 (the render of --passes 0..2 writes it at its end), resumed twice.
   render("reference", {"--spp", "6", "--passes", "0..2", "--checkpoint", ck}, "first.pfilm");
   render("reference", {"--spp", "4", "--checkpoint", ck, "--resume", ck}, "second.exr");
   const fs::path final_exr = render("reference", {"--spp", "6", "--checkpoint", ck, "--resume", ck}, "final.exr");
-  EXPECT_EQ(pixels_of(final_exr), whole);
+  EXPECT_EQ(test::pixel_floats(final_exr), whole);
   ImageMetadata meta;
   read_image(final_exr, &meta);
   const auto value = [&](const std::string& key) {
@@ -419,30 +412,9 @@ TEST_F(PiecesCli, ADamagedCheckpointIsRefusedWithExit2AndNothingWritten) {
 
 // ------------------------------------------------------- Signals and kill -9
 
-// Runs the pathlab binary with `args`, sending it `signal` after `delay`
-// (none if signal is 0) - counted from when `wait_for` exists, if given.
-// Returns its exit status (128 + the signal if it ended by one).
 int run_binary(const std::vector<std::string>& args, int signal, std::chrono::milliseconds delay,
                const fs::path& wait_for = {}) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    std::vector<char*> argv{const_cast<char*>(PATHLAB_BINARY)};
-    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    ::execv(PATHLAB_BINARY, argv.data());
-    ::_exit(127);
-  }
-  if (signal != 0) {
-    int status = 0;
-    while (!wait_for.empty() && !fs::exists(wait_for))
-      if (::waitpid(pid, &status, WNOHANG) == pid) return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : WEXITSTATUS(status);
-      else std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    std::this_thread::sleep_for(delay);
-    ::kill(pid, signal);
-  }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFSIGNALED(status) ? 128 + WTERMSIG(status) : WEXITSTATUS(status);
+  return test::run_process(PATHLAB_BINARY, args, signal, delay, wait_for);
 }
 
 class Interrupted : public test::TempDirTest {
@@ -456,7 +428,7 @@ class Interrupted : public test::TempDirTest {
 
 TEST_F(Interrupted, KillNineAtAnyMomentThenResumeGivesTheSameBits) {
   ASSERT_EQ(run_binary(args("whole.exr", {}), 0, {}), 0);
-  const std::vector<float> whole = pixels_of(dir_ / "whole.exr");
+  const std::vector<float> whole = test::pixel_floats(dir_ / "whole.exr");
   // A batch here is 64 passes (2^18 samples): five of them, a checkpoint after each.
   for (const int ms : {150, 450, 900}) {
     const std::string ck = (dir_ / ("ck" + std::to_string(ms) + ".pfilm")).string();
@@ -468,7 +440,7 @@ TEST_F(Interrupted, KillNineAtAnyMomentThenResumeGivesTheSameBits) {
     std::vector<std::string> extra = {"--checkpoint", ck};
     if (fs::exists(ck)) extra.insert(extra.end(), {"--resume", ck});
     ASSERT_EQ(run_binary(args("resumed.exr", extra), 0, {}), 0) << ms << " ms";
-    EXPECT_EQ(pixels_of(dir_ / "resumed.exr"), whole) << "killed after " << ms << " ms";
+    EXPECT_EQ(test::pixel_floats(dir_ / "resumed.exr"), whole) << "killed after " << ms << " ms";
   }
 }
 

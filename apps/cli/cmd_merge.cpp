@@ -59,13 +59,7 @@ int MergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
       meta.emplace_back(kv.substr(0, space), space == std::string::npos ? "" : kv.substr(space + 1));
     }
   write_exr(exr, image, meta);
-  try {
-    write_png(png, image, exposure);
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(exr, ignored);
-    throw;
-  }
+  write_png_beside(exr, png, image, exposure);
   if (merged.film.bad_sample_count() > 0)
     err << "pathlab: warning: " << merged.film.bad_sample_count()
         << " sample(s) had NaN, infinite or out-of-range radiance and were left out of the image\n";

@@ -288,14 +288,7 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     }
     if (layers.empty()) write_exr(exr, image, meta);
     else write_exr_channels(exr, film.width(), film.height(), aov_channels(film, *aov_buffers, layers), meta);
-    try {
-      write_png(png, image, exposure);
-    } catch (...) {
-      // The two files are one result: do not leave the EXR without its PNG.
-      std::error_code ignored;
-      std::filesystem::remove(exr, ignored);
-      throw;
-    }
+    write_png_beside(exr, png, image, exposure);
   }
   if (interrupted != 0) {
     err << "pathlab: interrupted (" << (interrupted == SIGINT ? "SIGINT" : "SIGTERM") << ") after passes "
