@@ -333,6 +333,38 @@ TEST_F(PiecesCli, AResumedRenderIsBitIdenticalAndRecordsItsHistory) {
   EXPECT_EQ(value("fingerprint").size(), 32u);
 }
 
+// A progressive render (--target-relmse) resumed from a checkpoint stops at
+// the pass an uninterrupted one stops at, with the same bits: its passes stay
+// on the grid from 0 and it decides from the film it resumed.
+TEST_F(PiecesCli, ATargetRelmseRenderResumedStopsWhereTheUninterruptedOneDoes) {
+  // 256x256: a pass of render_until is 4 samples per pixel.
+  const std::vector<std::string> common{"--resolution", "256x256", "-q"};
+  const auto run = [&](std::vector<std::string> extra, const std::string& out) {
+    std::vector<std::string> args{"render", "-o", (dir_ / out).string(), "--seed", "3"};
+    args.insert(args.end(), common.begin(), common.end());
+    args.insert(args.end(), extra.begin(), extra.end());
+    const test::CliResult r = run_cli(args);
+    EXPECT_EQ(r.code, 0) << r.err;
+  };
+  run({"--target-relmse", "0.05", "--spp", "64"}, "whole.exr");
+  const std::string ck = (dir_ / "ck.pfilm").string();
+  run({"--spp", "8", "--checkpoint", ck, "--aov", "variance"}, "first.exr");
+  run({"--target-relmse", "0.05", "--spp", "64", "--resume", ck}, "resumed.exr");
+  ImageMetadata whole_meta, resumed_meta;
+  const std::vector<float> whole = test::pixel_floats(dir_ / "whole.exr");
+  read_image(dir_ / "whole.exr", &whole_meta);
+  read_image(dir_ / "resumed.exr", &resumed_meta);
+  const auto spp = [](const ImageMetadata& m) {
+    for (const auto& [k, v] : m)
+      if (k == "spp") return v;
+    return std::string();
+  };
+  EXPECT_EQ(spp(resumed_meta), spp(whole_meta));
+  EXPECT_GT(std::stoi(spp(whole_meta)), 8);  // it did go on past the checkpoint
+  EXPECT_LT(std::stoi(spp(whole_meta)), 64);  // and stopped on the target, not the cap
+  EXPECT_EQ(test::pixel_floats(dir_ / "resumed.exr"), whole);
+}
+
 TEST_F(PiecesCli, ResumeRefusesAnotherSceneFileMeshSettingOrVersion) {
   const fs::path mesh = write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
   const std::string scene_text = R"({"pathlab_scene": 1, "camera": {"position": [0.3, 0.3, 2], "look_at": [0.3, 0.3, 0]},
