@@ -42,6 +42,7 @@ struct ErrorSink {
 // indices that the decision hashes (core/alpha.h).
 struct AlphaGeometry {
   float alpha = 1.0f;
+  float cutoff = -1.0f;              // Material::alpha_cutoff
   std::uint32_t shape = 0;           // index into Scene::shapes
   std::uint32_t first_instance = 0;  // geometry ID of instance 0 in the top scene
   // A textured coverage (else null): the texture, its images, and the mesh
@@ -53,13 +54,17 @@ struct AlphaGeometry {
 
   // The coverage at barycentrics (b1, b2) of triangle `prim`.
   float at(unsigned prim, float b1, float b2) const {
-    if (!texture) return alpha;
-    vec2 uv(b1, b2);
-    if (mesh->has_uvs()) {
-      const glm::uvec3 v = mesh->triangles[prim];
-      uv = (1.0f - b1 - b2) * mesh->uvs[v.x] + b1 * mesh->uvs[v.y] + b2 * mesh->uvs[v.z];
+    float a = alpha;
+    if (texture) {
+      vec2 uv(b1, b2);
+      if (mesh->has_uvs()) {
+        const glm::uvec3 v = mesh->triangles[prim];
+        uv = (1.0f - b1 - b2) * mesh->uvs[v.x] + b1 * mesh->uvs[v.y] + b2 * mesh->uvs[v.z];
+      }
+      a = std::clamp(textures->nearest_number(*texture, uv), 0.0f, 1.0f);
     }
-    return std::clamp(textures->nearest_number(*texture, uv), 0.0f, 1.0f);
+    if (cutoff >= 0.0f) a = a >= cutoff ? 1.0f : 0.0f;
+    return a;
   }
 };
 
@@ -220,8 +225,8 @@ void EmbreeAccel::Impl::attach(RTCScene target, const Shape& shape, std::uint32_
     // Only the geometries with alpha get filters: Embree calls none on the
     // others, which trace as fast as in a scene without alpha.
     alpha_geometries.push_back(std::make_unique<AlphaGeometry>(AlphaGeometry{
-        material->alpha, index, first_instance, material->alpha_texture ? &*material->alpha_texture : nullptr,
-        textures, &shape.mesh}));
+        material->alpha, material->alpha_cutoff, index, first_instance,
+        material->alpha_texture ? &*material->alpha_texture : nullptr, textures, &shape.mesh}));
     rtcSetGeometryUserData(geom, alpha_geometries.back().get());
     rtcSetGeometryIntersectFilterFunction(geom, &alpha_filter);
     rtcSetGeometryOccludedFilterFunction(geom, &alpha_filter);

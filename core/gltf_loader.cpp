@@ -527,6 +527,8 @@ std::uint32_t Flattener::material(int index) {
   p.sheen = 0.0f;
   Spectrum emission(0.0f);
   float coverage = 1.0f;  // Material::alpha
+  float cutoff = -1.0f;   // Material::alpha_cutoff
+  std::optional<TextureRef> coverage_texture;  // Material::alpha_texture
   std::vector<TexturedParam> textures;
   std::optional<NormalMap> normal_map;
   std::optional<TextureRef> emission_texture;
@@ -565,23 +567,28 @@ std::uint32_t Flattener::material(int index) {
     }
     // alphaMode (glTF 2.0, 3.9.4) onto the material's coverage: OPAQUE
     // ignores alpha, MASK keeps the surface where alpha >= alphaCutoff and
-    // cuts it elsewhere, BLEND is stochastic coverage. The factor alone:
-    // the base colour texture's alpha is not read.
+    // cuts it elsewhere, BLEND is stochastic coverage. Alpha is the factor's
+    // times the base colour texture's (its fourth channel, always linear;
+    // 1 for an image without one).
     if (m.alphaMode == "MASK") {
       if (!(m.alphaCutoff >= 0.0)) fail(file_, at + "/alphaCutoff", "must not be negative");
-      coverage = alpha >= static_cast<float>(m.alphaCutoff) ? 1.0f : 0.0f;
+      cutoff = static_cast<float>(m.alphaCutoff);
+      coverage = alpha >= cutoff ? 1.0f : 0.0f;
     } else if (m.alphaMode == "BLEND") {
       coverage = alpha;
     }
     // Textures multiply their factors (glTF 2.0, 3.9): the factor is the
     // TextureRef's scale.
-    if (pbr.baseColorTexture.index >= 0 && m.alphaMode != "OPAQUE")
-      ignored_.insert("baseColorTexture's alpha (the factor alone gives the coverage)");
     if (pbr.baseColorTexture.index >= 0)
       if (auto t = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, pbr.baseColorTexture.extensions,
                            TextureColorSpace::Srgb, at + "/pbrMetallicRoughness/baseColorTexture")) {
         t->scale = p.base_color;
         textures.push_back({MaterialParam::BaseColor, *t});
+        if (m.alphaMode == "MASK" || m.alphaMode == "BLEND") {
+          t->channel = 3;
+          t->scale = Spectrum(alpha);
+          coverage_texture = t;
+        }
       }
     if (pbr.metallicRoughnessTexture.index >= 0)
       if (auto t = texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
@@ -613,6 +620,8 @@ std::uint32_t Flattener::material(int index) {
   out.material.name = name;
   out.material.emission = emission;
   out.material.alpha = coverage;
+  out.material.alpha_cutoff = cutoff;
+  out.material.alpha_texture = coverage_texture;
   for (const TexturedParam& t : textures) out.material.set_texture(t.param, t.texture);
   if (emission_texture && !is_black(emission)) {
     emission_texture->scale = emission;

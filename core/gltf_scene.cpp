@@ -44,6 +44,7 @@ void append_gltf(Scene& scene, const GltfContent& content, const std::vector<std
       };
       for (TexturedParam& t : added.textured) image(t.texture);
       if (added.normal_map) image(added.normal_map->texture);
+      if (added.alpha_texture) image(*added.alpha_texture);
       added.name = unique_name(added.name, [&](const std::string& name) {
         return std::any_of(scene.materials.begin(), scene.materials.end(), [&](const Material& x) { return x.name == name; });
       });

@@ -161,6 +161,9 @@ struct Material {
   // texture coordinates, clamped to [0, 1] (Textures::nearest_number).
   float alpha = 1.0f;
   std::optional<TextureRef> alpha_texture{};
+  // >= 0: the coverage is a mask, 1 where it is at least this and 0 below
+  // (glTF's alphaMode MASK and alphaCutoff); < 0: stochastic coverage.
+  float alpha_cutoff = -1.0f;
   DisneyParams disney{};       // type Disney
   DielectricParams glass{};    // type Dielectric
   // Derived from `disney` (or, for the general path, from `albedo`) by the

@@ -219,9 +219,11 @@ float Textures::number(const TextureRef& ref, const TextureFootprint& at) const 
 }
 
 float Textures::nearest_number(const TextureRef& ref, vec2 uv) const {
+  const int c = stored_channel(ref.image, ref.channel);
+  if (c < 0) return ref.scale.x + ref.offset.x;  // the alpha of an image without one: 1
   OIIO::TextureSystem& ts = *oiio_->ts;
   OIIO::TextureOpt opt;
-  opt.firstchannel = ref.channel;
+  opt.firstchannel = c;
   opt.swrap = opt.twrap = oiio_wrap(ref.wrap);
   opt.interpmode = OIIO::TextureOpt::InterpClosest;
   opt.fill = 0.0f;

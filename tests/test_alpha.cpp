@@ -151,6 +151,25 @@ TEST_F(AlphaTexture, CutsOutTheClearTexels) {
   }
 }
 
+// A mask (glTF's alphaMode MASK: Material::alpha_cutoff): coverage at or
+// above the cutoff is opaque, below it clear. Texels 0.7 and 0.3 with a
+// cutoff of 0.5: the left half stops every ray and the right half none,
+// where stochastic coverage would let 30 % and 70 % through.
+TEST_F(AlphaTexture, ACutoffMakesTheCoverageAMask) {
+  test::write_image(dir_ / "mask.exr", 2, 1, 1, {0.7f, 0.3f});
+  Scene scene = layers(1, 1.0f, false, R"({"texture": "mask.exr"})", dir_ / "mask.json");
+  for (Material& m : scene.materials)
+    if (m.alpha_texture) m.alpha_cutoff = 0.5f;
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const std::vector<FilmSample> a = samples(ReferenceTracer(compiled, settings));
+  const auto count = static_cast<std::size_t>(settings.spp);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::size_t x = (i / count) % 32;
+    ASSERT_EQ(a[i].L.x, x < 16 ? 0.0f : 1.0f) << "sample " << i << ", pixel column " << x;
+  }
+}
+
 // A texture of 0.25 everywhere (one channel, linear by default: an sRGB
 // decode would make it 0.05): 3/4 of the camera rays pass.
 TEST_F(AlphaTexture, GreyTextureIsCoverageReadLinear) {

@@ -234,7 +234,8 @@ TEST_F(Gltf, MaterialsMapOntoDisney) {
 
 // alphaMode onto the material's coverage (core/alpha.h): MASK cuts at
 // alphaCutoff (0.5 by default), BLEND is the alpha itself, OPAQUE ignores it.
-// The factor alone: a base colour texture's alpha is said to be ignored.
+// With a base colour texture its alpha (channel 3, linear) times the factor
+// is the coverage, a mask under MASK.
 TEST_F(Gltf, AlphaModesMapOntoCoverage) {
   GltfWriter w = quad(test::kGltfShort);
   const json first = w.doc["meshes"][0]["primitives"][0];
@@ -244,9 +245,11 @@ TEST_F(Gltf, AlphaModesMapOntoCoverage) {
                                     {{"alphaMode", "BLEND"}, {"pbrMetallicRoughness", factor(0.25)}},
                                     {{"alphaMode", "OPAQUE"}, {"pbrMetallicRoughness", factor(0.25)}},
                                     {{"alphaMode", "BLEND"},
-                                     {"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 0.5}}, {"baseColorTexture", {{"index", 0}}}}}}});
+                                     {"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 0.5}}, {"baseColorTexture", {{"index", 0}}}}}},
+                                    {{"alphaMode", "MASK"}, {"alphaCutoff", 0.4},
+                                     {"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1, 0.8}}, {"baseColorTexture", {{"index", 0}}}}}}});
   w.doc["meshes"][0]["primitives"] = json::array();
-  for (int m = 0; m < 5; ++m) {
+  for (int m = 0; m < 6; ++m) {
     json p = first;
     p["material"] = m;
     w.doc["meshes"][0]["primitives"].push_back(p);
@@ -255,12 +258,19 @@ TEST_F(Gltf, AlphaModesMapOntoCoverage) {
   w.doc["images"] = json::array({{{"uri", "base.png"}}});
   w.doc["textures"] = json::array({{{"source", 0}}});
   const GltfContent c = load_all(w, "alpha");
-  ASSERT_EQ(c.primitives.size(), 5u);
-  const float expected[] = {1.0f, 0.0f, 0.25f, 1.0f, 0.5f};
-  for (int m = 0; m < 5; ++m) EXPECT_EQ(c.materials[c.primitives[static_cast<std::size_t>(m)].material].material.alpha, expected[m]) << m;
-  std::string all;
-  for (const std::string& line : c.warnings) all += line + "\n";
-  EXPECT_NE(all.find("baseColorTexture's alpha (the factor alone gives the coverage)"), std::string::npos) << all;
+  ASSERT_EQ(c.primitives.size(), 6u);
+  const auto material = [&](int m) { return c.materials[c.primitives[static_cast<std::size_t>(m)].material].material; };
+  const float expected[] = {1.0f, 0.0f, 0.25f, 1.0f, 0.5f, 1.0f};
+  const float cutoff[] = {0.5f, 0.6f, -1.0f, -1.0f, -1.0f, 0.4f};
+  for (int m = 0; m < 6; ++m) {
+    EXPECT_EQ(material(m).alpha, expected[m]) << m;
+    EXPECT_EQ(material(m).alpha_cutoff, cutoff[m]) << m;
+    EXPECT_EQ(material(m).alpha_texture.has_value(), m >= 4) << m;
+  }
+  for (const int m : {4, 5}) {
+    EXPECT_EQ(material(m).alpha_texture->channel, 3);
+    EXPECT_EQ(material(m).alpha_texture->scale.x, m == 4 ? 0.5f : 0.8f);
+  }
 }
 
 // Textures: base colour (an external PNG), metallic-roughness (a PNG in a
