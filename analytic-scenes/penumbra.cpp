@@ -3,7 +3,10 @@
 // material is one_sided), and at most one black occluder strictly between
 // the emitter's plane and the ground: a closed convex mesh (a box) or a
 // planar convex polygon (a quad), of coverage alpha (core/alpha.h; 1 if its
-// material has none). Nothing else reflects, so a ground point x receives
+// material has none) - or a planar quad whose alpha texture is a mask (0 or
+// 1 at every texel, read linear) opaque on a rectangle of texels: a convex
+// cut-out, which the model takes as the occluder (alpha 1), its corners
+// where the texel edges lie on the quad. Nothing else reflects, so a ground point x receives
 // direct light only:
 //   L(x) = rho / pi * Le * FF(x),
 //   FF(x) = F(emitter) - o F(emitter ∩ shadow(x)),
@@ -29,6 +32,9 @@
 #include "analytic-scenes/polygon_irradiance.h"
 #include "analytic-scenes/room.h"
 #include "core/geometry.h"
+#include "core/image_io.h"
+
+#include <algorithm>
 
 #include <sstream>
 
@@ -92,6 +98,7 @@ std::optional<std::pair<std::size_t, double>> nearest_hit(const std::vector<cons
 
 class Penumbra final : public AnalyticModel {
  public:
+  Shape cutout;                      // the opaque part of an occluder with an alpha mask
   const Shape* emitter = nullptr;
   const Shape* ground = nullptr;
   const Shape* occluder = nullptr;  // may be null
@@ -161,6 +168,62 @@ class Penumbra final : public AnalyticModel {
   }
 };
 
+// The opaque part of the planar occluder `occ`, whose material's alpha is a
+// texture: every texel 0 or 1 (after scale, offset and the cutoff), the 1s
+// a rectangle of texels. Read at the nearest texel (core/alpha.h), texel
+// (x, y) from the top covers u in [x, x + 1) / W and v in (1 - (y + 1) / H,
+// 1 - y / H]; the quad's uvs map affinely onto it. Nothing if no texel is
+// opaque.
+std::optional<Shape> opaque_part(const Scene& scene, const Shape& occ, std::string_view name) {
+  const Material& m = scene.materials[occ.material];
+  const TextureRef& ref = *m.alpha_texture;
+  const TextureImage& image = scene.textures[ref.image];
+  if (image.colorspace != TextureColorSpace::Linear) refuse(scene, name, "the occluder's alpha texture must be linear");
+  if (ref.channel > 2) refuse(scene, name, "the occluder's alpha must be one of the texture's first three channels");
+  if (!occ.mesh.has_uvs() || occ.mesh.triangles.size() != 2)
+    refuse(scene, name, "an occluder with an alpha texture must be a quad with texture coordinates (a rectangle)");
+  const Image texels = read_image(image.file);
+  const int w = texels.width, h = texels.height;
+  int x0 = w, x1 = -1, y0 = h, y1 = -1;
+  std::vector<bool> opaque(static_cast<std::size_t>(w) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float a = std::clamp(ref.scale.x * texels.at(x, y)[ref.channel] + ref.offset.x, 0.0f, 1.0f);
+      if (m.alpha_cutoff >= 0.0f) a = a >= m.alpha_cutoff ? 1.0f : 0.0f;
+      if (a != 0.0f && a != 1.0f)
+        refuse(scene, name, "the occluder's alpha texture must be a mask, 0 or 1 at every texel (texel (" +
+                                std::to_string(x) + ", " + std::to_string(y) + ") is " + std::to_string(a) + ")");
+      if (a == 1.0f) {
+        opaque[static_cast<std::size_t>(y) * w + x] = true;
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+    }
+  if (x1 < 0) return std::nullopt;
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x)
+      if (!opaque[static_cast<std::size_t>(y) * w + x])
+        refuse(scene, name, "the opaque texels of the occluder's alpha texture must form a rectangle (a convex cut-out)");
+  // p(uv) = p0 + A (uv - uv0), from the first triangle.
+  const glm::uvec3 t = occ.mesh.triangles[0];
+  const dvec3 p0(occ.mesh.positions[t.x]), e1 = dvec3(occ.mesh.positions[t.y]) - p0, e2 = dvec3(occ.mesh.positions[t.z]) - p0;
+  const glm::dvec2 uv0(occ.mesh.uvs[t.x]), d1 = glm::dvec2(occ.mesh.uvs[t.y]) - uv0, d2 = glm::dvec2(occ.mesh.uvs[t.z]) - uv0;
+  const double det = d1.x * d2.y - d1.y * d2.x;
+  if (std::abs(det) < 1e-12) refuse(scene, name, "the occluder's texture coordinates are degenerate");
+  const auto at = [&](double u, double v) {
+    const glm::dvec2 d(u - uv0.x, v - uv0.y);
+    const double a = (d.x * d2.y - d.y * d2.x) / det, b = (d1.x * d.y - d1.y * d.x) / det;
+    return vec3(p0 + a * e1 + b * e2);
+  };
+  const double u_lo = static_cast<double>(x0) / w, u_hi = static_cast<double>(x1 + 1) / w;
+  const double v_lo = 1.0 - static_cast<double>(y1 + 1) / h, v_hi = 1.0 - static_cast<double>(y0) / h;
+  Shape part = occ;
+  part.description = occ.description + " (its opaque texels)";
+  part.mesh = TriangleMesh{};
+  part.mesh.positions = {at(u_lo, v_lo), at(u_hi, v_lo), at(u_hi, v_hi), at(u_lo, v_hi)};
+  part.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return part;
+}
+
 }  // namespace
 
 std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
@@ -224,10 +287,13 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
     }
     if (occ->kind != Shape::Kind::Triangles || !(convex_polygon || (is_closed(*occ) && is_convex(*occ))))
       refuse(scene, kName, "the occluder must be a closed convex mesh (a box) or a planar convex polygon (a quad)");
-    if (scene.materials[occ->material].alpha_texture)
-      refuse(scene, kName, "the occluder's alpha must be a number (an alpha texture is not modelled)");
-    const double a = scene.materials[occ->material].alpha;
-    model->opacity = convex_polygon ? a : 1.0 - (1.0 - a) * (1.0 - a);
+    if (scene.materials[occ->material].alpha_texture) {
+      if (!convex_polygon) refuse(scene, kName, "an alpha texture is modelled on a planar occluder (a quad) only");
+      model->opacity = 1.0;
+    } else {
+      const double a = scene.materials[occ->material].alpha;
+      model->opacity = convex_polygon ? a : 1.0 - (1.0 - a) * (1.0 - a);
+    }
     // Strictly between the emitter's plane and the whole ground, so that from
     // every ground point it projects onto the emitter's plane.
     double ground_near = kInfinity;
@@ -236,6 +302,14 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
       const double h = ep->distance(dvec3(v));
       if (!(h > 0.0 && h < ground_near))
         refuse(scene, kName, "the occluder must lie strictly between the emitter's front and the ground");
+    }
+    if (scene.materials[occ->material].alpha_texture) {
+      const std::optional<Shape> part = opaque_part(scene, *occ, kName);
+      model->occluder = nullptr;  // a mask that is clear everywhere occludes nothing
+      if (part) {
+        model->cutout = *part;
+        model->occluder = &model->cutout;
+      }
     }
   }
   model->Le = em.emission;
@@ -249,7 +323,9 @@ std::unique_ptr<AnalyticModel> make_penumbra(const Scene& scene) {
     << "' albedo (" << gm.albedo.x << ", " << gm.albedo.y << ", " << gm.albedo.z << ")"
     << (gm.one_sided ? " one-sided" : "")
     << (model->occluder ? ", one occluder" : ", no occluder");
-  if (model->occluder && scene.materials[model->occluder->material].has_alpha())
+  if (model->occluder == &model->cutout)
+    d << " cut out by its alpha mask to the quad of its opaque texels";
+  else if (model->occluder && scene.materials[model->occluder->material].has_alpha())
     d << " of alpha " << scene.materials[model->occluder->material].alpha << " (stops " << model->opacity
       << " of the segments through it)";
   d << ", depth cap " << model->max_depth;
