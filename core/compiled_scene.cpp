@@ -133,8 +133,7 @@ void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const v
   if (shape.kind == Shape::Kind::Triangles && (shape.mesh.has_normals() || shape.mesh.has_uvs())) {
     const glm::uvec3 v = shape.mesh.triangles[hit.prim];
     const float b0 = 1.0f - hit.uv.x - hit.uv.y;
-    if (shape.mesh.has_uvs())
-      s->uv = b0 * shape.mesh.uvs[v.x] + hit.uv.x * shape.mesh.uvs[v.y] + hit.uv.y * shape.mesh.uvs[v.z];
+    s->uv = shape.mesh.uv_at(hit.prim, hit.uv);
     if (shape.mesh.has_normals()) {
       const std::vector<vec3>& n = shape.mesh.normals;
       if (to_normal == nullptr) {
@@ -248,7 +247,7 @@ void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayH
     }
   }
   if (m.is_textured() && params != nullptr) {
-    evaluate_textured(m, *textures_, at, TextureFootprint{s->uv, 0.0f}, params);
+    evaluate_textured(m, *textures_, at, params);
     s->params = params;
   }
 }

@@ -56,12 +56,7 @@ struct AlphaGeometry {
   float at(unsigned prim, float b1, float b2) const {
     float a = alpha;
     if (texture) {
-      vec2 uv(b1, b2);
-      if (mesh->has_uvs()) {
-        const glm::uvec3 v = mesh->triangles[prim];
-        uv = (1.0f - b1 - b2) * mesh->uvs[v.x] + b1 * mesh->uvs[v.y] + b2 * mesh->uvs[v.z];
-      }
-      a = std::clamp(textures->nearest_number(*texture, uv), 0.0f, 1.0f);
+      a = std::clamp(textures->nearest_number(*texture, mesh->uv_at(prim, vec2(b1, b2))), 0.0f, 1.0f);
     }
     if (cutoff >= 0.0f) a = a >= cutoff ? 1.0f : 0.0f;
     return a;

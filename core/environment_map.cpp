@@ -61,21 +61,19 @@ glm::ivec2 EnvironmentMap::texel_of(vec2 uv) const {
                     std::clamp(static_cast<int>(uv.y * static_cast<float>(height())), 0, height() - 1));
 }
 
-Spectrum EnvironmentMap::radiance(const vec3& dir) const {
-  const glm::ivec2 t = texel_of(direction_to_uv(to_local_ * dir));
-  return texels_.at(t.x, t.y);
-}
-
-float EnvironmentMap::pdf(const vec3& dir) const {
+EnvironmentMap::Lookup EnvironmentMap::lookup(const vec3& dir) const {
   const vec3 local = to_local_ * dir;
+  const glm::ivec2 t = texel_of(direction_to_uv(local));
+  Lookup out;
+  out.radiance = texels_.at(t.x, t.y);
   // sin theta from the direction itself, not the texel: the density of the
   // map's (u, v) -> direction is 1 / (2 pi^2 sin theta) at that point. From
   // x and z, not 1 - y^2, which is 0 within 3e-4 rad of a pole in float.
   const float sin_theta = std::sqrt(local.x * local.x + local.z * local.z);
-  if (!(sin_theta > 0.0f)) return 0.0f;
-  const glm::ivec2 t = texel_of(direction_to_uv(local));
-  return distribution_.pdf(static_cast<std::size_t>(t.x), static_cast<std::size_t>(t.y)) /
-         (2.0f * kPi * kPi * sin_theta);
+  if (sin_theta > 0.0f)
+    out.pdf = distribution_.pdf(static_cast<std::size_t>(t.x), static_cast<std::size_t>(t.y)) /
+              (2.0f * kPi * kPi * sin_theta);
+  return out;
 }
 
 std::optional<EnvironmentMap::Sample> EnvironmentMap::sample(vec2 u) const {

@@ -58,10 +58,16 @@ class EnvironmentMap {
 
   // Radiance arriving from world direction `dir` (unit): the radiance of
   // rays that travel along -dir, i.e. what a ray with direction `dir` sees.
-  Spectrum radiance(const vec3& dir) const;
+  Spectrum radiance(const vec3& dir) const { return lookup(dir).radiance; }
   // Density in solid angle with which sample() returns `dir` (0 if the map
   // is black, at a pole or in a black texel).
-  float pdf(const vec3& dir) const;
+  float pdf(const vec3& dir) const { return lookup(dir).pdf; }
+  // Both, from one texel lookup (an escaping ray needs both).
+  struct Lookup {
+    Spectrum radiance{0.0f};
+    float pdf = 0.0f;
+  };
+  Lookup lookup(const vec3& dir) const;
 
   struct Sample {
     vec3 wi{0.0f};

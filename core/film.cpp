@@ -10,12 +10,6 @@ namespace pathlab {
 
 static_assert(sizeof(Sum1) == 16 && sizeof(Sum2) == 16);
 
-bool in_film_range(const Spectrum& L) {
-  // Also false for NaN: every comparison with it is.
-  for (int c = 0; c < 3; ++c)
-    if (!(std::abs(L[c]) < static_cast<float>(kFilmRadianceLimit))) return false;
-  return true;
-}
 
 Film::Film(int width, int height, FilterKind filter, FilmMoments moments)
     : width_(width),
@@ -51,6 +45,7 @@ void Film::add_batch(std::uint32_t first, std::uint32_t count, std::span<const F
       std::uint64_t bad = 0, rays = 0;
       for (int x = 0; x < width_; ++x) {
         Pixel& px = pixels_[index(x, y)];
+        Moments* const moments = variance ? &moments_sums_[index(x, y)] : nullptr;
         const std::size_t own = index(x, y) * count;
         for (std::uint32_t j = 0; j < count; ++j) rays += samples[own + j].rays;
         if (filter_ == FilterKind::Box) {
@@ -62,9 +57,8 @@ void Film::add_batch(std::uint32_t first, std::uint32_t count, std::span<const F
             }
             ++px.count;
             for (int c = 0; c < 3; ++c) px.sum_wL[c].add(L[c]);
-            if (!variance) continue;
-            Moments& m = moments_sums_[index(x, y)];
-            for (int c = 0; c < 3; ++c) m.sum_w2L2[c].add(static_cast<double>(L[c]) * L[c]);
+            if (!moments) continue;
+            for (int c = 0; c < 3; ++c) moments->sum_w2L2[c].add(static_cast<double>(L[c]) * L[c]);
           }
           continue;
         }
@@ -87,13 +81,12 @@ void Film::add_batch(std::uint32_t first, std::uint32_t count, std::span<const F
               const dvec3 l(s.L);
               sp.sum_w.add(w);
               for (int c = 0; c < 3; ++c) px.sum_wL[c].add(w * l[c]);
-              if (!variance) continue;
+              if (!moments) continue;
               const double w2 = w * w;
               sp.sum_w2.add(w2);
-              Moments& m = moments_sums_[index(x, y)];
               for (int c = 0; c < 3; ++c) {
                 sp.sum_w2L[c].add(w2 * l[c]);
-                m.sum_w2L2[c].add(w2 * l[c] * l[c]);
+                moments->sum_w2L2[c].add(w2 * l[c] * l[c]);
               }
             }
           }

@@ -45,8 +45,13 @@ struct BadSample {
 };
 
 inline constexpr double kFilmRadianceLimit = Sum1::kLimit;
-// True if the film can add L: finite and every component below kFilmRadianceLimit.
-bool in_film_range(const Spectrum& L);
+// True if the film can add L: finite and every component below
+// kFilmRadianceLimit (also false for NaN: every comparison with it is).
+inline bool in_film_range(const Spectrum& L) {
+  for (int c = 0; c < 3; ++c)
+    if (!(std::abs(L[c]) < static_cast<float>(kFilmRadianceLimit))) return false;
+  return true;
+}
 
 // What a film keeps beyond each pixel's weighted mean.
 enum class FilmMoments : std::uint8_t {

@@ -35,6 +35,9 @@ using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 // or is not writable. Called before a render so that a bad `-o` fails in a
 // second, not after an hour.
 void ensure_writable(const std::filesystem::path& file);
+// The file's extension in lower case (".exr" for "out.EXR"), for deciding
+// what to write.
+std::string lower_extension(const std::filesystem::path& file);
 
 // Calls write(temp) with a hidden temporary path in `file`'s folder (same
 // extension), then renames the temporary file to `file`. If `write` throws or

@@ -184,19 +184,21 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
     if (!suns_.empty()) add_suns(ls.wi, &ls.Le, &ls.pdf);
     return ls;
   }
-  if (const auto sun = std::find_if(suns_.begin(), suns_.end(), [&](const SunDisk& d) { return d.entry == std::int64_t(i); });
-      sun != suns_.end()) {
+  // The sun disks are the last entries, in order.
+  if (!suns_.empty() && static_cast<std::int64_t>(i) >= suns_.front().entry) {
+    const SunDisk* sun = &suns_[i - static_cast<std::size_t>(suns_.front().entry)];
     // Uniform in the cone, by 1 - cos theta = u.x (1 - cos alpha): sin theta
     // from that difference keeps the disk's size exact for a tiny sun.
     const float one_minus_cos = u.x * sun->one_minus_cos;
     const float sin_theta = std::sqrt(std::max(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
     const float phi = 2.0f * kPi * u.y;
     const vec3 local(sin_theta * std::cos(phi), sin_theta * std::sin(phi), 1.0f - one_minus_cos);
-    ls.wi = glm::normalize(sun->frame.s * local.x + sun->frame.t * local.y + sun->frame.n * local.z);
+    ls.wi = glm::normalize(sun->frame.to_world(local));
     ls.dist = kInfinity;
     ls.infinite = true;
-    ls.Le = environment(ls.wi);
-    ls.pdf = pdf_environment(ls.wi);
+    const Sky sky_there = sky(ls.wi);
+    ls.Le = sky_there.Le;
+    ls.pdf = sky_there.pdf;
     if (!(ls.pdf > 0.0f) || is_black(ls.Le)) return std::nullopt;  // rounded out of the cone
     return ls;
   }
@@ -230,13 +232,8 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
     return ls;
   }
   // The texture at the point's uv, as CompiledScene::resolve gives a hit there.
-  vec2 uv = b;
-  if (shape.kind == Shape::Kind::Sphere) {
-    uv = sphere_uv((ls.p - shape.center) / shape.radius);
-  } else if (shape.mesh.has_uvs()) {
-    const glm::uvec3 v = shape.mesh.triangles[e.prim];
-    uv = (1.0f - b.x - b.y) * shape.mesh.uvs[v.x] + b.x * shape.mesh.uvs[v.y] + b.y * shape.mesh.uvs[v.z];
-  }
+  const vec2 uv = shape.kind == Shape::Kind::Sphere ? sphere_uv((ls.p - shape.center) / shape.radius)
+                                                    : shape.mesh.uv_at(e.prim, b);
   ls.Le = emission_at(m, textures_, uv);
   return ls;
 }
@@ -266,27 +263,19 @@ void LightSampler::add_suns(const vec3& dir, Spectrum* Le, float* pdf) const {
     }
 }
 
-float LightSampler::pdf_environment(const vec3& wi) const {
-  float pdf = 0.0f;
-  if (env_index_ >= 0) {
-    const float pmf = pmf_[static_cast<std::size_t>(env_index_)];
-    pdf = scene_->environment_map ? pmf * scene_->environment_map->pdf(wi) : pmf * kInv4Pi;
+LightSampler::Sky LightSampler::sky(const vec3& dir) const {
+  Sky out;
+  const float pmf = env_index_ >= 0 ? pmf_[static_cast<std::size_t>(env_index_)] : 0.0f;
+  if (scene_->environment_map) {
+    const EnvironmentMap::Lookup m = scene_->environment_map->lookup(dir);
+    out.Le = m.radiance;
+    out.pdf = pmf * m.pdf;
+  } else {
+    out.Le = scene_->environment.value_or(Spectrum(0.0f));
+    out.pdf = pmf * kInv4Pi;
   }
-  if (!suns_.empty()) {
-    Spectrum unused(0.0f);
-    add_suns(wi, &unused, &pdf);
-  }
-  return pdf;
-}
-
-Spectrum LightSampler::environment(const vec3& dir) const {
-  Spectrum L = scene_->environment_map ? scene_->environment_map->radiance(dir)
-                                       : scene_->environment.value_or(Spectrum(0.0f));
-  if (!suns_.empty()) {
-    float unused = 0.0f;
-    add_suns(dir, &L, &unused);
-  }
-  return L;
+  if (!suns_.empty()) add_suns(dir, &out.Le, &out.pdf);
+  return out;
 }
 
 std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_choice) const {

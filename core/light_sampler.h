@@ -89,11 +89,17 @@ class LightSampler {
   float pdf(const vec3& ref, const Surfel& hit) const;
   // Density with which sample() would produce direction `wi` towards the
   // environment or a sun disk (0 without them): the sum over those lights.
-  float pdf_environment(const vec3& wi) const;
+  float pdf_environment(const vec3& wi) const { return sky(wi).pdf; }
   // The radiance a ray with direction `dir` sees when it escapes the scene:
   // the environment's plus that of every sun disk it points into (black
-  // without them). Both tracers' escapes call this.
-  Spectrum environment(const vec3& dir) const;
+  // without them).
+  Spectrum environment(const vec3& dir) const { return sky(dir).Le; }
+  // Both, from one lookup: what both tracers' escapes call.
+  struct Sky {
+    Spectrum Le{0.0f};
+    float pdf = 0.0f;
+  };
+  Sky sky(const vec3& dir) const;
 
   // A delta light picked in proportion to its power. Nothing if it sends no
   // light towards `ref` (outside a spot's cone, or at its position).

@@ -132,8 +132,7 @@ Spectrum clamp01(const Spectrum& c) { return glm::clamp(c, Spectrum(0.0f), Spect
 
 }  // namespace
 
-void evaluate_textured(const Material& m, const Textures& textures, const TextureFootprint& at,
-                       const TextureFootprint& emission_at, SurfaceParams* out) {
+void evaluate_textured(const Material& m, const Textures& textures, const TextureFootprint& at, SurfaceParams* out) {
   out->albedo = m.albedo;
   out->emission = m.emission;
   out->glass = m.glass;
@@ -142,7 +141,7 @@ void evaluate_textured(const Material& m, const Textures& textures, const Textur
     const TextureRef& r = t.texture;
     switch (t.param) {
       case MaterialParam::Albedo: out->albedo = clamp01(textures.color(r, at)); break;
-      case MaterialParam::Emission: out->emission = glm::max(textures.color(r, emission_at), Spectrum(0.0f)); break;
+      case MaterialParam::Emission: out->emission = emission_at(m, &textures, at.uv); break;
       case MaterialParam::GlassReflectance: out->glass.reflectance = clamp01(textures.color(r, at)); break;
       case MaterialParam::GlassTransmittance: out->glass.transmittance = clamp01(textures.color(r, at)); break;
       case MaterialParam::BaseColor: p.base_color = clamp01(textures.color(r, at)); break;

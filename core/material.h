@@ -197,14 +197,13 @@ struct Material {
   void set_texture(MaterialParam p, const TextureRef& texture);
 };
 
-// The parameters of `m` at a point: `at` for reflection, `emission_at` for
-// emission (emission is read without filtering: see docs/scene-format.md).
-// Disney parameters are clamped to their ranges, colours to >= 0 and
-// reflectances to <= 1.
-void evaluate_textured(const Material& m, const Textures& textures, const TextureFootprint& at,
-                       const TextureFootprint& emission_at, SurfaceParams* out);
+// The parameters of `m` at a point: reflection's filtered over `at`'s
+// footprint, emission's read at `at.uv` without filtering (emission_at; see
+// docs/scene-format.md). Disney parameters are clamped to their ranges,
+// colours to >= 0 and reflectances to <= 1.
+void evaluate_textured(const Material& m, const Textures& textures, const TextureFootprint& at, SurfaceParams* out);
 // The emission of `m` at a point (its constant, or its texture read without
-// filtering); for light sampling.
+// filtering): what a hit and a light sample there both see.
 Spectrum emission_at(const Material& m, const Textures* textures, vec2 uv);
 
 // Materials of each type with the given parameters (and no emission).

@@ -75,8 +75,8 @@ class HashedWriter {
   ~HashedWriter() {
     if (fd_ >= 0) ::close(fd_);
   }
-  void write(const void* data, std::size_t n, bool hashed = true) {
-    if (hashed) XXH3_128bits_update(state_.get(), data, n);
+  void write(const void* data, std::size_t n) {
+    XXH3_128bits_update(state_.get(), data, n);
     const char* p = static_cast<const char*>(data);
     while (n > 0) {
       const ssize_t k = ::write(fd_, p, std::min<std::size_t>(n, std::size_t{1} << 30));
@@ -265,7 +265,7 @@ void write_partial_film(const Film& film, const PartialFilmInfo& pf, const fs::p
     for (const std::span<const std::uint64_t> a : {words.pixels, words.moments, words.splat})
       w.write(a.data(), a.size_bytes());
     const XXH128_hash_t h = w.digest();
-    w.write_u64(h.low64);  // hashed too, harmlessly: the reader stops hashing before it
+    w.write_u64(h.low64);  // hashed too, unread: the reader stops hashing before it
     w.write_u64(h.high64);
     w.finish();
   } catch (...) {

@@ -124,7 +124,6 @@ UntilResult render_until(const Tracer& tracer, Film& film, const StopRule& rule,
     ++r.passes;
     if (!go_on) {
       r.spp = reached;
-      r.stopped = true;
       break;
     }
     r.spp = last;

@@ -75,7 +75,6 @@ struct StopRule {
 struct UntilResult {
   RenderStats stats;
   std::uint32_t spp = 0;          // samples per pixel reached (whole passes)
-  bool stopped = false;           // batch_done stopped it
   std::uint32_t passes = 0;
   double estimated_relmse = 0.0;  // of the final film
   double last_pass_seconds = 0.0;

@@ -101,7 +101,6 @@ class Distribution2D {
   Distribution2D() = default;
   Distribution2D(std::span<const float> weights, std::size_t width, std::size_t height);
 
-  double total() const { return marginal_.total(); }
   // Density on [0, 1)^2 in cell (x, y).
   float pdf(std::size_t x, std::size_t y) const { return marginal_.pdf(y) * conditional_[y].pdf(x); }
 

@@ -171,7 +171,7 @@ Textures::~Textures() {
 }
 
 void Textures::lookup(std::uint32_t image, TextureWrap wrap, int first, int n, const TextureFootprint& at,
-                      float* out) const {
+                      float* out, bool nearest) const {
   // Debian's OpenImageIO keeps its assertions: channels past the image's
   // would abort the process inside OIIO, so callers map them first.
   if (first < 0 || first + n > images_[image].channels)
@@ -181,7 +181,8 @@ void Textures::lookup(std::uint32_t image, TextureWrap wrap, int first, int n, c
   OIIO::TextureOpt opt;
   opt.firstchannel = first;
   opt.swrap = opt.twrap = oiio_wrap(wrap);
-  opt.interpmode = OIIO::TextureOpt::InterpBilinear;  // not OIIO's default "smart bicubic": the same kernel at every level
+  // Not OIIO's default "smart bicubic": the same kernel at every level.
+  opt.interpmode = nearest ? OIIO::TextureOpt::InterpClosest : OIIO::TextureOpt::InterpBilinear;
   opt.fill = 0.0f;
   // An isotropic footprint: the cone's width along both image axes.
   const float d = at.width;
@@ -221,15 +222,8 @@ float Textures::number(const TextureRef& ref, const TextureFootprint& at) const 
 float Textures::nearest_number(const TextureRef& ref, vec2 uv) const {
   const int c = stored_channel(ref.image, ref.channel);
   if (c < 0) return ref.scale.x + ref.offset.x;  // the alpha of an image without one: 1
-  OIIO::TextureSystem& ts = *oiio_->ts;
-  OIIO::TextureOpt opt;
-  opt.firstchannel = c;
-  opt.swrap = opt.twrap = oiio_wrap(ref.wrap);
-  opt.interpmode = OIIO::TextureOpt::InterpClosest;
-  opt.fill = 0.0f;
   float v = 0.0f;
-  ts.texture(static_cast<OIIO::TextureSystem::TextureHandle*>(images_[ref.image].handle), ts.get_perthread_info(), opt,
-             uv.x, 1.0f - uv.y, 0.0f, 0.0f, 0.0f, 0.0f, 1, &v);
+  lookup(ref.image, ref.wrap, c, 1, {uv, 0.0f}, &v, true);
   return ref.scale.x * v + ref.offset.x;
 }
 

@@ -136,8 +136,10 @@ class Textures {
   Spectrum mean_color(const TextureRef& ref) const;
 
   // The raw lookup: `n` channels from `first` (decoded, before scale and
-  // offset) into `out`.
-  void lookup(std::uint32_t image, TextureWrap wrap, int first, int n, const TextureFootprint& at, float* out) const;
+  // offset) into `out`; bilinear over the footprint, or the nearest texel
+  // of the finest level.
+  void lookup(std::uint32_t image, TextureWrap wrap, int first, int n, const TextureFootprint& at, float* out,
+              bool nearest = false) const;
 
  private:
   struct Image {

@@ -22,6 +22,4 @@ MpiJob::Result MpiJob::render(const Tracer&, Film&, std::uint32_t, std::uint32_t
   throw SystemError("MpiJob::render: built without MPI");
 }
 
-void MpiJob::reduce(const Film&, const RenderStats&, Film*, RenderStats*) const {}
-
 }  // namespace pathlab

@@ -32,8 +32,9 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
   Surfel s;
   ++path.rays;
   if (!scene.intersect(ray, &s, path.cone, path.params)) {
-    const Spectrum Le = scene.lights().environment(ray.dir);
-    const float w = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, scene.lights().pdf_environment(ray.dir));
+    const LightSampler::Sky sky = scene.lights().sky(ray.dir);
+    const Spectrum Le = sky.Le;
+    const float w = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, sky.pdf);
     if (path.observer) {
       path.observer->on_escape({vertex, Le, w, beta * w * Le});
       path.observer->on_end({vertex, PathEnd::Escaped});

@@ -327,16 +327,11 @@ void WavefrontTracer::intersect(Wave& w) const {
   w.clock.batch(camera_rays ? kCameraQueries : kBounceQueries, t0, n);
   for (std::size_t i = 0; i < n; ++i)
     if (found[i]) scene_.prefetch(hits[i]);
-  if (scene_.has_textures()) {
-    for (std::size_t i = 0; i < n; ++i) {
-      ++w.rays[i];
-      if (found[i]) scene_.resolve(rays[i], hits[i], &w.surfel[i], w.cone[i], &w.params[i]);
-    }
-    return;
-  }
+  const bool textured = scene_.has_textures();  // then w.cone and w.params are sized
   for (std::size_t i = 0; i < n; ++i) {
     ++w.rays[i];
-    if (found[i]) scene_.resolve(rays[i], hits[i], &w.surfel[i]);
+    if (found[i])
+      scene_.resolve(rays[i], hits[i], &w.surfel[i], textured ? w.cone[i] : RayCone{}, textured ? &w.params[i] : nullptr);
   }
 }
 
@@ -349,9 +344,9 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
   for (std::size_t i = 0; i < w.n; ++i) {
     const Surfel& s = w.surfel[i];
     if (!w.found[i]) {
-      const Spectrum Le = scene_.lights().environment(w.ray[i].dir);
-      const float we =
-          is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf_environment(w.ray[i].dir));
+      const LightSampler::Sky sky = scene_.lights().sky(w.ray[i].dir);
+      const Spectrum Le = sky.Le;
+      const float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], sky.pdf);
       w.L[i] += w.beta[i] * (we * Le);
       if (obs) {
         obs->on_escape({w.vertex[i], Le, we, w.beta[i] * we * Le});

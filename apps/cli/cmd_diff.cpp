@@ -99,9 +99,7 @@ int DiffCommand::run(std::ostream& out, std::ostream& err) const {
   fs::path heatmap_file;
   if (!heatmap.empty()) {
     heatmap_file = heatmap;
-    std::string ext = heatmap_file.extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext != ".png") throw InputError(heatmap + ": --heatmap must be a .png file");
+    if (lower_extension(heatmap_file) != ".png") throw InputError(heatmap + ": --heatmap must be a .png file");
     std::error_code ec_heatmap, ec_input;
     const fs::path canonical_heatmap = fs::weakly_canonical(heatmap_file, ec_heatmap);
     for (const std::string& input : {a, b}) {

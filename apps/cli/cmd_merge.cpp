@@ -27,9 +27,7 @@ void MergeCommand::add_to(CLI::App& app) {
 
 int MergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   const std::filesystem::path exr(output);
-  std::string ext = exr.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext != ".exr") throw InputError(exr.string() + ": the output must be an .exr file (a .png is written beside it)");
+  if (lower_extension(exr) != ".exr") throw InputError(exr.string() + ": the output must be an .exr file (a .png is written beside it)");
   std::filesystem::path png = exr;
   png.replace_extension(".png");
   ensure_writable(exr);

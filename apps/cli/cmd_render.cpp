@@ -59,12 +59,6 @@ void RenderCommand::add_to(CLI::App& app) {
 
 namespace {
 
-std::string lower_extension(const std::filesystem::path& p) {
-  std::string ext = p.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext;
-}
-
 // "A..B" -> [A, B).
 PassRange parse_passes(const std::string& text) {
   const std::size_t dots = text.find("..");
@@ -192,14 +186,17 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   const auto info_at = [&](std::uint32_t end, const RenderStats& so_far) { return info_of(film, end, so_far); };
 
   const InterruptGuard interrupts;
+  // True (and the clock restarted) when a checkpoint is due.
   auto last_checkpoint = std::chrono::steady_clock::now();
+  const auto checkpoint_due = [&] {
+    const auto now = std::chrono::steady_clock::now();
+    if (!checkpoint || std::chrono::duration<double>(now - last_checkpoint).count() < checkpoint_every) return false;
+    last_checkpoint = now;
+    return true;
+  };
   const BatchDoneFn batch_done = [&](std::uint32_t end, const RenderStats& so_far) {
     if (InterruptGuard::received() != 0) return false;
-    const auto now = std::chrono::steady_clock::now();
-    if (checkpoint && std::chrono::duration<double>(now - last_checkpoint).count() >= checkpoint_every) {
-      write_partial_film(film, info_at(end, so_far), *checkpoint);
-      last_checkpoint = now;
-    }
+    if (checkpoint_due()) write_partial_film(film, info_at(end, so_far), *checkpoint);
     return true;
   };
 
@@ -215,18 +212,12 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     // whole render. Rank 0 writes the checkpoints and the outputs.
     const std::uint32_t block = batch_size(film.width(), film.height(), static_cast<int>(range.end - start));
     const MpiJob::Result r = job.render(
-        driven, film, start, range.end, block, [] { return InterruptGuard::received() != 0; },
-        [&] {
-          const auto now = std::chrono::steady_clock::now();
-          if (!checkpoint || std::chrono::duration<double>(now - last_checkpoint).count() < checkpoint_every)
-            return false;
-          last_checkpoint = now;
-          return true;
-        },
+        driven, film, start, range.end, block, [] { return InterruptGuard::received() != 0; }, checkpoint_due,
         [&](std::uint32_t reached, Film& sum, const RenderStats& total) {
+          // Every reduction is a checkpoint, the last one too (at the end
+          // or on an interrupt): the one write of it.
           stats = total;
-          info = info_of(sum, reached, total);
-          if (reached < range.end && checkpoint) write_partial_film(sum, info, *checkpoint);
+          if (checkpoint) write_partial_film(sum, info_of(sum, reached, total), *checkpoint);
           film = std::move(sum);  // the last one is the job's film
         },
         [&](double f) { bar.update(f); });
@@ -254,7 +245,7 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   bar.finish();
   if (!job.distributed()) interrupted = InterruptGuard::received();
   info = info_at(end, stats);
-  if (checkpoint) write_partial_film(film, info, *checkpoint);
+  if (checkpoint && !job.distributed()) write_partial_film(film, info, *checkpoint);  // MPI: written as reduced
   if (partial_output) write_partial_film(film, info, exr);
   const int spp_done = static_cast<int>(info.passes.count());
   stats = info.stats;  // this render and the ones it resumed

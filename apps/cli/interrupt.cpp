@@ -36,6 +36,5 @@ InterruptGuard::~InterruptGuard() {
 }
 
 int InterruptGuard::received() { return g_received.load(); }
-void InterruptGuard::simulate(int signal) { g_received = signal; }
 
 }  // namespace pathlab::cli

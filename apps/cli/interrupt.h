@@ -16,8 +16,6 @@ class InterruptGuard {
 
   // The signal received since the guard was made (SIGINT or SIGTERM), or 0.
   static int received();
-  // For tests: behave as if `signal` had arrived.
-  static void simulate(int signal);
 };
 
 }  // namespace pathlab::cli
