@@ -24,12 +24,15 @@
 //   path differentials argue the same way). A diffuse bounce therefore reads
 //   the next surface's textures heavily filtered, which is what the
 //   integral over that lobe does anyway.
+// With the point filter there is no cone to carry: every lookup reads the
+// finest level, after a scatter as at the camera.
 // Both tracers carry the same cone, computed by these functions, so they
 // read the same texels; a scene without textures carries none (the tracers
 // skip this arithmetic).
 #pragma once
 
 #include "core/math.h"
+#include "core/texture.h"
 
 #include <algorithm>
 #include <cmath>
@@ -48,8 +51,10 @@ inline float pixel_spread_angle(float fov_y_degrees, int height) {
   return std::atan(2.0f * std::tan(0.5f * fov_y_degrees * kPi / 180.0f) / static_cast<float>(height));
 }
 
-// The cone leaving a hit at distance `t` along `in` after a scatter.
-inline RayCone scattered_cone(const RayCone& in, float t, bool impulse, float pdf) {
+// The cone leaving a hit at distance `t` along `in` after a scatter (none
+// with the point filter).
+inline RayCone scattered_cone(const RayCone& in, float t, bool impulse, float pdf, TextureFilter filter) {
+  if (filter == TextureFilter::Point) return {};
   RayCone out{in.width_at(t), in.spread};
   if (!impulse) {
     const float lobe = pdf > 0.0f ? 2.0f * std::sqrt(1.0f / (kPi * pdf)) : kPi;

@@ -187,9 +187,16 @@ TEST(RayCone, CameraSpreadIsOnePixelsAngle) {
   const RayCone c{0.0f, 0.01f};
   EXPECT_FLOAT_EQ(c.width_at(4.0f), 0.04f);
   // An impulse keeps the spread, a diffuse bounce widens it to the lobe's.
-  EXPECT_FLOAT_EQ(scattered_cone(c, 4.0f, true, 1.0f).spread, 0.01f);
-  EXPECT_FLOAT_EQ(scattered_cone(c, 4.0f, true, 1.0f).width, 0.04f);
-  EXPECT_NEAR(scattered_cone(c, 4.0f, false, 1.0f / kPi).spread, 2.0f, 1e-6f);
+  EXPECT_FLOAT_EQ(scattered_cone(c, 4.0f, true, 1.0f, TextureFilter::Cone).spread, 0.01f);
+  EXPECT_FLOAT_EQ(scattered_cone(c, 4.0f, true, 1.0f, TextureFilter::Cone).width, 0.04f);
+  EXPECT_NEAR(scattered_cone(c, 4.0f, false, 1.0f / kPi, TextureFilter::Cone).spread, 2.0f, 1e-6f);
+  // The point filter carries no cone past a scatter either: the finest level
+  // at every bounce, as at the camera (a diffuse bounce widened it to 2 rad).
+  for (const bool impulse : {false, true}) {
+    const RayCone p = scattered_cone(c, 4.0f, impulse, 1.0f / kPi, TextureFilter::Point);
+    EXPECT_EQ(p.width, 0.0f);
+    EXPECT_EQ(p.spread, 0.0f);
+  }
 }
 
 // The footprint resolve() passes to OIIO at a camera ray's hit is the

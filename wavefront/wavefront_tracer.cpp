@@ -484,7 +484,9 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
     if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i], next});
     w.prev[i] = PreviousVertex{s.p, bs->pdf, bs->impulse,
                                !(strategy == Strategy::LightBsdf && w.u(i, Dim::Technique) < 0.5f)};
-    if (textured) w.cone[i] = scattered_cone(w.cone[i], glm::length(s.p - w.ray[i].origin), bs->impulse, bs->pdf);
+    if (textured)
+      w.cone[i] = scattered_cone(w.cone[i], glm::length(s.p - w.ray[i].origin), bs->impulse, bs->pdf,
+                                 settings_.texture_filter);
     w.ray[i] = next;
     w.vertex[i] = v + 1;
   }
