@@ -26,8 +26,11 @@
 #include <sys/wait.h>
 
 #include <cstdlib>
+#include <cmath>
 #include <fstream>
+#include <regex>
 #include <set>
+#include <sstream>
 
 namespace pathlab::debug {
 namespace {
@@ -79,7 +82,14 @@ TEST(DebugScript, ParsesCommandsAndNamesTheLineOfAMistake) {
   EXPECT_EQ(cmds[1].kind, ScriptCommand::Kind::Click);
   EXPECT_EQ(cmds[1].y, 4);
   EXPECT_EQ(cmds[3].arg, "a.vtp");
-  for (const char* bad : {"clik 3 4", "click 3", "view sideways", "wait-spp -1", "quit now"}) {
+  const auto more = parse_script("wheel 10 20 -3\ndrag 5 6 -40 7\nsplit 0.25\nscale log\ncompare tracer\nnext-nan\n", "t.txt");
+  ASSERT_EQ(more.size(), 6u);
+  EXPECT_EQ(more[0].dx, -3);
+  EXPECT_EQ(more[1].dx, -40);
+  EXPECT_EQ(more[1].dy, 7);
+  EXPECT_FLOAT_EQ(more[2].value, 0.25f);
+  for (const char* bad : {"clik 3 4", "click 3", "scale sideways", "wait-spp -1", "quit now", "wheel 1 2", "split 1.5",
+                          "compare nothing", "drag 1 2 3"}) {
     try {
       parse_script(std::string("view beauty\n") + bad + "\n", "s.txt");
       ADD_FAILURE() << bad;
@@ -108,14 +118,23 @@ TEST(DebugSession, RendersProgressivelyReadsOutAndRetracesTheRendersSample) {
   EXPECT_FALSE(t.text.empty());
   EXPECT_FALSE(t.lines.empty());
 
-  // Every view draws something; a bad pixel request is an error, not a crash.
-  for (View v : kAllViews) {
-    const auto rgba = view_rgba(snap, v, 0.0f);
+  // The layers are the EXR channels of the film and every AOV (aov_channels),
+  // then the NaN/Inf and sample counts; each draws something.
+  std::vector<std::string> names;
+  for (const Layer& l : snap.layers) names.push_back(l.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"beauty", "albedo", "normal", "depth", "material", "variance", "pathlength",
+                                             "nonfinite", "samples"}));
+  EXPECT_EQ(find_layer(snap.layers, "albedo")->image.pixels, snap.albedo.pixels);
+  EXPECT_EQ(find_layer(snap.layers, "beauty")->channels, "R,G,B");
+  EXPECT_EQ(find_layer(snap.layers, "depth")->channels, "Z");
+  for (const Layer& l : snap.layers) {
+    const Mapping m = default_mapping(l);
+    const auto rgba = layer_rgba(l, m, 0.0f, auto_range(l, m));
     ASSERT_EQ(rgba.size(), 24u * 24u * 4u);
     std::set<std::uint32_t> colours;
     for (std::size_t i = 0; i < rgba.size(); i += 4) colours.insert(rgba[i] | rgba[i + 1] << 8 | rgba[i + 2] << 16);
-    if (v != View::NonFinite) {
-      EXPECT_GT(colours.size(), 2u) << view_name(v);
+    if (l.name != "nonfinite" && l.name != "samples") {
+      EXPECT_GT(colours.size(), 2u) << l.name;
     }
   }
   EXPECT_THROW(session.retrace(24, 0, 0), InputError);
@@ -246,6 +265,304 @@ TEST_F(DebugGui, ScriptedSessionExportsThePathAndShowsTheImageWithItsOverlay) {
     for (int x = res + 10; x < screen.width; ++x, ++count) panel += screen.at(x, y).y, panel2 += screen.at(x, y).y * screen.at(x, y).y;
   EXPECT_GT(panel2 / count - (panel / count) * (panel / count), 1e-4) << "the panel is blank";
   EXPECT_TRUE(std::filesystem::exists(last));
+}
+
+// Layers come from EXR channel names, generically: a layer another part of
+// pathlab adds (per-bounce radiance L0, a stage buffer) needs no GUI change.
+TEST(DebugLayers, GroupsChannelsIntoLayersInRgbOrder) {
+  const std::vector<ExrChannel> channels = {{"B", {3}},      {"G", {2}},       {"R", {1}},       {"L0.B", {6}},
+                                            {"L0.G", {5}},   {"L0.R", {4}},    {"depth.Z", {7}}, {"uv.U", {8}},
+                                            {"uv.V", {9}},   {"stage_count.Y", {10}}};
+  const std::vector<Layer> layers = layers_from_channels(1, 1, channels);
+  ASSERT_EQ(layers.size(), 5u);
+  EXPECT_EQ(layers[0].name, "beauty");
+  EXPECT_EQ(layers[0].channels, "R,G,B");
+  EXPECT_EQ(layers[0].image.pixels[0], vec3(1, 2, 3));
+  EXPECT_EQ(layers[1].name, "L0");
+  EXPECT_EQ(layers[1].image.pixels[0], vec3(4, 5, 6));
+  EXPECT_EQ(default_mapping(layers[1]), Mapping::Tone);
+  EXPECT_EQ(layers[2].image.pixels[0], vec3(7));
+  EXPECT_EQ(default_mapping(layers[2]), Mapping::Linear);
+  EXPECT_EQ(layers[3].count, 2);
+  EXPECT_EQ(layers[3].image.pixels[0], vec3(8, 9, 0));
+  EXPECT_EQ(layers[4].name, "stage_count");
+}
+
+// Linear and log views map the auto range onto the ramp; values <= 0 are
+// black under log, non-finite values magenta under every mapping.
+TEST(DebugViews, LinearAndLogRangesMapOntoTheRamp) {
+  Layer l;
+  l.name = "variance";
+  l.channels = "Y";
+  l.count = 1;
+  l.image = Image(5, 1);
+  const float values[] = {1e-6f, 1e-4f, 1e-2f, 0.0f, NAN};
+  for (int i = 0; i < 5; ++i) l.image.pixels[static_cast<std::size_t>(i)] = vec3(values[i]);
+  const Range lin = auto_range(l, Mapping::Linear), log = auto_range(l, Mapping::Log);
+  EXPECT_EQ(lin.lo, 0.0f);
+  EXPECT_EQ(lin.hi, 1e-2f);
+  EXPECT_EQ(log.lo, 1e-6f);
+  EXPECT_EQ(log.hi, 1e-2f);
+  const auto px = [](const std::vector<std::uint8_t>& rgba, int i) {
+    return vec3(rgba[4 * static_cast<std::size_t>(i)], rgba[4 * static_cast<std::size_t>(i) + 1],
+                rgba[4 * static_cast<std::size_t>(i) + 2]) / 255.0f;
+  };
+  const auto near = [](vec3 a, vec3 b) { return glm::length(a - b) < 1.5f / 255.0f; };
+  const auto lg = layer_rgba(l, Mapping::Log, 0.0f, log);
+  EXPECT_TRUE(near(px(lg, 0), ramp_colour(0.0f)));
+  EXPECT_TRUE(near(px(lg, 1), ramp_colour(0.5f)));  // 1e-4 is halfway between 1e-6 and 1e-2 in log
+  EXPECT_TRUE(near(px(lg, 2), ramp_colour(1.0f)));
+  EXPECT_TRUE(near(px(lg, 3), vec3(0.0f)));
+  EXPECT_TRUE(near(px(lg, 4), vec3(1, 0, 1)));
+  const auto ln = layer_rgba(l, Mapping::Linear, 0.0f, lin);
+  EXPECT_TRUE(near(px(ln, 1), ramp_colour(0.01f)));
+  EXPECT_TRUE(near(px(ln, 3), ramp_colour(0.0f)));
+  EXPECT_FALSE(near(ramp_colour(0.0f), ramp_colour(0.5f)));
+}
+
+// A Cornell box whose light is so bright (3e38) that next-event estimates
+// overflow: some samples are Inf or NaN.
+std::filesystem::path write_nan_scene(const std::filesystem::path& dir, int res) {
+  std::ifstream in(std::string(PATHLAB_SOURCE_DIR) + "/scenes/cornell-box.json");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  text = std::regex_replace(text, std::regex(R"("radiance": \[17, 12, 4\])"), R"("radiance": [3e38, 3e38, 3e38])");
+  text = std::regex_replace(text, std::regex(R"(\[512, 512\])"), "[" + std::to_string(res) + ", " + std::to_string(res) + "]");
+  const auto file = dir / "nan-box.json";
+  std::ofstream(file) << text;
+  return file;
+}
+
+// Every NaN/Inf sample of the scene at `spp`, in the order next-NaN visits
+// them (pixels in scanline order, samples in order), found by replaying
+// every sample with the reference tracer.
+std::vector<SampleRef> all_nonfinite(const std::filesystem::path& scene_file, int spp) {
+  Scene scene = load_scene(scene_file);
+  RenderSettings settings = scene.render;
+  settings.spp = spp;  // as the render that found them
+  const int w = scene.film.width, h = scene.film.height;
+  const CompiledScene compiled(std::move(scene));
+  const ReferenceTracer tracer(compiled, settings);
+  std::vector<SampleRef> out;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int s = 0; s < spp; ++s)
+        if (!is_finite(tracer.trace_sample(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                                           static_cast<std::uint32_t>(s), nullptr).L))
+          out.push_back({static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(s)});
+  return out;
+}
+
+TEST_F(DebugGui, NextNonFiniteVisitsEveryNanSampleInScanlineOrder) {
+  SessionSettings settings;
+  settings.scene_file = write_nan_scene(dir_, 16).string();
+  settings.spp = 4;
+  Session session(settings);
+  ASSERT_TRUE(session.wait_spp(4, 120.0));
+  Snapshot snap;
+  ASSERT_TRUE(session.snapshot(snap));
+  const std::vector<SampleRef> want = all_nonfinite(settings.scene_file, 4);
+  ASSERT_GT(want.size(), 1u) << "the scene should give NaN/Inf samples";
+  std::optional<SampleRef> at;
+  for (std::size_t k = 0; k <= want.size(); ++k) {  // once round, and back to the first
+    at = at ? session.next_nonfinite(snap, static_cast<int>(at->x), static_cast<int>(at->y), at->sample)
+            : session.next_nonfinite(snap, -1, -1, std::nullopt);
+    ASSERT_TRUE(at);
+    const SampleRef& w = want[k % want.size()];
+    EXPECT_TRUE(at->x == w.x && at->y == w.y && at->sample == w.sample)
+        << k << ": got (" << at->x << ", " << at->y << ") sample " << at->sample << ", want (" << w.x << ", " << w.y
+        << ") sample " << w.sample;
+  }
+  // A finite scene has none.
+  Session clean(small_cornell(8, 2));
+  ASSERT_TRUE(clean.wait_spp(2, 120.0));
+  Snapshot c;
+  ASSERT_TRUE(clean.snapshot(c));
+  EXPECT_FALSE(clean.next_nonfinite(c, -1, -1, std::nullopt));
+}
+
+std::string read_text(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+int run_gui(const std::filesystem::path& dir, const std::string& args, const std::string& script_text, std::string* err) {
+  const auto script = dir / "script.txt";
+  std::ofstream(script) << script_text;
+  const std::string command = std::string(PATHLAB_DEBUG_BINARY) + " " + args + " --script " + script.string() + " 2>" +
+                              (dir / "err.txt").string();
+  const int status = std::system(command.c_str());
+  *err = command + "\n" + read_text(dir / "err.txt");
+  return status;
+}
+
+// The channel values a readout line shows for `layer`: "layer: R a  G b  B c".
+std::vector<double> readout_values(const std::string& text, const std::string& layer) {
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(layer + ": ", 0) != 0) continue;
+    std::istringstream in(line.substr(layer.size() + 2));
+    std::vector<double> v;
+    std::string name;
+    double x = 0;
+    while (in >> name >> x) v.push_back(x);
+    return v;
+  }
+  return {};
+}
+
+std::string str(const vec3& v) {
+  std::ostringstream o;
+  o << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+  return o.str();
+}
+
+vec3 screen_at(const Image& shot, double x, double y) { return shot.at(static_cast<int>(x), static_cast<int>(y)); }
+
+// As a person would: zoom with the wheel about a point, pan by dragging,
+// point at a window position and read the buffer values there (checked
+// against the saved film and AOVs at the pixel the zoom and pan put under
+// it), switch variance to a log scale (checked against the ramp colour the
+// range gives), then jump to the next NaN/Inf sample from the NaN view.
+TEST_F(DebugGui, ZoomPanReadoutLogScaleAndNextNan) {
+  const int res = 64, spp = 8;
+  const auto scene = write_nan_scene(dir_, res);
+  const auto exr = dir_ / "image.exr", logshot = dir_ / "log.png", nanshot = dir_ / "nan.png";
+  // Wheel 4 notches in at (20, 20), then drag by (-50, -20): screen = origin + pixel * zoom.
+  const double zoom = std::pow(1.25, 4), ox = 20.0 - 20.0 * zoom - 50.0, oy = 20.0 - 20.0 * zoom - 20.0;
+  const int mx = 40, my = 40;
+  const int px = static_cast<int>(std::floor((mx - ox) / zoom)), py = static_cast<int>(std::floor((my - oy) / zoom));
+  // The Cornell box for the buffers, then the NaN scene for the jump.
+  std::ostringstream script;
+  script << "wait-spp " << spp << "\nwheel 20 20 4\ndrag 300 300 -50 -20\nmouse " << mx << " " << my
+         << "\nview albedo\nreadout " << (dir_ / "albedo.txt").string() << "\nview variance\nscale log\nreadout "
+         << (dir_ / "variance.txt").string() << "\nscreenshot " << logshot.string() << "\nsave " << exr.string()
+         << "\nopen " << scene.string() << "\nwait-spp " << spp << "\nview nan\nnext-nan\nreadout "
+         << (dir_ / "nan.txt").string() << "\nscreenshot " << nanshot.string() << "\nquit\n";
+  std::string err;
+  ASSERT_EQ(run_gui(dir_, "--resolution 64x64 --spp " + std::to_string(spp), script.str(), &err), 0) << err;
+
+  const std::vector<Layer> saved = read_image_layers(exr);
+  const Layer* albedo = find_layer(saved, "albedo");
+  const Layer* variance = find_layer(saved, "variance");
+  ASSERT_TRUE(albedo && variance && find_layer(saved, "nonfinite"));
+  ASSERT_GE(px, 0);
+  ASSERT_LT(px, res);
+  ASSERT_GE(py, 0);
+  ASSERT_LT(py, res);
+  const std::string albedo_text = read_text(dir_ / "albedo.txt");
+  EXPECT_NE(albedo_text.find("pixel (" + std::to_string(px) + ", " + std::to_string(py) + ")"), std::string::npos)
+      << "the zoom and pan put another pixel under the mouse: " << albedo_text;
+  for (const auto& [text, layer] : {std::pair(albedo_text, albedo), std::pair(read_text(dir_ / "variance.txt"), variance)}) {
+    const std::vector<double> shown = readout_values(text, layer->name);
+    ASSERT_EQ(shown.size(), 3u) << text;
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(shown[static_cast<std::size_t>(c)], layer->image.at(px, py)[c], 1e-6 * std::abs(layer->image.at(px, py)[c]))
+          << layer->name << " channel " << c << "\n" << text;
+  }
+
+  // The log view of variance: the pixel under the mouse has the ramp colour of
+  // its log value within the layer's positive range (computed here from the saved layer).
+  double lo = INFINITY, hi = -INFINITY;
+  for (const vec3& v : variance->image.pixels) {
+    const double m = (static_cast<double>(v.x) + v.y + v.z) / 3.0;
+    if (std::isfinite(m) && m > 0) lo = std::min(lo, m), hi = std::max(hi, m);
+  }
+  const vec3 v = variance->image.at(px, py);
+  const double m = (static_cast<double>(v.x) + v.y + v.z) / 3.0;
+  ASSERT_GT(m, 0.0);
+  const vec3 want = ramp_colour(static_cast<float>((std::log10(m) - std::log10(lo)) / (std::log10(hi) - std::log10(lo))));
+  const Image shot = read_image(logshot);
+  EXPECT_LT(glm::length(screen_at(shot, mx, my) - want), 3.0f / 255.0f)
+      << "log view colour at the mouse; linear would be " << str(ramp_colour(static_cast<float>((m - lo) / (hi - lo))));
+
+  // Next NaN/Inf: the first NaN/Inf sample in scanline order, found by
+  // replaying every sample here; the view is centred on it and its path drawn.
+  const std::vector<SampleRef> bad = all_nonfinite(scene, spp);
+  ASSERT_FALSE(bad.empty());
+  const std::string nan_text = read_text(dir_ / "nan.txt");
+  const std::string retraced = "retraced: pixel (" + std::to_string(bad[0].x) + ", " + std::to_string(bad[0].y) +
+                               ") sample " + std::to_string(bad[0].sample);
+  EXPECT_NE(nan_text.find(retraced), std::string::npos) << "want " << retraced << "\n" << nan_text;
+  EXPECT_EQ(nan_text.find("NaN/Inf samples 0"), std::string::npos) << nan_text;
+  const Image nan_shot = read_image(nanshot);
+  const auto is = [](const vec3& c, const unsigned char (&k)[4]) {
+    return std::abs(c.x - k[0] / 255.0f) < 0.1f && std::abs(c.y - k[1] / 255.0f) < 0.1f && std::abs(c.z - k[2] / 255.0f) < 0.1f;
+  };
+  // Centred: the area is 800 x 720 (the window less the panel), the first
+  // vertex of the retraced path lies on the pixel's camera ray.
+  bool vertex_at_centre = false;
+  for (int dy = -3; dy <= 3; ++dy)
+    for (int dx = -3; dx <= 3; ++dx) vertex_at_centre |= is(nan_shot.at(400 + dx, 360 + dy), kVertexColour);
+  EXPECT_TRUE(vertex_at_centre) << "the jump does not centre the NaN pixel with its path";
+  int red = 0;
+  for (int y = 0; y < 720; ++y)
+    for (int x = 0; x < 800; ++x) red += nan_shot.at(x, y).x > 0.95f && nan_shot.at(x, y).y < 0.05f && nan_shot.at(x, y).z < 0.05f;
+  EXPECT_GT(red, 0) << "no red NaN pixel in the NaN view";
+}
+
+// The split view: this render against an image file whose beauty is a flat
+// grey and which has a layer the render lacks (a stage buffer), and against
+// the other tracer; the divider dragged to a new place.
+TEST_F(DebugGui, SplitViewComparesAnImageFileAndTheOtherTracer) {
+  const int res = 64, spp = 4;
+  const auto other = dir_ / "other.exr", exr = dir_ / "image.exr";
+  std::vector<ExrChannel> channels;
+  for (const char* c : {"R", "G", "B"}) channels.push_back({c, std::vector<float>(res * res, 0.5f)});
+  ExrChannel stage{"stage_count.Y", std::vector<float>(res * res)};
+  for (int y = 0; y < res; ++y)
+    for (int x = 0; x < res; ++x) stage.values[static_cast<std::size_t>(y * res + x)] = static_cast<float>(x);
+  channels.push_back(stage);
+  write_exr_channels(other, res, res, channels, {});
+  const auto a = dir_ / "file.png", b = dir_ / "stage.png", c = dir_ / "tracer.png";
+  // Fit: zoom min(800, 720) / 64 = 11.25, the image from x = 40 to 760; the divider from 400 to 200.
+  std::ostringstream script;
+  script << "wait-spp " << spp << "\nfit\ncompare-image " << other.string() << "\ndrag 400 300 -200 0\nscreenshot "
+         << a.string() << "\nview stage_count\nmouse 600 300\nreadout " << (dir_ / "stage.txt").string()
+         << "\nscreenshot " << b.string() << "\nview beauty\ncompare tracer\nwait-spp " << spp << "\nscreenshot "
+         << c.string() << "\nsave " << exr.string() << "\nquit\n";
+  std::string err;
+  ASSERT_EQ(run_gui(dir_, "--resolution 64x64 --spp " + std::to_string(spp), script.str(), &err), 0) << err;
+
+  const std::vector<Layer> saved = read_image_layers(exr);
+  const Layer* beauty = find_layer(saved, "beauty");
+  ASSERT_NE(beauty, nullptr);
+  const double zoom = 11.25, ox = 40.0;
+  const auto tone = [&](double sx, double sy) {
+    const vec3 v = beauty->image.at(static_cast<int>((sx - ox) / zoom), static_cast<int>(sy / zoom));
+    return vec3(linear_to_srgb(v.x), linear_to_srgb(v.y), linear_to_srgb(v.z));
+  };
+  const auto near = [](vec3 p, vec3 q) { return glm::length(p - q) < 4.0f / 255.0f; };
+  const Image file_shot = read_image(a);
+  const vec3 white(1.0f), grey(linear_to_srgb(0.5f));
+  EXPECT_TRUE(near(screen_at(file_shot, 200, 100), white)) << "no divider at x = 200 after the drag";
+  EXPECT_FALSE(near(screen_at(file_shot, 400, 100), white)) << "the divider stayed at 400";
+  int left = 0, right = 0, n = 0;
+  for (double y = 100; y < 700; y += 50, ++n) {
+    left += near(screen_at(file_shot, 120, y), tone(120, y));
+    right += near(screen_at(file_shot, 600, y), grey);
+  }
+  EXPECT_EQ(right, n) << "the right side does not show the image file";
+  EXPECT_GE(left, n - 2) << "the left side does not show the render: at (120, 300) " << str(screen_at(file_shot, 120, 300))
+                         << ", want " << str(tone(120, 300));
+
+  // The file's own layer: the right side on the ramp (x = pixel column, range 0..63), the left empty.
+  const Image stage_shot = read_image(b);
+  const double col = std::floor((600 - ox) / zoom);
+  EXPECT_TRUE(near(screen_at(stage_shot, 600, 300), ramp_colour(static_cast<float>(col / 63.0))));
+  EXPECT_TRUE(near(screen_at(stage_shot, 120, 300), vec3(0.1f, 0.1f, 0.12f)))
+      << str(screen_at(stage_shot, 120, 300));
+  const std::vector<double> shown = readout_values(read_text(dir_ / "stage.txt"), "other.exr stage_count");
+  ASSERT_EQ(shown.size(), 1u) << read_text(dir_ / "stage.txt");
+  EXPECT_EQ(shown[0], col);
+
+  // The other tracer, same scene and seed: both sides show the same image.
+  const Image tracer_shot = read_image(c);
+  int same = 0;
+  n = 0;
+  for (double y = 100; y < 700; y += 50)
+    for (double x : {120.0, 600.0}) same += near(screen_at(tracer_shot, x, y), tone(x, y)), ++n;
+  EXPECT_GE(same, n - 2) << "reference | wavefront split does not show the render on both sides: at (600, 300) "
+                         << str(screen_at(tracer_shot, 600, 300)) << ", want " << str(tone(600, 300));
 }
 
 TEST_F(DebugGui, AFailingScriptCommandNamesItsLineAndExitsWithTwo) {

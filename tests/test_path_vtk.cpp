@@ -8,6 +8,8 @@
 #include "core/tracer.h"
 #include "debugtools/path_geometry.h"
 #include "debugtools/path_recorder.h"
+#include "debugtools/scene_geometry.h"
+#include "tests/test_scenes.h"
 #include "tests/temp_dir.h"
 
 #include <gtest/gtest.h>
@@ -20,7 +22,14 @@
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkStringArray.h>
+#include <vtkIdTypeArray.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkXMLMultiBlockDataReader.h>
 #include <vtkXMLPolyDataReader.h>
+
+#include <map>
+#include <set>
+#include <tuple>
 
 #include <sstream>
 
@@ -192,6 +201,193 @@ TEST_F(PathVtk, RefusesBadRangesAndBothTracers) {
     EXPECT_EQ(cli::run(static_cast<int>(argv.size()), argv.data(), out, err), 2) << extra[0] << " " << extra[1];
   }
   EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+// --vtk-geometry: the scene's triangles beside the paths.
+
+vtkIdType field_value(vtkPolyData* poly, const char* name) {
+  auto* a = vtkIdTypeArray::SafeDownCast(poly->GetFieldData()->GetArray(name));
+  return a ? a->GetValue(0) : -12345;
+}
+
+// Runs trace-pixel on the 32x32 Cornell box with --vtk-geometry; returns the exit code.
+int trace_with_geometry(const std::filesystem::path& vtp, const char* scope, const std::string& limit, std::string* err_text) {
+  const std::string path = vtp.string();
+  std::vector<const char*> argv = {"pathlab", "trace-pixel", "--pixel", "16,12", "--samples", "0..7", "--resolution",
+                                   "32x32", "--vtk", path.c_str(), "--vtk-geometry", scope};
+  if (!limit.empty()) argv.insert(argv.end(), {"--vtk-max-triangles", limit.c_str()});
+  std::ostringstream out, err;
+  const int code = cli::run(static_cast<int>(argv.size()), argv.data(), out, err);
+  *err_text = err.str();
+  return code;
+}
+
+std::size_t cornell_triangles() {
+  std::size_t n = 0;
+  for (const Shape& s : builtin_cornell_box().shapes) n += s.mesh.triangles.size();
+  return n;
+}
+
+// Every triangle a recorded path hit is in the file, with the scene mesh's
+// own vertex coordinates (read from the Scene here, not through
+// scene_geometry), the hit point on it, and the number of hits.
+TEST_F(PathVtk, GeometryHasTheTrianglesThePathsHitWithTheirCoordinates) {
+  const auto vtp = dir_ / "paths.vtp";
+  std::string err;
+  ASSERT_EQ(trace_with_geometry(vtp, "hit", "", &err), 0) << err;
+  EXPECT_NE(err.find("paths.geometry.vtp"), std::string::npos) << err;
+  const auto poly = read_vtp(dir_ / "paths.geometry.vtp");
+  ASSERT_NE(poly, nullptr);
+  vtkDataArray* shape = poly->GetCellData()->GetArray("shape");
+  vtkDataArray* prim = poly->GetCellData()->GetArray("prim");
+  vtkDataArray* hits = poly->GetCellData()->GetArray("hits");
+  ASSERT_TRUE(shape && prim && hits && poly->GetCellData()->GetArray("instance") && poly->GetCellData()->GetArray("material"));
+  std::map<std::pair<int, int>, vtkIdType> cell_of;
+  for (vtkIdType c = 0; c < poly->GetNumberOfCells(); ++c)
+    cell_of[{static_cast<int>(shape->GetTuple1(c)), static_cast<int>(prim->GetTuple1(c))}] = c;
+
+  const Expected expected = record("reference", 16, 12, 8);
+  Scene scene = builtin_cornell_box();
+  std::map<std::pair<int, int>, int> hit_count;
+  for (const PathRecorder& p : expected.paths)
+    for (const PathEvent& e : p.events())
+      if (const auto* h = std::get_if<HitEvent>(&e)) ++hit_count[{static_cast<int>(h->shape), static_cast<int>(h->prim)}];
+  ASSERT_GT(hit_count.size(), 2u);
+  EXPECT_EQ(poly->GetNumberOfPolys(), static_cast<vtkIdType>(hit_count.size()));
+  for (const auto& [key, count] : hit_count) {
+    const auto it = cell_of.find(key);
+    ASSERT_NE(it, cell_of.end()) << "shape " << key.first << " triangle " << key.second << " is missing";
+    EXPECT_EQ(hits->GetTuple1(it->second), count);
+    const TriangleMesh& mesh = scene.shapes[static_cast<std::size_t>(key.first)].mesh;
+    const glm::uvec3 v = mesh.triangles[static_cast<std::size_t>(key.second)];
+    vtkIdType n = 0;
+    const vtkIdType* ids = nullptr;
+    poly->GetPolys()->GetCellAtId(it->second, n, ids);
+    ASSERT_EQ(n, 3);
+    const unsigned corner[3] = {v.x, v.y, v.z};
+    for (int k = 0; k < 3; ++k) {
+      double p[3];
+      poly->GetPoint(ids[k], p);
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(static_cast<float>(p[c]), mesh.positions[corner[k]][c]) << "corner " << k;
+    }
+  }
+  // Each hit point lies on its triangle (barycentrics in [0,1], off the plane by rounding only).
+  for (const PathRecorder& p : expected.paths)
+    for (const PathEvent& e : p.events())
+      if (const auto* h = std::get_if<HitEvent>(&e)) {
+        const vtkIdType c = cell_of.at({static_cast<int>(h->shape), static_cast<int>(h->prim)});
+        vtkIdType n = 0;
+        const vtkIdType* ids = nullptr;
+        poly->GetPolys()->GetCellAtId(c, n, ids);
+        vec3 q[3];
+        for (int k = 0; k < 3; ++k) {
+          double d[3];
+          poly->GetPoint(ids[k], d);
+          q[k] = vec3(d[0], d[1], d[2]);
+        }
+        const vec3 e1 = q[1] - q[0], e2 = q[2] - q[0], nrm = glm::cross(e1, e2), w = h->p - q[0];
+        const float area2 = glm::dot(nrm, nrm);
+        const float b1 = glm::dot(glm::cross(w, e2), nrm) / area2, b2 = glm::dot(glm::cross(e1, w), nrm) / area2;
+        EXPECT_GE(b1, -1e-4f);
+        EXPECT_GE(b2, -1e-4f);
+        EXPECT_LE(b1 + b2, 1.0f + 1e-4f);
+        EXPECT_LT(std::abs(glm::dot(w, glm::normalize(nrm))), 1e-4f);
+      }
+  EXPECT_EQ(field_value(poly, "scene_triangles"), static_cast<vtkIdType>(cornell_triangles()));
+  EXPECT_EQ(field_value(poly, "complete"), 0);
+}
+
+// scope scene: the whole scene when it fits under the limit; one triangle
+// over the limit, only the hit triangles, and the message and the file say so.
+TEST_F(PathVtk, GeometryOfTheWholeSceneHonoursTheTriangleLimit) {
+  const std::size_t total = cornell_triangles();
+  std::string err;
+  const auto all = dir_ / "all.vtp";
+  ASSERT_EQ(trace_with_geometry(all, "scene", std::to_string(total), &err), 0) << err;
+  const auto whole = read_vtp(dir_ / "all.geometry.vtp");
+  EXPECT_EQ(whole->GetNumberOfPolys(), static_cast<vtkIdType>(total));
+  EXPECT_EQ(field_value(whole, "complete"), 1);
+  EXPECT_EQ(field_value(whole, "limit"), static_cast<vtkIdType>(total));
+  const std::string hit_err = err;
+
+  // The multiblock file opens both: block 0 the paths, block 1 the geometry.
+  vtkNew<vtkXMLMultiBlockDataReader> mb;
+  mb->SetFileName((dir_ / "all.vtm").c_str());
+  mb->Update();
+  auto* blocks = vtkMultiBlockDataSet::SafeDownCast(mb->GetOutput());
+  ASSERT_NE(blocks, nullptr);
+  ASSERT_EQ(blocks->GetNumberOfBlocks(), 2u);
+  auto* paths = vtkPolyData::SafeDownCast(blocks->GetBlock(0));
+  auto* geometry = vtkPolyData::SafeDownCast(blocks->GetBlock(1));
+  ASSERT_TRUE(paths && geometry);
+  EXPECT_EQ(paths->GetNumberOfLines(), read_vtp(all)->GetNumberOfLines());
+  EXPECT_EQ(geometry->GetNumberOfPolys(), static_cast<vtkIdType>(total));
+
+  const auto capped = dir_ / "capped.vtp";
+  ASSERT_EQ(trace_with_geometry(capped, "scene", std::to_string(total - 1), &err), 0) << err;
+  const auto part = read_vtp(dir_ / "capped.geometry.vtp");
+  const auto hit_only = dir_ / "hit.vtp";
+  std::string err2;
+  ASSERT_EQ(trace_with_geometry(hit_only, "hit", "", &err2), 0) << err2;
+  EXPECT_EQ(part->GetNumberOfPolys(), read_vtp(dir_ / "hit.geometry.vtp")->GetNumberOfPolys());
+  EXPECT_LT(part->GetNumberOfPolys(), static_cast<vtkIdType>(total));
+  EXPECT_EQ(field_value(part, "complete"), 0);
+  EXPECT_EQ(field_value(part, "limit"), static_cast<vtkIdType>(total - 1));
+  EXPECT_EQ(field_value(part, "scene_triangles"), static_cast<vtkIdType>(total));
+  EXPECT_NE(err.find("over --vtk-max-triangles " + std::to_string(total - 1)), std::string::npos) << err;
+  EXPECT_NE(err.find("of the scene's " + std::to_string(total) + " triangles"), std::string::npos) << err;
+  EXPECT_EQ(hit_err.find("over --vtk-max-triangles"), std::string::npos) << hit_err;
+
+  // Without --vtk the option is refused.
+  const char* argv[] = {"pathlab", "trace-pixel", "--pixel", "3,3", "--resolution", "8x8", "--vtk-geometry", "hit"};
+  std::ostringstream out, e;
+  EXPECT_EQ(cli::run(static_cast<int>(std::size(argv)), argv, out, e), 2);
+}
+
+// Instanced shapes are placed by their instance, and spheres tessellated onto
+// the sphere: every hit on an instanced mesh lies on its written triangle,
+// and every facet corner of a sphere lies at the radius from the placed centre.
+TEST(SceneGeometry, PlacesInstancesAndTessellatesSpheres) {
+  const CompiledScene compiled(test::cornell_with_instances());
+  const Scene& scene = compiled.scene();
+  const auto tracer = make_tracer("reference", compiled, scene.render);
+  std::vector<PathRecorder> paths;
+  for (std::uint32_t y = 0; y < static_cast<std::uint32_t>(scene.film.height); y += 16)
+    for (std::uint32_t x = 0; x < static_cast<std::uint32_t>(scene.film.width); x += 16)
+      tracer->trace_sample(x, y, 0, &paths.emplace_back());
+  const SceneGeometry g = scene_geometry(scene, paths, GeometryScope::Hit, 0);
+  int instanced_mesh_hits = 0, sphere_hits = 0;
+  for (const PathRecorder& p : paths)
+    for (const PathEvent& e : p.events()) {
+      const auto* h = std::get_if<HitEvent>(&e);
+      if (!h || h->instance == kNoInstance) continue;
+      const bool sphere = scene.shapes[h->shape].kind == Shape::Kind::Sphere;
+      std::vector<const GeometryTriangle*> mine;
+      for (const GeometryTriangle& t : g.triangles)
+        if (t.shape == h->shape && t.instance == static_cast<std::int64_t>(h->instance) &&
+            (sphere || t.prim == static_cast<std::int64_t>(h->prim)))
+          mine.push_back(&t);
+      if (sphere) {
+        ++sphere_hits;
+        ASSERT_EQ(mine.size(), kSphereTriangles);
+        const mat4& m = scene.instances[h->instance].to_world;
+        const Shape& s = scene.shapes[h->shape];
+        const vec3 c = vec3(m * vec4(s.center, 1.0f));
+        const float r = glm::length(vec3(m * vec4(s.center + vec3(s.radius, 0, 0), 1.0f)) - c);  // uniform scale
+        for (const GeometryTriangle* t : mine)
+          for (const vec3& p : t->p) EXPECT_NEAR(glm::length(p - c), r, 1e-4f * (1.0f + r));
+      } else {
+        ++instanced_mesh_hits;
+        ASSERT_EQ(mine.size(), 1u);
+        const vec3 e1 = mine[0]->p[1] - mine[0]->p[0], e2 = mine[0]->p[2] - mine[0]->p[0];
+        const vec3 n = glm::normalize(glm::cross(e1, e2));
+        EXPECT_LT(std::abs(glm::dot(h->p - mine[0]->p[0], n)), 1e-3f);
+        EXPECT_LT(glm::length(h->p - mine[0]->p[0]), glm::length(e1) + glm::length(e2));
+      }
+    }
+  EXPECT_GT(instanced_mesh_hits, 0);
+  EXPECT_GT(sphere_hits, 0);
+  EXPECT_EQ(tessellate_sphere(vec3(0.0f), 1.0f).size(), kSphereTriangles);
 }
 
 }  // namespace

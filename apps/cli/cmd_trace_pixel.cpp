@@ -10,6 +10,7 @@
 #include "core/tracer.h"
 #include "debugtools/path_compare.h"
 #include "debugtools/path_recorder.h"
+#include "debugtools/scene_geometry.h"
 #include "debugtools/vtk_export.h"
 
 #include <ostream>
@@ -25,7 +26,15 @@ void TracePixelCommand::add_to(CLI::App& app) {
   CLI::Option* one = cmd->add_option("--sample", sample, "Sample index within the pixel");
   cmd->add_option("--samples", samples, "A range of samples A..B (inclusive), e.g. 0..15")->excludes(one);
   cmd->add_flag("--json", json, "Print the path as JSON on stdout (docs/trace-pixel-json.md); one sample only");
-  cmd->add_option("--vtk", vtk, "Also write the paths as VTK PolyData (.vtp, docs/path-vtk.md)");
+  CLI::Option* vtk_option = cmd->add_option("--vtk", vtk, "Also write the paths as VTK PolyData (.vtp, docs/path-vtk.md)");
+  cmd->add_option("--vtk-geometry", vtk_geometry,
+                  "With --vtk: also the triangles the paths hit (hit) or the whole scene (scene), as OUT.geometry.vtp "
+                  "and OUT.vtm opening both")
+      ->check(CLI::IsMember({"hit", "scene"}))
+      ->needs(vtk_option);
+  cmd->add_option("--vtk-max-triangles", vtk_max_triangles,
+                  "--vtk-geometry scene: write the whole scene only up to this many triangles (spheres tessellated)")
+      ->check(CLI::PositiveNumber);
   cmd->callback([this] { selected = true; });
 }
 
@@ -58,6 +67,7 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
   if (!vtk.empty()) {  // fail before tracing
     if (!vtk_export_available()) write_path_vtp(vtk, {});  // throws: built without VTK
     ensure_writable(vtk);
+    if (!vtk_geometry.empty()) ensure_writable(multiblock_path(vtk));
   }
 
   const ThreadLimit one_thread(1);
@@ -72,8 +82,9 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
   };
   if (scene.tracer != "both") {
     std::vector<PathLine> lines;
+    std::vector<PathRecorder> recorders;  // for --vtk-geometry
     for (std::uint32_t s_index = first;; ++s_index) {
-      PathRecorder recorder;
+      PathRecorder& recorder = recorders.emplace_back();
       const TraceHeader header = record(scene.tracer, s_index, recorder);
       if (json) out << path_to_json(header, recorder, sc).dump(2) << "\n";
       else err << path_to_text(header, recorder, sc);
@@ -81,7 +92,18 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
       for (PathLine& l : path_lines(recorder, s_index, 2.0f * compiled.bounds_radius())) lines.push_back(std::move(l));
       if (s_index == last) break;
     }
-    if (!vtk.empty()) {
+    if (!vtk.empty() && !vtk_geometry.empty()) {
+      const SceneGeometry g = scene_geometry(sc, recorders, vtk_geometry == "scene" ? GeometryScope::Scene : GeometryScope::Hit,
+                                             vtk_max_triangles);
+      write_paths_and_geometry(vtk, lines, g);
+      err << "pathlab: wrote " << vtk << " (" << (last - first + 1) << " path(s), " << lines.size() << " lines), "
+          << geometry_vtp_path(vtk) << " (" << g.triangles.size() << " of the scene's " << g.scene_triangles
+          << " triangles" << (g.complete ? "" : vtk_geometry == "scene" && g.scene_triangles > vtk_max_triangles
+                                                   ? ": over --vtk-max-triangles " + std::to_string(vtk_max_triangles) +
+                                                         ", so only those the paths hit"
+                                                   : ": those the paths hit")
+          << ") and " << multiblock_path(vtk) << " (opens both)\n";
+    } else if (!vtk.empty()) {
       write_path_vtp(vtk, lines);
       err << "pathlab: wrote " << vtk << " (" << (last - first + 1) << " path(s), " << lines.size() << " lines)\n";
     }

@@ -73,6 +73,8 @@ struct TracePixelCommand {
   std::uint32_t sample = 0;
   std::string samples;  // "A..B", inclusive; excludes --sample
   std::string vtk;      // --vtk out.vtp
+  std::string vtk_geometry;                   // --vtk-geometry hit|scene
+  std::size_t vtk_max_triangles = 1000000;    // --vtk-max-triangles N
   bool json = false;
   bool selected = false;
   void add_to(CLI::App& app);

@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "1 or 0 (all)")->check(CLI::IsMember({0, 1}));
   app.add_option("--materials", materials, "authored, white (Lambert) or mirror")
       ->check(CLI::IsMember({"authored", "white", "mirror"}));
-  app.add_option("--view", o.view, "beauty, albedo, normal, depth, material, variance, pathlength, nan");
+  app.add_option("--view", o.view, "Any layer of the render (beauty, albedo, normal, depth, material, variance, pathlength, nonfinite, samples, ...) or nan");
   app.add_option("--exposure", o.exposure, "Exposure in stops");
   app.add_option("--script", o.script, "Run the commands of FILE (see debugtools/gui/script.h), then quit");
   app.add_option("--screenshot", o.screenshot, "Save the window as PNG when it closes");

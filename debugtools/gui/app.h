@@ -1,6 +1,8 @@
 // pathlab-debug: the window (GLFW + OpenGL 3 + Dear ImGui) around a Session.
-// The image is drawn 1:1 at the window's top-left corner (scaled down only if
-// it would not fit a 1600x1000 window), the panel to its right.
+// The image starts 1:1 at the window's top-left corner (scaled down only if
+// it would not fit a 1600x1000 window), the panel to its right; the wheel
+// zooms about the cursor, a drag pans, the split view puts another render or
+// image file right of a draggable divider (docs/pathlab-debug.md).
 #pragma once
 
 #include "debugtools/gui/session.h"

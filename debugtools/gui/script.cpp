@@ -27,6 +27,9 @@ std::vector<ScriptCommand> parse_script(const std::string& text, const std::stri
       if (!(in >> c.x) || (count == 2 && !(in >> c.y)) || c.x < 0 || c.y < 0)
         fail(word + " expects " + (count == 2 ? "two non-negative integers" : "a non-negative integer"));
     };
+    const auto signed_int = [&](int& v) {
+      if (!(in >> v)) fail(word + " expects an integer");
+    };
     const auto name = [&] {
       if (!(in >> c.arg)) fail(word + " expects an argument");
     };
@@ -38,8 +41,29 @@ std::vector<ScriptCommand> parse_script(const std::string& text, const std::stri
       c.kind = Kind::Exposure;
       if (!(in >> c.value)) fail("exposure expects a number of stops");
     } else if (word == "view") {
-      c.kind = Kind::View, name();
-      if (!parse_view(c.arg)) fail("unknown view '" + c.arg + "'");
+      c.kind = Kind::View, name();  // the layers exist only once the render runs: checked then
+    } else if (word == "scale") {
+      c.kind = Kind::Scale, name();
+      if (!parse_mapping(c.arg)) fail("unknown scale '" + c.arg + "' (tone, normal, id, linear, log)");
+    } else if (word == "mouse") c.kind = Kind::Mouse, ints(2);
+    else if (word == "wheel") {
+      c.kind = Kind::Wheel, ints(2);
+      signed_int(c.dx);
+    } else if (word == "drag") {
+      c.kind = Kind::Drag, ints(2);
+      signed_int(c.dx);
+      signed_int(c.dy);
+    } else if (word == "fit") c.kind = Kind::Fit;
+    else if (word == "actual-size") c.kind = Kind::ActualSize;
+    else if (word == "readout") c.kind = Kind::Readout, name();
+    else if (word == "next-nan") c.kind = Kind::NextNan;
+    else if (word == "compare") {
+      c.kind = Kind::Compare, name();
+      if (c.arg != "tracer" && c.arg != "off") fail("compare expects tracer or off (compare-image PATH for a file)");
+    } else if (word == "compare-image") c.kind = Kind::CompareImage, name();
+    else if (word == "split") {
+      c.kind = Kind::Split;
+      if (!(in >> c.value) || !(c.value >= 0.0f && c.value <= 1.0f)) fail("split expects a fraction from 0 to 1");
     } else if (word == "materials") {
       c.kind = Kind::Materials, name();
       if (!parse_material_override(c.arg)) fail("unknown materials '" + c.arg + "' (authored, white, mirror)");

@@ -7,8 +7,22 @@
 //   hover X Y             point at pixel (X, Y): the readout panel shows it
 //   click X Y             click pixel (X, Y): retrace the chosen sample, draw its path
 //   sample S              the sample a click retraces (default 0)
-//   view NAME             beauty, albedo, normal, depth, material, variance, pathlength, nan
+//   view NAME             any layer of the render (beauty, albedo, normal, depth, material,
+//                         variance, pathlength, nonfinite, samples, ...) or nan (the NaN/Inf map)
+//   scale NAME            how the layer is mapped: tone, normal, id, linear, log (views.h)
 //   exposure STOPS        exposure of the view
+//   mouse WX WY           move the mouse to window position (WX, WY) (hover by window position)
+//   wheel WX WY N         turn the mouse wheel N notches (negative: out) at (WX, WY): zoom about it
+//   drag WX WY DX DY      drag with the left button from (WX, WY) by (DX, DY): pans the image,
+//                         or moves the split view's divider when it starts on it
+//   fit                   the "Fit" button: the whole image in the window
+//   actual-size           the "1:1" button: one image pixel per screen pixel
+//   readout PATH          write the pixel panel's text (the buffer values under the mouse) to PATH
+//   next-nan              the "Next NaN/Inf" button: jump to the next NaN/Inf sample and retrace it
+//   compare tracer        split view: this render | the same scene and seed with the other tracer
+//   compare-image PATH    split view: this render | an image file (every EXR layer)
+//   compare off           back to one image
+//   split F               put the split view's divider at fraction F (0..1) of the image area
 //   materials NAME        authored, white, mirror (restarts the render)
 //   tracer NAME           reference, wavefront (restarts the render)
 //   open PATH             open a scene file (restarts the render)
@@ -24,11 +38,13 @@
 namespace pathlab::debug {
 
 struct ScriptCommand {
-  enum class Kind { WaitSpp, Hover, Click, Sample, View, Exposure, Materials, Tracer, Open, ExportVtk, Save,
-                    Screenshot, Quit };
+  enum class Kind { WaitSpp, Hover, Click, Sample, View, Scale, Exposure, Materials, Tracer, Open, ExportVtk, Save,
+                    Screenshot, Mouse, Wheel, Drag, Fit, ActualSize, Readout, NextNan, Compare, CompareImage, Split,
+                    Quit };
   Kind kind = Kind::Quit;
-  int x = 0, y = 0;      // hover, click; x is N for wait-spp and S for sample
-  float value = 0.0f;    // exposure
+  int x = 0, y = 0;      // hover, click, mouse, wheel, drag; x is N for wait-spp and S for sample
+  int dx = 0, dy = 0;    // drag; dx is N for wheel
+  float value = 0.0f;    // exposure, split
   std::string arg;       // names and paths
   std::string where;     // "file:line" for messages
 };

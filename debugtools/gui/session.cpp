@@ -121,6 +121,12 @@ void Session::worker(std::uint64_t /*generation*/) {
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x)
         snap->samples[static_cast<std::size_t>(y) * w + x] = static_cast<std::uint32_t>(film.sample_count(x, y));
+    std::vector<ExrChannel> channels = aov_channels(film, aovs, kAllAovs);
+    add_exr_layer(channels, "nonfinite", snap->nonfinite, "Y");
+    Image counts(w, h);
+    for (std::size_t i = 0; i < pixels; ++i) counts.pixels[i] = vec3(static_cast<float>(snap->samples[i]));
+    add_exr_layer(channels, "samples", counts, "Y");
+    snap->layers = layers_from_channels(w, h, channels);
     {
       const std::lock_guard lock(mutex_);
       latest_ = std::move(snap);
@@ -182,6 +188,30 @@ PixelReadout Session::readout(const Snapshot& snap, int x, int y) const {
   return r;
 }
 
+std::optional<SampleRef> Session::next_nonfinite(const Snapshot& snap, int x, int y,
+                                                 std::optional<std::uint32_t> sample) const {
+  const Layer* counts = find_layer(snap.layers, "nonfinite");
+  if (!counts || snap.width <= 0 || snap.height <= 0) return std::nullopt;
+  const std::size_t n = static_cast<std::size_t>(snap.width) * snap.height;
+  const bool inside = x >= 0 && y >= 0 && x < snap.width && y < snap.height;
+  const std::size_t here = inside ? static_cast<std::size_t>(y) * snap.width + x : n - 1;
+  // The first bad sample of pixel i at index >= from, by replaying them.
+  const auto find = [&](std::size_t i, std::uint32_t from) -> std::optional<SampleRef> {
+    const auto px = static_cast<std::uint32_t>(i % snap.width), py = static_cast<std::uint32_t>(i / snap.width);
+    for (std::uint32_t s = from; s < static_cast<std::uint32_t>(snap.spp_done); ++s)
+      if (!is_finite(tracer_->trace_sample(px, py, s, nullptr).L)) return SampleRef{px, py, s};
+    return std::nullopt;
+  };
+  if (inside && sample && counts->image.pixels[here].x > 0.0f)
+    if (auto r = find(here, *sample + 1)) return r;
+  for (std::size_t k = 1; k <= n; ++k) {  // the pixels after this one, wrapping around to it
+    const std::size_t i = (here + k) % n;
+    if (counts->image.pixels[i].x > 0.0f)
+      if (auto r = find(i, 0)) return r;
+  }
+  return std::nullopt;
+}
+
 const Retrace& Session::retrace(std::uint32_t x, std::uint32_t y, std::uint32_t sample) {
   const Scene& sc = compiled_->scene();
   if (x >= static_cast<std::uint32_t>(sc.film.width) || y >= static_cast<std::uint32_t>(sc.film.height))
@@ -221,17 +251,17 @@ void Session::save_image(const std::filesystem::path& file, float exposure) cons
     return;
   }
   if (ext != ".exr") throw InputError(file.string() + ": save as .exr or .png");
+  // Every layer the viewer shows, under its own name ("beauty": R, G, B).
   std::vector<ExrChannel> channels;
-  const auto add = [&](const std::string& layer, const Image& img, std::string_view names) {
-    add_exr_layer(channels, layer, img, names);
-  };
-  add("", snap.beauty, "RGB");
-  add("albedo", snap.albedo, "RGB");
-  add("normal", snap.normal, "XYZ");
-  add("depth", snap.depth, "Z");
-  add("material", snap.material, "Y");
-  add("variance", snap.variance, "RGB");
-  add("pathlength", snap.path_length, "Y");
+  for (const Layer& l : snap.layers) {
+    const std::vector<std::string> names = channel_names(l);
+    for (int c = 0; c < std::min(l.count, 3); ++c) {
+      ExrChannel& ch = channels.emplace_back();
+      ch.name = (l.name == "beauty" ? "" : l.name + ".") + names[static_cast<std::size_t>(c)];
+      ch.values.resize(l.image.pixels.size());
+      for (std::size_t i = 0; i < l.image.pixels.size(); ++i) ch.values[i] = l.image.pixels[i][c];
+    }
+  }
   const Scene& sc = compiled_->scene();
   write_exr_channels(file, snap.width, snap.height, channels,
                      {{"scene", sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string()},

@@ -8,6 +8,7 @@
 
 #include "core/image_io.h"
 #include "core/scene.h"
+#include "debugtools/gui/layers.h"
 #include "debugtools/material_override.h"
 #include "debugtools/path_geometry.h"
 #include "debugtools/path_recorder.h"
@@ -52,6 +53,17 @@ struct Snapshot {
   double seconds = 0.0;       // since the (re)start
   Image beauty, variance, albedo, normal, depth, material, path_length, nonfinite;
   std::vector<std::uint32_t> samples;  // own samples per pixel
+  // Every buffer as a named layer: the channels aov_channels() gives for the
+  // film and all AOVs (beauty, albedo, normal, depth, material, variance,
+  // pathlength, and whatever is added there later), then "nonfinite" (NaN/Inf
+  // samples per pixel) and "samples" (own samples per pixel). The views and
+  // the readout are generic over this list.
+  std::vector<Layer> layers;
+};
+
+// A sample whose radiance was NaN or infinite.
+struct SampleRef {
+  std::uint32_t x = 0, y = 0, sample = 0;
 };
 
 struct PixelReadout {
@@ -103,6 +115,13 @@ class Session {
 
   PixelReadout readout(const Snapshot& snap, int x, int y) const;
 
+  // The next NaN/Inf sample after sample `sample` of pixel (x, y), in
+  // scanline order of the pixels whose "nonfinite" count in `snap` is
+  // positive (wrapping around; the same pixel's later samples first). Its
+  // index is found by replaying the pixel's samples 0..spp_done-1 on this
+  // thread. Empty when the snapshot has no NaN/Inf sample.
+  std::optional<SampleRef> next_nonfinite(const Snapshot& snap, int x, int y, std::optional<std::uint32_t> sample) const;
+
   // Replays sample `sample` of pixel (x, y) on this thread with the render's
   // seed and settings; the result is kept as the current retrace.
   const Retrace& retrace(std::uint32_t x, std::uint32_t y, std::uint32_t sample);
@@ -110,7 +129,7 @@ class Session {
   // Writes the current retrace's polylines (docs/path-vtk.md). Throws
   // InputError when nothing was retraced or the file cannot be written.
   void export_vtk(const std::filesystem::path& file) const;
-  // Saves the image: .exr (beauty and every AOV as layers) or .png
+  // Saves the image: .exr (every layer of the snapshot, beauty as R, G, B) or .png
   // (tone-mapped with `exposure` stops). Throws InputError / SystemError.
   void save_image(const std::filesystem::path& file, float exposure) const;
 

@@ -5,37 +5,68 @@
 
 namespace pathlab::debug {
 
-const char* view_name(View v) {
-  switch (v) {
-    case View::Beauty: return "beauty";
-    case View::Albedo: return "albedo";
-    case View::Normal: return "normal";
-    case View::Depth: return "depth";
-    case View::Material: return "material";
-    case View::Variance: return "variance";
-    case View::PathLength: return "pathlength";
-    case View::NonFinite: return "nan";
+const char* mapping_name(Mapping m) {
+  switch (m) {
+    case Mapping::Tone: return "tone";
+    case Mapping::Normal: return "normal";
+    case Mapping::Id: return "id";
+    case Mapping::Linear: return "linear";
+    case Mapping::Log: return "log";
   }
   return "?";
 }
 
-std::optional<View> parse_view(std::string_view name) {
-  for (View v : kAllViews)
-    if (name == view_name(v)) return v;
+std::optional<Mapping> parse_mapping(std::string_view name) {
+  for (Mapping m : kAllMappings)
+    if (name == mapping_name(m)) return m;
   return std::nullopt;
+}
+
+Mapping default_mapping(const Layer& layer) {
+  const std::string& n = layer.name;
+  if (n == "normal") return Mapping::Normal;
+  if (n == "material") return Mapping::Id;
+  for (const char* statistic : {"variance", "error", "stddev", "sigma", "count"})
+    if (n.find(statistic) != std::string::npos) return Mapping::Linear;
+  if (layer.channels.rfind("R,G,B", 0) == 0) return Mapping::Tone;
+  return Mapping::Linear;
+}
+
+float layer_scalar(const Layer& layer, std::size_t pixel) {
+  const vec3& v = layer.image.pixels[pixel];
+  const int k = std::clamp(layer.count, 1, 3);
+  float sum = 0.0f;
+  for (int c = 0; c < k; ++c) sum += v[c];
+  return sum / static_cast<float>(k);
+}
+
+Range auto_range(const Layer& layer, Mapping mapping) {
+  Range r;
+  r.lo = INFINITY;
+  r.hi = -INFINITY;
+  for (std::size_t i = 0; i < layer.image.pixels.size(); ++i) {
+    const float v = layer_scalar(layer, i);
+    if (!std::isfinite(v) || (mapping == Mapping::Log && v <= 0.0f)) continue;
+    r.lo = std::min(r.lo, v);
+    r.hi = std::max(r.hi, v);
+  }
+  r.valid = r.lo <= r.hi;
+  if (!r.valid) r.lo = 0.0f, r.hi = 1.0f;
+  return r;
+}
+
+vec3 ramp_colour(float t) {
+  // Viridis at five stops, linearly interpolated.
+  static const vec3 stops[] = {{0.267f, 0.005f, 0.329f}, {0.230f, 0.322f, 0.546f}, {0.128f, 0.567f, 0.551f},
+                               {0.369f, 0.789f, 0.383f}, {0.993f, 0.906f, 0.144f}};
+  const float x = std::clamp(std::isfinite(t) ? t : 0.0f, 0.0f, 1.0f) * 4.0f;
+  const int i = std::min(static_cast<int>(x), 3);
+  return glm::mix(stops[i], stops[i + 1], x - static_cast<float>(i));
 }
 
 namespace {
 
 std::uint8_t byte(float v) { return static_cast<std::uint8_t>(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f); }
-std::uint8_t srgb_byte(float v) { return byte(linear_to_srgb(v)); }
-
-float largest(const Image& img) {
-  float m = 0.0f;
-  for (const vec3& p : img.pixels)
-    if (std::isfinite(max_component(p))) m = std::max(m, max_component(p));
-  return m > 0.0f ? m : 1.0f;
-}
 
 // A distinct, stable colour per material id (golden-ratio hue steps).
 vec3 id_colour(float id) {
@@ -46,44 +77,62 @@ vec3 id_colour(float id) {
   return 0.25f + 0.7f * rgb[static_cast<int>(h) % 6];
 }
 
+void put(std::uint8_t* o, const vec3& display) {
+  for (int k = 0; k < 3; ++k) o[k] = byte(display[k]);
+  o[3] = 255;
+}
+
+const vec3 kMagenta(1.0f, 0.0f, 1.0f);
+
 }  // namespace
 
-std::vector<std::uint8_t> view_rgba(const Snapshot& snap, View view, float exposure) {
-  const std::size_t n = static_cast<std::size_t>(snap.width) * snap.height;
+std::vector<std::uint8_t> layer_rgba(const Layer& layer, Mapping mapping, float exposure, const Range& range) {
+  const std::size_t n = layer.image.pixels.size();
   std::vector<std::uint8_t> out(n * 4, 255);
-  if (snap.beauty.pixels.size() != n) return out;
   const float scale = std::exp2(exposure);
-  const Image* src = &snap.beauty;
-  float norm = 1.0f;
-  switch (view) {
-    case View::Albedo: src = &snap.albedo; break;
-    case View::Normal: src = &snap.normal; break;
-    case View::Depth: src = &snap.depth, norm = largest(snap.depth); break;
-    case View::Material: src = &snap.material; break;
-    case View::Variance: src = &snap.variance, norm = largest(snap.variance); break;
-    case View::PathLength: src = &snap.path_length, norm = largest(snap.path_length); break;
-    case View::Beauty:
-    case View::NonFinite: break;
-  }
+  const bool log = mapping == Mapping::Log;
+  const float lo = log ? std::log10(std::max(range.lo, 1e-38f)) : range.lo;
+  const float hi = log ? std::log10(std::max(range.hi, 1e-38f)) : range.hi;
   for (std::size_t i = 0; i < n; ++i) {
-    const vec3 v = src->pixels[i];
+    const vec3& v = layer.image.pixels[i];
     std::uint8_t* o = &out[4 * i];
-    vec3 c(0.0f);
-    bool encoded = false;  // already display values (no sRGB curve)
-    switch (view) {
-      case View::Beauty: c = v * scale; break;
-      case View::Albedo: c = v; break;
-      case View::Normal: c = 0.5f + 0.5f * v, encoded = true; break;
-      case View::Depth: c = vec3(v.x > 0.0f ? 1.0f - 0.8f * v.x / norm : 0.0f), encoded = true; break;
-      case View::Material: c = id_colour(v.x), encoded = true; break;
-      case View::Variance: c = vec3((v.x + v.y + v.z) / (3.0f * norm) * scale); break;
-      case View::PathLength: c = vec3(v.x / norm), encoded = true; break;
-      case View::NonFinite:
-        c = snap.nonfinite.pixels[i].x > 0.0f ? vec3(1, 0, 0) : 0.25f * v * scale;
-        break;
+    if (!is_finite(v)) {
+      put(o, kMagenta);
+      continue;
     }
-    if (std::isnan(c.x) || std::isnan(c.y) || std::isnan(c.z)) c = vec3(1, 0, 1), encoded = true;  // magenta
-    for (int k = 0; k < 3; ++k) o[k] = encoded ? byte(c[k]) : srgb_byte(c[k]);
+    switch (mapping) {
+      case Mapping::Tone: {
+        const vec3 c = v * scale;
+        put(o, vec3(linear_to_srgb(c.x), linear_to_srgb(c.y), linear_to_srgb(c.z)));
+        break;
+      }
+      case Mapping::Normal: put(o, 0.5f + 0.5f * v); break;
+      case Mapping::Id: put(o, id_colour(v.x)); break;
+      case Mapping::Linear:
+      case Mapping::Log: {
+        const float s = layer_scalar(layer, i);
+        if (log && s <= 0.0f) {
+          put(o, vec3(0.0f));
+          break;
+        }
+        const float x = log ? std::log10(s) : s;
+        put(o, ramp_colour(hi > lo ? (x - lo) / (hi - lo) : 0.5f));
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<std::uint8_t> nonfinite_rgba(const Layer& beauty, const Layer& nonfinite, float exposure) {
+  const std::size_t n = beauty.image.pixels.size();
+  std::vector<std::uint8_t> out(n * 4, 255);
+  const float scale = 0.25f * std::exp2(exposure);
+  for (std::size_t i = 0; i < n; ++i) {
+    const vec3 c = beauty.image.pixels[i] * scale;
+    if (i < nonfinite.image.pixels.size() && nonfinite.image.pixels[i].x > 0.0f) put(&out[4 * i], vec3(1, 0, 0));
+    else if (!is_finite(c)) put(&out[4 * i], kMagenta);
+    else put(&out[4 * i], vec3(linear_to_srgb(c.x), linear_to_srgb(c.y), linear_to_srgb(c.z)));
   }
   return out;
 }
