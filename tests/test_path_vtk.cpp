@@ -370,12 +370,12 @@ TEST(SceneGeometry, PlacesInstancesAndTessellatesSpheres) {
       if (sphere) {
         ++sphere_hits;
         ASSERT_EQ(mine.size(), kSphereTriangles);
-        const mat4& m = scene.instances[h->instance].to_world;
+        // Back in the group's space (the placement may scale unevenly), on the sphere.
+        const mat4 to_local = glm::inverse(scene.instances[h->instance].to_world);
         const Shape& s = scene.shapes[h->shape];
-        const vec3 c = vec3(m * vec4(s.center, 1.0f));
-        const float r = glm::length(vec3(m * vec4(s.center + vec3(s.radius, 0, 0), 1.0f)) - c);  // uniform scale
         for (const GeometryTriangle* t : mine)
-          for (const vec3& p : t->p) EXPECT_NEAR(glm::length(p - c), r, 1e-4f * (1.0f + r));
+          for (const vec3& corner : t->p)
+            EXPECT_NEAR(glm::length(vec3(to_local * vec4(corner, 1.0f)) - s.center), s.radius, 1e-4f * (1.0f + s.radius));
       } else {
         ++instanced_mesh_hits;
         ASSERT_EQ(mine.size(), 1u);

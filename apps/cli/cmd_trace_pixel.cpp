@@ -97,12 +97,12 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
                                              vtk_max_triangles);
       write_paths_and_geometry(vtk, lines, g);
       err << "pathlab: wrote " << vtk << " (" << (last - first + 1) << " path(s), " << lines.size() << " lines), "
-          << geometry_vtp_path(vtk) << " (" << g.triangles.size() << " of the scene's " << g.scene_triangles
+          << geometry_vtp_path(vtk).string() << " (" << g.triangles.size() << " of the scene's " << g.scene_triangles
           << " triangles" << (g.complete ? "" : vtk_geometry == "scene" && g.scene_triangles > vtk_max_triangles
                                                    ? ": over --vtk-max-triangles " + std::to_string(vtk_max_triangles) +
                                                          ", so only those the paths hit"
                                                    : ": those the paths hit")
-          << ") and " << multiblock_path(vtk) << " (opens both)\n";
+          << ") and " << multiblock_path(vtk).string() << " (opens both)\n";
     } else if (!vtk.empty()) {
       write_path_vtp(vtk, lines);
       err << "pathlab: wrote " << vtk << " (" << (last - first + 1) << " path(s), " << lines.size() << " lines)\n";
