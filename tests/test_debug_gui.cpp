@@ -354,14 +354,17 @@ std::vector<SampleRef> all_nonfinite(const std::filesystem::path& scene_file, in
 
 TEST_F(DebugGui, NextNonFiniteVisitsEveryNanSampleInScanlineOrder) {
   SessionSettings settings;
-  settings.scene_file = write_nan_scene(dir_, 16).string();
-  settings.spp = 4;
+  settings.scene_file = write_nan_scene(dir_, 4).string();
+  settings.spp = 64;
   Session session(settings);
-  ASSERT_TRUE(session.wait_spp(4, 120.0));
+  ASSERT_TRUE(session.wait_spp(64, 120.0));
   Snapshot snap;
   ASSERT_TRUE(session.snapshot(snap));
-  const std::vector<SampleRef> want = all_nonfinite(settings.scene_file, 4);
+  const std::vector<SampleRef> want = all_nonfinite(settings.scene_file, 64);
   ASSERT_GT(want.size(), 1u) << "the scene should give NaN/Inf samples";
+  bool two_in_a_pixel = false;  // so that the walk must go on within a pixel too
+  for (std::size_t k = 1; k < want.size(); ++k) two_in_a_pixel |= want[k].x == want[k - 1].x && want[k].y == want[k - 1].y;
+  ASSERT_TRUE(two_in_a_pixel);
   std::optional<SampleRef> at;
   for (std::size_t k = 0; k <= want.size(); ++k) {  // once round, and back to the first
     at = at ? session.next_nonfinite(snap, static_cast<int>(at->x), static_cast<int>(at->y), at->sample)
