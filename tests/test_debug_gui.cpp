@@ -491,11 +491,25 @@ TEST_F(DebugGui, ZoomPanReadoutLogScaleAndNextNan) {
   const auto is = [](const vec3& c, const unsigned char (&k)[4]) {
     return std::abs(c.x - k[0] / 255.0f) < 0.1f && std::abs(c.y - k[1] / 255.0f) < 0.1f && std::abs(c.z - k[2] / 255.0f) < 0.1f;
   };
-  // Centred: the area is 800 x 720 (the window less the panel), the first
-  // vertex of the retraced path lies on the pixel's camera ray.
+  // Zoomed in (at least 8x) and centred above the events window; the first
+  // vertex of the retraced path lies on the pixel's camera ray. Where the pixel
+  // is drawn comes from the readout's zoom and origin.
+  double z = 0, ox2 = 0, oy2 = 0;
+  {
+    const auto at = nan_text.find("zoom ");
+    ASSERT_NE(at, std::string::npos) << nan_text;
+    std::istringstream in(nan_text.substr(at + 5));
+    std::string word;
+    in >> z >> word >> ox2 >> oy2;
+  }
+  EXPECT_GE(z, 8.0);
+  const double cx = ox2 + (bad[0].x + 0.5) * z, cy = oy2 + (bad[0].y + 0.5) * z;
+  EXPECT_NEAR(cx, 400.0, 1.0);
+  EXPECT_NEAR(cy, 0.5 * 0.62 * 720.0, 1.0);
   bool vertex_at_centre = false;
   for (int dy = -3; dy <= 3; ++dy)
-    for (int dx = -3; dx <= 3; ++dx) vertex_at_centre |= is(nan_shot.at(400 + dx, 360 + dy), kVertexColour);
+    for (int dx = -3; dx <= 3; ++dx)
+      vertex_at_centre |= is(nan_shot.at(static_cast<int>(cx) + dx, static_cast<int>(cy) + dy), kVertexColour);
   EXPECT_TRUE(vertex_at_centre) << "the jump does not centre the NaN pixel with its path";
   int red = 0;
   for (int y = 0; y < 720; ++y)

@@ -34,6 +34,8 @@ constexpr double kScriptWaitSeconds = 600.0;
 constexpr float kMinZoom = 1.0f / 32.0f, kMaxZoom = 128.0f;
 constexpr float kWheelStep = 1.25f;     // zoom factor per wheel notch
 constexpr float kDividerGrab = 6.0f;    // screen pixels either side of the split divider
+constexpr float kEventsTop = 0.62f;     // the events window starts this far down the image area
+constexpr float kJumpZoom = 8.0f;       // a jump to a NaN sample zooms in at least this far
 
 std::string g_glfw_error;  // the last GLFW error, for messages
 void glfw_error(int code, const char* text) { g_glfw_error = std::to_string(code) + " " + text; }
@@ -178,6 +180,7 @@ class App {
   std::string scene_path_, vtk_path_ = "out/path.vtp", save_path_ = "out/debug.exr", compare_path_;
   std::string status_, nan_status_;
   float events_font_ = 1.0f;
+  std::optional<float> events_top_;  // where the events window starts (it covers the image below)
 
   std::vector<ScriptCommand> script_;
   std::size_t next_command_ = 0;
@@ -285,6 +288,7 @@ void App::next_nan() {
     }
     retrace_sample_ = static_cast<int>(r->sample);
     session_.retrace(r->x, r->y, r->sample);
+    zoom_ = std::max(zoom_, kJumpZoom);
     centre_on(static_cast<int>(r->x), static_cast<int>(r->y));
     hover_ = std::pair(static_cast<int>(r->x), static_cast<int>(r->y));
     nan_status_ = "NaN/Inf: pixel (" + std::to_string(r->x) + ", " + std::to_string(r->y) + ") sample " +
@@ -320,9 +324,11 @@ void App::actual_size() {
   origin_ = ImVec2(0.0f, 0.0f);
 }
 
+// Centres pixel (x, y) in the part of the image area the events window leaves free.
 void App::centre_on(int x, int y) {
   const ImVec2 a = area();
-  origin_ = ImVec2(0.5f * a.x - (static_cast<float>(x) + 0.5f) * zoom_, 0.5f * a.y - (static_cast<float>(y) + 0.5f) * zoom_);
+  const float visible = std::clamp(events_top_.value_or(kEventsTop * a.y), 0.25f * a.y, a.y);
+  origin_ = ImVec2(0.5f * a.x - (static_cast<float>(x) + 0.5f) * zoom_, 0.5f * visible - (static_cast<float>(y) + 0.5f) * zoom_);
 }
 
 // The window for the current scene: the image 1:1 (or scaled down to fit
@@ -689,13 +695,13 @@ void App::draw_events() {
   const auto& r = session_.current_retrace();
   if (!r) return;
   const ImVec2 a = area();
-  const float image_bottom = to_screen(0.0f, static_cast<float>(snap_.height)).y;
-  const float top = std::clamp(image_bottom + 4.0f, 0.45f * a.y, 0.75f * a.y);
-  ImGui::SetNextWindowPos(ImVec2(0.0f, top), ImGuiCond_FirstUseEver);
-  ImGui::SetNextWindowSize(ImVec2(a.x, a.y - top), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowPos(ImVec2(0.0f, kEventsTop * a.y), ImGuiCond_FirstUseEver);
+  ImGui::SetNextWindowSize(ImVec2(a.x, (1.0f - kEventsTop) * a.y), ImGuiCond_FirstUseEver);
   const std::string title = "events: pixel (" + std::to_string(r->x) + ", " + std::to_string(r->y) + ") sample " +
                             std::to_string(r->sample) + "###events";
-  if (ImGui::Begin(title.c_str())) {
+  const bool open = ImGui::Begin(title.c_str());
+  events_top_ = open ? ImGui::GetWindowPos().y : a.y;  // collapsed: only its title bar
+  if (open) {
     ImGui::SetNextItemWidth(120.0f);
     ImGui::SliderFloat("text size", &events_font_, 0.7f, 2.0f, "%.1f");
     ImGui::SameLine();
