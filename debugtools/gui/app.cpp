@@ -568,7 +568,7 @@ std::vector<std::string> App::readout_lines() const {
 
 void App::draw_panel() {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
-  // Anchored at the right edge; drag its left edge to widen it.
+  // Anchored at the right edge; its width from the "panel width" slider (or an edge drag).
   ImGui::SetNextWindowPos(ImVec2(display.x, 0), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
   ImGui::SetNextWindowSize(ImVec2(panel_width_, display.y), ImGuiCond_Always);
   ImGui::Begin("pathlab-debug", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse);
@@ -645,6 +645,8 @@ void App::draw_panel() {
   if (ImGui::Button("1:1")) actual_size();
   ImGui::SameLine();
   ImGui::Text("zoom %.3g  (wheel: zoom, drag: pan)", static_cast<double>(zoom_));
+  ImGui::SetNextItemWidth(140.0f);
+  ImGui::SliderFloat("panel width", &panel_width_, 300.0f, std::max(300.0f, 0.8f * display.x), "%.0f");
   if (ImGui::Button("Next NaN/Inf sample")) next_nan();
   if (!nan_status_.empty()) {
     ImGui::SameLine();
