@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <tuple>
 #include <fstream>
 
 namespace pathlab {
@@ -20,33 +21,57 @@ bool same_sample(const FilmSample& a, const FilmSample& b) {
   return a.hits == b.hits && a.rays == b.rays;
 }
 
-SampleComparison compare_samples(std::span<const FilmSample> a, std::span<const FilmSample> b, int width,
-                                 std::uint32_t count, std::uint32_t first, const ReplayFn& replay) {
+void SampleComparer::add_batch(std::span<const FilmSample> a, std::span<const FilmSample> b, std::uint32_t count,
+                               std::uint32_t first) {
   if (a.size() != b.size()) throw InputError("compare: the two sides hold different numbers of samples");
-  SampleComparison r;
-  r.samples = a.size();
-  std::vector<std::size_t> differing;
+  samples_ += a.size();
   for (std::size_t i = 0; i < a.size(); ++i) {
-    if (same_sample(a[i], b[i])) ++r.equal;
-    else differing.push_back(i);
-  }
-  // Few enough to agree: replay them all (each must be explained). Else the
-  // verdict is made; the first one says where to look.
-  const bool few = static_cast<double>(r.equal) >= kSameSeedShare * static_cast<double>(r.samples);
-  const std::size_t replays = few ? differing.size() : std::min<std::size_t>(1, differing.size());
-  for (std::size_t k = 0; k < replays; ++k) {
-    const std::size_t i = differing[k];
+    if (same_sample(a[i], b[i])) {
+      ++equal_;
+      continue;
+    }
     SampleDisagreement d;
-    d.x = static_cast<std::uint32_t>((i / count) % static_cast<std::size_t>(width));
-    d.y = static_cast<std::uint32_t>((i / count) / static_cast<std::size_t>(width));
+    d.x = static_cast<std::uint32_t>((i / count) % static_cast<std::size_t>(width_));
+    d.y = static_cast<std::uint32_t>((i / count) / static_cast<std::size_t>(width_));
     d.sample = first + static_cast<std::uint32_t>(i % count);
     d.a = a[i];
     d.b = b[i];
+    differing_.push_back(d);
+    if (differing_.size() >= 2 * keep_) trim(keep_);
+  }
+}
+
+void SampleComparer::trim(std::size_t n) {
+  std::sort(differing_.begin(), differing_.end(), [](const SampleDisagreement& p, const SampleDisagreement& q) {
+    return std::tie(p.y, p.x, p.sample) < std::tie(q.y, q.x, q.sample);
+  });
+  if (differing_.size() > n) differing_.resize(n);
+}
+
+SampleComparison SampleComparer::finish(const ReplayFn& replay) {
+  SampleComparison r;
+  r.samples = samples_;
+  r.equal = equal_;
+  trim(keep_);
+  const std::vector<SampleDisagreement>& order = differing_;
+  // Few enough to agree: replay them all (each must be explained). Else the
+  // verdict is made; the first one says where to look.
+  const bool few = static_cast<double>(r.equal) >= kSameSeedShare * static_cast<double>(r.samples);
+  const std::size_t replays = few ? order.size() : std::min<std::size_t>(1, order.size());
+  for (std::size_t k = 0; k < replays; ++k) {
+    SampleDisagreement d = order[k];
     d.divergence = replay(d.x, d.y, d.sample);
     if (!d.divergence.rounding) ++r.unexplained;
     r.replayed.push_back(std::move(d));
   }
   return r;
+}
+
+SampleComparison compare_samples(std::span<const FilmSample> a, std::span<const FilmSample> b, int width,
+                                 std::uint32_t count, std::uint32_t first, const ReplayFn& replay) {
+  SampleComparer c(width, a.size());
+  c.add_batch(a, b, count, first);
+  return c.finish(replay);
 }
 
 PathDivergence replay_divergence(const Tracer& a, const Tracer& b, std::uint32_t x, std::uint32_t y,
@@ -59,21 +84,33 @@ PathDivergence replay_divergence(const Tracer& a, const Tracer& b, std::uint32_t
 
 SampleComparison compare_tracers(const Tracer& a, const Tracer& b, std::uint32_t spp) {
   const FilmDesc& film = a.scene().scene().film;
-  const std::size_t n = static_cast<std::size_t>(film.width) * static_cast<std::size_t>(film.height) * spp;
-  std::vector<FilmSample> sa(n), sb(n);
-  a.render_batch(0, spp, sa);
-  b.render_batch(0, spp, sb);
-  return compare_samples(sa, sb, film.width, spp, 0, [&](std::uint32_t x, std::uint32_t y, std::uint32_t s) {
-    return replay_divergence(a, b, x, y, s);
-  });
+  const std::size_t pixels = static_cast<std::size_t>(film.width) * static_cast<std::size_t>(film.height);
+  const auto per_batch = static_cast<std::uint32_t>(std::clamp<std::size_t>((std::size_t{1} << 20) / pixels, 1, spp));
+  SampleComparer c(film.width, pixels * spp);
+  std::vector<FilmSample> sa, sb;
+  for (std::uint32_t first = 0; first < spp; first += per_batch) {
+    const std::uint32_t count = std::min(per_batch, spp - first);
+    sa.resize(pixels * count);
+    sb.resize(pixels * count);
+    a.render_batch(first, count, sa);
+    b.render_batch(first, count, sb);
+    c.add_batch(sa, sb, count, first);
+  }
+  return c.finish([&](std::uint32_t x, std::uint32_t y, std::uint32_t s) { return replay_divergence(a, b, x, y, s); });
 }
 
 BounceAccumulator render_bounces(const Tracer& tracer, std::uint32_t spp) {
   const FilmDesc& film = tracer.scene().scene().film;
   BounceAccumulator acc(film.width, film.height);
   const BounceTracer bt(tracer, acc);
-  std::vector<FilmSample> out(static_cast<std::size_t>(film.width) * static_cast<std::size_t>(film.height) * spp);
-  bt.render_batch(0, spp, out);
+  const std::size_t pixels = static_cast<std::size_t>(film.width) * static_cast<std::size_t>(film.height);
+  const auto per_batch = static_cast<std::uint32_t>(std::clamp<std::size_t>((std::size_t{1} << 20) / pixels, 1, spp));
+  std::vector<FilmSample> out;
+  for (std::uint32_t first = 0; first < spp; first += per_batch) {
+    const std::uint32_t count = std::min(per_batch, spp - first);
+    out.resize(pixels * count);
+    bt.render_batch(first, count, out);
+  }
   return acc;
 }
 

@@ -70,8 +70,30 @@ struct SampleComparison {
 // paths part.
 using ReplayFn = std::function<PathDivergence(std::uint32_t x, std::uint32_t y, std::uint32_t sample)>;
 
-// a and b hold samples [first, first + count) of every pixel of a
-// width-pixel film, pixel-major (as Tracer::render_batch fills them).
+// Gathers batches of both sides' samples, then replays disagreements in
+// order. Keeps only the disagreeing samples, so a render may come in any
+// number of batches.
+class SampleComparer {
+ public:
+  // `total`: the samples both sides will hold in all (only the first
+  // 0.1 % + 1 disagreements in order are kept: more cannot agree).
+  SampleComparer(int width, std::size_t total)
+      : width_(width), keep_(static_cast<std::size_t>((1.0 - kSameSeedShare) * static_cast<double>(total)) + 1) {}
+  // a and b hold samples [first, first + count) of every pixel,
+  // pixel-major (as Tracer::render_batch fills them).
+  void add_batch(std::span<const FilmSample> a, std::span<const FilmSample> b, std::uint32_t count,
+                 std::uint32_t first);
+  SampleComparison finish(const ReplayFn& replay);
+
+ private:
+  void trim(std::size_t n);  // sorts the disagreements and keeps the first n
+  int width_;
+  std::size_t keep_;
+  std::size_t samples_ = 0, equal_ = 0;
+  std::vector<SampleDisagreement> differing_;  // not yet replayed
+};
+
+// One batch: samples [first, first + count) of every pixel of a width-pixel film.
 SampleComparison compare_samples(std::span<const FilmSample> a, std::span<const FilmSample> b, int width,
                                  std::uint32_t count, std::uint32_t first, const ReplayFn& replay);
 
@@ -79,8 +101,9 @@ SampleComparison compare_samples(std::span<const FilmSample> a, std::span<const 
 PathDivergence replay_divergence(const Tracer& a, const Tracer& b, std::uint32_t x, std::uint32_t y,
                                  std::uint32_t sample, float tolerance = kReplayTolerance);
 
-// Renders samples [0, spp) of every pixel with both (render_batch) and
-// compares them, replaying disagreements with both.
+// Renders samples [0, spp) of every pixel with both (render_batch, in
+// batches of about 2^20 samples) and compares them, replaying
+// disagreements with both.
 SampleComparison compare_tracers(const Tracer& a, const Tracer& b, std::uint32_t spp);
 
 struct BounceDeviation {

@@ -8,6 +8,7 @@
 #include "apps/cli/cli.h"
 #include "core/compiled_scene.h"
 #include "core/error.h"
+#include "core/scene_loader.h"
 #include "debugtools/compare.h"
 #include "debugtools/tracers.h"
 #include "tests/temp_dir.h"

@@ -185,19 +185,19 @@ int CompareCommand::run(std::ostream& out, std::ostream& err) const {
     return 0;
   }
 
-  // The two sides: samples and per-bounce layers.
-  std::vector<FilmSample> sa(static_cast<std::size_t>(sc.film.width) * static_cast<std::size_t>(sc.film.height) * spp);
-  ta->render_batch(0, spp, sa);
+  // The two sides: samples and per-bounce layers. Here, both are rendered
+  // in batches; from another build, its whole export file is read.
   const BounceAccumulator ba = render_bounces(*ta, spp);
+  std::vector<FilmSample> sa;
   std::unique_ptr<Tracer> tb;
   SampleExport other;
   std::optional<TempDir> tmp;
   if (with.empty()) {
     tb = make_tracer(sides[1], compiled, settings);
-    other.samples.resize(sa.size());
-    tb->render_batch(0, spp, other.samples);
     other.bounces = render_bounces(*tb, spp);
   } else {
+    sa.resize(static_cast<std::size_t>(sc.film.width) * static_cast<std::size_t>(sc.film.height) * spp);
+    ta->render_batch(0, spp, sa);
     tmp.emplace();
     const std::string file = (tmp->path / "other.samples").string();
     std::vector<std::string> argv{with, "compare"};
@@ -245,7 +245,8 @@ int CompareCommand::run(std::ostream& out, std::ostream& err) const {
     }
     return first_divergence(a, path_events_from_json(doc, sc, with + " trace-pixel --json"), kReplayTolerance);
   };
-  const SampleComparison samples = compare_samples(sa, other.samples, sc.film.width, spp, 0, replay);
+  const SampleComparison samples =
+      tb ? compare_tracers(*ta, *tb, spp) : compare_samples(sa, other.samples, sc.film.width, spp, 0, replay);
   const BounceComparison bounces = compare_bounces(ba, other.bounces, alpha);
   const bool agree = samples.agree() && bounces.agree();
 
