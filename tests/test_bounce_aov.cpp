@@ -38,9 +38,9 @@ const char* const kTracers[] = {"reference", "wavefront"};
 TEST(BounceLayers, FurnaceLayerDIsLeTimesRhoToTheD) {
   constexpr float Le = 0.5f, rho = 0.7f;
   constexpr int max_depth = 10;  // depths 0..10: 8, 9 and 10 in the rest layer
-  const Scene scene = test::furnace_scene(Le, rho, max_depth, 100, Strategy::Bsdf, 4);
+  Scene scene = test::furnace_scene(Le, rho, max_depth, 100, Strategy::Bsdf, 4);
   const RenderSettings settings = scene.render;
-  const CompiledScene compiled(Scene(scene));
+  const CompiledScene compiled(std::move(scene));
   for (const char* name : kTracers) {
     const auto tracer = make_tracer(name, compiled, settings);
     for (std::uint32_t s = 0; s < 4; ++s) {
@@ -174,7 +174,9 @@ TEST(StageBuffers, ArraysAtBounceKAndTheirHandOverToKPlus1) {
         ++light_samples;
         EXPECT_GT(r.light_pdf, 0.0f);
       }
-      if (r.reached && std::isfinite(r.distance)) EXPECT_GT(r.distance, 0.0f);
+      if (r.reached && std::isfinite(r.distance)) {
+        EXPECT_GT(r.distance, 0.0f);
+      }
     }
   }
   EXPECT_GT(light_samples, 0);

@@ -63,23 +63,26 @@ std::string wrapper(const std::filesystem::path& dir, const std::string& extra) 
   return script.string();
 }
 
-// Another "build" whose tracer samples only the BSDF: every sample differs
-// (the first vertex takes no light sample), so the first one in row-major
-// order is pixel 0,0 sample 0; its paths part at vertex 1, and both replay
-// commands are given.
+// Another "build" whose tracer samples only the BSDF: two thirds of the
+// samples differ. Pixels 0,0 and 1,0 see the ceiling, in the light's plane,
+// where no light sample is taken (f = 0), so their first samples agree up to
+// vertex 2 and the first that differs in row-major order is pixel 2,0 sample
+// 0 (pixel 2,0's first vertex is on the ceiling too; its paths part at vertex
+// 2). Both replay commands are given, and the per-bounce test names L1 (NEE
+// is missing from B).
 TEST_F(CompareCli, AnotherBuildThatPartsDisagreesFromTheFirstSample) {
   const std::string other = wrapper(dir_, "--strategy bsdf");
   std::string out, err;
   ASSERT_EQ(run({"compare", "--resolution", "16x12", "--spp", "4", "--with", other}, &out, &err), 1) << out << err;
   EXPECT_NE(out.find("DISAGREE"), std::string::npos) << out;
-  EXPECT_NE(out.find("first disagreeing sample (row-major pixel, then sample): pixel 0,0 sample 0:"),
+  EXPECT_NE(out.find("first disagreeing sample (row-major pixel, then sample): pixel 2,0 sample 0:"),
             std::string::npos)
       << out;
-  EXPECT_NE(out.find("first divergence: event 2: different events at vertex 1"), std::string::npos) << out;
-  EXPECT_NE(out.find("replay: pathlab trace-pixel --pixel 0,0 --sample 0 --seed 0 --tracer wavefront"),
+  EXPECT_NE(out.find("first divergence: event 4: different events at vertex 2"), std::string::npos) << out;
+  EXPECT_NE(out.find("replay: pathlab trace-pixel --pixel 2,0 --sample 0 --seed 0 --tracer wavefront"),
             std::string::npos)
       << out;
-  EXPECT_NE(out.find("replay: " + other + " trace-pixel --pixel 0,0 --sample 0"), std::string::npos) << out;
+  EXPECT_NE(out.find("replay: " + other + " trace-pixel --pixel 2,0 --sample 0"), std::string::npos) << out;
   EXPECT_NE(out.find("first depth that disagrees: L1"), std::string::npos) << out;
 }
 
