@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <tuple>
 
 namespace pathlab {
 namespace {
@@ -121,6 +122,34 @@ TEST_F(CompareCli, ExportFileRoundTripsAndRefusesATruncatedOne) {
   } catch (const InputError& ex) {
     EXPECT_NE(std::string(ex.what()).find(file + ": truncated"), std::string::npos) << ex.what();
   }
+}
+
+// The first disagreeing sample is the first in row-major pixel, then sample
+// order, whatever batch it came in: here the second batch holds pixel 1,0
+// sample 2, which comes before pixel 0,1 sample 1 of the first.
+TEST(CompareSamples, FirstDisagreementIsRowMajorThenSampleAcrossBatches) {
+  constexpr int width = 2, height = 2;
+  constexpr std::uint32_t per_batch = 2;
+  SampleComparer c(width, width * height * 4);
+  std::vector<std::tuple<std::uint32_t, std::uint32_t, std::uint32_t>> replayed;
+  for (std::uint32_t first : {0u, 2u}) {
+    std::vector<FilmSample> a(width * height * per_batch), b(a.size());
+    for (std::size_t i = 0; i < a.size(); ++i) a[i].L = b[i].L = Spectrum(0.5f);
+    if (first == 0) b[2 * per_batch + 1].L.x = 0.6f;  // pixel 0,1 (index 2), sample 1
+    else b[1 * per_batch + 0].L.y = 0.4f;            // pixel 1,0 (index 1), sample 2
+    c.add_batch(a, b, per_batch, first);
+  }
+  const SampleComparison r = c.finish([&](std::uint32_t x, std::uint32_t y, std::uint32_t s) {
+    replayed.emplace_back(x, y, s);
+    return PathDivergence{};
+  });
+  EXPECT_EQ(r.samples, 16u);
+  EXPECT_EQ(r.equal, 14u);
+  ASSERT_EQ(r.replayed.size(), 1u);  // 2 of 16 differ: too many to agree, so only the first is replayed
+  EXPECT_EQ(r.replayed[0].x, 1u);
+  EXPECT_EQ(r.replayed[0].y, 0u);
+  EXPECT_EQ(r.replayed[0].sample, 2u);
+  EXPECT_EQ(replayed.size(), 1u);
 }
 
 // Two renders at independent seeds estimate the same layers: the per-bounce
