@@ -3,7 +3,8 @@
 // that passes a planted bug is broken).
 //
 // They exist only in builds compiled with PATHLAB_FAULT_INJECTION, which
-// only tests/ does (pathlab_core_faults, pathlab_reference_faults). In every
+// only tests/ does (pathlab_core_faults, pathlab_reference_faults,
+// pathlab_wavefront_faults). In every
 // other build PATHLAB_FAULT(name) is the constant false and the faulty
 // branches vanish.
 #pragma once
@@ -27,6 +28,8 @@ enum class Fault {
   DiffuseNotCoupled,      // bsdf/disney.cpp: energy compensation forgets to dim the diffuse under the specular layer
   DielectricFresnelIgnored,// surfel.cpp: glass always refracts (Fresnel reflection dropped, TIR kept)
   AlphaKeysNotSet,        // reference: every ray keeps alpha key 0, so each triangle decides once for all rays
+  WavefrontMisWeightLostAtDepth2,  // wavefront (scalar stages): emission a continuation ray finds after two
+                                   // bounces (vertex 3) is counted with weight 1, its MIS weight lost
 };
 
 #ifdef PATHLAB_FAULT_INJECTION

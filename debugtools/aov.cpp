@@ -1,9 +1,12 @@
 #include "debugtools/aov.h"
 
 #include "core/parallel.h"
+#include "debugtools/bounce_aov.h"
 #include "core/rng.h"
 #include "core/sample_dims.h"
 #include "core/surfel.h"
+
+#include <stdexcept>
 
 namespace pathlab {
 
@@ -33,6 +36,7 @@ const char* aov_name(Aov a) {
     case Aov::Material: return "material";
     case Aov::Variance: return "variance";
     case Aov::PathLength: return "pathlength";
+    case Aov::Bounces: return "bounces";
   }
   return "?";
 }
@@ -131,7 +135,8 @@ void add_exr_layer(std::vector<ExrChannel>& out, const std::string& layer, const
   }
 }
 
-std::vector<ExrChannel> aov_channels(const Film& film, const AovAccumulator& aovs, std::span<const Aov> which) {
+std::vector<ExrChannel> aov_channels(const Film& film, const AovAccumulator& aovs, std::span<const Aov> which,
+                                     const BounceAccumulator* bounces) {
   std::vector<ExrChannel> channels;
   const auto add = [&](const std::string& layer, const Image& img, std::string_view names) {
     add_exr_layer(channels, layer, img, names);
@@ -145,6 +150,10 @@ std::vector<ExrChannel> aov_channels(const Film& film, const AovAccumulator& aov
       case Aov::Material: add("material", aovs.material(), "Y"); break;
       case Aov::Variance: add("variance", film.variance_of_mean(), "RGB"); break;
       case Aov::PathLength: add("pathlength", aovs.path_length(), "Y"); break;
+      case Aov::Bounces:
+        if (!bounces) throw std::logic_error("aov_channels: the bounces layers need their accumulator");
+        add_bounce_channels(channels, *bounces);
+        break;
     }
   }
   return channels;

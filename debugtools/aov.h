@@ -33,9 +33,14 @@
 
 namespace pathlab {
 
-enum class Aov : std::uint8_t { Albedo, Normal, Depth, Material, Variance, PathLength };
-inline constexpr Aov kAllAovs[] = {Aov::Albedo, Aov::Normal, Aov::Depth, Aov::Material, Aov::Variance, Aov::PathLength};
-const char* aov_name(Aov a);  // "albedo", "normal", "depth", "material", "variance", "pathlength"
+class BounceAccumulator;
+
+// Bounces: the per-bounce decomposition (debugtools/bounce_aov.h), which
+// needs its own pass (BounceTracer); the others come from AovAccumulator.
+enum class Aov : std::uint8_t { Albedo, Normal, Depth, Material, Variance, PathLength, Bounces };
+inline constexpr Aov kAllAovs[] = {Aov::Albedo,   Aov::Normal,     Aov::Depth,  Aov::Material,
+                                   Aov::Variance, Aov::PathLength, Aov::Bounces};
+const char* aov_name(Aov a);  // "albedo", "normal", "depth", "material", "variance", "pathlength", "bounces"
 std::optional<Aov> parse_aov(std::string_view name);
 
 class AovAccumulator {
@@ -102,7 +107,9 @@ void add_exr_layer(std::vector<ExrChannel>& out, const std::string& layer, const
 
 // The EXR channels of the beauty image (R, G, B) followed by the requested
 // AOVs as named layers: albedo.{R,G,B}, normal.{X,Y,Z}, depth.Z, material.Y,
-// variance.{R,G,B} (the film's variance of the pixel mean), pathlength.Y.
-std::vector<ExrChannel> aov_channels(const Film& film, const AovAccumulator& aovs, std::span<const Aov> which);
+// variance.{R,G,B} (the film's variance of the pixel mean), pathlength.Y,
+// and for `bounces` the layers of `bounces` (add_bounce_channels; required then).
+std::vector<ExrChannel> aov_channels(const Film& film, const AovAccumulator& aovs, std::span<const Aov> which,
+                                     const BounceAccumulator* bounces = nullptr);
 
 }  // namespace pathlab

@@ -5,6 +5,8 @@
 #include "core/parallel.h"
 #include "core/render.h"
 #include "core/scene_loader.h"
+#include "debugtools/bounce_aov.h"
+#include "debugtools/compare.h"
 #include "debugtools/path_compare.h"
 #include "debugtools/path_recorder.h"
 #include "reference/reference_tracer.h"
@@ -67,45 +69,54 @@ Scene load_case(const SameSeedCase& c) {
 
 class SameSeed : public testing::TestWithParam<SameSeedCase> {};
 
-// Every sample of both tracers is compared. A sample counts as equal if its
-// radiance agrees within 1e-4 relative (plus 1e-6 absolute for values near 0)
-// and it reached as many surfaces and cast as many rays. At least 99.9 % must
-// be; each one that is not must be explained by rounding: replayed with both
+// Every sample of both tracers is compared, by the rule `pathlab compare`
+// applies (debugtools/compare.h): a sample counts as equal if its radiance
+// agrees within 1e-4 relative (plus 1e-6 absolute for values near 0) and it
+// reached as many surfaces and cast as many rays. At least 99.9 % must be;
+// each one that is not must be explained by rounding: replayed with both
 // tracers, its paths agree event by event (positions and directions within
 // 1e-3) up to the vertex where they part, i.e. the same path until a float
 // difference flipped a decision, not a different estimator.
+//
+// The per-bounce layers (debugtools/bounce_aov.h) of every sample that
+// agrees are the same bits in both tracers: each event's contribution is
+// the same product of the same numbers in both.
 TEST_P(SameSeed, WavefrontFollowsTheReferencesPaths) {
   Scene scene = load_case(GetParam());
   const RenderSettings settings = scene.render;
   const CompiledScene compiled(std::move(scene));
   const ReferenceTracer reference(compiled, settings);
   const WavefrontTracer wavefront(compiled, settings, 997);  // several waves, odd size
-  const std::size_t pixels = static_cast<std::size_t>(compiled.scene().film.width) * compiled.scene().film.height;
   const auto count = static_cast<std::uint32_t>(settings.spp);
-  std::vector<FilmSample> a(pixels * count), b(pixels * count);
-  reference.render_batch(0, count, a);
-  wavefront.render_batch(0, count, b);
-  std::size_t equal = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_EQ(a[i].film, b[i].film);
-    bool same = true;
-    for (int c = 0; c < 3; ++c)
-      same = same && std::abs(a[i].L[c] - b[i].L[c]) <= 1e-4f * std::max(std::abs(a[i].L[c]), std::abs(b[i].L[c])) + 1e-6f;
-    same = same && a[i].hits == b[i].hits && a[i].rays == b[i].rays;
-    if (same) {
-      ++equal;
-      continue;
-    }
-    const auto x = static_cast<std::uint32_t>((i / count) % compiled.scene().film.width);
-    const auto y = static_cast<std::uint32_t>((i / count) / compiled.scene().film.width);
-    PathRecorder ra, rb;
-    reference.trace_sample(x, y, static_cast<std::uint32_t>(i % count), &ra);
-    wavefront.trace_sample(x, y, static_cast<std::uint32_t>(i % count), &rb);
-    const PathDivergence d = first_divergence(ra.events(), rb.events(), 1e-3f);
-    EXPECT_TRUE(d.rounding) << "pixel " << x << "," << y << " sample " << i % count << ": " << d.reason;
-  }
-  EXPECT_GE(static_cast<double>(equal), 0.999 * static_cast<double>(a.size()))
-      << a.size() - equal << " of " << a.size() << " samples differ";
+  const SampleComparison r = compare_tracers(reference, wavefront, count);
+  for (const SampleDisagreement& d : r.replayed)
+    EXPECT_TRUE(d.divergence.rounding) << "pixel " << d.x << "," << d.y << " sample " << d.sample << ": "
+                                       << d.divergence.reason;
+  EXPECT_GE(static_cast<double>(r.equal), kSameSeedShare * static_cast<double>(r.samples))
+      << r.differing() << " of " << r.samples << " samples differ";
+  EXPECT_TRUE(r.agree());
+
+  std::size_t layers_equal = 0, compared = 0;
+  const FilmDesc& film = compiled.scene().film;
+  for (std::uint32_t y = 0; y < static_cast<std::uint32_t>(film.height); ++y)
+    for (std::uint32_t x = 0; x < static_cast<std::uint32_t>(film.width); ++x)
+      for (std::uint32_t j = 0; j < count; ++j) {
+        BounceObserver a, b;
+        const FilmSample fa = reference.trace_sample(x, y, j, &a), fb = wavefront.trace_sample(x, y, j, &b);
+        if (!same_sample(fa, fb)) continue;  // a path that parted (counted above)
+        ++compared;
+        bool same = true;
+        for (int d = 0; d < kBounceLayers; ++d)
+          for (int t = 0; t < kTechniques; ++t) {
+            const Spectrum& la = a.layers.L[static_cast<std::size_t>(d)][static_cast<std::size_t>(t)];
+            const Spectrum& lb = b.layers.L[static_cast<std::size_t>(d)][static_cast<std::size_t>(t)];
+            same = same && la == lb;
+            EXPECT_EQ(la, lb) << "pixel " << x << "," << y << " sample " << j << " layer " << bounce_layer_name(d)
+                              << "." << technique_name(static_cast<Technique>(t));
+          }
+        layers_equal += same ? 1 : 0;
+      }
+  EXPECT_EQ(layers_equal, compared);
 }
 
 std::vector<SameSeedCase> same_seed_cases() {

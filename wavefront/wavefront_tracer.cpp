@@ -1,5 +1,6 @@
 #include "wavefront/wavefront_tracer.h"
 
+#include "core/faults.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "core/strategy_weights.h"
@@ -9,6 +10,8 @@
 #include <bit>
 #include <chrono>
 #include <cstddef>
+#include <limits>
+#include <stdexcept>
 #include <optional>
 #include <type_traits>
 
@@ -63,6 +66,10 @@ struct WavefrontTracer::Wave {
   std::vector<Ray> query;
   std::vector<std::uint32_t> query_slot;
   std::vector<std::uint8_t> query_result;
+  // render_batch_recording only: where each path's state at vertex
+  // record_vertex goes (indexed by out_index); null otherwise.
+  StageRecord* record = nullptr;
+  int record_vertex = 0;
 
   void resize(std::size_t size) {
     out_index.resize(size), x.resize(size), y.resize(size), sample.resize(size), rng.resize(size, SampleStream(0, 0, 0));
@@ -357,7 +364,8 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
     }
     const vec3 wo = -w.ray[i].dir;
     const Spectrum Le = s.emitted(wo);
-    const float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf(w.prev[i].p, s));
+    float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf(w.prev[i].p, s));
+    if (PATHLAB_FAULT(WavefrontMisWeightLostAtDepth2) && w.vertex[i] == 3 && we > 0.0f) we = 1.0f;
     const Spectrum added = w.beta[i] * (we * Le);
     w.L[i] += added;
     if (obs)
@@ -378,6 +386,7 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
 void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
   const LightSampler& lights = scene_.lights();
   const Strategy strategy = settings_.strategy;
+  const bool keep = obs != nullptr || w.record != nullptr;  // someone reads the light samples back
   for (std::size_t i = 0; i < w.n; ++i) {
     w.shadow_state[2 * i] = w.shadow_state[2 * i + 1] = 0;
     if (!w.alive[i]) continue;
@@ -387,7 +396,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
       if (const auto ls = lights.sample_delta(s.p, w.u(i, Dim::DeltaLightChoice))) {
         const Spectrum f = s.eval(ls->wi, wo);
         if (!is_black(f)) {
-          if (obs) w.light[2 * i] = *ls;  // only the observer reads it back
+          if (keep) w.light[2 * i] = *ls;  // only the observer and the stage records read it back
           w.unoccluded[2 * i] = f * ls->Le / ls->pdf;
           w.light_weight[2 * i] = 1.0f;
           w.shadow[2 * i] = shadow_ray(s, *ls);
@@ -402,7 +411,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
       const Spectrum f = s.eval(ls->wi, wo);
       if (is_black(f)) continue;
       const float lw = light_sample_weight(strategy, ls->pdf, s.pdf(ls->wi, wo));
-      if (obs) w.light[2 * i + 1] = *ls;
+      if (keep) w.light[2 * i + 1] = *ls;
       w.unoccluded[2 * i + 1] = f * ls->Le * (lw / ls->pdf);
       w.light_weight[2 * i + 1] = lw;
       w.shadow[2 * i + 1] = shadow_ray(s, *ls);
@@ -538,17 +547,36 @@ void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver*
   w.clock = Clock{};
   const std::uint64_t t0 = clock_ns();
   generate_camera_rays(w, obs);
-  while (w.n > 0) {
+  for (int vertex = 1; w.n > 0; ++vertex) {
     intersect(w);
     add_emission(w, obs);
     sample_lights(w, obs);
     trace_shadow_rays(w);
     add_light(w, obs);
+    const bool recorded = w.record != nullptr && vertex == w.record_vertex;
+    if (recorded) record_stage(w);
     scatter(w, obs);
+    if (recorded) record_survival(w);
     compact(w, out);
   }
   w.clock.nanoseconds[kWave] = clock_ns() - t0;
   publish(w.clock);
+}
+
+void WavefrontTracer::record_stage(Wave& w) {
+  for (std::size_t i = 0; i < w.n; ++i) {
+    StageRecord& r = w.record[w.out_index[i]];
+    r.reached = true;
+    r.throughput = w.beta[i];
+    r.dir = w.ray[i].dir;
+    r.distance = w.found[i] ? w.hit[i].t : std::numeric_limits<float>::infinity();
+    r.light_sampled = w.shadow_state[2 * i + 1] != 0;
+    r.light_pdf = r.light_sampled ? w.light[2 * i + 1].pdf : 0.0f;
+  }
+}
+
+void WavefrontTracer::record_survival(Wave& w) {
+  for (std::size_t i = 0; i < w.n; ++i) w.record[w.out_index[i]].survived = w.alive[i] != 0;
 }
 
 // The vectorised twin of run_wave: the same stages and the same Embree
@@ -595,6 +623,18 @@ WavefrontTimes WavefrontTracer::times() const {
 }
 
 void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const {
+  render_waves(first, count, out, 0, {});
+}
+
+void WavefrontTracer::render_batch_recording(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out,
+                                             int vertex, std::span<StageRecord> records) const {
+  if (records.size() != out.size()) throw std::invalid_argument("render_batch_recording: one record per sample");
+  std::fill(records.begin(), records.end(), StageRecord{});
+  render_waves(first, count, out, vertex, records);
+}
+
+void WavefrontTracer::render_waves(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out,
+                                   int record_vertex, std::span<StageRecord> records) const {
   const auto width = static_cast<std::uint32_t>(scene_.scene().film.width);
   // At least ~64 waves per batch so that small batches still keep every
   // thread busy, but never below 256 paths; the size depends only on the
@@ -623,7 +663,7 @@ void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std
   // Each thread keeps its wave's arrays from one batch to the next
   // (allocating and page-faulting them in per wave cost more than tracing).
   const std::size_t n_max = std::min(wave_size, out.size());
-  if (vector_) {
+  if (vector_ && records.empty()) {  // the records are the scalar stages' arrays
     parallel_for(0, waves, 1, [&](std::size_t k0, std::size_t k1) {
       thread_local Lanes lanes;
       if (lanes.capacity() < n_max) lanes.resize(n_max);
@@ -648,6 +688,8 @@ void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std
   parallel_for(0, waves, 1, [&](std::size_t k0, std::size_t k1) {
     thread_local Wave w;
     if (w.capacity() < n_max) w.resize(n_max);
+    w.record = records.empty() ? nullptr : records.data();
+    w.record_vertex = record_vertex;
     for (std::size_t k = k0; k < k1; ++k) {
       const std::size_t begin = k * wave_size;
       w.n = std::min(wave_size, out.size() - begin);

@@ -56,6 +56,19 @@ enum class WavefrontStages : std::uint8_t {
   Scalar,  // the scalar stages always (the baseline they are measured and tested against)
 };
 
+// One path's state at a chosen vertex K, for `render --dump-stage-buffers`
+// (docs/aov.md): what the per-path arrays held while the ray reaching
+// vertex K (the camera ray for K = 1) was processed.
+struct StageRecord {
+  Spectrum throughput{0.0f};  // the path throughput that ray carries
+  vec3 dir{0.0f};             // its direction
+  float distance = 0.0f;      // to the surface it hit (infinity: it escaped)
+  float light_pdf = 0.0f;     // the area light sample's pdf at vertex K (0: none taken)
+  bool reached = false;       // the path was still alive to trace that ray
+  bool light_sampled = false; // an area light sample was taken at vertex K
+  bool survived = false;      // alive after that bounce's compaction (goes on to vertex K + 1)
+};
+
 class WavefrontTracer final : public Tracer {
  public:
   // Paths per wave, at most: a batch is cut into waves of this size, or
@@ -74,6 +87,14 @@ class WavefrontTracer final : public Tracer {
   void render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const override;
   FilmSample trace_sample(std::uint32_t x, std::uint32_t y, std::uint32_t sample,
                           PathObserver* observer) const override;
+
+  // render_batch through the scalar stages that also records, for every
+  // sample of the batch, its path's state at vertex `vertex` into
+  // records[its slot] (pixel-major like `out`; a path that ended before
+  // has reached = false). Costs the normal render one untaken branch per
+  // wave and bounce.
+  void render_batch_recording(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out, int vertex,
+                              std::span<StageRecord> records) const;
 
   // Memory the path state of one wave takes per path, in bytes.
   std::size_t bytes_per_path() const;
@@ -100,6 +121,12 @@ class WavefrontTracer final : public Tracer {
   // Traces the wave's paths to their ends, writing each one's sample to
   // out[its out_index] as it ends.
   void run_wave(Wave& wave, std::span<FilmSample> out, PathObserver* observer) const;
+  // render_batch, and render_batch_recording when `records` is not empty.
+  void render_waves(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out, int record_vertex,
+                    std::span<StageRecord> records) const;
+  // The wave's paths at the recorded vertex: before scattering, then after.
+  static void record_stage(Wave& w);
+  static void record_survival(Wave& w);
   void generate_camera_rays(Wave& w, PathObserver* obs) const;
   void intersect(Wave& w) const;
   void add_emission(Wave& w, PathObserver* obs) const;

@@ -18,6 +18,7 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
   DiffCommand diff;
   CheckCommand check;
   ConvergeCommand converge;
+  CompareCommand compare;
   MergeCommand merge;
   render.add_to(app);
   merge.add_to(app);
@@ -25,6 +26,7 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
   diff.add_to(app);
   trace_pixel.add_to(app);
   converge.add_to(app);
+  compare.add_to(app);
 
   try {
     app.parse(argc, argv);
@@ -44,6 +46,7 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
     if (diff.selected) return diff.run(out, err);
     if (check.selected) return check.run(out, err);
     if (converge.selected) return converge.run(out, err);
+    if (compare.selected) return compare.run(out, err);
   } catch (const InputError& e) {
     err << "pathlab: error: " << e.what() << "\n";
     return 2;

@@ -15,11 +15,14 @@
 #include "core/parallel.h"
 #include "core/render.h"
 #include "debugtools/aov.h"
+#include "debugtools/bounce_aov.h"
+#include "debugtools/stage_buffers.h"
 #include "distributed/mpi_job.h"
 #include "wavefront/wavefront_tracer.h"
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -34,7 +37,9 @@ void RenderCommand::add_to(CLI::App& app) {
   cmd->add_option("-o,--output", output, "Output EXR (a tone-mapped PNG is written beside it); default out/<scene>.exr");
   std::vector<std::string> aov_names;
   for (Aov a : kAllAovs) aov_names.emplace_back(aov_name(a));
-  cmd->add_option("--aov", aovs, "Extra EXR layers, comma-separated: albedo, normal, depth, material, variance, pathlength")
+  cmd->add_option("--aov", aovs,
+                  "Extra EXR layers, comma-separated: albedo, normal, depth, material, variance, pathlength, bounces "
+                  "(radiance per path depth L0..L7 and rest, by technique bsdf / nee)")
       ->delimiter(',')
       ->check(CLI::IsMember(aov_names));
   cmd->add_option("--threads", threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
@@ -53,6 +58,11 @@ void RenderCommand::add_to(CLI::App& app) {
   cmd->add_option("--passes", passes,
                   "Render only sample passes A..B (sample indices A to B-1 of every pixel); with -o X.pfilm the "
                   "partial film is written for 'pathlab merge'");
+  cmd->add_option("--dump-stage-buffers", stage_buffers,
+                  "Wavefront only: write its per-path arrays at bounce K (vertex K; 1 = the camera rays' hits) "
+                  "splatted to images, DIR/bounceK-<array>.exr (docs/aov.md)")
+      ->expected(2)
+      ->type_name("K DIR");
   cmd->add_flag("-q,--quiet", quiet, "Print only warnings and errors");
   cmd->callback([this] { selected = true; });
 }
@@ -106,6 +116,32 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     throw InputError("--aov: only the variance layer is kept in a partial film; the others cannot go with "
                      "--checkpoint, --resume, --passes or a .pfilm output yet");
   if (partial_output && !layers.empty()) throw InputError("--aov: a .pfilm output holds no image layers");
+  const bool bounces_aov = std::find(layers.begin(), layers.end(), Aov::Bounces) != layers.end();
+  if (bounces_aov && s.render.clamp > 0.0f)
+    throw InputError("--aov bounces: the layers hold each sample's unclamped radiance, so with --clamp they would not "
+                     "sum to the image; render them without --clamp");
+  std::optional<int> stage_vertex;
+  std::filesystem::path stage_dir;
+  if (!stage_buffers.empty()) {
+    int k = 0;
+    const std::string& text = stage_buffers[0];
+    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), k);
+    if (ec != std::errc() || ptr != text.data() + text.size() || k < 1 || k > kMaxVerticesUncapped)
+      throw InputError("--dump-stage-buffers " + text + ": K must be a vertex number in [1, " +
+                       std::to_string(kMaxVerticesUncapped) + "] (1 = the camera rays' hits)");
+    if (scene.tracer != "wavefront")
+      throw InputError("--dump-stage-buffers: the stage buffers are the wavefront's; add --tracer wavefront");
+    if (pieces || progressive || job.distributed() || bounces_aov)
+      throw InputError("--dump-stage-buffers goes with a plain render: not with --checkpoint, --resume, --passes, a "
+                       ".pfilm output, --time, --target-relmse, mpirun or --aov bounces");
+    stage_vertex = k;
+    stage_dir = stage_buffers[1];
+    std::error_code dir_error;  // refused before rendering, not after
+    std::filesystem::create_directories(stage_dir, dir_error);
+    if (dir_error || !std::filesystem::is_directory(stage_dir))
+      throw InputError("--dump-stage-buffers: " + stage_dir.string() + ": cannot create the folder" +
+                       (dir_error ? ": " + dir_error.message() : std::string()));
+  }
   if (passes && progressive) throw InputError("--passes renders a fixed range of passes; --time and --target-relmse cannot go with it");
   if (job.distributed() && progressive)
     throw InputError("--time and --target-relmse are not supported under mpirun yet; give --spp");
@@ -142,12 +178,31 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   const RenderSettings settings = s.render;
   const CompiledScene compiled(std::move(s));
   const auto tracer = make_tracer(scene.tracer, compiled, settings);
-  // With --aov the driver renders through a tracer that also fills the AOVs.
+  // With --aov the driver renders through a tracer that also fills the AOVs
+  // (and, for `bounces`, one that traces every sample with an observer);
+  // with --dump-stage-buffers through one that records the wavefront's
+  // arrays. Without them the driver renders the tracer itself.
+  const Tracer* inner = tracer.get();
+  std::optional<StageBuffers> stage_images;
+  std::optional<StageBufferTracer> stage_tracer;
+  if (stage_vertex) {
+    stage_images.emplace(compiled.scene().film.width, compiled.scene().film.height, *stage_vertex);
+    stage_tracer.emplace(dynamic_cast<const WavefrontTracer&>(*tracer), *stage_images);
+    inner = &*stage_tracer;
+  }
+  std::optional<BounceAccumulator> bounce_buffers;
+  std::optional<BounceTracer> bounce_tracer;
+  if (bounces_aov) {
+    bounce_buffers.emplace(compiled.scene().film.width, compiled.scene().film.height);
+    bounce_tracer.emplace(*inner, *bounce_buffers);
+    inner = &*bounce_tracer;
+  }
   std::optional<AovAccumulator> aov_buffers;
   std::optional<AovTracer> aov_tracer;
   if (!layers.empty()) {
     aov_buffers.emplace(compiled, settings);
-    aov_tracer.emplace(*tracer, *aov_buffers);
+    aov_tracer.emplace(*inner, *aov_buffers);
+    inner = &*aov_tracer;
   }
   const Scene& sc = compiled.scene();
   if (const std::size_t n = compiled.lights().unsampled_light_count(); n > 0 && chatty)
@@ -201,7 +256,7 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   };
 
   ProgressBar bar(err, "rendering", !quiet && chatty && stderr_is_terminal());
-  const Tracer& driven = aov_tracer ? static_cast<const Tracer&>(*aov_tracer) : *tracer;
+  const Tracer& driven = *inner;
   std::optional<UntilResult> until;
   RenderStats stats;
   std::uint32_t end = start;
@@ -278,8 +333,16 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
       if (target_relmse) meta.emplace_back("target_relmse", std::to_string(*target_relmse));
     }
     if (layers.empty()) write_exr(exr, image, meta);
-    else write_exr_channels(exr, film.width(), film.height(), aov_channels(film, *aov_buffers, layers), meta);
+    else
+      write_exr_channels(exr, film.width(), film.height(),
+                         aov_channels(film, *aov_buffers, layers, bounce_buffers ? &*bounce_buffers : nullptr), meta);
     write_png_beside(exr, png, image, exposure);
+    if (stage_images) {
+      meta.emplace_back("stage_buffers_vertex", std::to_string(*stage_vertex));
+      const auto files = stage_images->write(stage_dir, meta);
+      if (!quiet) err << "pathlab: wrote the wavefront's arrays at bounce " << *stage_vertex << " (scalar stages) to "
+                      << stage_dir.string() << "/bounce" << *stage_vertex << "-*.exr (" << files.size() << " images)\n";
+    }
   }
   if (interrupted != 0) {
     err << "pathlab: interrupted (" << (interrupted == SIGINT ? "SIGINT" : "SIGTERM") << ") after passes "
@@ -312,6 +375,11 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
           << wf->stages_description() << "; rays to Embree: camera " << ray_batch_mode_name(wf->ray_modes().camera)
           << ", bounce " << ray_batch_mode_name(wf->ray_modes().bounce) << ", shadow "
           << ray_batch_mode_name(wf->ray_modes().shadow) << "\n";
+      if (bounce_tracer || stage_tracer)
+        err << "pathlab: wavefront: this render ran the scalar stages ("
+            << (bounce_tracer ? "--aov bounces traces each sample with an observer, one path per wave"
+                              : "--dump-stage-buffers records the scalar stages' arrays")
+            << ")\n";
       if (const WavefrontTimes t = wf->times(); t.waves_seconds > 0.0) {
         std::snprintf(line, sizeof line,
                       "%.0f%% of the waves' time in Embree; per thread, camera %.3g, bounce %.3g, shadow %.3g rays/s",

@@ -26,6 +26,7 @@ struct RenderCommand {
   double checkpoint_every = 600.0;        // --checkpoint-every SECONDS
   std::optional<std::string> resume;      // --resume FILE
   std::optional<std::string> passes;      // --passes A..B
+  std::vector<std::string> stage_buffers;  // --dump-stage-buffers K DIR
   bool quiet = false;
   bool selected = false;
   void add_to(CLI::App& app);
@@ -75,6 +76,22 @@ struct TracePixelCommand {
   std::string vtk;      // --vtk out.vtp
   std::string vtk_geometry;                   // --vtk-geometry hit|scene
   std::size_t vtk_max_triangles = 1000000;    // --vtk-max-triangles N
+  bool json = false;
+  bool selected = false;
+  void add_to(CLI::App& app);
+  int run(std::ostream& out, std::ostream& err) const;
+};
+
+// pathlab compare [SCENE] [--tracers A,B] [--with OTHER] [--export FILE] [--json]:
+// two tracers or two builds at the same seed (debugtools/compare.h, docs/compare.md).
+struct CompareCommand {
+  SceneOptions scene;
+  CLI::Option* tracer_option = nullptr;  // SceneOptions' --tracer, refused here
+  std::vector<std::string> tracers;      // --tracers A,B
+  std::string with;                      // --with: the other build's binary
+  std::string export_file;               // --export FILE
+  double alpha = 1e-4;
+  int threads = 0;
   bool json = false;
   bool selected = false;
   void add_to(CLI::App& app);
