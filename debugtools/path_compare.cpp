@@ -35,6 +35,8 @@ struct Difference {
 
 Difference compare(const PathEvent& ea, const PathEvent& eb, float tol) {
   Difference d;
+  // Every field of every event kind is compared; the first that differs is
+  // named as "<what it is> (<field>)", e.g. "light visibility (visible)".
   auto check = [&](bool ok, const char* what) {
     if (!ok && d.what.empty()) d.what = what;
   };
@@ -49,26 +51,53 @@ Difference compare(const PathEvent& ea, const PathEvent& eb, float tol) {
         using T = std::decay_t<decltype(a)>;
         const T& b = std::get<T>(eb);
         if constexpr (std::is_same_v<T, CameraEvent>) {
-          check(near(a.film, b.film, tol) && near(a.origin, b.origin, tol) && near(a.dir, b.dir, tol), "camera ray");
+          check(a.x == b.x && a.y == b.y, "camera ray (pixel x, y)");
+          check(a.sample == b.sample, "camera ray (sample)");
+          check(near(a.film, b.film, tol), "camera ray (film)");
+          check(near(a.origin, b.origin, tol), "camera ray (origin)");
+          check(near(a.dir, b.dir, tol), "camera ray (dir)");
         } else if constexpr (std::is_same_v<T, HitEvent>) {
-          check(a.shape == b.shape && a.instance == b.instance && a.material == b.material, "surface hit");
-          check(near(a.p, b.p, tol), "hit position");
-          check(near(a.added, b.added, tol) && near(a.emission_weight, b.emission_weight, tol), "emission added");
+          check(a.shape == b.shape, "surface hit (shape)");
+          check(a.prim == b.prim, "surface hit (prim)");
+          check(a.instance == b.instance, "surface hit (instance)");
+          check(a.material == b.material, "surface hit (material)");
+          check(a.front == b.front, "surface hit (front)");
+          check(near(a.p, b.p, tol), "hit position (p)");
+          check(near(a.n, b.n, tol), "hit normal (n)");
+          check(near(a.throughput, b.throughput, tol), "throughput at the hit (throughput)");
+          check(near(a.emitted, b.emitted, tol), "emission added (emitted)");
+          check(near(a.emission_weight, b.emission_weight, tol), "emission added (emission_weight)");
+          check(near(a.added, b.added, tol), "emission added (added)");
         } else if constexpr (std::is_same_v<T, EscapeEvent>) {
-          check(near(a.added, b.added, tol), "environment added");
+          check(near(a.emitted, b.emitted, tol), "environment added (emitted)");
+          check(near(a.emission_weight, b.emission_weight, tol), "environment added (emission_weight)");
+          check(near(a.added, b.added, tol), "environment added (added)");
         } else if constexpr (std::is_same_v<T, LightEvent>) {
-          check(a.delta == b.delta && a.light == b.light, "light chosen");
-          check(near(a.wi, b.wi, tol) && near(a.pdf, b.pdf, tol), "light direction or pdf");
-          check(near(a.ray, b.ray, tol), "shadow ray");
-          outcome(a.visible == b.visible, "light visibility");
-          check(near(a.added, b.added, tol), "light added");
+          check(a.delta == b.delta, "light chosen (delta)");
+          check(a.infinite == b.infinite, "light chosen (infinite)");
+          check(a.light == b.light, "light chosen (light)");
+          // The point is undefined for a light at infinity (LightEvent).
+          check(a.infinite || b.infinite || near(a.point, b.point, tol), "light point (point)");
+          check(near(a.wi, b.wi, tol), "light direction or pdf (wi)");
+          check(near(a.dist, b.dist, tol), "light direction or pdf (dist)");
+          check(near(a.pdf, b.pdf, tol), "light direction or pdf (pdf)");
+          check(near(a.Le, b.Le, tol), "light radiance (Le)");
+          check(near(a.ray, b.ray, tol), "shadow ray (ray)");
+          outcome(a.visible == b.visible, "light visibility (visible)");
+          check(near(a.mis_weight, b.mis_weight, tol), "light MIS weight (mis_weight)");
+          check(near(a.added, b.added, tol), "light added (added)");
         } else if constexpr (std::is_same_v<T, ScatterEvent>) {
-          check(a.lobe == b.lobe && a.impulse == b.impulse, "lobe");
-          check(near(a.wi, b.wi, tol) && near(a.pdf, b.pdf, tol), "scattered direction or pdf");
-          check(near(a.throughput, b.throughput, tol), "throughput");
-          check(near(a.next, b.next, tol), "continuation ray");
+          check(a.lobe == b.lobe, "lobe (lobe)");
+          check(a.impulse == b.impulse, "lobe (impulse)");
+          check(a.cosine == b.cosine, "lobe (cosine)");
+          check(near(a.wi, b.wi, tol), "scattered direction or pdf (wi)");
+          check(near(a.pdf, b.pdf, tol), "scattered direction or pdf (pdf)");
+          check(near(a.weight, b.weight, tol), "scattering weight (weight)");
+          check(near(a.survival, b.survival, tol), "roulette survival (survival)");
+          check(near(a.throughput, b.throughput, tol), "throughput (throughput)");
+          check(near(a.next, b.next, tol), "continuation ray (next)");
         } else if constexpr (std::is_same_v<T, EndEvent>) {
-          outcome(a.reason == b.reason, "why the path ended");
+          outcome(a.reason == b.reason, "why the path ended (reason)");
         }
       },
       ea);

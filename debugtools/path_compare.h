@@ -22,8 +22,11 @@ struct PathDivergence {
 };
 
 // Events agree if they are of the same kind at the same vertex, their
-// discrete outcomes are equal, and their positions, directions, pdfs and
-// contributions agree within `tolerance` relative (absolute below 1).
+// discrete outcomes and indices are equal, and every other field (positions,
+// normals, directions, rays, pdfs, weights, radiance, contributions) agrees
+// within `tolerance` relative (absolute below 1). Every field of every event
+// kind is compared; `reason` names the first that differs, in parentheses
+// ("event 3 (vertex 1): light visibility (visible) differs").
 PathDivergence first_divergence(const std::vector<PathEvent>& a, const std::vector<PathEvent>& b, float tolerance);
 
 }  // namespace pathlab

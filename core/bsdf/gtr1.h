@@ -14,7 +14,12 @@ inline float alpha_from_gloss(float gloss) { return 0.1f + (0.001f - 0.1f) * glo
 inline float D(float cos_h, float a) {
   if (cos_h <= 0.0f) return 0.0f;
   const float a2 = a * a;  // a in [0.001, 0.1] (gloss in [0, 1]): a2 < 1, ln(a2) < 0
-  return (a2 - 1.0f) / (kPi * std::log(a2) * (1.0f + (a2 - 1.0f) * cos_h * cos_h));
+  // 1 + (a2 - 1) cos^2 written as a2 cos^2 + (1 - cos)(1 + cos): at the
+  // peak (cos -> 1) the published form cancels 1 against 1 - a2 and keeps
+  // only the float rounding of a2 - 1 (6e-8, 6 % of a2 = 1e-6 at gloss 1:
+  // D was 1.3 % low there). 1 - cos is exact near 1.
+  const float denom = a2 * cos_h * cos_h + (1.0f - cos_h) * (1.0f + cos_h);
+  return (a2 - 1.0f) / (kPi * std::log(a2) * denom);
 }
 
 // smithG_GGX(NdotV, alphaG) / (2 NdotV)-style term: 1 / (c + sqrt(a^2 + c^2 - a^2 c^2)),

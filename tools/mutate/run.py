@@ -1,0 +1,253 @@
+#!/usr/bin/env python3
+"""Mutation testing for pathlab: does the test suite catch realistic bugs?
+
+Each file in tools/mutate/mutations/ is one small patch (a planted bug, with
+a comment header saying what it is). For each, this script applies it to a
+scratch worktree of the repository, rebuilds incrementally, runs a test
+selection and records whether the tests KILLED the mutant (a test failed,
+and which), let it SURVIVE (everything passed) or it did not build
+(BUILD-FAILED, not counted in the kill rate). Then it reverts the patch and
+goes on. Python's standard library only.
+
+  tools/mutate/run.py                          # every mutation, the whole suite
+  tools/mutate/run.py --subset fast            # the fast closed-form tests only
+  tools/mutate/run.py --only 'bsdf-*' --only film-variance-no-bessel
+  tools/mutate/run.py --test pathlab_unit_tests:'Film*:Bsdf*' --test pathlab_value_tests
+
+The scratch worktree (default $TMPDIR/pathlab-mutate) is a detached
+`git worktree` of the repository's HEAD: commit what you want mutated. Its
+build directory persists between runs, so only the first build is full.
+See docs/mutation-testing.md.
+"""
+
+import argparse
+import fnmatch
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+# Test selections. "full" is the whole registered suite (every ctest test but
+# the hours-long "long" label); "unit" the fast CI label; "fast" the
+# closed-form value tests alone (one small binary, seconds to rebuild).
+SUBSETS = {
+    "full": {"ctest": ["-LE", "long"], "build": ["all"]},
+    "unit": {"ctest": ["-L", "unit"], "build": ["all"]},
+    "fast": {"tests": ["pathlab_value_tests"]},
+}
+
+
+def run(cmd, cwd=None, timeout=None, env=None):
+    """Runs cmd; returns (returncode, combined output). A timeout is rc 124."""
+    try:
+        p = subprocess.run(cmd, cwd=cwd, timeout=timeout, env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, text=True, errors="replace")
+        return p.returncode, p.stdout
+    except subprocess.TimeoutExpired as e:
+        out = e.stdout.decode(errors="replace") if isinstance(e.stdout, bytes) else (e.stdout or "")
+        return 124, out + f"\n[mutate] timed out after {timeout} s\n"
+
+
+def describe(patch):
+    """The first '#' comment line of a patch file: what the bug is."""
+    for line in patch.read_text().splitlines():
+        if line.startswith("#"):
+            return line.lstrip("# ").strip()
+        if line.startswith("diff ") or line.startswith("---"):
+            break
+    return ""
+
+
+def patched_files(patch):
+    return [m.group(1) for m in re.finditer(r"^\+\+\+ b/(\S+)", patch.read_text(), re.M)]
+
+
+class Scratch:
+    def __init__(self, repo, path, build_dir, cmake_args, jobs):
+        self.repo, self.path, self.build, self.cmake_args, self.jobs = repo, path, build_dir, cmake_args, jobs
+        self.log = None
+
+    def prepare(self):
+        head = run(["git", "-C", str(self.repo), "rev-parse", "HEAD"])[1].strip()
+        if not (self.path / ".git").exists():
+            rc, out = run(["git", "-C", str(self.repo), "worktree", "add", "--detach", str(self.path), head])
+            if rc != 0:
+                sys.exit(f"mutate: cannot create the scratch worktree {self.path}:\n{out}")
+        else:
+            run(["git", "-C", str(self.path), "checkout", "--quiet", "--detach", head])
+        self.reset()
+        self.log = open(self.path / "mutate.log", "w")  # untracked, beside build-mutate/
+        if not (self.build / "build.ninja").exists():
+            rc, out = run(["cmake", "-S", str(self.path), "-B", str(self.build), "-G", "Ninja",
+                           "-DPATHLAB_WERROR=ON"] + self.cmake_args)
+            self.log.write(out)
+            if rc != 0:
+                sys.exit(f"mutate: cmake failed in {self.build} (see the log)")
+        return head
+
+    def reset(self):
+        # Restores every tracked file (a patch only edits tracked files).
+        run(["git", "-C", str(self.path), "checkout", "--quiet", "--", "."])
+
+    def apply(self, patch):
+        rc, out = run(["git", "-C", str(self.path), "apply", "--whitespace=nowarn", str(patch)])
+        return rc == 0, out
+
+    def build_targets(self, targets, timeout):
+        cmd = ["cmake", "--build", str(self.build), "-j", str(self.jobs)]
+        for t in targets:
+            cmd += ["--target", t]
+        return run(cmd, timeout=timeout)
+
+
+def failing_cases(output):
+    """gtest's '[  FAILED  ] Suite.Case' lines (unique, in order)."""
+    seen = []
+    for m in re.finditer(r"^\[  FAILED  \] ([\w/.]+)", output, re.M):
+        if m.group(1) not in seen:
+            seen.append(m.group(1))
+    return seen
+
+
+def run_selection(scratch, selection, timeout, all_tests):
+    """Runs the tests; returns (killed_by or None, output)."""
+    if "ctest" in selection:
+        rc, out = run(["ctest", "--test-dir", str(scratch.build), "-j", str(scratch.jobs), "--output-on-failure",
+                       "--timeout", str(timeout)] + selection["ctest"], timeout=timeout * 4)
+        if rc == 0:
+            return None, out
+        failed = re.findall(r"^\s*\d+ - (\S+) \(", out.split("The following tests FAILED:")[-1], re.M)
+        cases = failing_cases(out)
+        who = ", ".join(failed) or f"ctest rc {rc}"
+        if cases:
+            who += ": " + " ".join(cases[:3]) + (" ..." if len(cases) > 3 else "")
+        return who, out
+    killed, outputs = [], []
+    for spec in selection["tests"]:
+        binary, _, gfilter = spec.partition(":")
+        exe = scratch.build / "tests" / binary
+        cmd = [str(exe), "--gtest_brief=1"] + ([f"--gtest_filter={gfilter}"] if gfilter else [])
+        rc, out = run(cmd, timeout=timeout)
+        outputs.append(out)
+        if rc != 0:
+            cases = failing_cases(out)
+            who = binary + (": " + " ".join(cases[:3]) + (" ..." if len(cases) > 3 else "") if cases
+                            else f" rc {rc}")
+            killed.append(who)
+            if not all_tests:
+                break
+    return ("; ".join(killed) or None), "\n".join(outputs)
+
+
+def build_targets_of(selection):
+    if "build" in selection:
+        return selection["build"]
+    return sorted({spec.partition(":")[0] for spec in selection["tests"]})
+
+
+def main():
+    here = Path(__file__).resolve().parent
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--repo", type=Path, default=here.parent.parent, help="the repository (default: this one)")
+    ap.add_argument("--scratch", type=Path, default=Path(tempfile.gettempdir()) / "pathlab-mutate",
+                    help="scratch worktree (created if missing, reused otherwise)")
+    ap.add_argument("--mutations", type=Path, default=here / "mutations", help="directory of *.patch files")
+    ap.add_argument("--only", action="append", default=[], metavar="GLOB",
+                    help="run only the mutations whose name matches (repeatable)")
+    ap.add_argument("--subset", choices=sorted(SUBSETS), default="full",
+                    help="test selection: full (default: the whole suite), unit, fast (pathlab_value_tests)")
+    ap.add_argument("--test", action="append", default=[], metavar="BINARY[:GTEST_FILTER]",
+                    help="run these test binaries instead of --subset (repeatable)")
+    ap.add_argument("--all-tests", action="store_true",
+                    help="with --test: run every binary even after one has killed the mutant")
+    ap.add_argument("--timeout", type=int, default=1800, help="seconds per build and per test run")
+    ap.add_argument("--jobs", type=int, default=2, help="build and ctest parallelism")
+    ap.add_argument("--data-dir", default=os.environ.get("PATHLAB_DATA_DIR", ""),
+                    help="-DPATHLAB_DATA_DIR for the scratch build (default: $PATHLAB_DATA_DIR)")
+    ap.add_argument("--cmake-arg", action="append", default=[], help="extra cmake configure argument")
+    ap.add_argument("--results", type=Path, default=None, help="write the results as JSON here")
+    ap.add_argument("--list", action="store_true", help="list the mutations and exit")
+    args = ap.parse_args()
+
+    patches = sorted(args.mutations.glob("*.patch"))
+    if args.only:
+        patches = [p for p in patches if any(fnmatch.fnmatch(p.stem, g) for g in args.only)]
+    if not patches:
+        sys.exit("mutate: no mutation selected")
+    if args.list:
+        for p in patches:
+            print(f"{p.stem:40s} {','.join(patched_files(p)):45s} {describe(p)}")
+        return 0
+
+    selection = {"tests": args.test} if args.test else SUBSETS[args.subset]
+    cmake_args = list(args.cmake_arg) + ([f"-DPATHLAB_DATA_DIR={args.data_dir}"] if args.data_dir else [])
+    scratch_path = args.scratch.resolve()
+    scratch_path.parent.mkdir(parents=True, exist_ok=True)
+    scratch = Scratch(args.repo.resolve(), scratch_path, scratch_path / "build-mutate", cmake_args, args.jobs)
+    head = scratch.prepare()
+    log_path = scratch_path / "mutate.log"
+    with scratch.log as log:
+        targets = build_targets_of(selection)
+        print(f"mutate: {len(patches)} mutation(s) of {head[:12]} in {scratch_path}, tests: "
+              f"{args.test or args.subset}; log {log_path}", flush=True)
+
+        # The unmutated tree must build and pass, or every mutant looks killed.
+        t0 = time.time()
+        rc, out = scratch.build_targets(targets, args.timeout)
+        log.write(out)
+        if rc != 0:
+            sys.exit(f"mutate: the unmutated tree does not build (see {log_path})")
+        killer, out = run_selection(scratch, selection, args.timeout, True)
+        log.write(out)
+        if killer:
+            sys.exit(f"mutate: the unmutated tree fails its tests ({killer}); fix that first")
+        print(f"mutate: baseline builds and passes ({time.time() - t0:.0f} s)", flush=True)
+
+        results = []
+        for patch in patches:
+            t0 = time.time()
+            scratch.reset()
+            log.write(f"\n===== {patch.stem} =====\n")
+            ok, out = scratch.apply(patch)
+            if not ok:
+                first = out.strip().splitlines()[0] if out.strip() else ""
+                status, killer = "BUILD-FAILED", "patch does not apply: " + first
+            else:
+                rc, out = scratch.build_targets(targets, args.timeout)
+                log.write(out)
+                if rc != 0:
+                    status, killer = "BUILD-FAILED", "compile error" if rc != 124 else "build timed out"
+                else:
+                    killer, out = run_selection(scratch, selection, args.timeout, args.all_tests)
+                    log.write(out)
+                    status = "KILLED" if killer else "SURVIVED"
+            scratch.reset()
+            r = {"mutation": patch.stem, "files": patched_files(patch), "what": describe(patch), "status": status,
+                 "killed_by": killer or "", "seconds": round(time.time() - t0, 1)}
+            results.append(r)
+            print(f"  {r['mutation']:40s} {status:12s} {r['killed_by']}", flush=True)
+        # Leave the scratch tree clean and its build matching it.
+        scratch.build_targets(targets, args.timeout)
+
+    killed = sum(r["status"] == "KILLED" for r in results)
+    survived = sum(r["status"] == "SURVIVED" for r in results)
+    failed = sum(r["status"] == "BUILD-FAILED" for r in results)
+    print()
+    print(f"{'mutation':40s} {'file':42s} {'status':12s} killed by")
+    for r in results:
+        print(f"{r['mutation']:40s} {','.join(r['files'])[:42]:42s} {r['status']:12s} {r['killed_by']}")
+    rate = 100.0 * killed / (killed + survived) if killed + survived else 0.0
+    print(f"\nkilled {killed}, survived {survived}, build-failed {failed}: kill rate {rate:.1f} % "
+          f"({killed}/{killed + survived} of the mutants that built)")
+    if args.results:
+        args.results.write_text(json.dumps({"head": head, "tests": args.test or args.subset, "results": results,
+                                            "killed": killed, "survived": survived, "build_failed": failed}, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
