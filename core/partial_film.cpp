@@ -320,6 +320,15 @@ PartialFilm read_partial_film(const fs::path& path) {
     const std::string filter = h.at("filter").get<std::string>(), moments = h.at("moments").get<std::string>();
     if ((filter != "box" && filter != "bilinear") || (moments != "mean" && moments != "mean_and_variance"))
       r.fail("unknown filter or moments in its header");
+    // The arrays must be in the file before a film of that size is made: a
+    // corrupted resolution would otherwise allocate (and zero) up to 240 GB.
+    const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
+    const std::uint64_t words_per_pixel = Film::kPixelWords + (moments == "mean" ? 0 : Film::kMomentWords) +
+                                          (filter == "box" ? 0 : Film::kSplatWords);
+    if (pixels * words_per_pixel * 8 + 16 > r.size() - r.position())
+      r.fail("truncated: a " + std::to_string(width) + "x" + std::to_string(height) + " film needs " +
+             std::to_string(pixels * words_per_pixel * 8) + " bytes of arrays, the file has " +
+             std::to_string(r.size() - r.position()) + " after its header, checksum included");
     PartialFilm result{Film(width, height, filter == "box" ? FilterKind::Box : FilterKind::Bilinear,
                             moments == "mean" ? FilmMoments::Mean : FilmMoments::MeanAndVariance),
                        {}};
