@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cerrno>
 #include <cinttypes>
 #include <cstdio>
@@ -166,8 +167,19 @@ class Reader {
   std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state_{XXH3_createState(), &XXH3_freeState};
 };
 
-std::uint64_t parse_hex64(const json& j) { return std::stoull(j.get<std::string>(), nullptr, 16); }
-Sum1 parse_sum(const json& j) { return Sum1::from_words(parse_hex64(j.at(0)), parse_hex64(j.at(1))); }
+// A 64-bit word as the writer gives it: hex digits only (std::stoull threw
+// std::invalid_argument on "zz", which is no InputError).
+std::uint64_t parse_hex64(const json& j, const Reader& r, const char* key) {
+  const std::string text = j.get<std::string>();
+  std::uint64_t v = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v, 16);
+  if (text.empty() || ec != std::errc() || end != text.data() + text.size())
+    r.fail(std::string("its header's stats.") + key + " holds \"" + text.substr(0, 40) + "\", not a 64-bit hex word");
+  return v;
+}
+Sum1 parse_sum(const json& j, const Reader& r, const char* key) {
+  return Sum1::from_words(parse_hex64(j.at(0), r, key), parse_hex64(j.at(1), r, key));
+}
 
 }  // namespace
 
@@ -308,6 +320,15 @@ PartialFilm read_partial_film(const fs::path& path) {
     const std::string filter = h.at("filter").get<std::string>(), moments = h.at("moments").get<std::string>();
     if ((filter != "box" && filter != "bilinear") || (moments != "mean" && moments != "mean_and_variance"))
       r.fail("unknown filter or moments in its header");
+    // The arrays must be in the file before a film of that size is made: a
+    // corrupted resolution would otherwise allocate (and zero) up to 240 GB.
+    const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
+    const std::uint64_t words_per_pixel = Film::kPixelWords + (moments == "mean" ? 0 : Film::kMomentWords) +
+                                          (filter == "box" ? 0 : Film::kSplatWords);
+    if (pixels * words_per_pixel * 8 + 16 > r.size() - r.position())
+      r.fail("truncated: a " + std::to_string(width) + "x" + std::to_string(height) + " film needs " +
+             std::to_string(pixels * words_per_pixel * 8) + " bytes of arrays, the file has " +
+             std::to_string(r.size() - r.position()) + " after its header, checksum included");
     PartialFilm result{Film(width, height, filter == "box" ? FilterKind::Box : FilterKind::Bilinear,
                             moments == "mean" ? FilmMoments::Mean : FilmMoments::MeanAndVariance),
                        {}};
@@ -324,8 +345,8 @@ PartialFilm read_partial_film(const fs::path& path) {
     pf.stats.samples = st.at("samples").get<std::uint64_t>();
     pf.stats.rays = st.at("rays").get<std::uint64_t>();
     pf.stats.clamped_samples = st.at("clamped_samples").get<std::uint64_t>();
-    pf.stats.energy_total = parse_sum(st.at("energy_total"));
-    pf.stats.energy_clamped = parse_sum(st.at("energy_clamped"));
+    pf.stats.energy_total = parse_sum(st.at("energy_total"), r, "energy_total");
+    pf.stats.energy_clamped = parse_sum(st.at("energy_clamped"), r, "energy_clamped");
     std::vector<BadSample> kept;
     for (const json& b : h.at("bad_samples")) {
       const json& L = b.at("L");

@@ -366,7 +366,7 @@ void read_groups(const Node& node, Scene& scene, const std::filesystem::path& fo
     if (!list.value().is_array() || list.value().empty()) list.fail("expected a non-empty array of shapes");
     // A glTF file in "shapes" may have added groups already (its meshes that
     // several nodes place).
-    if (std::any_of(scene.groups.begin(), scene.groups.end(), [&](const ShapeGroup& g) { return g.name == name; }))
+    if (std::any_of(scene.groups.begin(), scene.groups.end(), [&name = name](const ShapeGroup& g) { return g.name == name; }))
       list.fail("the group name " + in_quotes(name) + " is taken by a glTF mesh's group; choose another");
     ShapeGroup group{name, {}};
     for (std::size_t i = 0; i < list.value().size(); ++i) {
@@ -408,7 +408,7 @@ void read_instances(const Node& node, Scene* scene) {
     const Node group = item.required("group");
     const std::string name = group.string();
     const auto found = std::find_if(scene->groups.begin(), scene->groups.end(),
-                                    [&](const ShapeGroup& g) { return g.name == name; });
+                                    [&name = name](const ShapeGroup& g) { return g.name == name; });
     if (found == scene->groups.end()) {
       std::vector<std::string_view> names;
       for (const ShapeGroup& g : scene->groups) names.push_back(g.name);
@@ -499,7 +499,7 @@ void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path
   }
   for (const auto& [gltf_name, unused] : by_name)
     if (std::none_of(content.materials.begin(), content.materials.end(),
-                     [&](const GltfMaterial& m) { return m.gltf_name == gltf_name; }))
+                     [&gltf_name = gltf_name](const GltfMaterial& m) { return m.gltf_name == gltf_name; }))
       node.child("materials").child(gltf_name).fail(path.filename().string() + " has no material named " +
                                                     in_quotes(gltf_name) + suggestion(gltf_name, gltf_names));
   for (const std::string& w : content.warnings) scene.warnings.push_back(file.message(w));

@@ -22,6 +22,8 @@ packages=(
   libvtk9-dev             # path polylines as VTK PolyData (debugtools/)
   libglfw3-dev libgl-dev libimgui-dev  # the pathlab-debug GUI
   xvfb xauth              # run the GUI headless in tests
+  clang                   # clang 14: the sanitizer + libFuzzer build of CI (fuzz/, tools/run-fuzzers.sh)
+  libclang-rt-14-dev      # clang 14's compiler-rt: libFuzzer, ASan, UBSan and TSan runtimes
   curl ca-certificates    # tools/fetch-data.sh: test data from the npm registry
 )
 
