@@ -60,6 +60,7 @@ Difference compare(const PathEvent& ea, const PathEvent& eb, float tol) {
           check(a.delta == b.delta && a.light == b.light, "light chosen");
           check(near(a.wi, b.wi, tol) && near(a.pdf, b.pdf, tol), "light direction or pdf");
           check(near(a.ray, b.ray, tol), "shadow ray");
+          outcome(a.rejected == b.rejected, "light sample rejected (below the surface, black BSDF, no sample)");
           outcome(a.visible == b.visible, "light visibility");
           check(near(a.added, b.added, tol), "light added");
         } else if constexpr (std::is_same_v<T, ScatterEvent>) {
