@@ -23,6 +23,7 @@
 #pragma once
 
 #include "core/geometry.h"
+#include "core/path_observer.h"
 #include "core/scene.h"
 #include "core/surfel.h"
 
@@ -46,6 +47,27 @@ struct LightSample {
   std::uint32_t light = 0;
   bool infinite = false;  // the shadow ray is unbounded (environment, directional light)
 };
+
+// The observer's event for a light sample rejected before any shadow ray
+// (LightEvent::rejected): from the sample `ls` (null when the sampler gave
+// none). Both tracers report a rejection through this, identically.
+inline LightEvent rejected_light_event(int vertex, bool delta, const LightSample* ls, LightRejection reason) {
+  LightEvent e;
+  e.vertex = vertex;
+  e.delta = delta;
+  e.rejected = reason;
+  e.mis_weight = 0.0f;
+  if (ls != nullptr) {
+    e.infinite = ls->infinite;
+    e.light = ls->light;
+    e.point = ls->p;
+    e.wi = ls->wi;
+    e.dist = ls->dist;
+    e.pdf = ls->pdf;
+    e.Le = ls->Le;
+  }
+  return e;
+}
 
 // The shadow ray from `s` to the light sample `ls`: unbounded towards an
 // infinite light (the environment, a directional light), else ending just

@@ -13,4 +13,14 @@ const char* path_end_name(PathEnd end) {
   return "?";
 }
 
+const char* light_rejection_name(LightRejection r) {
+  switch (r) {
+    case LightRejection::None: return "none";
+    case LightRejection::NoSample: return "no_sample";
+    case LightRejection::BelowSurface: return "below_surface";
+    case LightRejection::BlackBsdf: return "black_bsdf";
+  }
+  return "?";
+}
+
 }  // namespace pathlab

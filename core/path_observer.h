@@ -50,6 +50,22 @@ struct EscapeEvent {
   Spectrum added{0.0f};
 };
 
+// Why a light sample brought nothing before any shadow ray was traced (a
+// next-event estimate that is missing for a reason, rather than silently).
+enum class LightRejection : std::uint8_t {
+  None,          // a shadow ray was traced: see `visible`
+  NoSample,      // the light sampler gave none: zero density, the back of a one-sided
+                 // emitter, seen edge-on, outside a spot's cone (no light, point, wi)
+  BelowSurface,  // the light lies on the other side of the surface than the viewer
+  BlackBsdf,     // the BSDF is zero for this pair of directions (same side)
+};
+const char* light_rejection_name(LightRejection r);  // "none", "no_sample", "below_surface", "black_bsdf"
+// The reason a sample towards `wi` that the BSDF valued at zero was
+// rejected, from the geometric normal `n` and the direction to the viewer `wo`.
+inline LightRejection black_light_sample_reason(const vec3& n, const vec3& wi, const vec3& wo) {
+  return glm::dot(n, wi) * glm::dot(n, wo) <= 0.0f ? LightRejection::BelowSurface : LightRejection::BlackBsdf;
+}
+
 struct LightEvent {
   int vertex = 0;
   bool delta = false;       // a point light
@@ -62,7 +78,8 @@ struct LightEvent {
   bool visible = false;
   float mis_weight = 1.0f;
   Spectrum added{0.0f};
-  Ray ray{vec3(0.0f), vec3(0.0f), 0.0f};  // the shadow ray as traced (offset off both surfaces)
+  Ray ray{vec3(0.0f), vec3(0.0f), 0.0f};  // the shadow ray as traced (offset off both surfaces); tmax 0 if none
+  LightRejection rejected = LightRejection::None;  // not None: no shadow ray, visible false, added 0
 };
 
 struct ScatterEvent {

@@ -1,7 +1,10 @@
 #include "core/render.h"
 
+#include "core/texture.h"
+
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <new>
 
@@ -17,16 +20,45 @@ void clamp_samples(std::span<FilmSample> out, float limit, RenderStats& stats) {
     if (!in_film_range(s.L)) continue;
     const double before = average(s.L);
     stats.energy_total.add(before);
-    const float m = max_component(s.L);
-    if (m > limit) {
-      s.L *= limit / m;
+    const Spectrum clamped = clamp_radiance(s.L, limit);
+    if (clamped != s.L) {
+      s.L = clamped;
       ++stats.clamped_samples;
       stats.energy_clamped.add(before - average(s.L));
     }
   }
 }
 
+std::string float_text(float v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", static_cast<double>(v));
+  return text;
+}
+
 }  // namespace
+
+Spectrum clamp_radiance(const Spectrum& L, float limit) {
+  if (!(limit > 0.0f) || !in_film_range(L)) return L;
+  const float m = max_component(L);
+  return m > limit ? L * (limit / m) : L;
+}
+
+std::vector<std::pair<std::string, std::string>> sample_settings(const RenderSettings& r) {
+  return {
+      {"strategy", strategy_name(r.strategy)},
+      {"seed", std::to_string(r.seed)},
+      {"max_depth", std::to_string(r.max_depth)},
+      {"rr_depth", std::to_string(r.rr_depth)},
+      {"bsdf_sampling", bsdf_sampling_name(r.bsdf_sampling)},
+      {"clamp", float_text(r.clamp)},
+      {"min_pdf", float_text(r.min_pdf)},
+      {"general_shading", r.force_general_shading ? "on" : "off"},
+      {"texture_filter", texture_filter_name(r.texture_filter)},
+      {"bvh", r.compact_bvh ? "compact" : "fast"},
+  };
+}
+
+const char* git_revision() { return PATHLAB_GIT_COMMIT; }
 
 SampleBuffer::SampleBuffer(std::size_t size) : size_(size) {
   if (size > static_cast<std::size_t>(-1) / sizeof(FilmSample)) throw std::bad_array_new_length();

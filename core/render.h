@@ -11,6 +11,9 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace pathlab {
 
@@ -115,6 +118,27 @@ class SampleBuffer {
   std::unique_ptr<FilmSample, Free> data_;
   std::size_t size_;
 };
+
+// The firefly clamp (RenderSettings::clamp) on one sample, as the film
+// receives it: a finite sample whose largest component exceeds `limit` is
+// scaled by limit / that component, keeping its colour. limit <= 0 is off;
+// a sample outside the film's range (NaN, Inf, huge: in_film_range) is left
+// as it is, for the film to count and locate. render_samples() and
+// trace-pixel both call this, so a replayed sample reports the film's bits.
+Spectrum clamp_radiance(const Spectrum& L, float limit);
+
+// Every setting that changes a sample's bits, as (key, value) text, in a
+// fixed order: strategy, seed, max_depth, rr_depth, bsdf_sampling, clamp,
+// min_pdf, general_shading, texture_filter (and bvh, which changes no bit
+// but names the build). Floats are written with 9 significant digits (they
+// read back to the same float). Recorded in a render's EXR header
+// ("pathlab:<key>") and in trace-pixel's header and JSON. Not in it: spp
+// and the tracer, which the caller records.
+std::vector<std::pair<std::string, std::string>> sample_settings(const RenderSettings& settings);
+
+// The git commit pathlab was built from (12 hex digits, "unknown" outside a
+// git checkout), as in the render fingerprint (core/partial_film.h).
+const char* git_revision();
 
 // Samples per pixel in one batch: about 2^18 samples per batch, at least one
 // sample per pixel. Depends only on the resolution and spp.

@@ -83,6 +83,7 @@ Difference compare(const PathEvent& ea, const PathEvent& eb, float tol) {
           check(near(a.pdf, b.pdf, tol), "light direction or pdf (pdf)");
           check(near(a.Le, b.Le, tol), "light radiance (Le)");
           check(near(a.ray, b.ray, tol), "shadow ray (ray)");
+          outcome(a.rejected == b.rejected, "light sample rejected (rejected: below the surface, black BSDF, no sample)");
           outcome(a.visible == b.visible, "light visibility (visible)");
           check(near(a.mis_weight, b.mis_weight, tol), "light MIS weight (mis_weight)");
           check(near(a.added, b.added, tol), "light added (added)");

@@ -26,6 +26,7 @@ std::vector<PathLine> path_lines(const PathRecorder& path, std::uint32_t sample,
             line.points.push_back(
                 {last_p + last_dir * escape_length, e.vertex, beta, e.added, 0.0f, -1, kPointEscape});
           } else if constexpr (std::is_same_v<E, LightEvent>) {
+            if (e.rejected != LightRejection::None) return;  // no shadow ray was traced
             if (!line.points.empty()) {
               current().added += e.added;
               if (e.visible) current().flags |= kPointNeeVisible;

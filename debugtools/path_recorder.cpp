@@ -1,6 +1,7 @@
 #include "debugtools/path_recorder.h"
 
 #include "core/light_sampler.h"
+#include "core/render.h"
 
 #include <cstdio>
 #include <sstream>
@@ -67,6 +68,9 @@ struct JsonVisitor {
               {"pdf", e.pdf},     {"Le", j3(e.Le)},       {"visible", e.visible},
               {"mis_weight", e.mis_weight}, {"added", j3(e.added)}};
     j["dist"] = std::isinf(e.dist) ? json(nullptr) : json(e.dist);  // null: the environment
+    // Why no shadow ray was traced, or null; no_sample: no light was picked.
+    j["rejected"] = e.rejected == LightRejection::None ? json(nullptr) : json(light_rejection_name(e.rejected));
+    if (e.rejected == LightRejection::NoSample) j["light"] = nullptr;
     return j;
   }
   json operator()(const ScatterEvent& e) const {
@@ -100,6 +104,17 @@ struct TextVisitor {
         << "  added " << fmt3(e.added) << "\n";
   }
   void operator()(const LightEvent& e) const {
+    if (e.rejected == LightRejection::NoSample) {
+      out << "#" << e.vertex << " light    " << (e.delta ? "delta" : "area") << " REJECTED no_sample"
+          << "  (the light sampler gave none: zero pdf, back of a one-sided emitter, edge-on or outside a spot cone)\n";
+      return;
+    }
+    if (e.rejected != LightRejection::None) {
+      out << "#" << e.vertex << " light    " << light_kind(scene, e) << " " << e.light << " REJECTED "
+          << light_rejection_name(e.rejected) << "  wi " << fmt3(e.wi) << "  pdf " << fmt(e.pdf) << "  Le "
+          << fmt3(e.Le) << "  (no shadow ray, nothing added)\n";
+      return;
+    }
     out << "#" << e.vertex << " light    " << light_kind(scene, e) << " " << e.light;
     if (!e.infinite) out << "  point " << fmt3(e.point) << "  dist " << fmt(e.dist);
     out << "  wi " << fmt3(e.wi) << "  pdf " << fmt(e.pdf) << "  Le " << fmt3(e.Le)
@@ -119,9 +134,15 @@ struct TextVisitor {
 
 }  // namespace
 
+Spectrum film_radiance(const TraceHeader& h, const PathRecorder& path) {
+  return clamp_radiance(path.result(), h.settings.clamp);
+}
+
 json path_to_json(const TraceHeader& h, const PathRecorder& path, const Scene& scene) {
   json events = json::array();
   for (const PathEvent& e : path.events()) events.push_back(std::visit(JsonVisitor{scene}, e));
+  const RenderSettings& r = h.settings;
+  const Spectrum film = film_radiance(h, path);
   return {{"format", "pathlab-trace"},
           {"version", 1},
           {"scene", h.scene},
@@ -129,12 +150,23 @@ json path_to_json(const TraceHeader& h, const PathRecorder& path, const Scene& s
           {"resolution", {h.width, h.height}},
           {"pixel", {h.x, h.y}},
           {"sample", h.sample},
-          {"seed", h.settings.seed},
-          {"strategy", strategy_name(h.settings.strategy)},
-          {"max_depth", h.settings.max_depth},
-          {"rr_depth", h.settings.rr_depth},
+          {"seed", r.seed},
+          {"strategy", strategy_name(r.strategy)},
+          {"max_depth", r.max_depth},
+          {"rr_depth", r.rr_depth},
+          {"bsdf_sampling", bsdf_sampling_name(r.bsdf_sampling)},
+          {"clamp", r.clamp},
+          {"min_pdf", r.min_pdf},
+          {"general_shading", r.force_general_shading},
+          {"texture_filter", texture_filter_name(r.texture_filter)},
+          {"bvh", r.compact_bvh ? "compact" : "fast"},
+          {"pathlab_version", PATHLAB_VERSION},
+          {"git_revision", git_revision()},
+          {"command_line", h.command_line.empty() ? json(nullptr) : json(h.command_line)},
           {"events", events},
-          {"radiance", j3(path.result())}};
+          {"radiance", j3(path.result())},
+          {"film_radiance", j3(film)},
+          {"clamped", film != path.result()}};
 }
 
 std::string event_to_text(const PathEvent& event, const Scene& scene) {
@@ -148,14 +180,33 @@ std::string trace_header_text(const TraceHeader& h) {
   out << h.scene << "  " << h.width << "x" << h.height << "  pixel (" << h.x << ", " << h.y << ")  sample " << h.sample << "  seed " << h.settings.seed
       << "  tracer " << h.tracer << "  strategy " << strategy_name(h.settings.strategy) << "  max depth "
       << h.settings.max_depth << "  rr depth " << h.settings.rr_depth << "\n";
+  // Every other setting that changes a sample (core/render.h), and the build.
+  out << "settings   ";
+  for (const auto& [key, value] : sample_settings(h.settings)) {
+    if (key == "strategy" || key == "seed" || key == "max_depth" || key == "rr_depth") continue;
+    out << " " << key << " " << value;
+  }
+  out << "\npathlab " << PATHLAB_VERSION << " (git " << git_revision() << ")";
+  if (!h.command_line.empty()) out << "  command: " << h.command_line;
+  out << "\n";
   return out.str();
+}
+
+// The radiance line, and what the film receives when the clamp changed it.
+std::string result_text(const TraceHeader& h, const PathRecorder& path, const char* who) {
+  const Spectrum film = film_radiance(h, path);
+  std::string text = std::string(who) + "radiance    " + fmt3(path.result()) + "\n";
+  if (film != path.result())
+    text += std::string(who) + "film        " + fmt3(film) + "  (clamped to " + fmt(h.settings.clamp) +
+            ": what the film receives)\n";
+  return text;
 }
 
 std::string path_to_text(const TraceHeader& h, const PathRecorder& path, const Scene& scene) {
   std::ostringstream out;
   out << trace_header_text(h);
   for (const PathEvent& e : path.events()) out << event_to_text(e, scene);
-  out << "radiance    " << fmt3(path.result()) << "\n";
+  out << result_text(h, path, "");
   return out.str();
 }
 

@@ -40,7 +40,13 @@ struct TraceHeader {
   std::uint32_t x = 0, y = 0, sample = 0;
   RenderSettings settings;
   int width = 0, height = 0;  // the film: pixel numbering and camera rays depend on it
+  std::string command_line{};  // the command that produced the trace, if any
 };
+
+// What the film receives for the recorded sample: its radiance after the
+// firefly clamp of `settings` (clamp_radiance, core/render.h), the same
+// function and bits as a render's.
+Spectrum film_radiance(const TraceHeader& header, const PathRecorder& path);
 
 // The JSON document of a recorded path (format version 1).
 nlohmann::json path_to_json(const TraceHeader& header, const PathRecorder& path, const Scene& scene);
@@ -48,6 +54,9 @@ nlohmann::json path_to_json(const TraceHeader& header, const PathRecorder& path,
 std::string event_to_text(const PathEvent& event, const Scene& scene);
 // The header line of a listing.
 std::string trace_header_text(const TraceHeader& header);
+// "radiance (r, g, b)" and, if the clamp changed it, "film (r, g, b)
+// (clamped to C ...)", each line starting with `who`.
+std::string result_text(const TraceHeader& header, const PathRecorder& path, const char* who);
 // A human-readable listing, one event per line or two.
 std::string path_to_text(const TraceHeader& header, const PathRecorder& path, const Scene& scene);
 

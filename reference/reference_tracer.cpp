@@ -112,9 +112,16 @@ Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vert
   const LightSampler& lights = scene_.lights();
   if (!lights.has_delta_lights()) return Spectrum(0.0f);
   const std::optional<LightSample> ls = lights.sample_delta(s.p, path.u(vertex, Dim::DeltaLightChoice));
-  if (!ls) return Spectrum(0.0f);
+  if (!ls) {
+    if (path.observer) path.observer->on_light(rejected_light_event(vertex, true, nullptr, LightRejection::NoSample));
+    return Spectrum(0.0f);
+  }
   const Spectrum f = s.eval(ls->wi, wo);
-  if (is_black(f)) return Spectrum(0.0f);
+  if (is_black(f)) {
+    if (path.observer)
+      path.observer->on_light(rejected_light_event(vertex, true, &*ls, black_light_sample_reason(s.n, ls->wi, wo)));
+    return Spectrum(0.0f);
+  }
   ++path.rays;
   Ray shadow = shadow_ray(s, *ls);
   shadow.alpha_key = path.alpha_key(scene_, vertex);
@@ -130,9 +137,17 @@ Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int verte
                                       Path& path) const {
   const std::optional<LightSample> ls = scene_.lights().sample(
       s.p, path.u(vertex, Dim::LightChoice), vec2(path.u(vertex, Dim::LightX), path.u(vertex, Dim::LightY)));
-  if (!ls) return Spectrum(0.0f);
+  if (!ls) {
+    if (path.observer && scene_.lights().has_area_lights())
+      path.observer->on_light(rejected_light_event(vertex, false, nullptr, LightRejection::NoSample));
+    return Spectrum(0.0f);
+  }
   const Spectrum f = s.eval(ls->wi, wo);
-  if (is_black(f)) return Spectrum(0.0f);
+  if (is_black(f)) {
+    if (path.observer)
+      path.observer->on_light(rejected_light_event(vertex, false, &*ls, black_light_sample_reason(s.n, ls->wi, wo)));
+    return Spectrum(0.0f);
+  }
   const float w = light_sample_weight(settings_.strategy, ls->pdf, s.pdf(ls->wi, wo));
   ++path.rays;
   Ray shadow = shadow_ray(s, *ls);

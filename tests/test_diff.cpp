@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -207,7 +208,7 @@ TEST_F(DiffTest, MismatchedSizesExitTwoNamingBothSizes) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("A (" + fa + ") is 4x3, B (" + fb + ") is 5x3"), std::string::npos) << r.err;
   EXPECT_THROW(compare_images(ramp(4, 3), ramp(4, 2)), InputError);
-  EXPECT_THROW(error_heatmap(ramp(4, 3), ramp(4, 2), nullptr), InputError);
+  EXPECT_THROW(pixel_errors(ramp(4, 3), ramp(4, 2)), InputError);
 }
 
 TEST_F(DiffTest, MissingFileExitTwoNamingIt) {
@@ -308,7 +309,7 @@ TEST_F(DiffTest, JsonIsStable) {
   EXPECT_TRUE(r1.err.find("MAE") == std::string::npos) << "no table with --json";
   const json j = json::parse(r1.out);
   EXPECT_EQ(j["format"], "pathlab-diff");
-  EXPECT_EQ(j["version"], 1);
+  EXPECT_EQ(j["version"], 2);
   EXPECT_EQ(j["files"]["a"], fa);
   EXPECT_EQ(j["files"]["b"], fb);
   EXPECT_EQ(j["width"], 8);
@@ -325,12 +326,14 @@ TEST_F(DiffTest, JsonIsStable) {
   // The top-level keys, exactly (sorted by the writer).
   std::vector<std::string> keys;
   for (const auto& item : j.items()) keys.push_back(item.key());
-  EXPECT_EQ(keys, (std::vector<std::string>{"check", "compared_pixels", "files", "format", "heatmap", "height",
-                                            "max_abs_at", "mean", "metrics", "nonfinite", "pixels", "psnr_peak",
-                                            "version", "width"}));
+  EXPECT_EQ(keys, (std::vector<std::string>{"check", "compared_pixels", "files", "first_over", "format", "heatmap",
+                                            "height", "max_abs_at", "mean", "metrics", "nonfinite", "over_threshold",
+                                            "pixels", "psnr_peak", "statistical", "threshold", "version", "width",
+                                            "worst"}));
+  EXPECT_TRUE(j["statistical"].is_null()) << "no variance layers";
 }
 
-TEST_F(DiffTest, HeatmapOfIdenticalImagesIsTheColourOfZero) {
+TEST_F(DiffTest, HeatmapOfIdenticalImagesIsNeutral) {
   const Image b = ramp(7, 5);
   const fs::path png = dir_ / "maps" / "heat.png";  // the folder is created
   const CliResult r = run_cli({"diff", exr("a", b), exr("b", b), "--heatmap", png.string(), "--json"});
@@ -338,49 +341,130 @@ TEST_F(DiffTest, HeatmapOfIdenticalImagesIsTheColourOfZero) {
   EXPECT_NE(r.err.find("wrote heatmap " + png.string()), std::string::npos) << r.err;
   const json j = json::parse(r.out);
   EXPECT_EQ(j["heatmap"]["file"], png.string());
-  EXPECT_EQ(j["heatmap"]["scale"], 0.0);
+  EXPECT_EQ(j["heatmap"]["neutral"], 1e-6);
+  EXPECT_EQ(j["heatmap"]["quantity"], "abs_diff");
 
   const Image map = read_image(png);
-  ASSERT_EQ(map.width, 7);
-  ASSERT_EQ(map.height, 5);
-  const auto zero = heatmap_colour(0.0);
-  EXPECT_EQ(zero, (std::array<std::uint8_t, 3>{0, 0, 4}));
-  for (const vec3& p : map.pixels) {
-    EXPECT_EQ(code(p.x), zero[0]);
-    EXPECT_EQ(code(p.y), zero[1]);
-    EXPECT_EQ(code(p.z), zero[2]);
-  }
+  ASSERT_EQ(map.width, kLegendMinWidth);
+  ASSERT_EQ(map.height, 5 + kLegendHeight);
+  for (int y = 0; y < 5; ++y)
+    for (int x = 0; x < 7; ++x) {
+      const vec3& p = map.at(x, y);
+      EXPECT_EQ((std::array<int, 3>{code(p.x), code(p.y), code(p.z)}), (std::array<int, 3>{128, 128, 128}));
+    }
+}
+
+// 1e-8 of rounding noise is drawn neutral, not as an alarm: errors at or
+// below the threshold are grey, the scale starts above them.
+TEST_F(DiffTest, HeatmapDrawsRoundingNoiseNeutral) {
+  Image a(4, 1), b(4, 1);
+  a.at(0, 0) = vec3(1e-8f, 0.0f, 0.0f);
+  a.at(1, 0) = vec3(0.0f, 2e-8f, 0.0f);
+  a.at(2, 0) = vec3(0.25f, 0.0f, 0.0f);
+  a.at(3, 0) = vec3(0.5f, 0.0f, 0.0f);
+  const std::vector<double> e = pixel_errors(a, b);
+  EXPECT_EQ(e[3], 0.5);
+  const HeatmapRange range = default_heatmap_range(e, false, 1e-6);
+  EXPECT_EQ(range.lo, 0.0);
+  EXPECT_EQ(range.hi, 0.5);  // the 99th percentile of the two values above the threshold
+  const Image map = draw_heatmap(e, 4, 1, range, "x");
+  const auto codes_at = [&](int x) {
+    const vec3& p = map.at(x, 0);
+    return std::array<int, 3>{code(linear_to_srgb(p.x) * 1.0f), code(linear_to_srgb(p.y)), code(linear_to_srgb(p.z))};
+  };
+  EXPECT_EQ(codes_at(0), (std::array<int, 3>{128, 128, 128}));
+  EXPECT_EQ(codes_at(1), (std::array<int, 3>{128, 128, 128}));
+  EXPECT_EQ(codes_at(2), (std::array<int, 3>{0xbc, 0x37, 0x54}));  // t = 0.5
+  EXPECT_EQ(codes_at(3), (std::array<int, 3>{0xfc, 0xff, 0xa4}));  // t = 1
+  // With the threshold at 0 the noise is on the scale, and a log scale spans it.
+  const HeatmapRange log_range = default_heatmap_range(e, true, 0.0);
+  EXPECT_EQ(log_range.lo, static_cast<double>(1e-8f));
+  EXPECT_EQ(log_range.hi, 0.5);
 }
 
 TEST_F(DiffTest, HeatmapScaleIsThe99thPercentileAndNaNIsMagenta) {
-  // Errors i/64 for i = 0..99 (exact); pixel 100 is NaN in A.
+  // Errors (i+1)/64 for i = 0..99 (exact); pixel 100 is NaN in A.
   Image a(101, 1), b(101, 1);
-  for (int i = 0; i < 100; ++i) a.at(i, 0) = vec3(static_cast<float>(i) / 64.0f);
+  for (int i = 0; i < 100; ++i) a.at(i, 0) = vec3(static_cast<float>(i + 1) / 64.0f);
   a.at(100, 0) = vec3(kNaNf, 0.0f, 0.0f);
-  double scale = -1.0;
-  const Image map = error_heatmap(a, b, &scale);
-  EXPECT_EQ(scale, 98.0 / 64.0);  // nearest rank: the 99th smallest of 100
+  const HeatmapRange range = default_heatmap_range(pixel_errors(a, b), false, 0.0);
+  EXPECT_EQ(range.hi, 99.0 / 64.0);  // nearest rank: the 99th smallest of 100
 
   const fs::path png = dir_ / "heat.png";
-  const CliResult r = run_cli({"diff", exr("a", a), exr("b", b), "--heatmap", png.string()});
+  const CliResult r = run_cli({"diff", exr("a", a), exr("b", b), "--heatmap", png.string(), "--threshold", "0"});
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find(">= 1.53125, the 99th percentile"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("linear scale from 0 (black) to 1.54688 (pale yellow)"), std::string::npos) << r.err;
   const Image back = read_image(png);
-  ASSERT_EQ(back.width, 101);
-  ASSERT_EQ(back.height, 1);
+  ASSERT_EQ(back.width, kLegendMinWidth);
+  ASSERT_EQ(back.height, 1 + kLegendHeight);
   const auto codes = [&](int x) {
     const vec3& p = back.at(x, 0);
     return std::array<int, 3>{code(p.x), code(p.y), code(p.z)};
   };
-  EXPECT_EQ(codes(0), (std::array<int, 3>{0x00, 0x00, 0x04}));
-  EXPECT_EQ(codes(49), (std::array<int, 3>{0xbc, 0x37, 0x54}));  // t = 0.5, a control point
   EXPECT_EQ(codes(98), (std::array<int, 3>{0xfc, 0xff, 0xa4}));  // t = 1
-  EXPECT_EQ(codes(99), (std::array<int, 3>{0xfc, 0xff, 0xa4}));  // above the scale: saturated
+  EXPECT_EQ(codes(99), (std::array<int, 3>{0xfc, 0xff, 0xa4}));  // above the range: saturated
   EXPECT_EQ(codes(100), (std::array<int, 3>{255, 0, 255}));      // NaN: magenta
   for (int i = 0; i < 100; ++i) {
-    const auto want = heatmap_colour((i / 64.0) / scale);
+    const auto want = heatmap_colour(((i + 1) / 64.0) / range.hi);
     EXPECT_EQ(codes(i), (std::array<int, 3>{want[0], want[1], want[2]})) << i;
   }
+}
+
+// The legend under the map: the colour bar, and the stated range written
+// under it (compared pixel for pixel with draw_text), on a linear and a log scale.
+TEST_F(DiffTest, HeatmapLegendShowsTheStatedRange) {
+  Image a(20, 10), b(20, 10);
+  a.at(3, 2) = vec3(0.01f, 0.0f, 0.0f);
+  for (const bool log : {false, true}) {
+    const fs::path png = dir_ / (log ? "log.png" : "lin.png");
+    std::vector<std::string> args = {"diff", exr("a", a), exr("b", b), "--heatmap", png.string(), "--json"};
+    if (log) args.insert(args.end(), {"--log", "--range", "0.0001,1"});
+    else args.insert(args.end(), {"--range", "0,0.02"});
+    const CliResult r = run_cli(args);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json j = json::parse(r.out);
+    EXPECT_EQ(j["heatmap"]["log"], log);
+    EXPECT_EQ(j["heatmap"]["lo"], log ? 0.0001 : 0.0);
+    EXPECT_EQ(j["heatmap"]["hi"], log ? 1.0 : 0.02);
+    EXPECT_NE(r.err.find(log ? "log scale from 0.0001 (black) to 1 (pale yellow)" : "linear scale from 0 (black) to 0.02"),
+              std::string::npos) << r.err;
+
+    const Image back = read_image(png);
+    ASSERT_EQ(back.width, kLegendMinWidth);
+    ASSERT_EQ(back.height, 10 + kLegendHeight);
+    const auto codes = [&](int x, int y) {
+      const vec3& p = back.at(x, y);
+      return std::array<int, 3>{code(p.x), code(p.y), code(p.z)};
+    };
+    // The pixel: t = 0.5 on both scales (0.01 of 0..0.02; 10^-2 of 10^-4..1).
+    EXPECT_EQ(codes(3, 2), (std::array<int, 3>{0xbc, 0x37, 0x54}));
+    // The colour bar, 6 px in from each side, 10 px under the map + 4.
+    const int bar_w = kLegendMinWidth - 12;
+    EXPECT_EQ(codes(6, 10 + 4), (std::array<int, 3>{0x00, 0x00, 0x04}));
+    EXPECT_EQ(codes(6 + bar_w - 1, 10 + 9), (std::array<int, 3>{0xfc, 0xff, 0xa4}));
+    // The numbers: lo at the left, the middle, hi at the right, in white.
+    const std::string lo = log ? "0.0001" : "0", mid = log ? "0.01" : "0.01", hi = log ? "1" : "0.02";
+    Image want(back.width, back.height);
+    const int y = 10 + 4 + 12;
+    draw_text(want, 6, y, lo, vec3(1.0f));
+    draw_text(want, 6 + bar_w / 2 - text_width(mid) / 2, y, mid, vec3(1.0f));
+    draw_text(want, 6 + bar_w - text_width(hi), y, hi, vec3(1.0f));
+    int lit = 0;
+    for (int yy = y; yy < y + 7; ++yy)
+      for (int x = 0; x < back.width; ++x) {
+        const bool on = want.at(x, yy).x == 1.0f;
+        lit += on;
+        EXPECT_EQ(codes(x, yy), on ? (std::array<int, 3>{255, 255, 255}) : (std::array<int, 3>{0, 0, 0}))
+            << (log ? "log" : "linear") << " legend numbers at (" << x << "," << yy << ")";
+      }
+    EXPECT_GT(lit, 20);
+  }
+  // A bad range is one clear message.
+  const CliResult bad = run_cli({"diff", exr("a", a), exr("b", b), "--heatmap", (dir_ / "x.png").string(), "--log",
+                                 "--range", "0,1"});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--range 0,1: expected LO,HI with 0 <= LO < HI and LO > 0 for --log"), std::string::npos)
+      << bad.err;
 }
 
 TEST_F(DiffTest, HeatmapColoursSurviveThePngEncoding) {
@@ -411,6 +495,213 @@ TEST_F(DiffTest, HeatmapPathIsCheckedFirst) {
   r = run_cli({"diff", fa, (dir_ / "missing.exr").string(), "--heatmap", "/proc/heat.png"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("/proc/heat.png: cannot write output"), std::string::npos) << r.err;
+}
+
+
+TEST_F(DiffTest, FirstAndWorstPixelsAndCountsAreLocatedExactly) {
+  const Image b = ramp(9, 7);
+  Image a = b;
+  a.at(0, 0).x += 1e-7f;  // B is 0 there: rounding-level, below the default threshold 1e-6
+  a.at(6, 1).y += 0.5f;   // the first pixel over it, in row order
+  a.at(2, 4).z += 1.75f;  // the worst
+  a.at(8, 5).x -= 0.25f;
+  const ImageMetrics m = compare_images(a, b, 1e-6);
+  EXPECT_EQ(m.over, 3u);
+  EXPECT_EQ(m.over_fraction, 3.0 / 63.0);
+  EXPECT_EQ(m.first_over, (PixelXY{6, 1}));
+  EXPECT_EQ(m.first_over_channel, 1);
+  EXPECT_EQ(m.first_over_a, static_cast<double>(a.at(6, 1).y));
+  EXPECT_EQ(m.first_over_b, static_cast<double>(b.at(6, 1).y));
+  EXPECT_EQ(m.max_at, (PixelXY{2, 4}));
+  EXPECT_EQ(m.max_channel, 2);
+  EXPECT_EQ(m.max_abs, 1.75);
+  // Threshold 0: every difference counts, and the first is at (0,0).
+  const ImageMetrics all = compare_images(a, b, 0.0);
+  EXPECT_EQ(all.over, 4u);
+  EXPECT_EQ(all.first_over, (PixelXY{0, 0}));
+  EXPECT_EQ(all.first_over_channel, 0);
+
+  const std::string fa = exr("a", a), fb = exr("b", b);
+  const CliResult js = run_cli({"diff", fa, fb, "--json"});
+  ASSERT_EQ(js.code, 0) << js.err;
+  const json j = json::parse(js.out);
+  EXPECT_EQ(j["threshold"], 1e-6);
+  EXPECT_EQ(j["over_threshold"]["count"], 3);
+  EXPECT_EQ(j["over_threshold"]["fraction"], 3.0 / 63.0);
+  EXPECT_EQ(j["first_over"]["x"], 6);
+  EXPECT_EQ(j["first_over"]["y"], 1);
+  EXPECT_EQ(j["first_over"]["channel"], 1);
+  EXPECT_EQ(j["first_over"]["abs_diff"], 0.5);
+  EXPECT_EQ(j["worst"]["x"], 2);
+  EXPECT_EQ(j["worst"]["y"], 4);
+  EXPECT_EQ(j["worst"]["channel"], 2);
+  EXPECT_EQ(j["worst"]["a"].get<double>(), static_cast<double>(a.at(2, 4).z));
+  EXPECT_EQ(j["worst"]["b"].get<double>(), static_cast<double>(b.at(2, 4).z));
+  EXPECT_EQ(run_cli({"diff", fa, fb, "--json", "--threshold", "0"}).out.find("\"count\": 4") != std::string::npos, true);
+
+  const CliResult text = run_cli({"diff", fa, fb});
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.err.find("over threshold     3              of 63 pixels (4.762 %) have max |A - B| > 1e-06"),
+            std::string::npos) << text.err;
+  EXPECT_NE(text.err.find("first over                        at pixel (6,1) G: A "), std::string::npos) << text.err;
+  EXPECT_NE(text.err.find("worst pixel                       at pixel (2,4) B: A "), std::string::npos) << text.err;
+  EXPECT_EQ(run_cli({"diff", fa, fb, "--threshold", "-1"}).code, 2);
+}
+
+// ---- the statistical mode: images with a known variance of their means.
+
+// Standard normal deviates from a fixed, portable generator (Box-Muller on
+// mt19937_64, whose sequence the standard fixes).
+class Normal {
+ public:
+  explicit Normal(std::uint64_t seed) : rng_(seed) {}
+  double operator()() {
+    const double u1 = (static_cast<double>(rng_() >> 11) + 0.5) * 0x1.0p-53;
+    const double u2 = static_cast<double>(rng_() >> 11) * 0x1.0p-53;
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * 3.141592653589793 * u2);
+  }
+
+ private:
+  std::mt19937_64 rng_;
+};
+
+struct NoisyPair {
+  Image a, b, var_a, var_b;
+  double sigma = 0;  // of a - b
+};
+// The truth ramp(w, h) plus noise of standard deviation sa (in A) and sb (in
+// B), with those variances in the layers.
+NoisyPair noisy_pair(int w, int h, double sa, double sb, std::uint64_t seed) {
+  NoisyPair p;
+  const Image truth = ramp(w, h);
+  p.a = p.b = truth;
+  p.var_a = p.var_b = Image(w, h);
+  Normal n(seed);
+  for (std::size_t i = 0; i < truth.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      p.a.pixels[i][c] = static_cast<float>(truth.pixels[i][c] + sa * n());
+      p.b.pixels[i][c] = static_cast<float>(truth.pixels[i][c] + sb * n());
+      p.var_a.pixels[i][c] = static_cast<float>(sa * sa);
+      p.var_b.pixels[i][c] = static_cast<float>(sb * sb);
+    }
+  p.sigma = std::sqrt(static_cast<double>(static_cast<float>(sa * sa)) + static_cast<double>(static_cast<float>(sb * sb)));
+  return p;
+}
+
+TEST_F(DiffTest, StatisticalModeFindsATenSigmaShiftInOnePixel) {
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    NoisyPair p = noisy_pair(32, 32, 0.01, 0.02, seed);
+    p.a.at(5, 7).y += static_cast<float>(10.0 * p.sigma);
+    const StatisticalDiff s = statistical_diff(p.a, p.b, p.var_a, p.var_b, 1e-4, 0.0, false);
+    EXPECT_EQ(s.tests, 3u * 32 * 32);
+    EXPECT_NEAR(s.z_threshold, 5.53, 0.01);  // Sidak: 1 - (1 - 1e-4)^(1/3072) per test
+    EXPECT_FALSE(s.pass) << seed;
+    EXPECT_EQ(s.failing, 1u) << seed;
+    EXPECT_EQ(s.worst.at, (PixelXY{5, 7})) << seed;
+    EXPECT_EQ(s.worst.channel, 1) << seed;
+    EXPECT_EQ(s.first_failing.at, (PixelXY{5, 7})) << seed;
+    EXPECT_NEAR(s.worst.z, 10.0, 4.0) << seed;  // the shift, plus one unit of noise
+    EXPECT_TRUE(s.bias_pass) << seed;           // one pixel barely moves the mean
+  }
+
+  // Through the CLI: the layers are read back from the EXRs.
+  NoisyPair p = noisy_pair(32, 32, 0.01, 0.02, 1);
+  const auto with_variance = [&](const std::string& name, const Image& image, const Image& var) {
+    std::vector<ExrChannel> channels;
+    const char* names[] = {"R", "G", "B", "variance.R", "variance.G", "variance.B"};
+    for (int k = 0; k < 6; ++k) {
+      ExrChannel ch{names[k], {}};
+      for (const vec3& v : k < 3 ? image.pixels : var.pixels) ch.values.push_back(v[k % 3]);
+      channels.push_back(std::move(ch));
+    }
+    const fs::path file = dir_ / (name + ".exr");
+    write_exr_channels(file, image.width, image.height, channels, {});
+    return file.string();
+  };
+  const std::string fb = with_variance("b", p.b, p.var_b);
+  const std::string clean = with_variance("clean", p.a, p.var_a);
+  p.a.at(5, 7).y += static_cast<float>(10.0 * p.sigma);
+  const std::string shifted = with_variance("shifted", p.a, p.var_a);
+
+  CliResult r = run_cli({"diff", clean, fb, "--stat"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("pass: statistical test, 0 failing"), std::string::npos) << r.err;
+  r = run_cli({"diff", shifted, fb, "--stat", "--json", "--heatmap", (dir_ / "z.png").string()});
+  EXPECT_EQ(r.code, 1) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["statistical"]["failing"], 1);
+  EXPECT_EQ(j["statistical"]["first_failing"]["x"], 5);
+  EXPECT_EQ(j["statistical"]["first_failing"]["y"], 7);
+  EXPECT_EQ(j["statistical"]["first_failing"]["channel"], 1);
+  EXPECT_EQ(j["statistical"]["pass"], false);
+  EXPECT_EQ(j["heatmap"]["quantity"], "z");
+  EXPECT_EQ(j["heatmap"]["hi"].get<double>(), j["statistical"]["z_threshold"].get<double>());
+  // Without --stat the report is there but the exit code is the metrics'.
+  r = run_cli({"diff", shifted, fb});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("first failing      z "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("at pixel (5,7) G"), std::string::npos) << r.err;
+  // --stat without variance layers: one message naming the file.
+  const std::string plain = exr("plain", p.b);
+  r = run_cli({"diff", shifted, plain, "--stat"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(plain + ": --stat needs a variance layer"), std::string::npos) << r.err;
+}
+
+// Pure noise of the stated variance: the family of per-pixel tests fails in
+// a fraction alpha of the seeds (Sidak is exact for independent tests, and
+// the constant variance makes the 3x3 maximum the variance itself). Over 400
+// fixed seeds at alpha = 0.1 the number of failing seeds is Binomial(400,
+// 0.1): 40 +- 6; the bounds are 4.5 standard deviations (a false alarm of
+// this test about 1e-5). A test that ignored the multiple comparisons (or
+// used the wrong variance) fails far more often; one twice as strict fails
+// about half as often.
+TEST_F(DiffTest, PureNoisePassesAtTheStatedFalseAlarmRate) {
+  const int seeds = 400;
+  const double alpha = 0.1;
+  int pixel_failures = 0, bias_failures = 0;
+  for (int seed = 0; seed < seeds; ++seed) {
+    const NoisyPair p = noisy_pair(16, 16, 0.03, 0.01, 1000 + static_cast<std::uint64_t>(seed));
+    const StatisticalDiff s = statistical_diff(p.a, p.b, p.var_a, p.var_b, alpha, 0.0, false);
+    pixel_failures += !s.pixels_pass;
+    bias_failures += !s.bias_pass;
+  }
+  const double mean = seeds * alpha, sd = std::sqrt(seeds * alpha * (1.0 - alpha));
+  EXPECT_NEAR(pixel_failures, mean, 4.5 * sd) << "per-pixel tests";
+  EXPECT_NEAR(bias_failures, mean, 4.5 * sd) << "mean-difference test";
+}
+
+// A uniform shift of 0.5 sigma in every pixel fails no pixel but the mean
+// difference (z = 0.5 sqrt(256) = 8 against a threshold of about 4.0); with
+// the bilinear filter's correlation the error is 3x larger (z = 2.7) and it passes.
+TEST_F(DiffTest, MeanDifferenceTestFindsAUniformShift) {
+  NoisyPair p = noisy_pair(16, 16, 0.01, 0.01, 7);
+  for (vec3& v : p.a.pixels) v.x += static_cast<float>(0.5 * p.sigma);
+  const StatisticalDiff s = statistical_diff(p.a, p.b, p.var_a, p.var_b, 1e-4, 0.0, false);
+  EXPECT_TRUE(s.pixels_pass);
+  EXPECT_FALSE(s.bias_pass);
+  EXPECT_EQ(s.bias_channel, 0);
+  EXPECT_NEAR(s.bias_z, 8.0, 1.5);
+  const StatisticalDiff c = statistical_diff(p.a, p.b, p.var_a, p.var_b, 1e-4, 0.0, true);
+  EXPECT_TRUE(c.correlated);
+  EXPECT_NEAR(c.bias_z, s.bias_z / 3.0, 1e-9);
+  EXPECT_TRUE(c.bias_pass);
+}
+
+// A pixel whose own variance estimate is 0 (its few samples all missed the
+// light) takes its neighbours' largest, as pathlab check does.
+TEST_F(DiffTest, ZeroVarianceNextToNoiseUsesTheNeighbourhood) {
+  NoisyPair p = noisy_pair(8, 8, 0.01, 0.01, 3);
+  p.var_a.at(4, 4) = p.var_b.at(4, 4) = vec3(0.0f);
+  p.a.at(4, 4) = p.b.at(4, 4) + vec3(static_cast<float>(p.sigma));
+  const StatisticalDiff s = statistical_diff(p.a, p.b, p.var_a, p.var_b, 1e-4, 0.0, false);
+  EXPECT_TRUE(s.pixels_pass) << "z " << s.worst.z << " at (" << s.worst.at.x << "," << s.worst.at.y << ")";
+  // Noiseless pixels that differ by rounding only pass within the threshold.
+  Image var0(8, 8);
+  Image a = ramp(8, 8), b = a;
+  a.at(1, 1).x += 1e-7f;
+  EXPECT_TRUE(statistical_diff(a, b, var0, var0, 1e-4, 1e-6, false).pass);
+  EXPECT_FALSE(statistical_diff(a, b, var0, var0, 1e-4, 0.0, false).pass);
 }
 
 }  // namespace

@@ -8,6 +8,9 @@
 #include "debugtools/path_recorder.h"
 #include "reference/reference_tracer.h"
 #include "tests/test_scenes.h"
+#include "core/scene_loader.h"
+#include "debugtools/path_geometry.h"
+#include "debugtools/tracers.h"
 
 #include <gtest/gtest.h>
 
@@ -175,6 +178,75 @@ TEST(TracePixel, NanIsKeptOutOfTheImageAndReportedWithItsReplayCommand) {
   const auto j = nlohmann::json::parse(out.str());
   EXPECT_EQ(j["pixel"], nlohmann::json::array({3, 2}));
   EXPECT_EQ(j["sample"], 5);
+}
+
+
+// A floor lit by a point light; `below` puts it under the floor, `mirror`
+// makes the floor a mirror. Both tracers replay pixel (12,12) sample 0.
+Scene floor_with_point_light(bool below, bool mirror) {
+  const std::string text = std::string(R"({
+    "pathlab_scene": 1,
+    "camera": {"position": [0, 6, 0], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov_y": 90},
+    "film": {"resolution": [24, 24]},
+    "render": {"spp": 1, "max_depth": 1, "strategy": "light"},
+    "materials": {"floor": )") + (mirror ? R"({"type": "mirror"})" : R"({"type": "diffuse", "albedo": 0.5})") + R"(},
+    "shapes": [{"type": "rectangle", "material": "floor",
+                "transform": [{"rotate": {"axis": [1, 0, 0], "angle": -90}}, {"scale": 10}]}],
+    "lights": [{"type": "point", "position": [0, )" + (below ? "-2" : "2") + R"(, 0], "intensity": 1}]})";
+  return parse_scene(text, "floor.json");
+}
+
+// A light sample dropped before its shadow ray is an event with its reason,
+// in both tracers alike, in the JSON and the text.
+TEST(TracePixel, RejectedLightSamplesAreReportedByBothTracers) {
+  struct Case {
+    bool below, mirror;
+    LightRejection want;
+    const char* name;
+  };
+  for (const Case& c : {Case{true, false, LightRejection::BelowSurface, "below_surface"},
+                        Case{false, true, LightRejection::BlackBsdf, "black_bsdf"},
+                        Case{false, false, LightRejection::None, ""}}) {
+    Scene scene = floor_with_point_light(c.below, c.mirror);
+    const RenderSettings settings = scene.render;
+    const CompiledScene compiled(std::move(scene));
+    PathRecorder ref, wave;
+    make_tracer("reference", compiled, settings)->trace_sample(12, 12, 0, &ref);
+    make_tracer("wavefront", compiled, settings)->trace_sample(12, 12, 0, &wave);
+    const auto light_events = [](const PathRecorder& r) {
+      std::vector<LightEvent> out;
+      for (const PathEvent& e : r.events())
+        if (const auto* l = std::get_if<LightEvent>(&e)) out.push_back(*l);
+      return out;
+    };
+    const std::vector<LightEvent> lr = light_events(ref), lw = light_events(wave);
+    ASSERT_EQ(lr.size(), 1u) << c.name << ": the reference reports no light event";
+    ASSERT_EQ(lw.size(), 1u) << c.name << ": the wavefront reports no light event";
+    EXPECT_EQ(lr[0].rejected, c.want) << c.name;
+    EXPECT_EQ(lw[0].rejected, c.want) << c.name;
+    EXPECT_TRUE(first_divergence(ref.events(), wave.events(), 1e-4f).identical) << c.name;
+    if (c.want == LightRejection::None) {
+      EXPECT_TRUE(lr[0].visible);
+      continue;
+    }
+    EXPECT_FALSE(lr[0].visible);
+    EXPECT_EQ(lr[0].added, Spectrum(0.0f));
+    EXPECT_TRUE(lr[0].delta);
+    EXPECT_EQ(lr[0].wi.y < 0.0f, c.below) << "the light is where it was put";
+    const TraceHeader h{"floor", "reference", 12, 12, 0, settings, 24, 24};
+    const nlohmann::json j = path_to_json(h, ref, compiled.scene());
+    bool found = false;
+    for (const auto& e : j["events"])
+      if (e["type"] == "light") {
+        EXPECT_EQ(e["rejected"], c.name);
+        found = true;
+      }
+    EXPECT_TRUE(found);
+    const std::string text = path_to_text(h, wave, compiled.scene());
+    EXPECT_NE(text.find(std::string("point 0 REJECTED ") + c.name), std::string::npos) << text;
+    // A rejected sample traced no shadow ray: none is drawn.
+    for (const PathLine& l : path_lines(ref, 0, 10.0f)) EXPECT_NE(l.kind, PathLine::Kind::Shadow) << c.name;
+  }
 }
 
 }  // namespace

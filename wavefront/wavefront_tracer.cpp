@@ -60,7 +60,9 @@ struct WavefrontTracer::Wave {
   std::vector<LightSample> light;
   std::vector<Spectrum> unoccluded;  // f Le w / pdf, before visibility
   std::vector<float> light_weight;
-  std::vector<std::uint8_t> shadow_state;  // 0 none, 1 to trace, 2 visible, 3 occluded
+  // 0 none, 1 to trace, 2 visible, 3 occluded; with an observer only,
+  // 4 + LightRejection: rejected before a shadow ray (reported, adds nothing).
+  std::vector<std::uint8_t> shadow_state;
   // Scratch for the pending shadow rays: the rays, whose slot each belongs
   // to, and whether it is blocked.
   std::vector<Ray> query;
@@ -380,6 +382,12 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
   }
 }
 
+namespace {
+// shadow_state of a light sample rejected before its shadow ray.
+constexpr std::uint8_t kRejected = 4;
+std::uint8_t rejected_state(LightRejection r) { return static_cast<std::uint8_t>(kRejected + static_cast<int>(r)); }
+}  // namespace
+
 // Stage: next-event estimation, up to two light samples per path (a point
 // light in every strategy; an area light as the strategy says), each with
 // the contribution it brings if nothing blocks its shadow ray.
@@ -393,8 +401,14 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
     const Surfel& s = w.surfel[i];
     const vec3 wo = -w.ray[i].dir;
     if (lights.has_delta_lights()) {
-      if (const auto ls = lights.sample_delta(s.p, w.u(i, Dim::DeltaLightChoice))) {
+      const auto ls = lights.sample_delta(s.p, w.u(i, Dim::DeltaLightChoice));
+      if (obs && !ls) w.shadow_state[2 * i] = rejected_state(LightRejection::NoSample);
+      if (ls) {
         const Spectrum f = s.eval(ls->wi, wo);
+        if (obs && is_black(f)) {
+          w.light[2 * i] = *ls;
+          w.shadow_state[2 * i] = rejected_state(black_light_sample_reason(s.n, ls->wi, wo));
+        }
         if (!is_black(f)) {
           if (keep) w.light[2 * i] = *ls;  // only the observer and the stage records read it back
           w.unoccluded[2 * i] = f * ls->Le / ls->pdf;
@@ -407,9 +421,18 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
     }
     if (samples_area_lights(strategy, w.u(i, Dim::Technique))) {
       const auto ls = lights.sample(s.p, w.u(i, Dim::LightChoice), vec2(w.u(i, Dim::LightX), w.u(i, Dim::LightY)));
-      if (!ls) continue;
+      if (!ls) {
+        if (obs && lights.has_area_lights()) w.shadow_state[2 * i + 1] = rejected_state(LightRejection::NoSample);
+        continue;
+      }
       const Spectrum f = s.eval(ls->wi, wo);
-      if (is_black(f)) continue;
+      if (is_black(f)) {
+        if (obs) {
+          w.light[2 * i + 1] = *ls;
+          w.shadow_state[2 * i + 1] = rejected_state(black_light_sample_reason(s.n, ls->wi, wo));
+        }
+        continue;
+      }
       const float lw = light_sample_weight(strategy, ls->pdf, s.pdf(ls->wi, wo));
       if (keep) w.light[2 * i + 1] = *ls;
       w.unoccluded[2 * i + 1] = f * ls->Le * (lw / ls->pdf);
@@ -444,6 +467,13 @@ void WavefrontTracer::add_light(Wave& w, PathObserver* obs) const {
   for (std::size_t i = 0; i < w.n; ++i) {
     for (std::size_t k = 2 * i; k < 2 * i + 2; ++k) {
       if (w.shadow_state[k] == 0) continue;
+      if (w.shadow_state[k] >= kRejected) {  // set only with an observer
+        const auto reason = static_cast<LightRejection>(w.shadow_state[k] - kRejected);
+        if (obs)
+          obs->on_light(rejected_light_event(w.vertex[i], k == 2 * i,
+                                           reason == LightRejection::NoSample ? nullptr : &w.light[k], reason));
+        continue;
+      }
       const bool visible = w.shadow_state[k] == 2;
       const Spectrum added = visible ? w.beta[i] * w.unoccluded[k] : Spectrum(0.0f);
       w.L[i] += added;

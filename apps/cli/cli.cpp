@@ -27,6 +27,7 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
   trace_pixel.add_to(app);
   converge.add_to(app);
   compare.add_to(app);
+  render.command_line = trace_pixel.command_line = shell_command_line(argc, argv);
 
   try {
     app.parse(argc, argv);

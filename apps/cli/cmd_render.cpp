@@ -31,6 +31,24 @@
 
 namespace pathlab::cli {
 
+std::string shell_command_line(int argc, const char* const* argv) {
+  std::string line;
+  for (int i = 0; i < argc; ++i) {
+    const std::string word = argv[i] != nullptr ? argv[i] : "";
+    const bool plain = !word.empty() && word.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                                                               "0123456789_@%+=:,./-") == std::string::npos;
+    if (i > 0) line += ' ';
+    if (plain) {
+      line += word;
+      continue;
+    }
+    line += '\'';
+    for (char c : word) line += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    line += '\'';
+  }
+  return line;
+}
+
 void RenderCommand::add_to(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("render", "Render a scene to EXR and PNG");
   scene.add_to(*cmd, true);
@@ -309,19 +327,29 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     const Image image = film.image();
     char seconds[32];
     std::snprintf(seconds, sizeof seconds, "%.3f", stats.seconds);
+    char clamped_fraction[32];
+    std::snprintf(clamped_fraction, sizeof clamped_fraction, "%.6g", stats.relative_energy_clamped());
+    // Every setting that changes a sample (core/render.h), then what the
+    // render did and what made it (docs/scene-format.md, "EXR metadata").
     ImageMetadata meta = {
         {"scene", sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string()},
         {"tracer", std::string(tracer->name())},
-        {"strategy", strategy_name(settings.strategy)},
         {"spp", std::to_string(spp_done)},
-        {"seed", std::to_string(settings.seed)},
-        {"max_depth", std::to_string(settings.max_depth)},
-        {"rr_depth", std::to_string(settings.rr_depth)},
+        {"resolution", std::to_string(sc.film.width) + "x" + std::to_string(sc.film.height)},
         {"filter", sc.film.filter == FilterKind::Box ? "box" : "bilinear"},
+    };
+    for (auto& kv : sample_settings(settings)) meta.push_back(std::move(kv));
+    const std::vector<std::pair<std::string, std::string>> made = {
+        {"clamped", settings.clamp > 0.0f ? "yes" : "no"},
+        {"clamped_samples", std::to_string(stats.clamped_samples)},
+        {"clamped_energy_fraction", clamped_fraction},
         {"render_time_seconds", seconds},
         {"bad_samples", std::to_string(stats.bad_samples)},
         {"version", PATHLAB_VERSION},
+        {"git_revision", git_revision()},
+        {"command_line", command_line},
     };
+    for (const auto& kv : made) meta.push_back(kv);
     for (auto& kv : partial_film_metadata(info)) meta.push_back(std::move(kv));
     if (interrupted != 0) meta.emplace_back("interrupted", "yes");
     if (progressive) {

@@ -78,7 +78,7 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
   auto record = [&](const std::string& name, std::uint32_t sample_index, PathRecorder& recorder) {
     make_tracer(name, compiled, settings)->trace_sample(ux, uy, sample_index, &recorder);
     return TraceHeader{sc.file.empty() ? "<built-in " + sc.name + ">" : sc.file.string(), name, ux, uy, sample_index,
-                       settings, sc.film.width, sc.film.height};
+                       settings, sc.film.width, sc.film.height, command_line};
   };
   if (scene.tracer != "both") {
     std::vector<PathLine> lines;
@@ -124,7 +124,7 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
     return 0;
   }
   err << trace_header_text(TraceHeader{href.scene, "reference | wavefront", ux, uy, sample, settings, sc.film.width,
-                                       sc.film.height});
+                                       sc.film.height, command_line});
   const std::size_t n = std::max(ref.events().size(), wave.events().size());
   for (std::size_t i = 0; i < n; ++i) {
     if (!d.identical && i == d.event)
@@ -141,8 +141,7 @@ int TracePixelCommand::run(std::ostream& out, std::ostream& err) const {
     line("ref  ", ref);
     line("wave ", wave);
   }
-  err << "ref   radiance (" << ref.result().x << ", " << ref.result().y << ", " << ref.result().z << ")\n"
-      << "wave  radiance (" << wave.result().x << ", " << wave.result().y << ", " << wave.result().z << ")\n"
+  err << result_text(href, ref, "ref   ") << result_text(hwave, wave, "wave  ")
       << (d.identical ? "the paths agree at every event (tolerance 1e-4)\n" : "");
   return 0;
 }

@@ -14,6 +14,10 @@
 
 namespace pathlab::cli {
 
+// argv as one line a POSIX shell reads back to the same words: a word with
+// anything but [A-Za-z0-9_@%+=:,./-] is put in single quotes.
+std::string shell_command_line(int argc, const char* const* argv);
+
 struct RenderCommand {
   SceneOptions scene;
   std::string output;
@@ -28,6 +32,7 @@ struct RenderCommand {
   std::optional<std::string> passes;      // --passes A..B
   std::vector<std::string> stage_buffers;  // --dump-stage-buffers K DIR
   bool quiet = false;
+  std::string command_line;  // as typed (shell-quoted), for the EXR header
   bool selected = false;
   void add_to(CLI::App& app);
   int run(std::ostream& out, std::ostream& err) const;
@@ -63,6 +68,11 @@ struct DiffCommand {
   bool json = false;
   std::optional<double> tolerance;
   std::string metric = "rmse";
+  double threshold = 1e-6;  // --threshold: a pixel differs when max |A - B| over its channels exceeds it
+  bool stat = false;        // --stat: the statistical test decides the exit code
+  double alpha = 1e-4;      // --alpha: its family-wise false-alarm rate
+  bool log_scale = false;   // --log: the heatmap's scale
+  std::optional<std::string> range;  // --range LO,HI: the heatmap's range
   bool selected = false;
   void add_to(CLI::App& app);
   int run(std::ostream& out, std::ostream& err) const;
@@ -93,6 +103,7 @@ struct CompareCommand {
   double alpha = 1e-4;
   int threads = 0;
   bool json = false;
+  std::string command_line;  // as typed (shell-quoted), for the header
   bool selected = false;
   void add_to(CLI::App& app);
   int run(std::ostream& out, std::ostream& err) const;
