@@ -95,8 +95,9 @@ TEST_F(ConvergeCli, UsesAReferenceExrAsTheTruth) {
   const fs::path ref = dir_ / "ref.exr";
   ASSERT_EQ(run_cli({"render", scene, "-o", ref.string(), "--spp", "256", "--resolution", "8x6", "--seed", "99",
                      "--quiet"}).code, 0);
-  const auto r = run_cli({"converge", scene, "--reference", ref.string(), "--spp", "1,16", "--seeds", "2",
-                          "--resolution", "8x6", "--out", (dir_ / "report").string()});
+  const auto r = run_cli({"converge", scene, "--reference", ref.string(), "--tracers", "reference", "--strategies",
+                          "mis", "--spp", "1,16", "--seeds", "2", "--resolution", "8x6", "--out",
+                          (dir_ / "report").string()});
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string md = read_text(dir_ / "report" / "converge.md");
   EXPECT_NE(md.find("Ground truth: reference " + ref.string()), std::string::npos) << md;
