@@ -19,10 +19,12 @@
 // plane, which the model requires).
 //
 // The map is piecewise constant, so the expected pixel values have edges
-// wherever a pixel straddles a texel boundary; expected_image() refines its
-// midpoint grid to 128^2 per pixel and reports the last difference as the
-// quadrature error, which check() adds to each pixel's tolerance (measured
-// for the committed scenes in docs/analytic-scenes.md: far below the noise).
+// wherever a pixel straddles a texel boundary. Seen directly, those edges
+// are listed (edges()) and expected_image() refines along them; mirrored in
+// the sphere they are not, and there it refines its midpoint grid up to
+// 128^2 per pixel and reports the last difference as the quadrature error,
+// which check() adds to each pixel's tolerance (measured for the committed
+// scenes in docs/analytic-scenes.md: far below the noise).
 #include "analytic-scenes/models.h"
 #include "analytic-scenes/room.h"
 #include "core/environment_map.h"
