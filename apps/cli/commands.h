@@ -87,6 +87,7 @@ struct TracePixelCommand {
   std::string vtk_geometry;                   // --vtk-geometry hit|scene
   std::size_t vtk_max_triangles = 1000000;    // --vtk-max-triangles N
   bool json = false;
+  std::string command_line;  // as typed (shell-quoted), for the header
   bool selected = false;
   void add_to(CLI::App& app);
   int run(std::ostream& out, std::ostream& err) const;
@@ -103,7 +104,6 @@ struct CompareCommand {
   double alpha = 1e-4;
   int threads = 0;
   bool json = false;
-  std::string command_line;  // as typed (shell-quoted), for the header
   bool selected = false;
   void add_to(CLI::App& app);
   int run(std::ostream& out, std::ostream& err) const;
