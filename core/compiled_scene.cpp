@@ -3,6 +3,7 @@
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/parallel.h"
+#include "core/scene_limits.h"
 #include "core/tangents.h"
 
 #include <algorithm>
@@ -60,6 +61,7 @@ void check_alpha(const Scene& scene) {
 CompiledScene::CompiledScene(Scene scene)
     : scene_(std::move(scene)), camera_(scene_.camera, scene_.film.width, scene_.film.height) {
   check_instancing(scene_);
+  check_scene_range(scene_);  // no ray Embree would abort on (core/geometry.h)
   check_alpha(scene_);
   configure_shading(scene_);  // materials: shading path for the scene's lobes, sampling flavour, min pdf
   Box box;

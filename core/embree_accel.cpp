@@ -2,12 +2,15 @@
 
 #include "core/alpha.h"
 #include "core/error.h"
+#include "core/scene_limits.h"
 #include "core/texture.h"
 
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <vector>
 
@@ -80,6 +83,13 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
+}  // namespace
+
+namespace {
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+// Rays refused because Embree would abort on them (embree_rejected_rays): a
+// count for the render's warning, never read by the tracers.
+std::atomic<std::uint64_t> g_rejected{0};
 }  // namespace
 
 struct EmbreeAccel::Impl {
@@ -264,6 +274,11 @@ void fill(RTCRayHit& rh, const Ray& ray) {
 }  // namespace
 
 bool EmbreeAccel::intersect(const Ray& ray, RayHit* hit) const {
+  if (!embree_accepts(ray)) {
+    g_rejected.fetch_add(1, std::memory_order_relaxed);
+    hit->t = kNaN;
+    return false;
+  }
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit rh;
@@ -354,7 +369,32 @@ void for_each_packet(std::size_t n, Packet&& packet) {
   }
 }
 
+// Ray i of `rays` in the one-ray form.
+Ray ray_at(const RayArrays& r, std::size_t i) {
+  return Ray{vec3(r.ox[i], r.oy[i], r.oz[i]), vec3(r.dx[i], r.dy[i], r.dz[i]), r.tmax[i],
+             r.alpha_key ? r.alpha_key[i] : 0u};
+}
+
+// The number of rays Embree would refuse: a batch with any goes one ray at a
+// time, the refused ones skipped (every mode gives the same answers).
+std::size_t count_rejected(std::span<const Ray> rays) {
+  std::size_t n = 0;
+  for (const Ray& r : rays) n += embree_accepts(r) ? 0 : 1;
+  return n;
+}
+std::size_t count_rejected(const RayArrays& rays, std::size_t n) {
+  std::size_t bad = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    bad += embree_accepts(vec3(rays.ox[i], rays.oy[i], rays.oz[i]), vec3(rays.dx[i], rays.dy[i], rays.dz[i]),
+                          rays.tmax[i])
+               ? 0
+               : 1;
+  return bad;
+}
+
 }  // namespace
+
+std::uint64_t embree_rejected_rays() { return g_rejected.load(std::memory_order_relaxed); }
 
 void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> hits, std::span<std::uint8_t> found,
                                   RayBatchMode mode, bool coherent) const {
@@ -363,9 +403,18 @@ void EmbreeAccel::intersect_batch(std::span<const Ray> rays, std::span<RayHit> h
     found[i] = geom != RTC_INVALID_GEOMETRY_ID;
     if (found[i]) hits[i] = RayHit{tfar, impl_->shape_of(geom, inst), prim, vec2(u, v), impl_->instance_of(inst)};
   };
+  if (const std::size_t bad = count_rejected(rays); bad > 0) {
+    g_rejected.fetch_add(bad, std::memory_order_relaxed);
+    mode = RayBatchMode::Single;
+  }
   switch (mode) {
     case RayBatchMode::Single:
       for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (!embree_accepts(rays[i])) {
+          found[i] = 0;
+          hits[i].t = kNaN;
+          continue;
+        }
         RTCRayHit rh;
         fill(rh, rays[i]);
         rtcIntersect1(impl_->scene, &context, &rh);
@@ -413,9 +462,17 @@ bool coherent_occlusion(bool coherent, bool has_instances) { return coherent && 
 void EmbreeAccel::occluded_batch(std::span<const Ray> rays, std::span<std::uint8_t> occluded, RayBatchMode mode,
                                  bool coherent) const {
   RTCIntersectContext context = make_context(coherent_occlusion(coherent, !impl_->instance_group.empty()));
+  if (const std::size_t bad = count_rejected(rays); bad > 0) {
+    g_rejected.fetch_add(bad, std::memory_order_relaxed);
+    mode = RayBatchMode::Single;
+  }
   switch (mode) {
     case RayBatchMode::Single:
       for (std::size_t i = 0; i < rays.size(); ++i) {
+        if (!embree_accepts(rays[i])) {
+          occluded[i] = 1;
+          continue;
+        }
         RTCRay r;
         fill(r, rays[i]);
         rtcOccluded1(impl_->scene, &context, &r);
@@ -443,12 +500,6 @@ void EmbreeAccel::occluded_batch(std::span<const Ray> rays, std::span<std::uint8
 }
 
 namespace {
-
-// Ray i of `rays` in the one-ray form.
-Ray ray_at(const RayArrays& r, std::size_t i) {
-  return Ray{vec3(r.ox[i], r.oy[i], r.oz[i]), vec3(r.dx[i], r.dy[i], r.dz[i]), r.tmax[i],
-             r.alpha_key ? r.alpha_key[i] : 0u};
-}
 
 // Lanes [b, b + n) of `rays` as a 16-wide packet.
 template <typename Packet>
@@ -513,11 +564,20 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, cons
     hits.t[i] = tfar, hits.shape[i] = impl_->shape_of(geom, inst), hits.prim[i] = prim, hits.u[i] = u, hits.v[i] = v;
     if (hits.instance) hits.instance[i] = impl_->instance_of(inst);
   };
+  if (const std::size_t bad = count_rejected(rays, n); bad > 0) {
+    g_rejected.fetch_add(bad, std::memory_order_relaxed);
+    mode = RayBatchMode::Single;
+  }
   switch (mode) {
     case RayBatchMode::Single:
       for (std::size_t i = 0; i < n; ++i) {
+        const Ray ray = ray_at(rays, i);
+        if (!embree_accepts(ray)) {
+          record(i, kNaN, RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID, 0.0f, 0.0f, RTC_INVALID_GEOMETRY_ID);
+          continue;
+        }
         RTCRayHit rh;
-        fill(rh, ray_at(rays, i));
+        fill(rh, ray);
         rtcIntersect1(impl_->scene, &context, &rh);
         record(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.u, rh.hit.v, rh.hit.instID[0]);
       }
@@ -552,11 +612,20 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, cons
 void EmbreeAccel::occluded_arrays(const RayArrays& rays, std::size_t n, std::uint8_t* occluded, RayBatchMode mode,
                                   bool coherent) const {
   RTCIntersectContext context = make_context(coherent_occlusion(coherent, !impl_->instance_group.empty()));
+  if (const std::size_t bad = count_rejected(rays, n); bad > 0) {
+    g_rejected.fetch_add(bad, std::memory_order_relaxed);
+    mode = RayBatchMode::Single;
+  }
   switch (mode) {
     case RayBatchMode::Single:
       for (std::size_t i = 0; i < n; ++i) {
+        const Ray ray = ray_at(rays, i);
+        if (!embree_accepts(ray)) {
+          occluded[i] = 1;
+          continue;
+        }
         RTCRay r;
-        fill(r, ray_at(rays, i));
+        fill(r, ray);
         rtcOccluded1(impl_->scene, &context, &r);
         occluded[i] = r.tfar < 0.0f;
       }
@@ -580,6 +649,10 @@ void EmbreeAccel::occluded_arrays(const RayArrays& rays, std::size_t n, std::uin
 }
 
 bool EmbreeAccel::occluded(const Ray& ray) const {
+  if (!embree_accepts(ray)) {
+    g_rejected.fetch_add(1, std::memory_order_relaxed);
+    return true;
+  }
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay r;

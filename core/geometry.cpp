@@ -1,8 +1,11 @@
 #include "core/geometry.h"
 
+#include "core/error.h"
 #include "core/sampling.h"
+#include "core/scene_limits.h"
 
 #include <cmath>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -66,6 +69,43 @@ bool placed_finite(const Box& box, const mat4& to_world) {
   for (int c = 0; c < 8 && !box.empty(); ++c)
     if (!is_finite(vec3(to_world * vec4(box.corner(c), 1.0f)))) return false;
   return true;
+}
+
+bool placed_in_range(const Box& box, const mat4& to_world) {
+  for (int c = 0; c < 8 && !box.empty(); ++c)
+    if (!within_scene_range(vec3(to_world * vec4(box.corner(c), 1.0f)))) return false;
+  return true;
+}
+
+void check_scene_range(const Scene& scene) {
+  const std::string file = scene.file.empty() ? "<built-in " + scene.name + ">" : scene.file.string();
+  const std::string limit = " (the limit is 1e16 in each coordinate, so that every ray stays within Embree's 1.8e18)";
+  const auto fail = [&](const std::string& what) { throw InputError(file + ": " + what + limit); };
+  const CameraDesc& c = scene.camera;
+  if (!within_scene_range(c.position)) fail("the camera position lies beyond the scene coordinate limit");
+  if (!(c.aperture_radius <= kMaxSceneCoordinate) ||
+      !within_scene_range(glm::abs(c.position) + vec3(c.aperture_radius)))
+    fail("the camera aperture reaches beyond the scene coordinate limit");
+  if (!(c.focus_distance <= kMaxSceneCoordinate)) fail("the camera focus distance exceeds the scene coordinate limit");
+  for (const Shape& s : scene.shapes) {
+    if (s.kind == Shape::Kind::Sphere) {
+      if (!(s.radius >= kMinSphereRadius && s.radius <= kMaxSceneCoordinate))
+        fail(s.description + ": the sphere's radius must lie in [1e-18, 1e16]");
+      if (!within_scene_range(glm::abs(s.center) + vec3(s.radius)))
+        fail(s.description + ": the sphere reaches beyond the scene coordinate limit");
+      continue;
+    }
+    for (std::size_t v = 0; v < s.mesh.positions.size(); ++v)
+      if (!within_scene_range(s.mesh.positions[v]))
+        fail(s.description + ": vertex " + std::to_string(v) + " lies beyond the scene coordinate limit");
+  }
+  for (const Instance& i : scene.instances) {
+    Box box;
+    for (const std::uint32_t id : scene.groups[i.group].shapes) box.add(bounds(scene.shapes[id]));
+    if (!placed_in_range(box, i.to_world)) fail(i.description + ": the instance lies beyond the scene coordinate limit");
+  }
+  for (const DeltaLight& l : scene.delta_lights)
+    if (l.kind != DeltaLight::Kind::Directional && !within_scene_range(l.position)) fail("a light's position lies beyond the scene coordinate limit");
 }
 
 bool invertible_placement(const mat4& to_world) {

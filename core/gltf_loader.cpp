@@ -6,7 +6,9 @@
 
 #include "core/error.h"
 #include "core/geometry.h"
+#include "core/messages.h"
 #include "core/gltf_validate.h"
+#include "core/scene_limits.h"
 
 // No image decoding (textures are not supported yet), no default file system
 // access (the callbacks below read only approved buffers), no external image
@@ -372,7 +374,7 @@ std::optional<GltfPrimitive> Flattener::transformed_primitive(std::size_t mesh, 
   const std::size_t before = out.mesh.triangles.size();
   const std::size_t dropped = transform_mesh(&out.mesh, xf);
   for (const vec3& v : out.mesh.positions)
-    if (!is_finite(v)) fail(file_, node_at, "the transform moves vertices beyond the float range");
+    if (!within_scene_range(v)) fail(file_, node_at, "the transform moves vertices beyond the scene coordinate limit 1e16");
   if (dropped > 0)
     out_.warnings.push_back(out.description + ": dropped " + std::to_string(dropped) + " degenerate triangle(s) of " +
                             std::to_string(before));
@@ -429,7 +431,7 @@ bool Flattener::place_instance(std::size_t mesh, const mat4& xf, std::size_t nod
   if (!invertible_placement(xf)) return false;
   const std::optional<std::uint32_t> g = group(mesh);
   if (!g) return true;  // nothing to place
-  if (!placed_finite(group_boxes_[*g], xf)) return false;
+  if (!placed_in_range(group_boxes_[*g], xf)) return false;
   out_.instances.push_back(
       {*g, xf, file_.string() + ": /nodes/" + std::to_string(node) + " (mesh " + std::to_string(mesh) + ")"});
   return true;
@@ -542,7 +544,7 @@ std::uint32_t Flattener::material(int index) {
     const tinygltf::Material& m = model_.materials[static_cast<std::size_t>(index)];
     const std::string at = "/materials/" + std::to_string(index);
     const auto unit = [&](double v, const std::string& key) {
-      if (!(v >= 0.0 && v <= 1.0)) fail(file_, at + key, "must lie in [0, 1], found " + std::to_string(v));
+      if (!(v >= 0.0 && v <= 1.0)) fail(file_, at + key, "must lie in [0, 1], found " + format_number(v));
       return static_cast<float>(v);
     };
     const auto& pbr = m.pbrMetallicRoughness;

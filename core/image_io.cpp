@@ -2,6 +2,7 @@
 #include "core/image_io.h"
 
 #include "core/error.h"
+#include "core/temp_files.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -86,13 +87,25 @@ OIIO::ImageSpec exr_spec(int width, int height, std::vector<std::string> channel
 
 }  // namespace
 
+void make_output_folder(const fs::path& file) {
+  std::error_code ec;
+  const fs::path folder = folder_of(file);
+  fs::create_directories(folder, ec);
+  if (ec) throw InputError(file.string() + ": cannot write output: cannot create folder " + folder.string() + ": " + ec.message());
+}
+
 void write_via_temp_file(const fs::path& file, std::string_view what,
                          const std::function<void(const fs::path& temp)>& write) {
   ensure_writable(file);
+  make_output_folder(file);
   // Keep the real extension: whatever later inspects the temporary name
   // (OIIO, VTK, a file manager) sees the right type.
-  const fs::path temp = folder_of(file) / ("." + file.stem().string() + ".tmp-" + unique_suffix() +
-                                          file.extension().string());
+  const std::string prefix = "." + file.stem().string() + ".tmp-";
+  // What a killed writer of this file left behind (kill -9 cannot be caught).
+  remove_stale_temp_files(folder_of(file), prefix);
+  const fs::path temp = folder_of(file) / (prefix + unique_suffix() + file.extension().string());
+  // A signal that ends the process removes it (apps/cli/interrupt.cpp).
+  const TempFileRegistration registered(temp);
   bool committed = false;
   // Removes the temporary file unless the write was committed, also when
   // `write` throws.
@@ -125,9 +138,13 @@ void ensure_writable(const fs::path& file) {
   std::error_code ec;
   if (fs::is_directory(file, ec)) fail("is a folder");
 
-  const fs::path folder = folder_of(file);
-  fs::create_directories(folder, ec);
-  if (ec) fail("cannot create folder " + folder.string() + ": " + ec.message());
+  // The folder is made only when there is something to write in it
+  // (write_via_temp_file): a render that fails leaves no empty folder. Here
+  // its nearest existing ancestor must be a folder we may write in.
+  fs::path folder = folder_of(file);
+  while (!fs::exists(folder, ec) && folder.has_parent_path() && folder.parent_path() != folder)
+    folder = folder.parent_path();
+  if (!fs::exists(folder, ec)) folder = ".";
   if (!fs::is_directory(folder, ec)) fail(folder.string() + " is not a folder");
 
   // Probe by creating a file: access(2) says yes to root even on read-only

@@ -31,13 +31,19 @@ struct Image {
 // String metadata written into the EXR header as "pathlab:<key>".
 using ImageMetadata = std::vector<std::pair<std::string, std::string>>;
 
-// Throws InputError if `file`'s folder does not exist and cannot be created,
-// or is not writable. Called before a render so that a bad `-o` fails in a
-// second, not after an hour.
+// Throws InputError if `file` is a folder, or if the nearest existing
+// folder on its path is not a folder or not writable. Creates nothing (a
+// probe file only, removed at once): write_via_temp_file makes the missing
+// folders when there is something to write. Called before a render so that
+// a bad `-o` fails in a second, not after an hour.
 void ensure_writable(const std::filesystem::path& file);
 // The file's extension in lower case (".exr" for "out.EXR"), for deciding
 // what to write.
 std::string lower_extension(const std::filesystem::path& file);
+
+// Creates `file`'s folder (and its parents) if missing: just before the
+// first write into it. Throws InputError if it cannot.
+void make_output_folder(const std::filesystem::path& file);
 
 // Calls write(temp) with a hidden temporary path in `file`'s folder (same
 // extension), then renames the temporary file to `file`. If `write` throws or

@@ -1,6 +1,8 @@
 #include "core/json_document.h"
 
 #include "core/error.h"
+#include "core/limits.h"
+#include "core/messages.h"
 
 #include <algorithm>
 #include <cctype>
@@ -54,11 +56,7 @@ std::string parse_error_reason(const std::string& what) {
 }
 
 // Keys are quoted in messages; keep control characters out of the one line.
-std::string printable(std::string_view key) {
-  std::string out(key);
-  std::replace_if(out.begin(), out.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }, '?');
-  return out;
-}
+std::string printable(std::string_view key) { return shorten_input(key); }
 
 // If the token at or just before `offset` (where nlohmann gave up) is NaN or
 // an infinity as other languages write them (NaN, nan, Infinity, -inf, ...,
@@ -310,6 +308,12 @@ JsonDocument JsonDocument::load(const std::filesystem::path& file) {
     throw InputError(file.string() + ": cannot read scene: " +
                      (error != 0 ? std::strerror(error) : "unknown error"));
   };
+  // A device or a FIFO would be read for ever or block; a folder says so.
+  if (const std::string kind = special_file_kind(file); !kind.empty())
+    throw InputError(file.string() + ": cannot read scene: it is " + kind + ", not a regular file");
+  std::error_code size_error;
+  if (const std::uintmax_t bytes = std::filesystem::file_size(file, size_error); !size_error)
+    check_memory(bytes, file.string() + ": the scene file");
   errno = 0;
   const std::unique_ptr<std::FILE, int (*)(std::FILE*)> in(std::fopen(file.c_str(), "rb"),
                                                            &std::fclose);

@@ -6,6 +6,8 @@
 
 #include "core/error.h"
 #include "core/geometry.h"
+#include "core/limits.h"
+#include "core/messages.h"
 
 #include <tiny_obj_loader.h>
 #include <zlib.h>
@@ -270,7 +272,66 @@ TriangleMesh finish(const fs::path& file, RawMesh raw, MeshLoadReport* report) {
 struct ObjDirectives {
   std::vector<std::string> materials;  // `usemtl` names, in the order of first use
   std::vector<std::string> libraries;  // what `mtllib` lines name
+  // Per kind (vertex, normal, texture coordinate): the largest positive
+  // index a face gives, with its token and line.
+  struct Furthest {
+    long long index = 0;
+    std::string token;
+    int line = 0;
+  };
+  Furthest furthest[3];
 };
+
+// The kinds of OBJ index, in the order of scan_obj's counts ("v", "vn", "vt").
+constexpr const char* kObjIndexNames[3] = {"vertex", "normal", "texture coordinate"};
+
+// " (valid: 1..N or -N..-1)", or " (none is defined)".
+std::string obj_index_range(long long count) {
+  if (count == 0) return " (none is defined)";
+  return " (valid: 1.." + std::to_string(count) + " or -" + std::to_string(count) + "..-1)";
+}
+
+// tinyobj reads a face index it cannot parse ("a") as 0 and reports "zero
+// value", and resolves a negative index before checking it, so its messages
+// name neither the token nor the index as written. Check each token of an
+// "f" line here: v, v/vt, v//vn or v/vt/vn, each index a non-zero integer;
+// a negative one counts back from the `defined` (v, vn, vt) before this line.
+void check_obj_face(const fs::path& file, std::string_view line, int line_no, const int (&defined)[3],
+                    ObjDirectives::Furthest (&furthest)[3]) {
+  constexpr int kKindOfSlot[3] = {0, 2, 1};  // v/vt/vn -> vertex, texture coordinate, normal
+  std::size_t i = 1;
+  while (true) {
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    if (i >= line.size()) return;
+    const std::size_t start = i;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
+    const std::string_view token = line.substr(start, i - start);
+    if (token.starts_with("#")) return;  // a comment to the end of the line
+    std::size_t from = 0;
+    for (int slot = 0; slot < 3 && from <= token.size(); ++slot) {
+      const std::size_t slash = std::min(token.find('/', from), token.size());
+      const std::string_view part = token.substr(from, slash - from);
+      from = slash + 1;
+      const int kind = kKindOfSlot[slot];
+      if (part.empty()) {
+        if (slot == 0) fail(file, "face token " + quote_input(token) + ": the vertex index is missing", line_no);
+        continue;
+      }
+      long long index = 0;
+      const auto [end, ec] = std::from_chars(part.data() + (part[0] == '+' ? 1 : 0), part.data() + part.size(), index);
+      if (ec != std::errc() || end != part.data() + part.size() || index == 0)
+        fail(file, "face token " + quote_input(token) + ": " + kObjIndexNames[kind] + " index " + quote_input(part) +
+                       " is not a non-zero integer" + obj_index_range(defined[kind]),
+             line_no);
+      if (index < 0 && -index > defined[kind])
+        fail(file, "face token " + quote_input(token) + ": " + kObjIndexNames[kind] + " index " +
+                       std::to_string(index) + " counts back past the " + std::to_string(defined[kind]) + " " +
+                       kObjIndexNames[kind] + "(s) given before this line" + obj_index_range(defined[kind]),
+             line_no);
+      if (index > furthest[kind].index) furthest[kind] = {index, std::string(token), line_no};
+    }
+  }
+}
 
 // tinyobj turns a coordinate it cannot parse ("nan", "inf", "1,5", "abc")
 // into 0 without a warning, so a broken vertex would load silently at the
@@ -315,6 +376,10 @@ ObjDirectives scan_obj(const fs::path& file, std::string_view text) {
       if (!names.empty()) found.libraries.emplace_back(names);
       continue;
     }
+    if (line.size() > 1 && line[0] == 'f' && is_blank(line[1])) {
+      check_obj_face(file, line, line_no, {kinds[0].count, kinds[1].count, kinds[2].count}, found.furthest);
+      continue;
+    }
     Kind* kind = nullptr;
     for (Kind& k : kinds)
       if (line.size() > k.tag.size() && line.starts_with(k.tag) && is_blank(line[k.tag.size()])) kind = &k;
@@ -344,6 +409,17 @@ ObjDirectives scan_obj(const fs::path& file, std::string_view text) {
         bad(" has a non-finite coordinate (" + all + ")");
       }
     }
+  }
+  // Positive indices may refer to vertices given later in the file: checked
+  // against the totals at the end, the furthest of each kind.
+  const int totals[3] = {kinds[0].count, kinds[1].count, kinds[2].count};
+  for (int k = 0; k < 3; ++k) {
+    const ObjDirectives::Furthest& f = found.furthest[k];
+    if (f.index > totals[k])
+      fail(file, "face token " + quote_input(f.token) + ": " + kObjIndexNames[k] + " index " + std::to_string(f.index) +
+                     " is beyond the " + std::to_string(totals[k]) + " " + kObjIndexNames[k] + "(s) of the file" +
+                     obj_index_range(totals[k]),
+           f.line);
   }
   return found;
 }
@@ -681,6 +757,19 @@ RawMesh parse_ply(const fs::path& file, std::string_view text) {
   if (!have_vertex) fail(file, "PLY file has no 'vertex' element");
   if (!have_face) fail(file, "PLY file has no 'face' element");
 
+  // Element counts the body cannot hold are refused before anything is read:
+  // each element takes at least its scalars (binary) or a digit and a blank
+  // per property (ASCII).
+  const std::uint64_t body_bytes = text.size() - header.body_offset;
+  for (const PlyElement& element : header.elements) {
+    std::uint64_t least = 0;
+    for (const PlyProperty& p : element.properties)
+      least += header.encoding == Encoding::Ascii ? 2 : kScalarSize[static_cast<int>(p.is_list ? p.count_type : p.type)];
+    if (least > 0 && element.count > body_bytes / least)
+      fail(file, "the header declares " + std::to_string(element.count) + " " + plural(element.name) + ", more than the " +
+                     std::to_string(body_bytes) + " bytes after it can hold");
+  }
+
   RawMesh raw;
   raw.ignored = std::move(ignored);
   PlyBody body(file, text.substr(header.body_offset), header.encoding, header.line_count + 1);
@@ -738,6 +827,13 @@ RawMesh parse_ply(const fs::path& file, std::string_view text) {
 }  // namespace
 
 std::vector<char> read_file_maybe_gz(const std::filesystem::path& file) {
+  // /dev/zero, a FIFO or a folder would be read for ever, or block.
+  require_regular_file(file, "a mesh");
+  const std::uint64_t limit = memory_limit_bytes();
+  std::error_code size_error;
+  if (const std::uintmax_t bytes = std::filesystem::file_size(file, size_error); !size_error && bytes > limit)
+    fail(file, "the file has " + std::to_string(bytes / (1024 * 1024)) + " MB, more than the memory limit" +
+                   memory_limit_note());
   errno = 0;
   const std::unique_ptr<gzFile_s, int (*)(gzFile)> gz(gzopen(file.string().c_str(), "rb"), gzclose);
   if (!gz) fail(file, std::string("cannot open file: ") + (errno ? std::strerror(errno) : "out of memory"));
@@ -758,6 +854,10 @@ std::vector<char> read_file_maybe_gz(const std::filesystem::path& file) {
     }
     if (n == 0) break;
     size += static_cast<std::size_t>(n);
+    // Counted as it inflates: a small .gz may expand to any size.
+    if (size > limit)
+      fail(file, "decompresses to more than " + std::to_string(limit / (1024 * 1024)) + " MB, the memory limit" +
+                     memory_limit_note());
   }
   data.resize(size);
   return data;

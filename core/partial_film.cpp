@@ -1,6 +1,7 @@
 #include "core/partial_film.h"
 
 #include "core/error.h"
+#include "core/temp_files.h"
 
 #include <nlohmann/json.hpp>
 #include <xxhash.h>
@@ -267,6 +268,15 @@ void write_partial_film(const Film& film, const PartialFilmInfo& pf, const fs::p
   // Beside the target, so that the rename stays within one file system.
   fs::path tmp = path;
   tmp += ".tmp-" + std::to_string(::getpid());
+  // The folder only now that there is something to write (ensure_writable
+  // checked it could be made); what a killed writer left (kill -9) goes, and
+  // a signal removes this one (core/temp_files.h).
+  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  if (std::error_code made; !fs::create_directories(parent, made) && made)
+    throw InputError(path.string() + ": cannot write output: cannot create folder " + parent.string() + ": " +
+                     made.message());
+  remove_stale_temp_files(parent, path.filename().string() + ".tmp-");
+  const TempFileRegistration registered(tmp);
   try {
     HashedWriter w(tmp, path);
     w.write(kMagic, sizeof kMagic);
@@ -292,7 +302,7 @@ void write_partial_film(const Film& film, const PartialFilmInfo& pf, const fs::p
     throw SystemError(path.string() + ": could not replace it with the new partial film: " + ec.message());
   }
   // The rename itself reaches the disk with the folder's entry.
-  const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  const fs::path& folder = parent;
   if (const int dir = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dir >= 0) {
     ::fsync(dir);
     ::close(dir);

@@ -6,6 +6,7 @@
 #include "core/geometry.h"
 #include "core/gltf_loader.h"
 #include "core/json_document.h"
+#include "core/scene_limits.h"
 #include "core/scene_loader_internal.h"
 #include "core/tangents.h"
 
@@ -34,7 +35,9 @@ CameraDesc read_camera(const Node& node) {
   node.allow_only({"position", "look_at", "up", "fov_y", "aperture_radius", "focus_distance"});
   CameraDesc c;
   c.position = node.required("position").vector3();
+  if (!within_scene_range(c.position)) node.child("position").fail("the camera lies beyond the scene coordinate limit " + kRangeRule);
   c.look_at = node.required("look_at").vector3();
+  if (!within_scene_range(c.look_at)) node.child("look_at").fail("look_at lies beyond the scene coordinate limit " + kRangeRule);
   if (node.has("up")) c.up = node.child("up").vector3();
   const vec3 view = c.look_at - c.position;
   if (!is_finite(view) || !std::isfinite(glm::length(view)))
@@ -49,8 +52,12 @@ CameraDesc read_camera(const Node& node) {
   if (!(c.fov_y_degrees > 0.0f && c.fov_y_degrees < 180.0f)) node.child("fov_y").fail("fov_y must lie in (0, 180) degrees");
   c.aperture_radius = static_cast<float>(node.number_or("aperture_radius", 0.0));
   if (c.aperture_radius < 0.0f) node.child("aperture_radius").fail("aperture_radius must not be negative");
+  if (!within_scene_range(glm::abs(c.position) + vec3(c.aperture_radius)))
+    node.child("aperture_radius").fail("the aperture reaches beyond the scene coordinate limit " + kRangeRule);
   c.focus_distance = static_cast<float>(node.number_or("focus_distance", glm::length(c.look_at - c.position)));
   if (!(c.focus_distance > 0.0f)) node.child("focus_distance").fail("focus_distance must be positive");
+  if (!(c.focus_distance <= kMaxSceneCoordinate))
+    node.child("focus_distance").fail("focus_distance exceeds the scene coordinate limit " + kRangeRule);
   return c;
 }
 
@@ -137,7 +144,8 @@ RenderSettings read_render(const Node& node) {
   }
   if (node.has("texture_cache_mb")) {
     r.texture_cache_mb = static_cast<float>(node.child("texture_cache_mb").number());
-    if (!(r.texture_cache_mb >= 1.0f)) node.child("texture_cache_mb").fail("texture_cache_mb must be at least 1 (megabytes)");
+    if (!(r.texture_cache_mb >= 1.0f && r.texture_cache_mb <= 1.0e6f))
+      node.child("texture_cache_mb").fail("texture_cache_mb must lie in [1, 1e6] (megabytes), as --texture-cache-mb");
   }
   if (node.has("clamp")) {
     r.clamp = static_cast<float>(node.child("clamp").number());
@@ -426,8 +434,8 @@ void read_instances(const Node& node, Scene* scene) {
       const mat4 xf = read_transform(where);
       if (!invertible_placement(xf))
         where.fail("the transform is singular or not finite (determinant " +
-                   std::to_string(glm::determinant(mat3(xf))) + ")");
-      if (!placed_finite(box, xf)) where.fail("the transform moves the group beyond the float range (about 3.4e38)");
+                   format_number(glm::determinant(mat3(xf))) + ")");
+      if (!placed_in_range(box, xf)) where.fail("the transform moves the group beyond the scene coordinate limit " + kRangeRule);
       scene->instances.push_back({index, xf, description});
     };
     if (item.has("transform") == item.has("transforms"))
@@ -458,6 +466,7 @@ void read_gltf_shape(const Node& node, Scene& scene, const std::filesystem::path
   const std::filesystem::path path = resolve_scene_path(folder, file.string());
   if (names_data_file(file.string()) && !std::filesystem::exists(path))
     file.fail(file.string() + ": " + path.string() + " does not exist; " + data_directory_hint());
+  require_regular(file, path, "glTF file");
   // The overrides are read before the file, so that the loader knows which
   // materials will be lights (meshes with one are never grouped).
   std::optional<std::uint32_t> all;
@@ -528,10 +537,11 @@ std::shared_ptr<const EnvironmentMap> read_environment_map(const Node& l, const 
   const std::filesystem::path path = resolve_scene_path(folder, file.string());
   if (names_data_file(file.string()) && !std::filesystem::exists(path))
     file.fail(file.string() + ": " + path.string() + " does not exist; " + data_directory_hint());
+  require_regular(file, path, "environment image");
   float scale = 1.0f;
   if (l.has("scale")) {
     scale = static_cast<float>(l.child("scale").number());
-    if (!(scale >= 0.0f)) l.child("scale").fail("scale must be >= 0, found " + l.child("scale").value().dump());
+    if (!(scale >= 0.0f)) l.child("scale").fail("scale must be >= 0, found " + format_number(scale));
   }
   // Directions only: a rotation (a mirror too) keeps solid angles, so the
   // map's density stays a density; a scale or shear would not, and a
@@ -570,11 +580,15 @@ void read_lights(const Node& node, Scene* scene, const std::filesystem::path& fo
     if (type == "point") {
       l.allow_only({"type", "position", "intensity"});
       scene->delta_lights.push_back({l.required("position").vector3(), l.required("intensity").color(false)});
+      if (!within_scene_range(scene->delta_lights.back().position))
+        l.child("position").fail("the light lies beyond the scene coordinate limit " + kRangeRule);
     } else if (type == "spot") {
       l.allow_only({"type", "position", "direction", "look_at", "intensity", "cone_angle", "falloff_start"});
       DeltaLight spot;
       spot.kind = DeltaLight::Kind::Spot;
       spot.position = l.required("position").vector3();
+      if (!within_scene_range(spot.position))
+        l.child("position").fail("the light lies beyond the scene coordinate limit " + kRangeRule);
       spot.intensity = l.required("intensity").color(false);
       if (l.has("direction") == l.has("look_at")) l.fail("a spot light needs exactly one of 'direction' and 'look_at'");
       const Node aim = l.has("direction") ? l.child("direction") : l.child("look_at");

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/json_document.h"
+#include "core/messages.h"
 #include "core/scene.h"
 
 #include <algorithm>
@@ -25,13 +26,12 @@ namespace pathlab::scene_detail {
 using json = nlohmann::json;
 using Pointer = json::json_pointer;
 
+// Why positions have a limit, for messages (core/geometry.h).
+inline const std::string kRangeRule = "1e16 (docs/scene-format.md: every ray must stay within Embree's 1.8e18)";
+
 // A name from the file, quoted for a one-line message: control characters
 // become '?' and very long names are cut.
-inline std::string in_quotes(std::string_view name) {
-  std::string out(name.substr(0, 60));
-  std::replace_if(out.begin(), out.end(), [](char c) { return static_cast<unsigned char>(c) < 0x20; }, '?');
-  return "'" + out + (name.size() > 60 ? "...'" : "'");
-}
+inline std::string in_quotes(std::string_view name) { return quote_input(name); }
 
 // " (did you mean 'x'?)" if one of `candidates` is close to `name`, else "".
 inline std::string suggestion(std::string_view name, std::span<const std::string_view> candidates) {
@@ -46,12 +46,13 @@ inline std::string describe(const json& v) {
     case json::value_t::array: return "an array of " + std::to_string(v.size());
     case json::value_t::string: {
       const std::string& s = v.get_ref<const std::string&>();
-      return "the string " + (s.size() <= 40 ? v.dump() : "\"" + s.substr(0, 40) + "...\"");
+      if (s.size() <= 60) return "the string " + v.dump();
+      return "the string \"" + shorten_input(s).insert(60, "\"");
     }
     case json::value_t::null: return "null";
     case json::value_t::boolean: return v.get<bool>() ? "true" : "false";
     case json::value_t::discarded: return "nothing";
-    default: return "the number " + v.dump();
+    default: return "the number " + (v.is_number_float() ? format_number(v.get<double>()) : v.dump());
   }
 }
 
@@ -79,7 +80,7 @@ class Node {
   std::string message(const std::string& problem) const {
     Pointer located = ptr_;
     while (!located.empty() && doc_.position(located).line == 0) located = located.parent_pointer();
-    const std::string path = ptr_.empty() ? std::string("(top level)") : ptr_.to_string();
+    const std::string path = ptr_.empty() ? std::string("(top level)") : shorten_input(ptr_.to_string());
     return doc_.where(located) + ": " + path + ": " + problem;
   }
   [[noreturn]] void fail(const std::string& problem) const { throw InputError(message(problem)); }
@@ -103,13 +104,13 @@ class Node {
     const double v = value_.get<double>();
     if (!std::isfinite(v)) fail("number is not finite");
     if (std::abs(v) > std::numeric_limits<float>::max())
-      fail("number " + value_.dump() + " is too large (the limit is 3.4e38)");
+      fail("number " + format_number(v) + " is too large (the limit is 3.4e38)");
     return v;
   }
   std::int64_t integer() const {
     if (!value_.is_number_integer()) fail("expected an integer, found " + describe(value_));
     if (value_.is_number_unsigned() && value_.get<std::uint64_t>() > static_cast<std::uint64_t>(INT64_MAX))
-      fail("integer " + value_.dump() + " is too large");
+      fail("integer " + quote_input(value_.dump()) + " is too large");
     return value_.get<std::int64_t>();
   }
   std::string string() const {
@@ -160,6 +161,10 @@ class Node {
   Pointer ptr_;
   const json& value_;
 };
+
+// Fails at `at` if `path` exists and is a device, a FIFO or a folder, which
+// would be read for ever or block ("<what> <path> must be a regular file").
+void require_regular(const Node& at, const std::filesystem::path& path, const std::string& what);
 
 // One transform step, or a list applied in order (the first listed is
 // applied to the shape first).

@@ -4,7 +4,9 @@
 #include "core/data_dir.h"
 #include "core/error.h"
 #include "core/geometry.h"
+#include "core/limits.h"
 #include "core/mesh.h"
+#include "core/scene_limits.h"
 #include "core/scene_loader_internal.h"
 
 #include <optional>
@@ -162,7 +164,9 @@ void place(const Node& node, Scene& scene, const mat4& xf, Shape& shape) {
   const Node where = node.has("transform") ? node.child("transform") : node;
   const std::size_t dropped = transform_mesh(&shape.mesh, xf);
   for (const vec3& p : shape.mesh.positions)
-    if (!is_finite(p)) where.fail("the transform moves vertices beyond the float range (about 3.4e38)");
+    if (!within_scene_range(p))
+      where.fail(node.has("transform") ? "the transform moves vertices beyond the scene coordinate limit " + kRangeRule
+                                       : "a vertex lies beyond the scene coordinate limit " + kRangeRule);
   if (dropped > 0 && !shape.mesh.triangles.empty())
     scene.warnings.push_back(where.message(shape.description + ": the transform made " + std::to_string(dropped) +
                                            " triangle(s) degenerate; dropped"));
@@ -174,6 +178,11 @@ void place(const Node& node, Scene& scene, const mat4& xf, Shape& shape) {
 }
 
 }  // namespace
+
+void require_regular(const Node& at, const std::filesystem::path& path, const std::string& what) {
+  if (const std::string kind = special_file_kind(path); !kind.empty())
+    at.fail(what + " " + path.string() + " must be a regular file, not " + kind);
+}
 
 std::uint32_t material_index(const Node& node, const std::map<std::string, std::uint32_t>& materials) {
   const std::string name = node.string();
@@ -218,6 +227,8 @@ void read_shape(const Node& node, Scene& scene, const std::filesystem::path& fol
     shape.center = node.has("center") ? node.child("center").vector3() : vec3(0.0f);
     shape.radius = static_cast<float>(node.number_or("radius", 1.0));
     if (!(shape.radius > 0.0f)) node.child("radius").fail("radius must be positive");
+    if (!(shape.radius >= kMinSphereRadius && shape.radius <= kMaxSceneCoordinate))
+      node.child("radius").fail("radius must lie in [1e-18, 1e16] (a smaller one squares to a denormal or zero)");
     // A sphere stays a sphere only under rotation, uniform scale, translation.
     const mat3 l(xf);
     const float sx = glm::length(l[0]), sy = glm::length(l[1]), sz = glm::length(l[2]);
@@ -228,11 +239,13 @@ void read_shape(const Node& node, Scene& scene, const std::filesystem::path& fol
     shape.center = vec3(xf * vec4(shape.center, 1.0f));
     shape.radius *= sx;
     const Node where = node.has("transform") ? node.child("transform") : node.child("radius");
-    if (!is_finite(shape.center) || !std::isfinite(shape.radius))
-      where.fail("the sphere lies beyond the float range after its transform");
     if (!(shape.radius > 0.0f))
       where.fail(std::string(scene.materials[shape.material].emits() ? "zero-area light: " : "") +
                  "the sphere's radius is zero after its transform");
+    if (!(shape.radius >= kMinSphereRadius && shape.radius <= kMaxSceneCoordinate))
+      where.fail("the sphere's radius after its transform must lie in [1e-18, 1e16]");
+    if (!within_scene_range(glm::abs(shape.center) + vec3(shape.radius)))
+      where.fail("the sphere reaches beyond the scene coordinate limit " + kRangeRule);
     scene.shapes.push_back(std::move(shape));
     return;
   }

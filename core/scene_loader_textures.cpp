@@ -3,6 +3,7 @@
 // "Textures").
 #include "core/data_dir.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/scene_loader_internal.h"
 
 #include <OpenImageIO/imageio.h>
@@ -69,6 +70,7 @@ TextureRef read_texture(const Node& node, Scene& scene, TextureUse use, TextureC
   // lacks, is reported at the key that names it.
   if (names_data_file(file.string()) && !std::filesystem::exists(path))
     file.fail(file.string() + ": " + path.string() + " does not exist; " + data_directory_hint());
+  require_regular(file, path, "texture");
   if (!std::filesystem::is_regular_file(path)) file.fail("texture " + path.string() + " does not exist");
   int channels = 0;
   {

@@ -4,6 +4,7 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "core/scene_limits.h"
 #include "core/strategy_weights.h"
 
 namespace pathlab {
@@ -32,6 +33,8 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
   Surfel s;
   ++path.rays;
   if (!scene.intersect(ray, &s, path.cone, path.params)) {
+    // A ray Embree refuses (NaN or beyond 1.8e18) makes the sample bad.
+    if (!embree_accepts(ray)) return Spectrum(std::numeric_limits<float>::quiet_NaN());
     const LightSampler::Sky sky = scene.lights().sky(ray.dir);
     const Spectrum Le = sky.Le;
     const float w = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, sky.pdf);

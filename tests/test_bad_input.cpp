@@ -829,7 +829,7 @@ TEST_F(BadInput, SingularOrHugeInstanceTransform) {
                   {"singular.json:", "/instances/0/transforms/1", "singular or not finite"});
   const std::string huge = scene(kMaterials, kLamp, kGroup + ",\n  \"instances\": [{\"group\": \"ball\", \"transform\": "
                                                       "[{\"scale\": [2e38, 1e-38, 1]}, {\"translate\": [3e38, 0, 0]}]}]");
-  expect_rejected(render(write("huge.json", huge)), {"huge.json:", "/instances/0/transform", "beyond the float range"});
+  expect_rejected(render(write("huge.json", huge)), {"huge.json:", "/instances/0/transform", "beyond the scene coordinate limit 1e16"});
   const std::string both = scene(kMaterials, kLamp, kGroup + ",\n  \"instances\": [{\"group\": \"ball\"}]");
   expect_rejected(render(write("both.json", both)), {"both.json:", "/instances/0", "exactly one of 'transform'"});
 }

@@ -179,12 +179,15 @@ TEST_F(ImageIoTest, WriteCreatesNestedFolders) {
   EXPECT_EQ(list_folder(png.parent_path()), std::vector<std::string>{"out.png"});
 }
 
-TEST_F(ImageIoTest, EnsureWritableCreatesFolderAndLeavesNoProbe) {
+// The folder is made only by the write itself: a render that fails after
+// the check leaves no empty folder.
+TEST_F(ImageIoTest, EnsureWritableCreatesNoFolderAndLeavesNoProbe) {
   const fs::path file = dir_ / "x" / "y" / "render.exr";
   ensure_writable(file);
-  EXPECT_TRUE(fs::is_directory(file.parent_path()));
-  EXPECT_TRUE(list_folder(file.parent_path()).empty());
-  EXPECT_FALSE(fs::exists(file));
+  EXPECT_FALSE(fs::exists(dir_ / "x"));
+  EXPECT_TRUE(list_folder(dir_).empty());
+  write_exr(file, Image(1, 1), {});
+  EXPECT_EQ(list_folder(file.parent_path()), std::vector<std::string>{"render.exr"});
 }
 
 TEST_F(ImageIoTest, WriteUnderRegularFileThrowsInputError) {

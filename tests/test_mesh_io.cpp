@@ -308,7 +308,7 @@ TEST_F(MeshIoErrors, FileProblems) {
   expect_input_error(dir_ / "missing.ply", {"cannot open", "No such file or directory"});
   expect_input_error(dir_ / "missing.obj.gz", {"cannot open", "No such file or directory"});
   fs::create_directories(dir_ / "folder.ply");
-  expect_input_error(dir_ / "folder.ply", {"cannot read", "Is a directory"});
+  expect_input_error(dir_ / "folder.ply", {"a mesh must be a regular file, not a folder"});
 
   std::string packed;
   {

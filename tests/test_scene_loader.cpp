@@ -758,14 +758,14 @@ TEST(SceneLoaderErrors, ZeroAreaLights) {
   EXPECT_EQ(error_of(plain).find("light"), std::string::npos) << error_of(plain);
   // A sphere light whose radius underflows under its transform.
   const std::string sphere = scene_text(
-      kMaterials, R"([{"type": "sphere", "material": "lamp", "radius": 1e-30, "transform": {"scale": 1e-30}}])");
+      kMaterials, R"([{"type": "sphere", "material": "lamp", "radius": 1e-10, "transform": [{"scale": 1e-30}, {"scale": 1e-30}]}])");
   expect_error(sphere, where_in(sphere, "\"transform\""), "/shapes/0/transform", "zero-area light: the sphere's radius is zero");
   // A sphere light of radius 0.
   const std::string zero = scene_text(kMaterials, R"([{"type": "sphere", "material": "lamp", "radius": 0}])");
   expect_error(zero, where_in(zero, "\"radius\""), "/shapes/0/radius", "radius must be positive");
   // Vertices pushed to infinity are not reported as a zero area.
   const std::string far = scene_text(kMaterials, R"([{"type": "rectangle", "material": "lamp", "transform": [{"scale": 3e38}, {"scale": 10}]}])");
-  EXPECT_NE(error_of(far).find("/shapes/0/transform: the transform moves vertices beyond the float range"), std::string::npos)
+  EXPECT_NE(error_of(far).find("/shapes/0/transform: the transform moves vertices beyond the scene coordinate limit 1e16"), std::string::npos)
       << error_of(far);
 }
 

@@ -14,6 +14,8 @@
 
 #include <immintrin.h>
 
+#include <limits>
+
 namespace pathlab::vector_stages {
 namespace {
 
@@ -373,7 +375,14 @@ void add_emission(const Scene& sc, const Wave& w) {
     const V3 beta = load3(w, kBetaR, i0, in);
     const V3 L = load3(w, kLR, i0, in);
     // Escaped: no environment, so Le = 0 and its weight 0; L += beta * (0 * 0).
+    // A ray the accel refused (t = NaN) makes the sample bad (NaN).
     V3 L_new = add(L, mul(beta, mul(k(0.0f), zero)));
+    if (const M refused = in & ~found & _mm512_cmp_ps_mask(load(w, kHitT, i0, in & ~found), k(0.0f), _CMP_UNORD_Q);
+        refused != 0) {
+      const F nan = k(std::numeric_limits<float>::quiet_NaN());
+      L_new = V3{_mm512_mask_mov_ps(L_new.x, refused, nan), _mm512_mask_mov_ps(L_new.y, refused, nan),
+                 _mm512_mask_mov_ps(L_new.z, refused, nan)};
+    }
     M alive = 0;
     if (found != 0) {
       // Surfel::emitted.

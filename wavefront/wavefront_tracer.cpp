@@ -3,12 +3,14 @@
 #include "core/faults.h"
 #include "core/parallel.h"
 #include "core/rng.h"
+#include "core/scene_limits.h"
 #include "core/strategy_weights.h"
 #include "wavefront/vector_stages.h"
 
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <limits>
 #include <cstddef>
 #include <limits>
 #include <stdexcept>
@@ -353,6 +355,11 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
   for (std::size_t i = 0; i < w.n; ++i) {
     const Surfel& s = w.surfel[i];
     if (!w.found[i]) {
+      if (!embree_accepts(w.ray[i])) {  // refused by the accel: a bad sample, as in the reference tracer
+        w.L[i] = Spectrum(std::numeric_limits<float>::quiet_NaN());
+        w.alive[i] = 0;
+        continue;
+      }
       const LightSampler::Sky sky = scene_.lights().sky(w.ray[i].dir);
       const Spectrum Le = sky.Le;
       const float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], sky.pdf);

@@ -1,13 +1,34 @@
 #include "apps/cli/cli.h"
 
 #include "apps/cli/commands.h"
+#include "apps/cli/interrupt.h"
+#include "apps/cli/validators.h"
 #include "core/error.h"
+#include "core/json_document.h"
+#include "core/messages.h"
 
+#include <algorithm>
 #include <iostream>
+#include <string>
+#include <string_view>
+#include <vector>
 
 namespace pathlab::cli {
+namespace {
 
-int run(int argc, const char* const* argv) { return run(argc, argv, std::cout, std::cerr); }
+// The finite-number check on every floating-point option (validators.h).
+void require_finite_numbers(CLI::App& app) {
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    for (CLI::Option* option : sub->get_options())
+      if (option->get_type_name().starts_with("FLOAT")) option->check(finite_number());  // "FLOAT:[0, 1]" too
+}
+
+}  // namespace
+
+int run(int argc, const char* const* argv) {
+  remove_temp_files_on_signals();
+  return run(argc, argv, std::cout, std::cerr);
+}
 
 int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err) {
   CLI::App app("pathlab: get path tracing right, then fast", "pathlab");
@@ -28,6 +49,25 @@ int run(int argc, const char* const* argv, std::ostream& out, std::ostream& err)
   converge.add_to(app);
   compare.add_to(app);
   render.command_line = trace_pixel.command_line = shell_command_line(argc, argv);
+  require_finite_numbers(app);
+
+  // A first word that is no command: CLI11 would say only "A subcommand is
+  // required". Name it, and the command it is closest to.
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string word = argv[1];
+    std::vector<std::string> names;
+    for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) names.push_back(sub->get_name());
+    if (std::find(names.begin(), names.end(), word) == names.end()) {
+      const std::vector<std::string_view> candidates(names.begin(), names.end());
+      const std::string near = nearest_name(word, candidates);
+      std::string list;
+      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+      err << "pathlab: error: unknown command " << quote_input(word)
+          << (near.empty() ? " (the commands: " + list + ")" : " (did you mean '" + near + "'?)") << "\n";
+      err << "Run 'pathlab --help' for the commands.\n";
+      return 2;
+    }
+  }
 
   try {
     app.parse(argc, argv);

@@ -3,6 +3,7 @@
 // statistics whether they agree (analytic-scenes/check.h). Exit 0 pass,
 // 1 fail, 2 bad input.
 #include "apps/cli/commands.h"
+#include "apps/cli/validators.h"
 
 #include "analytic-scenes/check.h"
 #include "analytic-scenes/expected_image.h"
@@ -23,7 +24,7 @@ void CheckCommand::add_to(CLI::App& app) {
   cmd->add_option("--out", out_dir, "Folder for the rendered, expected, error and z-score EXRs on failure; "
                                     "default out/check-<scene>");
   cmd->add_option("--threads", threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
-  cmd->add_option("--alpha", alpha, "Family-wise false-alarm rate of the tests")->check(CLI::Range(1e-12, 0.5));
+  cmd->add_option("--alpha", alpha, "Family-wise false-alarm rate of the tests")->check(number_range(1e-12, 0.5));
   cmd->callback([this] { selected = true; });
 }
 

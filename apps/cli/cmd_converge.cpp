@@ -2,6 +2,7 @@
 //                  [--spp 1,4,16,...] [--time-budgets SEC,...] [--seeds R] [--clamps C,...]
 //                  [--max-depths D,...] [--exclude-emitters] [--target-rmse X] [--threads N] --out DIR
 #include "apps/cli/commands.h"
+#include "apps/cli/validators.h"
 
 #include "core/error.h"
 #include "core/image_io.h"
@@ -24,14 +25,18 @@ void ConvergeCommand::add_to(CLI::App& app) {
   cmd->add_option("--spp", options.spp, "The samples-per-pixel ladder, increasing, comma-separated")
       ->delimiter(',')
       ->check(CLI::Range(1, 1 << 24));
-  cmd->add_option("--time-budgets", options.time_budgets, "Wall-clock budgets in seconds, comma-separated")->delimiter(',');
+  cmd->add_option("--time-budgets", options.time_budgets, "Wall-clock budgets in seconds, comma-separated")
+      ->delimiter(',')
+      ->check(positive_number());
   cmd->add_option("--seeds", options.seeds, "Independent seeds per budget (R)")->check(CLI::Range(1, 1000));
-  cmd->add_option("--clamps", options.clamps, "Radiance clamps to compare, comma-separated (0 = off)")->delimiter(',');
+  cmd->add_option("--clamps", options.clamps, "Radiance clamps to compare, comma-separated (0 = off)")
+      ->delimiter(',')
+      ->check(number_range(0.0, 3.4e38));
   cmd->add_option("--max-depths", options.max_depths, "Depth caps to compare against the uncapped answer, comma-separated")
       ->delimiter(',');
   cmd->add_flag("--exclude-emitters", options.exclude_emitters, "Leave out pixels that see an emitter directly");
   cmd->add_option("--target-rmse", target_rmse, "Report which configuration reaches this RMSE first")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--resolution", resolution, "Image size WxH (the reference EXR must match it)");
   cmd->add_option("--threads", threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
   cmd->add_option("--out", out_dir, "Folder for converge.csv, converge.md and the SVG plots")->required();

@@ -4,6 +4,7 @@
 // or checkpoints) into its image: the same bits as one process rendering
 // every pass (docs/overnight.md).
 #include "apps/cli/commands.h"
+#include "apps/cli/validators.h"
 
 #include "core/error.h"
 #include "core/image_io.h"
@@ -20,7 +21,7 @@ void MergeCommand::add_to(CLI::App& app) {
       ->required();
   cmd->add_option("-o,--output", output, "Output EXR (a tone-mapped PNG is written beside it)")->required();
   cmd->add_option("--film", film, "Also write the merged partial film here (to merge or resume further)");
-  cmd->add_option("--exposure", exposure, "Exposure of the PNG, in stops");
+  cmd->add_option("--exposure", exposure, "Exposure of the PNG, in stops")->check(number_range(-64.0, 64.0));
   cmd->add_flag("-q,--quiet", quiet, "Print only warnings and errors");
   cmd->callback([this] { selected = true; });
 }

@@ -5,15 +5,18 @@
 //                [--checkpoint FILE [--checkpoint-every S]] [--resume FILE] [--passes A..B]
 //                (-o part.pfilm writes the partial film instead of an image: docs/overnight.md)
 #include "apps/cli/commands.h"
+#include "apps/cli/validators.h"
 
 #include "apps/cli/interrupt.h"
 #include "apps/cli/progress.h"
 #include "core/compiled_scene.h"
 #include "core/error.h"
 #include "core/image_io.h"
+#include "core/limits.h"
 #include "core/partial_film.h"
 #include "core/parallel.h"
 #include "core/render.h"
+#include "core/scene_limits.h"
 #include "debugtools/aov.h"
 #include "debugtools/bounce_aov.h"
 #include "debugtools/stage_buffers.h"
@@ -61,17 +64,17 @@ void RenderCommand::add_to(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::IsMember(aov_names));
   cmd->add_option("--threads", threads, "Worker threads (0 = all)")->check(CLI::Range(0, 4096));
-  cmd->add_option("--exposure", exposure, "Exposure of the PNG, in stops");
+  cmd->add_option("--exposure", exposure, "Exposure of the PNG, in stops")->check(number_range(-64.0, 64.0));
   cmd->add_option("--time", time_budget, "Stop at this wall-clock budget (whole passes); --spp is then a cap")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--target-relmse", target_relmse,
                   "Stop when the relative MSE estimated from per-pixel variance falls below X; --spp is then a cap")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--checkpoint", checkpoint,
                   "Keep the render's state in FILE (a partial film), rewritten atomically every --checkpoint-every "
                   "seconds, on Ctrl-C / SIGTERM and at the end; --resume FILE goes on from it");
   cmd->add_option("--checkpoint-every", checkpoint_every, "Seconds between checkpoints (default 600)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   cmd->add_option("--resume", resume, "Go on from this checkpoint (same scene, files and settings) to the same bits");
   cmd->add_option("--passes", passes,
                   "Render only sample passes A..B (sample indices A to B-1 of every pixel); with -o X.pfilm the "
@@ -165,6 +168,18 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     throw InputError("--time and --target-relmse are not supported under mpirun yet; give --spp");
   if (job.distributed() && !layers.empty())
     throw InputError("--aov is not supported under mpirun yet (the AOV buffers are not reduced over ranks)");
+  // The film and what is written from it, before anything is allocated or a
+  // folder made (core/limits.h): per pixel the film's sums (56 bytes), its
+  // second moments (48) when kept, a splatting filter's sums (80), the image
+  // and its PNG (15), and each AOV's buffer and channels (64).
+  {
+    const bool moments = progressive || variance_aov;
+    const std::uint64_t per_pixel = 56 + (moments ? 48 : 0) + (s.film.filter == FilterKind::Box ? 0 : 80) + 15 +
+                                    64 * static_cast<std::uint64_t>(layers.size());
+    check_memory(static_cast<std::uint64_t>(s.film.width) * static_cast<std::uint64_t>(s.film.height) * per_pixel,
+                 "the " + std::to_string(s.film.width) + "x" + std::to_string(s.film.height) + " film" +
+                     (layers.empty() ? std::string() : " with " + std::to_string(layers.size()) + " AOV(s)"));
+  }
   const std::uint32_t spp = static_cast<std::uint32_t>(std::max(s.render.spp, 0));
   const PassRange range = passes ? parse_passes(*passes) : PassRange{0, spp};
 
@@ -379,6 +394,10 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
         << "\n";
   }
 
+  if (const std::uint64_t refused = embree_rejected_rays(); refused > 0)
+    err << "pathlab: warning: " << refused
+        << " ray(s) were NaN or beyond 1.8e18 and were not traced (Embree would abort on them); their samples "
+           "count as bad samples\n";
   if (stats.bad_samples > 0) {
     err << "pathlab: warning: " << stats.bad_samples
         << " sample(s) had NaN, infinite or out-of-range (>= 2^32) radiance and were left out of the image. "

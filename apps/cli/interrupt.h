@@ -7,6 +7,12 @@
 
 namespace pathlab::cli {
 
+// For the whole process: SIGINT, SIGTERM and SIGHUP remove the temporary
+// files of writes in progress (core/temp_files.h) and then end it as they do
+// by default. An InterruptGuard replaces this while it lives (and removes
+// them on its second signal). Called once by the pathlab binary's run().
+void remove_temp_files_on_signals();
+
 class InterruptGuard {
  public:
   InterruptGuard();

@@ -1,5 +1,7 @@
 #include "apps/cli/scene_options.h"
 
+#include "apps/cli/validators.h"
+
 #include "core/compiled_scene.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
@@ -30,16 +32,16 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
   cmd.add_option("--bsdf-sampling", bsdf_sampling, "Glossy lobe sampling: vndf (exact GGX visible normals) or cospow")
       ->check(CLI::IsMember({"vndf", "cospow"}));
   cmd.add_option("--clamp", clamp, "Clamp each sample's radiance to this maximum component (biased; 0 = off)")
-      ->check(CLI::Range(0.0f, 3.4e38f));
+      ->check(number_range(0.0, 3.4e38));
   cmd.add_option("--min-pdf", min_pdf, "Discard BSDF samples with a smaller density (biased; 0 = off)")
-      ->check(CLI::Range(0.0f, 3.4e38f));
+      ->check(number_range(0.0, 3.4e38));
   cmd.add_option("--bvh", bvh, "Embree's BVH: fast, or compact (less memory, slower; the same image)")
       ->check(CLI::IsMember({"fast", "compact"}));
   cmd.add_option("--texture-filter", texture_filter,
                  "Texture lookups: cone (filtered over the ray cone's footprint) or point (the finest level)")
       ->check(CLI::IsMember({"cone", "point"}));
   cmd.add_option("--texture-cache-mb", texture_cache_mb, "OpenImageIO's texture tile cache, in MB")
-      ->check(CLI::Range(1.0f, 1.0e6f));
+      ->check(number_range(1.0, 1.0e6));
   cmd.add_flag("--general-shading", general_shading,
                "Shade every material through the general Disney-capable code instead of code specialised to the "
                "scene's lobes (same image, slower)");
