@@ -40,6 +40,10 @@ class BounceAccumulator;
 enum class Aov : std::uint8_t { Albedo, Normal, Depth, Material, Variance, PathLength, Bounces };
 inline constexpr Aov kAllAovs[] = {Aov::Albedo,   Aov::Normal,     Aov::Depth,  Aov::Material,
                                    Aov::Variance, Aov::PathLength, Aov::Bounces};
+// The layers AovAccumulator gathers by itself, alongside any render (the
+// GUI's progressive render shows these; Bounces needs a BounceTracer pass).
+inline constexpr Aov kAccumulatedAovs[] = {Aov::Albedo,   Aov::Normal,   Aov::Depth,
+                                           Aov::Material, Aov::Variance, Aov::PathLength};
 const char* aov_name(Aov a);  // "albedo", "normal", "depth", "material", "variance", "pathlength", "bounces"
 std::optional<Aov> parse_aov(std::string_view name);
 

@@ -352,7 +352,16 @@ struct JsonEvents {
       const std::string kind = text(e, "kind");
       l.delta = kind != "area" && kind != "environment";
       l.infinite = kind == "environment";
-      l.light = static_cast<std::uint32_t>(integer(e, "light"));
+      // A light sample the sampler did not give (rejected "no_sample") names no light.
+      l.light = field(e, "light").is_null() ? 0u : static_cast<std::uint32_t>(integer(e, "light"));
+      // "rejected" is absent from the traces of builds older than it.
+      const nlohmann::json rejected = e.contains("rejected") ? e["rejected"] : nlohmann::json(nullptr);
+      if (!rejected.is_null()) {
+        bool known = false;
+        for (LightRejection r : {LightRejection::NoSample, LightRejection::BelowSurface, LightRejection::BlackBsdf})
+          if (rejected.is_string() && rejected.get<std::string>() == light_rejection_name(r)) l.rejected = r, known = true;
+        if (!known) fail("unknown light rejection " + rejected.dump());
+      }
       l.point = v3(e, "point");
       l.wi = v3(e, "wi");
       l.pdf = num(e, "pdf");

@@ -190,7 +190,8 @@ TEST_F(DebugGui, ScriptedSessionExportsThePathAndShowsTheImageWithItsOverlay) {
   vtkPolyData* poly = reader->GetOutput();
   std::size_t lights = 0, path_points = 0;
   for (const PathEvent& e : want.events()) {
-    lights += std::holds_alternative<LightEvent>(e);
+    const auto* l = std::get_if<LightEvent>(&e);
+    lights += l != nullptr && l->rejected == LightRejection::None;  // a rejected sample has no shadow ray
     path_points += std::holds_alternative<CameraEvent>(e) || std::holds_alternative<HitEvent>(e) ||
                    std::holds_alternative<EscapeEvent>(e);
   }

@@ -67,7 +67,7 @@ TEST_F(FaultLocation, CompareFindsALostMisWeightAtDepth2) {
   EXPECT_FALSE(d.identical);
   EXPECT_FALSE(d.rounding) << d.reason;
   EXPECT_EQ(d.vertex, 3);
-  EXPECT_NE(d.reason.find("emission added differs"), std::string::npos) << d.reason;
+  EXPECT_NE(d.reason.find("emission added (emission_weight) differs"), std::string::npos) << d.reason;
 
   const BounceComparison b = compare_bounces(render_bounces(reference, spp), render_bounces(wavefront, spp));
   EXPECT_EQ(b.first_depth, 2);

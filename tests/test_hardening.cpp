@@ -476,7 +476,7 @@ TEST(HardeningMessages, UnknownCommandIsNamedWithTheNearest) {
   EXPECT_NE(r.err.find("pathlab: error: unknown command 'rendr' (did you mean 'render'?)"), std::string::npos) << r.err;
   const auto far = run_cli({"xyzzy"});
   EXPECT_EQ(far.code, 2);
-  EXPECT_NE(far.err.find("unknown command 'xyzzy' (the commands: render, merge, check, diff, trace-pixel, converge)"),
+  EXPECT_NE(far.err.find("unknown command 'xyzzy' (the commands: render, merge, check, diff, trace-pixel, converge, compare)"),
             std::string::npos)
       << far.err;
 }

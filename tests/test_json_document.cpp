@@ -260,7 +260,7 @@ TEST_F(JsonDocumentLoad, DirectoryIsNotAScene) {
     (void)JsonDocument::load(dir_);
     FAIL() << "no exception";
   } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()), dir_.string() + ": cannot read scene: Is a directory");
+    EXPECT_EQ(std::string(e.what()), dir_.string() + ": cannot read scene: it is a folder, not a regular file");
   }
 }
 

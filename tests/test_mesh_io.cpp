@@ -371,7 +371,7 @@ TEST_F(MeshIoErrors, PlyMissingVertexCoordinatesOrFaces) {
 TEST_F(MeshIoErrors, PlyTruncated) {
   const std::string text = header_with("comment fine");
   expect_error("faces.ply", text.substr(0, text.size() - 4), {"truncated: expected 1 faces, found 0"});
-  expect_error("vertices.ply", text.substr(0, text.find("0 1 0")), {"truncated: expected 3 vertices, found 2"});
+  expect_error("vertices.ply", text.substr(0, text.find("0 1 0")), {"the header declares 3 vertices, more than the 12 bytes after it can hold"});
   const std::string binary = binary_ply(false, false, "vertex_indices");
   expect_error("binary.ply", binary.substr(0, binary.size() - 5), {"truncated: expected 2 faces, found 1"});
   // 90 bytes of vertices, then 12 bytes per 'skipme' element.
@@ -420,12 +420,12 @@ TEST_F(MeshIoErrors, BinaryPlyNonFiniteCoordinate) {
 // OBJ messages number faces and vertices from 1, like the file does.
 TEST_F(MeshIoErrors, ObjProblems) {
   const std::string verts = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
-  expect_error("zero.obj", verts + "f 0 1 2\n", {"cannot parse OBJ"});
+  expect_error("zero.obj", verts + "f 0 1 2\n", {"zero.obj:5:", "face token '0'", "not a non-zero integer", "valid: 1..4 or -4..-1"});
   expect_error("range.obj", verts + "f 1 2 3\nf 1 2 9\n",
-               {"face 2 refers to vertex 9 but the mesh has 4 vertices"});
-  expect_error("negative.obj", verts + "f 1 2 -9\n", {"face 1 refers to vertex -4 but the mesh has 4 vertices"});
+               {"range.obj:6:", "face token '9'", "vertex index 9 is beyond the 4 vertex(s)"});
+  expect_error("negative.obj", verts + "f 1 2 -9\n", {"negative.obj:5:", "face token '-9'", "vertex index -9 counts back past the 4 vertex(s)"});
   // tinyobj drops a quad with a bad index instead of failing; we still report it.
-  expect_error("quad.obj", verts + "f 1 2 3\nf 1 2 3 9\n", {"vertex", "4 vertices"});
+  expect_error("quad.obj", verts + "f 1 2 3\nf 1 2 3 9\n", {"quad.obj:6:", "face token '9'", "beyond the 4 vertex(s)"});
   // 1e39 overflows float.
   expect_error("huge.obj", verts + "v 1e39 0 0\nf 1 2 3\n", {"vertex 5 has a non-finite coordinate (inf, 0, 0)"});
   expect_error("line.obj", verts + "f 1 2\n", {"fewer than 3 vertices"});

@@ -121,7 +121,7 @@ void Session::worker(std::uint64_t /*generation*/) {
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x)
         snap->samples[static_cast<std::size_t>(y) * w + x] = static_cast<std::uint32_t>(film.sample_count(x, y));
-    std::vector<ExrChannel> channels = aov_channels(film, aovs, kAllAovs);
+    std::vector<ExrChannel> channels = aov_channels(film, aovs, kAccumulatedAovs);
     add_exr_layer(channels, "nonfinite", snap->nonfinite, "Y");
     Image counts(w, h);
     for (std::size_t i = 0; i < pixels; ++i) counts.pixels[i] = vec3(static_cast<float>(snap->samples[i]));
