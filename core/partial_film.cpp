@@ -1,6 +1,7 @@
 #include "core/partial_film.h"
 
 #include "core/error.h"
+#include "core/render.h"
 #include "core/temp_files.h"
 
 #include <nlohmann/json.hpp>
@@ -200,15 +201,9 @@ Fingerprint render_fingerprint(const Scene& scene, std::string_view tracer) {
   f.lines.push_back("setting tracer " + std::string(tracer));
   f.lines.push_back("setting resolution " + std::to_string(scene.film.width) + "x" + std::to_string(scene.film.height));
   f.lines.push_back(std::string("setting filter ") + filter_name(scene.film.filter));
-  f.lines.push_back(std::string("setting strategy ") + strategy_name(r.strategy));
-  f.lines.push_back("setting max_depth " + std::to_string(r.max_depth));
-  f.lines.push_back("setting rr_depth " + std::to_string(r.rr_depth));
-  f.lines.push_back("setting seed " + std::to_string(r.seed));
-  f.lines.push_back(std::string("setting bsdf_sampling ") + bsdf_sampling_name(r.bsdf_sampling));
-  f.lines.push_back("setting clamp " + exact(r.clamp));
-  f.lines.push_back("setting min_pdf " + exact(r.min_pdf));
-  f.lines.push_back(std::string("setting general_shading ") + (r.force_general_shading ? "on" : "off"));
-  f.lines.push_back(std::string("setting bvh ") + (r.compact_bvh ? "compact" : "fast"));
+  // Every setting that changes a sample, as the EXR header records them
+  // (core/render.h: one list, so a new setting cannot be left out here).
+  for (const auto& [key, value] : sample_settings(r)) f.lines.push_back("setting " + key + " " + value);
   std::string all;
   for (const std::string& line : f.lines) all += line + "\n";
   f.digest = hex128(XXH3_128bits(all.data(), all.size()));

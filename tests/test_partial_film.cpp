@@ -391,6 +391,11 @@ TEST_F(PiecesCli, ResumeRefusesAnotherSceneFileMeshSettingOrVersion) {
   EXPECT_NE(r.err.find("setting strategy"), std::string::npos) << r.err;
   r = resume({"--tracer", "wavefront"});
   EXPECT_NE(r.err.find("setting tracer"), std::string::npos) << r.err;
+  // Every setting of sample_settings() is in the fingerprint: the texture
+  // filter was once left out of it, so such a resume was accepted.
+  r = resume({"--texture-filter", "point"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("setting texture_filter"), std::string::npos) << r.err;
   write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1.5 0\nf 1 2 3\n");
   r = resume({});
   EXPECT_EQ(r.code, 2);
