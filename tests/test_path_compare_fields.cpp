@@ -113,6 +113,7 @@ std::vector<FieldCase> cases() {
       {2, "(ray)", on<LightEvent>([=](LightEvent& e) { e.ray.tmax += 3.0f * big; })},
       {2, "(ray)", on<LightEvent>([=](LightEvent& e) { e.ray.origin.z += big; })},
       {2, "visible", on<LightEvent>([](LightEvent& e) { e.visible = !e.visible; })},
+      {2, "rejected", on<LightEvent>([](LightEvent& e) { e.rejected = LightRejection::BelowSurface; })},
       {2, "mis_weight", on<LightEvent>([=](LightEvent& e) { e.mis_weight += big; })},
       {2, "(added)", on<LightEvent>([=](LightEvent& e) { e.added.z += big; })},
       {3, "(lobe)", on<ScatterEvent>([](ScatterEvent& e) { e.lobe = Lobe::Clearcoat; })},
@@ -148,7 +149,7 @@ TEST(PathCompare, EveryFieldOfEveryEventIsComparedAndNamed) {
     EXPECT_EQ(r.event, c.event) << c.field;
     ++n;
   }
-  EXPECT_EQ(n, 43);
+  EXPECT_EQ(n, 44);
 }
 
 // Within the tolerance every field agrees; a vertex or kind change is
