@@ -384,11 +384,7 @@ std::size_t count_rejected(std::span<const Ray> rays) {
 }
 std::size_t count_rejected(const RayArrays& rays, std::size_t n) {
   std::size_t bad = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    bad += embree_accepts(vec3(rays.ox[i], rays.oy[i], rays.oz[i]), vec3(rays.dx[i], rays.dy[i], rays.dz[i]),
-                          rays.tmax[i])
-               ? 0
-               : 1;
+  for (std::size_t i = 0; i < n; ++i) bad += embree_accepts(ray_at(rays, i)) ? 0 : 1;
   return bad;
 }
 

@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
-#include <limits>
 #include <cstddef>
 #include <limits>
 #include <stdexcept>
