@@ -139,10 +139,10 @@ TEST_F(ConvergeCli, ExcludeEmittersLeavesOutPixelsThatSeeAnEmitter) {
 
 TEST_F(ConvergeCli, RenderTimeBudgetRecordsTheSppReached) {
   const fs::path exr = dir_ / "t.exr";
-  // Passes of a 16x12 image take about a millisecond, so the budget rule's
-  // overshoot (at most one pass) stays far below the bound below even on a
-  // loaded machine or under the sanitizers; at the scene's own size one pass
-  // could outlast it.
+  // What the CLI records, not how long it took: how close a budget is kept is
+  // render_until's rule, tested without the CLI in RenderUntil.* against the
+  // pass times it measured. (A pass of this 16x12 image is 1365 spp, over a
+  // second under the sanitizers, so no wall-clock bound belongs here.)
   const auto r = run_cli({"render", kScenes + "penumbra-box.json", "-o", exr.string(), "--time", "0.2",
                           "--resolution", "16x12", "--quiet"});
   ASSERT_EQ(r.code, 0) << r.err;
@@ -150,9 +150,10 @@ TEST_F(ConvergeCli, RenderTimeBudgetRecordsTheSppReached) {
   read_image(exr, &meta);
   const int spp = std::stoi(meta_value(meta, "spp_reached"));
   EXPECT_GT(spp, 0);
+  EXPECT_EQ(spp % 1365, 0) << "whole passes";
   EXPECT_EQ(meta_value(meta, "spp"), std::to_string(spp));
   EXPECT_EQ(std::stod(meta_value(meta, "time_budget_seconds")), 0.2);
-  EXPECT_LE(std::stod(meta_value(meta, "render_time_seconds")), 0.2 * 3);
+  EXPECT_GT(std::stod(meta_value(meta, "render_time_seconds")), 0.0);
   EXPECT_GT(std::stod(meta_value(meta, "estimated_relmse")), 0.0);
 }
 
