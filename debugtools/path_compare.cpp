@@ -1,5 +1,6 @@
 #include "debugtools/path_compare.h"
 
+#include <iterator>
 #include <sstream>
 #include <type_traits>
 
@@ -105,6 +106,36 @@ Difference compare(const PathEvent& ea, const PathEvent& eb, float tol) {
   return d;
 }
 
+const char* kind_name(const PathEvent& e) {
+  static constexpr const char* kNames[] = {"camera ray", "hit", "escape", "light sample", "scatter", "end"};
+  static_assert(std::size(kNames) == std::variant_size_v<PathEvent>);
+  return kNames[e.index()];
+}
+
+// Whether a floating-point difference can explain two paths that agree up to
+// here and then record different kinds of event `a` and `b`: only through a decision taken by
+// comparing computed values with a threshold, i.e.
+//  - a ray that hits a surface in one path and escapes in the other (a
+//    grazing or edge hit): a hit against an escape;
+//  - a path that ends in one and goes on in the other by roulette, or by a
+//    sampled direction with no density or weight (grazing): an end for
+//    Roulette, Absorbed or NoSample (or Escaped: see the first case).
+// A depth cap is an integer comparison, and a light sample missing from one
+// path (next-event estimation skipped), an event of another vertex or extra
+// events after a path's end are changes of the algorithm, not rounding.
+bool flip_explains(const PathEvent& a, const PathEvent& b) {
+  const auto ends_by_comparison = [](const PathEvent& e) {
+    const auto* end = std::get_if<EndEvent>(&e);
+    return end != nullptr && end->reason != PathEnd::MaxDepth;
+  };
+  const auto hit_or_escape = [](const PathEvent& e) {
+    return std::holds_alternative<HitEvent>(e) || std::holds_alternative<EscapeEvent>(e);
+  };
+  if (vertex_of(a) != vertex_of(b)) return false;
+  if (hit_or_escape(a) && hit_or_escape(b)) return true;
+  return ends_by_comparison(a) || ends_by_comparison(b);
+}
+
 // Loose agreement of the geometric content of two events of one kind.
 bool still_close(const PathEvent& ea, const PathEvent& eb) {
   const Difference loose = compare(ea, eb, 1e-2f);
@@ -122,10 +153,11 @@ PathDivergence first_divergence(const std::vector<PathEvent>& a, const std::vect
       d.identical = false;
       d.event = i;
       d.vertex = vertex_of(a[i]);
-      // A different kind of event after an agreeing prefix: one path went on
-      // where the other ended, or took another branch - a flipped outcome.
-      d.rounding = i > 0;
-      why << "event " << i << ": different events at vertex " << vertex_of(a[i]) << " and " << vertex_of(b[i]);
+      // After an agreeing prefix: a flipped outcome if a threshold decision
+      // explains the different kinds (flip_explains), else a real change.
+      d.rounding = i > 0 && flip_explains(a[i], b[i]);
+      why << "event " << i << ": different events, a " << kind_name(a[i]) << " at vertex " << vertex_of(a[i])
+          << " and a " << kind_name(b[i]) << " at vertex " << vertex_of(b[i]);
       d.reason = why.str();
       return d;
     }
@@ -144,7 +176,9 @@ PathDivergence first_divergence(const std::vector<PathEvent>& a, const std::vect
     d.identical = false;
     d.event = n;
     d.vertex = n > 0 ? vertex_of(a[n - 1]) : 0;
-    d.rounding = n > 0;
+    // Recorded paths end with their EndEvent, so a longer one went on past
+    // an end the other agreed on: not a rounding difference.
+    d.rounding = false;
     d.reason = "one path has more events";
   }
   return d;

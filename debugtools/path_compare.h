@@ -13,8 +13,11 @@ struct PathDivergence {
   bool identical = true;  // every event agrees within the tolerance
   // The paths are the same path up to their parting, which a floating-point
   // difference explains: they part on a discrete outcome (a visibility, a
-  // roulette draw, the end of a path) or on values that still agree to 1e-2,
-  // never on an unrelated path (different camera ray, direction, surface).
+  // roulette draw, a hit against an escape, an end by roulette or by a
+  // sample with no density) or on values that still agree to 1e-2, never on
+  // an unrelated path (different camera ray, direction, surface) or a
+  // change of the algorithm (a light sample one path skips, an end by the
+  // depth cap, events past a path's end).
   bool rounding = true;
   std::size_t event = 0;  // index of the first event that differs
   int vertex = 0;         // its vertex

@@ -174,5 +174,56 @@ TEST(PathCompare, RoundingWithinTheToleranceIsNoDifference) {
   EXPECT_TRUE(first_divergence(b, c, 1e-4f).identical);
 }
 
+// A different kind of event after an agreeing prefix is a floating-point
+// flip only where a threshold decision explains it (a hit against an escape,
+// an end by roulette or by a sample with no density); a light sample one
+// path skips, an end by the depth cap or events past an end are real changes.
+TEST(PathCompare, OnlyThresholdDecisionsExplainDifferentEventKinds) {
+  const std::vector<PathEvent> a = full_path();  // camera, hit, light, scatter, escape, end
+  const auto part = [&](const std::vector<PathEvent>& b) { return first_divergence(a, b, 1e-4f); };
+  const auto end_at = [](int vertex, PathEnd reason) { return PathEvent(EndEvent{vertex, reason}); };
+
+  // Next-event estimation skipped at vertex 1: the light sample is missing.
+  std::vector<PathEvent> b = a;
+  b.erase(b.begin() + 2);
+  PathDivergence d = part(b);
+  EXPECT_EQ(d.event, 2u);
+  EXPECT_FALSE(d.rounding) << d.reason;
+  EXPECT_NE(d.reason.find("a light sample at vertex 1 and a scatter at vertex 1"), std::string::npos) << d.reason;
+
+  // Roulette ended the other path at vertex 1 before it scattered.
+  b = {a[0], a[1], a[2], end_at(1, PathEnd::Roulette)};
+  d = part(b);
+  EXPECT_EQ(d.event, 3u);
+  EXPECT_TRUE(d.rounding) << d.reason;
+  // ... but a depth cap at vertex 1 is not a rounding difference.
+  b.back() = end_at(1, PathEnd::MaxDepth);
+  EXPECT_FALSE(part(b).rounding);
+  // A sampled direction with no density (grazing) ends it: a flip.
+  b.back() = end_at(1, PathEnd::NoSample);
+  EXPECT_TRUE(part(b).rounding);
+
+  // The continuation ray hits a surface at vertex 2 where the other escaped.
+  b = a;
+  HitEvent hit = std::get<HitEvent>(a[1]);
+  hit.vertex = 2;
+  b[4] = hit;
+  b.resize(5);
+  d = part(b);
+  EXPECT_EQ(d.event, 4u);
+  EXPECT_TRUE(d.rounding) << d.reason;
+
+  // An event of another vertex is never a flip.
+  b = a;
+  std::get<EscapeEvent>(b[4]).vertex = 3;
+  EXPECT_FALSE(part(b).rounding);
+  // Nor are events past an end both paths agree on.
+  b = a;
+  b.push_back(a[1]);
+  d = part(b);
+  EXPECT_EQ(d.event, a.size());
+  EXPECT_FALSE(d.rounding) << d.reason;
+}
+
 }  // namespace
 }  // namespace pathlab
