@@ -53,7 +53,7 @@ float spot_profile(float cos_theta, float cos_outer, float cos_inner) {
 }
 
 double delta_power_over_4pi(const DeltaLight& light, float scene_radius) {
-  const double y = luminance(light.intensity);
+  const double y = luminance_double(light.intensity);
   switch (light.kind) {
     case DeltaLight::Kind::Point:
       return y;  // 4 pi Y(I)
@@ -94,7 +94,7 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius, const Texture
     // Flux of a Lambertian emitter: pi * L * area per emitting side.
     const TexturedParam* tex = textures ? m.texture_of(MaterialParam::Emission) : nullptr;
     const Spectrum mean_emission = tex ? glm::max(textures->mean_color(tex->texture), Spectrum(0.0f)) : m.emission;
-    const double per_area = kPi * luminance(mean_emission) * (m.two_sided_emission ? 2.0 : 1.0);
+    const double per_area = double(kPi) * luminance_double(mean_emission) * (m.two_sided_emission ? 2.0 : 1.0);
     first_entry_[s] = static_cast<std::int64_t>(entries_.size());
     if (shape.kind == Shape::Kind::Sphere) {
       const float area = 4.0f * kPi * shape.radius * shape.radius;
@@ -111,7 +111,7 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius, const Texture
   if (scene.environment && !is_black(*scene.environment)) {
     env_index_ = static_cast<std::int64_t>(entries_.size());
     entries_.push_back({0, 0, 0.0f, {}});
-    power.push_back(4.0 * kPi * kPi * double(scene_radius) * scene_radius * luminance(*scene.environment));
+    power.push_back(4.0 * kPi * kPi * double(scene_radius) * scene_radius * luminance_double(*scene.environment));
   }
   // An image: pi r^2 times its luminance integrated over the sphere (the
   // uniform case above is that for a constant map). A black map is no light.
@@ -135,7 +135,7 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius, const Texture
     sun.entry = static_cast<std::int64_t>(entries_.size());
     suns_.push_back(sun);
     entries_.push_back({0, 0, 0.0f, {}});
-    power.push_back(kPi * double(scene_radius) * scene_radius * luminance(dl.intensity));
+    power.push_back(kPi * double(scene_radius) * scene_radius * luminance_double(dl.intensity));
   }
   build_distribution(power, &pmf_, &cdf_);
 

@@ -33,6 +33,11 @@ inline float max_component(const vec3& v) { return std::max(v.x, std::max(v.y, v
 inline float average(const vec3& v) { return (v.x + v.y + v.z) * (1.0f / 3.0f); }
 // Rec. 709 luminance: the scalar "power" of a colour used to pick lights.
 inline float luminance(const Spectrum& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+// In double, for powers: a float sum overflows near FLT_MAX radiance, and
+// pi times it already above 1.1e38.
+inline double luminance_double(const Spectrum& c) {
+  return 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z);
+}
 inline bool is_black(const Spectrum& c) { return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f; }
 inline bool is_finite(const vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 inline float sqr(float x) { return x * x; }

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <map>
 
 namespace pathlab {
@@ -79,6 +80,27 @@ TEST(LightSampler, ALightTooDimToPickHasPdfZeroAndIsReported) {
   hit.p = vec3(3.25f, 0.25f, 0.0f);
   hit.n = vec3(0, 0, 1);
   EXPECT_EQ(scene.lights().pdf(vec3(3.3f, 0.3f, 1.0f), hit), 0.0f);
+}
+
+// Radiance up to FLT_MAX is a valid scene value: the powers that pick the
+// lights must not overflow (pi * 2e38 did in float, and every pmf became NaN:
+// a NaN MIS weight on every path that hit the lamp).
+TEST(LightSampler, PowersOfRadianceNearFloatMaxStayFinite) {
+  for (float big : {2e38f, std::numeric_limits<float>::max()}) {
+    Scene scene = two_lights(1.0f);
+    scene.materials[0].emission = Spectrum(big);
+    scene.materials[1].emission = Spectrum(big / 4.0f);
+    const CompiledScene compiled(std::move(scene));
+    const auto counts = count_every_pick(compiled.lights());
+    // Equal areas: picked 4 : 1.
+    EXPECT_NEAR(double(counts.at(0)) * 0x1p-24, 0.8, 1e-6) << big;
+    Surfel hit;
+    hit.shape = 0;
+    hit.p = vec3(0.25f, 0.25f, 0.0f);
+    hit.n = vec3(0, 0, 1);
+    const float pdf = compiled.lights().pdf(vec3(0.3f, 0.3f, 1.0f), hit);
+    EXPECT_TRUE(std::isfinite(pdf) && pdf > 0.0f) << big << ": pdf " << pdf;
+  }
 }
 
 }  // namespace
