@@ -151,10 +151,4 @@ void write_sample_export(const std::string& file, const SampleExport& e);
 // Throws InputError naming the file and what is wrong.
 SampleExport read_sample_export(const std::string& file);
 
-// The events of a `trace-pixel --json` document (docs/trace-pixel-json.md),
-// as far as it records them (no shadow or continuation rays: those stay
-// zero, on both sides of a comparison alike). Materials are numbered by
-// their name in `scene`. Throws InputError naming `what` and the event.
-std::vector<PathEvent> path_events_from_json(const nlohmann::json& doc, const Scene& scene, const std::string& what);
-
 }  // namespace pathlab

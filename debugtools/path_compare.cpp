@@ -83,15 +83,17 @@ Difference compare(const PathEvent& ea, const PathEvent& eb, float tol) {
           check(near(a.dist, b.dist, tol), "light direction or pdf (dist)");
           check(near(a.pdf, b.pdf, tol), "light direction or pdf (pdf)");
           check(near(a.Le, b.Le, tol), "light radiance (Le)");
-          check(near(a.ray, b.ray, tol), "shadow ray (ray)");
+          // Before the ray: a sample rejected on one side only has no ray there.
           outcome(a.rejected == b.rejected, "light sample rejected (rejected: below the surface, black BSDF, no sample)");
+          check(near(a.ray, b.ray, tol), "shadow ray (ray)");
           outcome(a.visible == b.visible, "light visibility (visible)");
           check(near(a.mis_weight, b.mis_weight, tol), "light MIS weight (mis_weight)");
           check(near(a.added, b.added, tol), "light added (added)");
         } else if constexpr (std::is_same_v<T, ScatterEvent>) {
+          // Cosine sampling (strategy cosine) replaces the lobe: named first.
+          check(a.cosine == b.cosine, "lobe (cosine)");
           check(a.lobe == b.lobe, "lobe (lobe)");
           check(a.impulse == b.impulse, "lobe (impulse)");
-          check(a.cosine == b.cosine, "lobe (cosine)");
           check(near(a.wi, b.wi, tol), "scattered direction or pdf (wi)");
           check(near(a.pdf, b.pdf, tol), "scattered direction or pdf (pdf)");
           check(near(a.weight, b.weight, tol), "scattering weight (weight)");

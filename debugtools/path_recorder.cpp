@@ -1,5 +1,6 @@
 #include "debugtools/path_recorder.h"
 
+#include "core/error.h"
 #include "core/light_sampler.h"
 #include "core/render.h"
 
@@ -12,6 +13,11 @@ namespace {
 using json = nlohmann::json;
 
 json j3(const vec3& v) { return json::array({v.x, v.y, v.z}); }
+
+// A ray as {origin, dir, tmax}; an unbounded one's tmax is null.
+json jray(const Ray& r) {
+  return {{"origin", j3(r.origin)}, {"dir", j3(r.dir)}, {"tmax", std::isinf(r.tmax) ? json(nullptr) : json(r.tmax)}};
+}
 
 std::string fmt3(const vec3& v) {
   char buf[96];
@@ -71,12 +77,14 @@ struct JsonVisitor {
     // Why no shadow ray was traced, or null; no_sample: no light was picked.
     j["rejected"] = e.rejected == LightRejection::None ? json(nullptr) : json(light_rejection_name(e.rejected));
     if (e.rejected == LightRejection::NoSample) j["light"] = nullptr;
+    j["ray"] = e.rejected == LightRejection::None ? jray(e.ray) : json(nullptr);  // the shadow ray
     return j;
   }
   json operator()(const ScatterEvent& e) const {
     return {{"type", "scatter"}, {"vertex", e.vertex}, {"lobe", e.cosine ? "cosine" : lobe_name(e.lobe)},
             {"impulse", e.impulse}, {"wi", j3(e.wi)}, {"pdf", e.pdf},
-            {"weight", j3(e.weight)}, {"survival", e.survival}, {"throughput", j3(e.throughput)}};
+            {"weight", j3(e.weight)}, {"survival", e.survival}, {"throughput", j3(e.throughput)},
+            {"next", jray(e.next)}};  // the continuation ray
   }
   json operator()(const EndEvent& e) const {
     return {{"type", "end"}, {"vertex", e.vertex}, {"reason", path_end_name(e.reason)}};
@@ -208,6 +216,204 @@ std::string path_to_text(const TraceHeader& h, const PathRecorder& path, const S
   for (const PathEvent& e : path.events()) out << event_to_text(e, scene);
   out << result_text(h, path, "");
   return out.str();
+}
+
+// --- trace-pixel --json back into events -----------------------------------
+
+namespace {
+struct JsonEvents {
+  const Scene& scene;
+  const std::string& what;
+  std::uint32_t pixel_x = 0, pixel_y = 0, sample = 0;  // from the document's header
+  std::size_t index = 0;
+
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw InputError(what + ": events[" + std::to_string(index) + "]: " + problem);
+  }
+  const nlohmann::json& field(const nlohmann::json& e, const char* key) const {
+    if (!e.contains(key)) fail(std::string("no \"") + key + "\"");
+    return e.at(key);
+  }
+  float num(const nlohmann::json& e, const char* key) const {
+    const nlohmann::json& v = field(e, key);
+    if (v.is_null()) return std::numeric_limits<float>::infinity();
+    if (!v.is_number()) fail(std::string("\"") + key + "\" is not a number");
+    return v.get<float>();
+  }
+  int integer(const nlohmann::json& e, const char* key) const {
+    const nlohmann::json& v = field(e, key);
+    if (!v.is_number_integer()) fail(std::string("\"") + key + "\" is not an integer");
+    return v.get<int>();
+  }
+  bool flag(const nlohmann::json& e, const char* key) const {
+    const nlohmann::json& v = field(e, key);
+    if (!v.is_boolean()) fail(std::string("\"") + key + "\" is not true or false");
+    return v.get<bool>();
+  }
+  vec3 v3(const nlohmann::json& e, const char* key) const {
+    const nlohmann::json& v = field(e, key);
+    if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
+      fail(std::string("\"") + key + "\" is not [x, y, z]");
+    return vec3(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
+  }
+  // A ray {origin, dir, tmax (null: unbounded)}; absent (a trace by a build
+  // older than the field) or null (a light sample with no shadow ray): a
+  // zero ray.
+  Ray ray(const nlohmann::json& e, const char* key) const {
+    if (!e.contains(key) || e.at(key).is_null()) return Ray{};
+    const nlohmann::json& r = e.at(key);
+    if (!r.is_object()) fail(std::string("\"") + key + "\" is not {origin, dir, tmax}");
+    return Ray{v3(r, "origin"), v3(r, "dir"), num(r, "tmax")};
+  }
+  std::string text(const nlohmann::json& e, const char* key) const {
+    const nlohmann::json& v = field(e, key);
+    if (!v.is_string()) fail(std::string("\"") + key + "\" is not a string");
+    return v.get<std::string>();
+  }
+
+  PathEvent event(const nlohmann::json& e) const {
+    const std::string type = text(e, "type");
+    if (type == "camera") {
+      const nlohmann::json& f = field(e, "film");
+      if (!f.is_array() || f.size() != 2) fail("\"film\" is not [x, y]");
+      CameraEvent c;
+      c.x = pixel_x;
+      c.y = pixel_y;
+      c.sample = sample;
+      c.film = vec2(f[0].get<float>(), f[1].get<float>());
+      c.origin = v3(e, "origin");
+      c.dir = v3(e, "dir");
+      return c;
+    }
+    if (type == "hit") {
+      HitEvent h;
+      h.vertex = integer(e, "vertex");
+      h.p = v3(e, "p");
+      h.n = v3(e, "n");
+      h.front = flag(e, "front");
+      const std::string material = text(e, "material");
+      h.material = static_cast<std::uint32_t>(scene.materials.size());  // unknown names stay apart
+      for (std::size_t m = 0; m < scene.materials.size(); ++m)
+        if (scene.materials[m].name == material) h.material = static_cast<std::uint32_t>(m);
+      h.shape = static_cast<std::uint32_t>(integer(e, "shape"));
+      h.prim = static_cast<std::uint32_t>(integer(e, "prim"));
+      const nlohmann::json& inst = field(e, "instance");
+      h.instance = inst.is_null() ? kNoInstance : inst.get<std::uint32_t>();
+      h.emitted = v3(e, "emitted");
+      h.emission_weight = num(e, "emission_weight");
+      h.added = v3(e, "added");
+      h.throughput = v3(e, "throughput");
+      return h;
+    }
+    if (type == "escape") {
+      EscapeEvent x;
+      x.vertex = integer(e, "vertex");
+      x.emitted = v3(e, "emitted");
+      x.emission_weight = num(e, "emission_weight");
+      x.added = v3(e, "added");
+      return x;
+    }
+    if (type == "light") {
+      LightEvent l;
+      l.vertex = integer(e, "vertex");
+      const std::string kind = text(e, "kind");
+      l.delta = kind != "area" && kind != "environment";
+      l.infinite = kind == "environment";
+      // A light sample the sampler did not give (rejected "no_sample") names no light.
+      l.light = field(e, "light").is_null() ? 0u : static_cast<std::uint32_t>(integer(e, "light"));
+      // "rejected" is absent from the traces of builds older than it.
+      const nlohmann::json rejected = e.contains("rejected") ? e["rejected"] : nlohmann::json(nullptr);
+      if (!rejected.is_null()) {
+        bool known = false;
+        for (LightRejection r : {LightRejection::NoSample, LightRejection::BelowSurface, LightRejection::BlackBsdf})
+          if (rejected.is_string() && rejected.get<std::string>() == light_rejection_name(r)) l.rejected = r, known = true;
+        if (!known) fail("unknown light rejection " + rejected.dump());
+      }
+      l.point = v3(e, "point");
+      l.wi = v3(e, "wi");
+      l.pdf = num(e, "pdf");
+      l.Le = v3(e, "Le");
+      l.visible = flag(e, "visible");
+      l.mis_weight = num(e, "mis_weight");
+      l.added = v3(e, "added");
+      l.dist = num(e, "dist");
+      l.ray = ray(e, "ray");
+      return l;
+    }
+    if (type == "scatter") {
+      ScatterEvent s;
+      s.vertex = integer(e, "vertex");
+      const std::string lobe = text(e, "lobe");
+      s.cosine = lobe == "cosine";
+      bool known = s.cosine;
+      for (int k = 0; k < static_cast<int>(Lobe::Count); ++k)
+        if (lobe == lobe_name(static_cast<Lobe>(k))) s.lobe = static_cast<Lobe>(k), known = true;
+      if (!known) fail("unknown lobe \"" + lobe + "\"");
+      s.impulse = flag(e, "impulse");
+      s.wi = v3(e, "wi");
+      s.pdf = num(e, "pdf");
+      s.weight = v3(e, "weight");
+      s.survival = num(e, "survival");
+      s.throughput = v3(e, "throughput");
+      s.next = ray(e, "next");
+      return s;
+    }
+    if (type == "end") {
+      EndEvent x;
+      x.vertex = integer(e, "vertex");
+      const std::string reason = text(e, "reason");
+      bool known = false;
+      for (PathEnd p : {PathEnd::Escaped, PathEnd::MaxDepth, PathEnd::Absorbed, PathEnd::Roulette, PathEnd::NoSample})
+        if (reason == path_end_name(p)) x.reason = p, known = true;
+      if (!known) fail("unknown end \"" + reason + "\"");
+      return x;
+    }
+    fail("unknown event type \"" + type + "\"");
+  }
+};
+}  // namespace
+
+bool trace_records_rays(const nlohmann::json& doc) {
+  if (!doc.is_object() || !doc.contains("events") || !doc.at("events").is_array()) return false;
+  for (const nlohmann::json& e : doc.at("events"))
+    if (e.is_object() && (e.contains("ray") || e.contains("next"))) return true;
+  return false;
+}
+
+void forget_rays(std::vector<PathEvent>& events) {
+  for (PathEvent& e : events) {
+    if (auto* l = std::get_if<LightEvent>(&e)) l->ray = Ray{};
+    if (auto* s = std::get_if<ScatterEvent>(&e)) s->next = Ray{};
+  }
+}
+
+std::vector<PathEvent> path_events_from_json(const nlohmann::json& doc, const Scene& scene, const std::string& what) {
+  if (!doc.is_object() || doc.value("format", "") != "pathlab-trace" || !doc.contains("events") ||
+      !doc.at("events").is_array())
+    throw InputError(what + ": not a `pathlab trace-pixel --json` document (format \"pathlab-trace\")");
+  JsonEvents parse{scene, what};
+  const auto header_int = [&](const nlohmann::json& v, const char* key) {
+    if (!v.is_number_unsigned()) throw InputError(what + ": \"" + key + "\" is not a non-negative integer");
+    return v.get<std::uint32_t>();
+  };
+  if (doc.contains("pixel")) {
+    const nlohmann::json& px = doc.at("pixel");
+    if (!px.is_array() || px.size() != 2) throw InputError(what + ": \"pixel\" is not [x, y]");
+    parse.pixel_x = header_int(px[0], "pixel");
+    parse.pixel_y = header_int(px[1], "pixel");
+  }
+  if (doc.contains("sample")) parse.sample = header_int(doc.at("sample"), "sample");
+  std::vector<PathEvent> events;
+  try {
+    for (const nlohmann::json& e : doc.at("events")) {
+      if (!e.is_object()) parse.fail("not an object");
+      events.push_back(parse.event(e));
+      ++parse.index;
+    }
+  } catch (const nlohmann::json::exception& ex) {
+    throw InputError(what + ": events[" + std::to_string(parse.index) + "]: " + ex.what());
+  }
+  return events;
 }
 
 }  // namespace pathlab

@@ -50,6 +50,18 @@ Spectrum film_radiance(const TraceHeader& header, const PathRecorder& path);
 
 // The JSON document of a recorded path (format version 1).
 nlohmann::json path_to_json(const TraceHeader& header, const PathRecorder& path, const Scene& scene);
+// The events of a `trace-pixel --json` document (docs/trace-pixel-json.md),
+// every field first_divergence compares: the camera's pixel and sample come
+// from the header; a document by a build older than the rays' fields has
+// no shadow or continuation rays, which stay zero (forget_rays() on the
+// other side of a comparison). Materials are numbered by their name in `scene`. Throws
+// InputError naming `what` and the event.
+std::vector<PathEvent> path_events_from_json(const nlohmann::json& doc, const Scene& scene, const std::string& what);
+// Whether the document records the rays (`ray` of light events, `next` of
+// scatter events).
+bool trace_records_rays(const nlohmann::json& doc);
+// Zeroes every shadow and continuation ray, as a document without them reads.
+void forget_rays(std::vector<PathEvent>& events);
 // One event as text (one line, two for a hit with emission).
 std::string event_to_text(const PathEvent& event, const Scene& scene);
 // The header line of a listing.

@@ -2,11 +2,14 @@
 // for each field, two event lists that differ in exactly that field are
 // reported at that event, with that field named in the reason.
 #include "debugtools/path_compare.h"
+#include "debugtools/path_recorder.h"
 
 #include <gtest/gtest.h>
 
 #include <functional>
 #include <string>
+#include <type_traits>
+#include <variant>
 #include <vector>
 
 namespace pathlab {
@@ -150,6 +153,64 @@ TEST(PathCompare, EveryFieldOfEveryEventIsComparedAndNamed) {
     ++n;
   }
   EXPECT_EQ(n, 44);
+}
+
+// Across builds (`compare --with`) paths are compared as read back from
+// `trace-pixel --json`: every field must survive the round trip, so a
+// difference in any of them is still found and named.
+TEST(PathCompare, EveryFieldSurvivesTheTraceJson) {
+  Scene scene;
+  for (const char* name : {"m0", "m1", "m2", "m3"}) {
+    Material m;
+    m.name = name;
+    scene.materials.push_back(m);
+  }
+  const auto round_trip = [&](const std::vector<PathEvent>& events) {
+    PathRecorder recorder;
+    for (const PathEvent& e : events)
+      std::visit(
+          [&](const auto& ev) {
+            using T = std::decay_t<decltype(ev)>;
+            if constexpr (std::is_same_v<T, CameraEvent>) recorder.on_camera(ev);
+            else if constexpr (std::is_same_v<T, HitEvent>) recorder.on_hit(ev);
+            else if constexpr (std::is_same_v<T, EscapeEvent>) recorder.on_escape(ev);
+            else if constexpr (std::is_same_v<T, LightEvent>) recorder.on_light(ev);
+            else if constexpr (std::is_same_v<T, ScatterEvent>) recorder.on_scatter(ev);
+            else recorder.on_end(ev);
+          },
+          e);
+    const CameraEvent& cam = std::get<CameraEvent>(events.front());
+    TraceHeader header{"test", "reference", cam.x, cam.y, cam.sample, RenderSettings{}, 8, 8};
+    // Through text, as between two processes.
+    const nlohmann::json doc = nlohmann::json::parse(path_to_json(header, recorder, scene).dump());
+    EXPECT_TRUE(trace_records_rays(doc));
+    return path_events_from_json(doc, scene, "round trip");
+  };
+  const std::vector<PathEvent> a = full_path();
+  const std::vector<PathEvent> a_read = round_trip(a);
+  ASSERT_TRUE(first_divergence(a, a_read, 1e-6f).identical) << first_divergence(a, a_read, 1e-6f).reason;
+  int n = 0;
+  for (const FieldCase& c : cases()) {
+    std::vector<PathEvent> b = a;
+    c.change(b[c.event]);
+    const PathDivergence d = first_divergence(a_read, round_trip(b), 1e-4f);
+    EXPECT_FALSE(d.identical) << "field " << c.field << " of event " << c.event << " is lost in the JSON";
+    EXPECT_EQ(d.event, c.event) << c.field << ": " << d.reason;
+    EXPECT_NE(d.reason.find(c.field), std::string::npos) << "the reason should name " << c.field << ": " << d.reason;
+    ++n;
+  }
+  EXPECT_EQ(n, 44);
+  // A trace without the rays (an older build) reads with zero rays, as
+  // forget_rays() leaves the other side.
+  PathRecorder recorder;
+  nlohmann::json old_doc =
+      path_to_json(TraceHeader{"test", "reference", 3, 4, 5, RenderSettings{}, 8, 8}, recorder, scene);
+  old_doc["events"] = nlohmann::json::array({{{"type", "end"}, {"vertex", 1}, {"reason", "escaped"}}});
+  EXPECT_FALSE(trace_records_rays(old_doc));
+  std::vector<PathEvent> forgotten = a_read;
+  forget_rays(forgotten);
+  EXPECT_EQ(std::get<LightEvent>(forgotten[2]).ray.tmax, Ray{}.tmax);
+  EXPECT_EQ(std::get<ScatterEvent>(forgotten[3]).next.dir, Ray{}.dir);
 }
 
 // Within the tolerance every field agrees; a vertex or kind change is

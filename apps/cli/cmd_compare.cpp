@@ -226,7 +226,7 @@ int CompareCommand::run(std::ostream& out, std::ostream& err) const {
     if (tb) return replay_divergence(*ta, *tb, x, y, sample);
     PathRecorder ours;
     ta->trace_sample(x, y, sample, &ours);
-    const std::vector<PathEvent> a =
+    std::vector<PathEvent> a =
         path_events_from_json(path_to_json(header(sides[0], x, y, sample), ours, sc), sc, "this build's trace");
     std::vector<std::string> argv{with, "trace-pixel"};
     for (std::string& arg : scene_args(scene, false)) argv.push_back(std::move(arg));
@@ -243,7 +243,9 @@ int CompareCommand::run(std::ostream& out, std::ostream& err) const {
     } catch (const nlohmann::json::exception& e) {
       throw InputError("--with " + with + ": its trace-pixel --json is not JSON: " + e.what());
     }
-    return first_divergence(a, path_events_from_json(doc, sc, with + " trace-pixel --json"), kReplayTolerance);
+    const std::vector<PathEvent> b = path_events_from_json(doc, sc, with + " trace-pixel --json");
+    if (!trace_records_rays(doc)) forget_rays(a);  // an older build: compared on everything else
+    return first_divergence(a, b, kReplayTolerance);
   };
   const SampleComparison samples =
       tb ? compare_tracers(*ta, *tb, spp) : compare_samples(sa, other.samples, sc.film.width, spp, 0, replay);
