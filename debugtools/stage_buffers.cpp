@@ -62,15 +62,16 @@ std::vector<std::filesystem::path> StageBuffers::write(const std::filesystem::pa
                      (ec ? ": " + ec.message() : std::string()));
   std::vector<std::filesystem::path> files;
   const std::string prefix = "bounce" + std::to_string(vertex_) + "-";
-  const std::pair<const char*, Image> images[] = {
-      {"reached", reached()},     {"throughput", throughput()}, {"direction", direction()},
-      {"distance", distance()},   {"survival", survival()},     {"light_pdf", light_pdf()},
-  };
-  for (const auto& [name, image] : images) {
-    files.push_back(dir / (prefix + name + ".exr"));
-    write_exr(files.back(), image, meta);
+  for (const Named& n : images()) {
+    files.push_back(dir / (prefix + n.name + ".exr"));
+    write_exr(files.back(), n.image, meta);
   }
   return files;
+}
+
+std::vector<StageBuffers::Named> StageBuffers::images() const {
+  return {{"reached", reached(), "Y"},   {"throughput", throughput(), "RGB"}, {"direction", direction(), "XYZ"},
+          {"distance", distance(), "Z"}, {"survival", survival(), "Y"},       {"light_pdf", light_pdf(), "Y"}};
 }
 
 void StageBufferTracer::render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const {

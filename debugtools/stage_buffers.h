@@ -37,6 +37,15 @@ class StageBuffers {
   Image survival() const;
   Image light_pdf() const;
 
+  // The six images above by name ("reached", ...), each with the channels
+  // it means (`Y` for a scalar, `RGB`, `XYZ` for a direction, `Z`).
+  struct Named {
+    const char* name;
+    Image image;
+    const char* channels;
+  };
+  std::vector<Named> images() const;
+
   // Writes DIR/bounceK-<name>.exr for each image above (DIR created if
   // needed); returns the files written. Throws InputError if it cannot.
   std::vector<std::filesystem::path> write(const std::filesystem::path& dir, const ImageMetadata& meta) const;

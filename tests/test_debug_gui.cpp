@@ -7,6 +7,7 @@
 #include "core/error.h"
 #include "core/image_io.h"
 #include "core/scene_loader.h"
+#include "debugtools/bounce_aov.h"
 #include "debugtools/gui/app.h"
 #include "debugtools/gui/script.h"
 #include "debugtools/gui/session.h"
@@ -88,8 +89,14 @@ TEST(DebugScript, ParsesCommandsAndNamesTheLineOfAMistake) {
   EXPECT_EQ(more[1].dx, -40);
   EXPECT_EQ(more[1].dy, 7);
   EXPECT_FLOAT_EQ(more[2].value, 0.25f);
+  const auto layers = parse_script("layers bounces\nlayers stage 3\nlayers none\n", "u.txt");
+  ASSERT_EQ(layers.size(), 3u);
+  EXPECT_EQ(layers[0].kind, ScriptCommand::Kind::Layers);
+  EXPECT_EQ(layers[1].arg, "stage");
+  EXPECT_EQ(layers[1].x, 3);
+  EXPECT_EQ(layers[2].arg, "none");
   for (const char* bad : {"clik 3 4", "click 3", "scale sideways", "wait-spp -1", "quit now", "wheel 1 2", "split 1.5",
-                          "compare nothing", "drag 1 2 3"}) {
+                          "compare nothing", "drag 1 2 3", "layers stage", "layers all", "layers bounces 2"}) {
     try {
       parse_script(std::string("view beauty\n") + bad + "\n", "s.txt");
       ADD_FAILURE() << bad;
@@ -148,6 +155,59 @@ TEST(DebugSession, RendersProgressivelyReadsOutAndRetracesTheRendersSample) {
   ASSERT_TRUE(session.snapshot(w));
   EXPECT_EQ(w.albedo.at(1, 12), vec3(1.0f));  // the red wall
   EXPECT_GT(max_component(w.beauty.at(12, 12)), 0.0f);
+}
+
+// The intermediate layers, live: the per-bounce decomposition (which sums to
+// the beauty, as `render --aov bounces` does) and the wavefront's stage
+// buffers, as layers of the snapshot the views and readout use.
+TEST(DebugSession, ShowsThePerBounceLayersAndTheStageBuffersLive) {
+  SessionSettings settings = small_cornell(12, 4);
+  settings.intermediate = SessionSettings::Intermediate::Bounces;
+  Session session(settings);
+  ASSERT_TRUE(session.wait_spp(4, 120.0));
+  Snapshot snap;
+  ASSERT_TRUE(session.snapshot(snap));
+  std::vector<std::string> names;
+  for (const Layer& l : snap.layers) names.push_back(l.name);
+  for (int d = 0; d <= kBounceDepths; ++d)
+    for (Technique t : {Technique::Bsdf, Technique::Nee}) {
+      const std::string name = bounce_layer_name(d) + "." + technique_name(t);
+      EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+    }
+  // The built-in box film: each layer is the mean over the pixel's samples,
+  // so the layers of a pixel sum to its beauty (float rounding apart).
+  for (int y = 0; y < 12; y += 3)
+    for (int x = 0; x < 12; x += 3) {
+      dvec3 sum(0.0);
+      for (const Layer& l : snap.layers)
+        if (l.name.size() > 1 && l.name[0] == 'L' && l.name.find('.') != std::string::npos)
+          sum += dvec3(l.image.at(x, y));
+      const vec3 beauty = snap.beauty.at(x, y);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], beauty[c], 1e-5 + 1e-4 * beauty[c]) << x << "," << y;
+    }
+  EXPECT_GT(max_component(find_layer(snap.layers, "L1.nee")->image.at(6, 6)), 0.0f);
+
+  // Stage buffers are the wavefront's: refused for the reference, the
+  // render left as it was.
+  SessionSettings stage = session.settings();
+  stage.intermediate = SessionSettings::Intermediate::StageBuffers;
+  stage.stage_vertex = 1;
+  EXPECT_THROW(session.apply(stage), InputError);
+  EXPECT_EQ(session.settings().intermediate, SessionSettings::Intermediate::Bounces);
+  stage.tracer = "wavefront";
+  session.apply(stage);
+  ASSERT_TRUE(session.wait_spp(4, 120.0));
+  ASSERT_TRUE(session.snapshot(snap));
+  for (const char* name : {"stage1.reached", "stage1.throughput", "stage1.direction", "stage1.distance",
+                           "stage1.survival", "stage1.light_pdf"})
+    EXPECT_NE(find_layer(snap.layers, name), nullptr) << name;
+  EXPECT_EQ(find_layer(snap.layers, "L0.bsdf"), nullptr);
+  // Every camera ray of the closed box reaches vertex 1 at throughput 1.
+  const Layer& reached = *find_layer(snap.layers, "stage1.reached");
+  EXPECT_EQ(reached.channels, "Y");
+  for (const vec3& v : reached.image.pixels) EXPECT_EQ(v.x, 1.0f);
+  EXPECT_EQ(find_layer(snap.layers, "stage1.throughput")->image.at(5, 5), vec3(1.0f));
+  EXPECT_GT(find_layer(snap.layers, "stage1.distance")->image.at(5, 5).x, 0.0f);
 }
 
 TEST(DebugSession, OpensAnotherSceneAndKeepsTheOldOneOnABadFile) {

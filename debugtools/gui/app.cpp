@@ -250,6 +250,10 @@ void App::set_compare(Compare c, const std::string& file) {
   if (c == Compare::Tracer) {
     SessionSettings s = session_.settings();
     s.tracer = s.tracer == "reference" ? "wavefront" : "reference";
+    // Per-bounce layers on both sides (compare them layer by layer); stage
+    // buffers only where the wavefront is.
+    if (s.intermediate == SessionSettings::Intermediate::StageBuffers && s.tracer != "wavefront")
+      s.intermediate = SessionSettings::Intermediate::None;
     other_session_ = std::make_unique<Session>(s);
   }
   compare_ = c;
@@ -616,6 +620,14 @@ void App::draw_panel() {
   int materials = static_cast<int>(next.materials);
   if (ImGui::Combo("materials", &materials, "as authored\0white Lambert\0mirror\0"))
     next.materials = static_cast<MaterialOverride>(materials), changed = true;
+  // Intermediate layers (they show up in the buffer list below).
+  int intermediate = static_cast<int>(next.intermediate);
+  if (ImGui::Combo("layers", &intermediate, "final only\0+ per bounce\0+ stage buffers\0"))
+    next.intermediate = static_cast<SessionSettings::Intermediate>(intermediate), changed = true;
+  if (next.intermediate == SessionSettings::Intermediate::StageBuffers) {
+    int vertex = next.stage_vertex;
+    if (ImGui::InputInt("at vertex", &vertex, 1, 1, on_enter) && vertex >= 1) next.stage_vertex = vertex, changed = true;
+  }
   if (ImGui::Button("Restart") || changed) apply(next);
   ImGui::Text("%d / %d spp  seed %llu  %.1f s", snap_.spp_done, snap_.spp_target,
               static_cast<unsigned long long>(snap_.seed), snap_.seconds);
@@ -768,6 +780,13 @@ void App::run_command(const ScriptCommand& c) {
     case Kind::Exposure: exposure_ = c.value, texture_dirty_ = true; break;
     case Kind::Materials: next.materials = *parse_material_override(c.arg), apply(next); break;
     case Kind::Tracer: next.tracer = c.arg, apply(next); break;
+    case Kind::Layers:
+      next.intermediate = c.arg == "bounces" ? SessionSettings::Intermediate::Bounces
+                          : c.arg == "stage" ? SessionSettings::Intermediate::StageBuffers
+                                             : SessionSettings::Intermediate::None;
+      if (c.arg == "stage") next.stage_vertex = c.x;
+      apply(next);
+      break;
     case Kind::Open: next.scene_file = c.arg, apply(next); break;
     case Kind::ExportVtk: session_.export_vtk(c.arg); break;
     case Kind::Save: session_.save_image(c.arg, exposure_); break;

@@ -70,6 +70,10 @@ std::vector<ScriptCommand> parse_script(const std::string& text, const std::stri
     } else if (word == "tracer") {
       c.kind = Kind::Tracer, name();
       if (c.arg != "reference" && c.arg != "wavefront") fail("unknown tracer '" + c.arg + "'");
+    } else if (word == "layers") {
+      c.kind = Kind::Layers, name();
+      if (c.arg == "stage") ints(1);
+      else if (c.arg != "bounces" && c.arg != "none") fail("layers expects bounces, stage K or none");
     } else if (word == "open") c.kind = Kind::Open, name();
     else if (word == "export-vtk") c.kind = Kind::ExportVtk, name();
     else if (word == "save") c.kind = Kind::Save, name();

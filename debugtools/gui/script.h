@@ -25,6 +25,9 @@
 //   split F               put the split view's divider at fraction F (0..1) of the image area
 //   materials NAME        authored, white, mirror (restarts the render)
 //   tracer NAME           reference, wavefront (restarts the render)
+//   layers bounces        add the per-bounce layers L0.bsdf .. Lrest.nee (restarts the render)
+//   layers stage K        add the wavefront's stage buffers at vertex K, stageK.* (restarts)
+//   layers none           neither
 //   open PATH             open a scene file (restarts the render)
 //   export-vtk PATH       the "Export VTK" button
 //   save PATH             the "Save image" button (.exr or .png)
@@ -40,9 +43,9 @@ namespace pathlab::debug {
 struct ScriptCommand {
   enum class Kind { WaitSpp, Hover, Click, Sample, View, Scale, Exposure, Materials, Tracer, Open, ExportVtk, Save,
                     Screenshot, Mouse, Wheel, Drag, Fit, ActualSize, Readout, NextNan, Compare, CompareImage, Split,
-                    Quit };
+                    Layers, Quit };
   Kind kind = Kind::Quit;
-  int x = 0, y = 0;      // hover, click, mouse, wheel, drag; x is N for wait-spp and S for sample
+  int x = 0, y = 0;      // hover, click, mouse, wheel, drag; x is N for wait-spp, S for sample, K for layers stage
   int dx = 0, dy = 0;    // drag; dx is N for wheel
   float value = 0.0f;    // exposure, split
   std::string arg;       // names and paths

@@ -8,11 +8,15 @@
 #include "core/scene_loader.h"
 #include "core/tracer.h"
 #include "debugtools/aov.h"
+#include "debugtools/bounce_aov.h"
+#include "debugtools/stage_buffers.h"
 #include "debugtools/tracers.h"
 #include "debugtools/vtk_export.h"
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 namespace pathlab::debug {
@@ -44,6 +48,13 @@ const Scene& Session::scene() const { return compiled_->scene(); }
 void Session::apply(const SessionSettings& next) {
   if (next.tracer != "reference" && next.tracer != "wavefront")
     throw InputError("unknown tracer '" + next.tracer + "' (expected reference or wavefront)");
+  if (next.intermediate == SessionSettings::Intermediate::StageBuffers) {
+    if (next.tracer != "wavefront")
+      throw InputError("stage buffers are the wavefront's: choose the wavefront tracer first");
+    if (next.stage_vertex < 1 || next.stage_vertex > kMaxVerticesUncapped)
+      throw InputError("stage buffers at vertex " + std::to_string(next.stage_vertex) + ": give a vertex in [1, " +
+                       std::to_string(kMaxVerticesUncapped) + "] (1 = the camera rays' hits)");
+  }
   // Load before stopping anything: a bad file leaves the current render alone.
   std::unique_ptr<Scene> authored;
   const bool reload = !authored_ || next.scene_file != loaded_file_ || next.width != settings_.width ||
@@ -96,6 +107,19 @@ void Session::worker(std::uint64_t /*generation*/) {
   const std::size_t pixels = static_cast<std::size_t>(w) * h;
   Film film(w, h, sc.film.filter);
   AovAccumulator aovs(*compiled_, render_settings_);
+  // The intermediate layers: the tracer wrapped to record them.
+  const Tracer* tracer = tracer_.get();
+  std::optional<BounceAccumulator> bounces;
+  std::optional<StageBuffers> stages;
+  std::unique_ptr<Tracer> recording;
+  if (settings_.intermediate == SessionSettings::Intermediate::Bounces) {
+    bounces.emplace(w, h);
+    recording = std::make_unique<BounceTracer>(*tracer_, *bounces);
+  } else if (settings_.intermediate == SessionSettings::Intermediate::StageBuffers) {
+    stages.emplace(w, h, settings_.stage_vertex);
+    recording = std::make_unique<StageBufferTracer>(dynamic_cast<const WavefrontTracer&>(*tracer_), *stages);
+  }
+  if (recording) tracer = recording.get();
   const std::uint32_t batch = batch_size(w, h, target);
   SampleBuffer samples(pixels * batch);
   const auto start = std::chrono::steady_clock::now();
@@ -126,6 +150,10 @@ void Session::worker(std::uint64_t /*generation*/) {
     Image counts(w, h);
     for (std::size_t i = 0; i < pixels; ++i) counts.pixels[i] = vec3(static_cast<float>(snap->samples[i]));
     add_exr_layer(channels, "samples", counts, "Y");
+    if (bounces) add_bounce_channels(channels, *bounces);
+    if (stages)
+      for (const StageBuffers::Named& n : stages->images())
+        add_exr_layer(channels, "stage" + std::to_string(stages->vertex()) + "." + n.name, n.image, n.channels);
     snap->layers = layers_from_channels(w, h, channels);
     {
       const std::lock_guard lock(mutex_);
@@ -138,7 +166,7 @@ void Session::worker(std::uint64_t /*generation*/) {
   for (std::uint32_t first = 0; first < static_cast<std::uint32_t>(target) && !stop_; first += batch) {
     const std::uint32_t count = std::min<std::uint32_t>(batch, static_cast<std::uint32_t>(target) - first);
     const std::span<FilmSample> out = samples.first(pixels * count);
-    tracer_->render_batch(first, count, out);
+    tracer->render_batch(first, count, out);
     if (stop_) break;
     film.add_batch(first, count, out);
     aovs.add_batch(first, count, out);

@@ -42,6 +42,13 @@ struct SessionSettings {
   bool freeze_seed = true;   // false: every restart draws with a new seed
   bool all_threads = true;   // false: one thread
   MaterialOverride materials = MaterialOverride::Authored;
+  // Intermediate layers, live (docs/aov.md): the per-bounce decomposition
+  // L0 .. L7, Lrest by technique (every sample through an observer: slower),
+  // or the wavefront's stage buffers at vertex `stage_vertex` (its scalar
+  // stages). One or the other.
+  enum class Intermediate : std::uint8_t { None, Bounces, StageBuffers };
+  Intermediate intermediate = Intermediate::None;
+  int stage_vertex = 1;
 };
 
 // The buffers of the render so far, copied for display.
@@ -56,8 +63,10 @@ struct Snapshot {
   // Every buffer as a named layer: the channels aov_channels() gives for the
   // film and all AOVs (beauty, albedo, normal, depth, material, variance,
   // pathlength, and whatever is added there later), then "nonfinite" (NaN/Inf
-  // samples per pixel) and "samples" (own samples per pixel). The views and
-  // the readout are generic over this list.
+  // samples per pixel) and "samples" (own samples per pixel), then the
+  // intermediate layers asked for: "L0.bsdf" ... "Lrest.nee", or
+  // "stage<K>.reached", ".throughput", ".direction", ".distance", ".survival",
+  // ".light_pdf". The views and the readout are generic over this list.
   std::vector<Layer> layers;
 };
 
