@@ -29,6 +29,7 @@ struct SameSeedCase {
   // "envmap" (below), else a file in analytic-scenes/
   std::string scene;
   Strategy strategy;
+  LightSampling light_sampling = LightSampling::Area;
 };
 
 // An environment image lighting a diffuse sphere on a rough metal ground,
@@ -64,6 +65,7 @@ Scene load_case(const SameSeedCase& c) {
   s.film.height = std::min(s.film.height, 24);
   s.render.spp = 4;
   s.render.strategy = c.strategy;
+  s.render.light_sampling = c.light_sampling;
   return s;
 }
 
@@ -133,13 +135,19 @@ std::vector<SameSeedCase> same_seed_cases() {
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
+  // Solid-angle light sampling (the wavefront's scalar stages, the same
+  // LightSampler): triangle lights, a sphere light, textured and delta lights.
+  for (const std::string& s : {std::string(""), std::string("penumbra-box.json"), std::string("white-sphere-emissive-room.json"),
+                               std::string("penumbra-emissive-polygon.json"), std::string("textured"), std::string("delta")})
+    for (Strategy st : test::kAllStrategies) cases.push_back({s, st, LightSampling::SolidAngle});
   return cases;
 }
 
 INSTANTIATE_TEST_SUITE_P(AllScenes, SameSeed, testing::ValuesIn(same_seed_cases()),
                          [](const testing::TestParamInfo<SameSeedCase>& p) {
                            std::string s = (p.param.scene.empty() ? std::string("cornell") : p.param.scene) + "_" +
-                                           strategy_name(p.param.strategy);
+                                           strategy_name(p.param.strategy) +
+                                           (p.param.light_sampling == LightSampling::SolidAngle ? "_solid_angle" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;
@@ -194,6 +202,22 @@ TEST(Wavefront, EnvironmentMapSameBitsForOneAndTwoThreads) {
   scene.film.width = 16;
   scene.film.height = 12;
   scene.render.spp = 4;
+  expect_same_bits_for_one_and_two_threads(std::move(scene));
+}
+
+// Solid-angle light sampling on the Cornell box with a sphere light: the
+// wavefront runs its scalar stages (asserted inside) and both tracers give
+// the same bits for any thread count and wave size.
+TEST(Wavefront, SolidAngleLightSamplingSameBitsForOneAndTwoThreads) {
+  Scene scene = test::small_cornell(16, 4, FilterKind::Box);
+  Shape bulb;
+  bulb.kind = Shape::Kind::Sphere;
+  bulb.center = vec3(0.3f, 0.5f, 0.2f);
+  bulb.radius = 0.1f;
+  for (std::uint32_t m = 0; m < scene.materials.size(); ++m)
+    if (scene.materials[m].emits()) bulb.material = m;
+  scene.shapes.push_back(bulb);
+  scene.render.light_sampling = LightSampling::SolidAngle;
   expect_same_bits_for_one_and_two_threads(std::move(scene));
 }
 
@@ -425,6 +449,9 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
 
   EXPECT_FALSE(vectorised(cornell, Strategy::Cosine));
   EXPECT_FALSE(vectorised(cornell, Strategy::Mis, true));  // --general-shading
+  Scene solid_angle = cornell;  // the stages sample lights by area only
+  solid_angle.render.light_sampling = LightSampling::SolidAngle;
+  EXPECT_FALSE(vectorised(solid_angle, Strategy::Mis));
   const auto analytic = std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes";
   Scene sphere_light = cornell;
   Shape bulb;
