@@ -43,7 +43,7 @@ namespace {
 constexpr double kPiD = std::numbers::pi;
 constexpr double kAlpha = 0.01;
 // Chi-square tests (triangles + spheres) and z-tests (irradiance) in this file.
-constexpr double kComparisons = 14 + 6 + 4 * 2 + 3 * 2;
+constexpr double kComparisons = 16 + 6 + 4 * 2 + 3 * 2;
 
 float uniform(std::uint64_t stream, std::uint64_t k) { return to_unit_float(mix64(mix64(stream) ^ k)); }
 
@@ -148,7 +148,9 @@ std::vector<TriangleCase> triangle_cases() {
   c.push_back({"facing", unit, vec3(0.1f, 0.2f, 2.0f), true});
   c.push_back({"oblique", unit, vec3(3.0f, 0.5f, 1.0f), true});
   c.push_back({"close_above", unit, vec3(0.0f, -0.3f, 0.05f), true});
-  c.push_back({"very_close_above", unit, vec3(0.0f, -0.3f, 0.002f), false});  // Omega > 6.2: by area
+  c.push_back({"closer_above", unit, vec3(0.0f, -0.3f, 0.03f), true});            // Omega 6.03
+  c.push_back({"nearly_hemisphere", unit, vec3(0.0f, -0.3f, 0.01f), true});       // Omega 6.199
+  c.push_back({"very_close_above", unit, vec3(0.0f, -0.3f, 0.002f), false});  // Omega 6.27 > 6.2: by area
   c.push_back({"grazing_beside", unit, vec3(1.6f, 0.3f, 0.001f), true});
   c.push_back({"behind", unit, vec3(0.2f, 0.1f, -0.7f), true});
   c.push_back({"right_angle_corner", {vec3(0, 0, 0), vec3(2, 0, 0), vec3(0, 0, 2)}, vec3(0.01f, 0.5f, 0.01f), true});
@@ -229,6 +231,21 @@ TEST_P(TriangleChi2, DirectionsHaveTheDensityPdfReports) {
     }
     const vec2 b = triangle_barycentrics_along(o, dvec3(ls->wi), dvec3(t.p0), dvec3(t.p1), dvec3(t.p2));
     observed[static_cast<std::size_t>(grid.cell(b.x, b.y))] += 1.0;
+    // pdf() of the point sampled: the density sample() used, the same bits
+    // on the spherical branch (one computation, one rule), to rounding of
+    // the point on the area branch.
+    if (k < 2000) {
+      Surfel hit;
+      hit.shape = 0;
+      hit.prim = 0;
+      hit.p = ls->p;
+      hit.n = ls->n;
+      if (spherical) {
+        ASSERT_EQ(lights.pdf(c.ref, hit), ls->pdf) << "sample " << k;
+      } else {
+        ASSERT_NEAR(lights.pdf(c.ref, hit), ls->pdf, 1e-3f * ls->pdf) << "sample " << k;
+      }
+    }
   }
   EXPECT_EQ(none, 0u);  // two-sided, not in the plane
   double total = 0.0, total_coarse = 0.0;
@@ -320,6 +337,9 @@ TEST_P(SphereChi2, DirectionsHaveTheDensityPdfReports) {
       continue;
     }
     observed[bin_of(dvec3(ls->wi))] += 1.0;
+    if (cone && k < 2000) {
+      ASSERT_EQ(lights.pdf(c.ref, hit_along(dvec3(ls->wi))), ls->pdf) << "sample " << k;
+    }
   }
   // Each bin by a 16 x 16 midpoint rule in (1 - cos theta, phi).
   const int m = 16;
