@@ -33,7 +33,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
-#include <sstream>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -141,6 +141,8 @@ struct TriangleCase {
   vec3 ref;
   bool spherical;  // what the fallback rule should choose
 };
+
+void PrintTo(const TriangleCase& c, std::ostream* os) { *os << c.name; }
 
 std::vector<TriangleCase> triangle_cases() {
   const std::array<vec3, 3> unit{vec3(-1, -1, 0), vec3(1, -1, 0), vec3(0, 1, 0)};
@@ -274,6 +276,8 @@ struct SphereCase {
   vec3 ref;
   bool cone;
 };
+
+void PrintTo(const SphereCase& c, std::ostream* os) { *os << c.name; }
 
 std::vector<SphereCase> sphere_cases() {
   return {{"far", vec3(0, 0, 0), 1.0f, vec3(0.0f, 0.0f, 5.0f), true},
