@@ -4,6 +4,7 @@
 #include "core/faults.h"
 #include "core/geometry.h"
 #include "core/sampling.h"
+#include "core/sampling_spherical.h"
 
 #include <algorithm>
 #include <cmath>
@@ -82,7 +83,7 @@ std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene) {
 float LightSampler::area_density(const Entry& e) { return PATHLAB_FAULT(LightPdfWithoutArea) ? 1.0f : 1.0f / e.area; }
 
 LightSampler::LightSampler(const Scene& scene, float scene_radius, const Textures* textures)
-    : scene_(&scene), textures_(textures) {
+    : scene_(&scene), textures_(textures), light_sampling_(scene.render.light_sampling) {
   std::vector<double> power;
   first_entry_.assign(scene.shapes.size(), -1);
   for (std::uint32_t s = 0; s < scene.shapes.size(); ++s) {
@@ -208,7 +209,19 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
   const bool textured = textures_ && m.emission_textured;
   vec2 b(0.0f);  // the triangle point's barycentrics (b1, b2), for a textured emitter
   SurfacePoint sp;
-  if (shape.kind == Shape::Kind::Sphere) {
+  const SolidAngleView view = solid_angle_view(e, ref);
+  if (view.density > 0.0) {
+    if (shape.kind == Shape::Kind::Sphere) {
+      const dvec3 n = sample_sphere_cone_normal(view.cone, u);
+      sp = sphere_point(shape, shape.center + shape.radius * vec3(n));
+    } else {
+      const dvec3 o(ref), p0(e.triangle.p0), p1(e.triangle.p1), p2(e.triangle.p2);
+      const dvec3 dir = sample_spherical_triangle(glm::normalize(p0 - o), glm::normalize(p1 - o),
+                                                  glm::normalize(p2 - o), view.omega, u);
+      b = triangle_barycentrics_along(o, dir, p0, p1, p2);
+      sp = triangle_point(e.triangle, b);
+    }
+  } else if (shape.kind == Shape::Kind::Sphere) {
     sp = sample_sphere(shape, u);
   } else if (!textured) {
     sp = sample_triangle(e.triangle, u);
@@ -225,7 +238,8 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
   ls.wi = d / ls.dist;
   const float cos_light = glm::dot(ls.n, -ls.wi);
   if (!m.two_sided_emission && cos_light <= 0.0f) return std::nullopt;  // back of a one-sided emitter
-  ls.pdf = pmf_[i] * area_to_solid_angle(area_density(e), faulty_distance(ls.dist), cos_light);
+  ls.pdf = view.density > 0.0 ? pmf_[i] * static_cast<float>(view.density)
+                              : pmf_[i] * area_to_solid_angle(area_density(e), faulty_distance(ls.dist), cos_light);
   if (!(ls.pdf > 0.0f) || std::isinf(ls.pdf)) return std::nullopt;  // seen edge-on
   if (!textured) {
     ls.Le = m.emission;
@@ -242,9 +256,35 @@ float LightSampler::pdf(const vec3& ref, const Surfel& hit) const {
   const std::int64_t first = first_entry_[hit.shape];
   if (first < 0) return 0.0f;
   const std::size_t i = static_cast<std::size_t>(first) + hit.prim;
+  if (light_sampling_ == LightSampling::SolidAngle) {
+    if (pmf_[i] == 0.0f) return 0.0f;
+    const SolidAngleView view = solid_angle_view(entries_[i], ref);
+    if (view.density > 0.0) return pmf_[i] * static_cast<float>(view.density);
+  }
   const vec3 d = hit.p - ref;
   const float dist = glm::length(d);
   return pmf_[i] * area_to_solid_angle(area_density(entries_[i]), faulty_distance(dist), glm::dot(hit.n, d) / dist);
+}
+
+LightSampler::SolidAngleView LightSampler::solid_angle_view(const Entry& e, const vec3& ref) const {
+  SolidAngleView view;
+  if (light_sampling_ != LightSampling::SolidAngle) return view;
+  const Shape& shape = scene_->shapes[e.shape];
+  const dvec3 o(ref);
+  if (shape.kind == Shape::Kind::Sphere) {
+    const dvec3 to = dvec3(shape.center) - o;
+    const double r = shape.radius;
+    if (!(glm::dot(to, to) > kSphereConeMargin * r * r)) return view;  // inside (or on) the sphere: by area
+    view.cone = sphere_cone(o, dvec3(shape.center), r);
+    view.density = 1.0 / view.cone.solid_angle();
+  } else {
+    view.omega = spherical_triangle_solid_angle(dvec3(e.triangle.p0) - o, dvec3(e.triangle.p1) - o,
+                                                dvec3(e.triangle.p2) - o);
+    if (!(view.omega >= kMinSphericalTriangle && view.omega <= kMaxSphericalTriangle)) return view;
+    view.density = 1.0 / view.omega;
+  }
+  if (!std::isfinite(view.density)) view.density = 0.0;
+  return view;
 }
 
 bool LightSampler::SunDisk::contains(const vec3& dir) const {

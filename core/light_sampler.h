@@ -4,7 +4,12 @@
 // (uniform, or an image: core/environment_map.h); one is picked in
 // proportion to its power, then a point on it uniformly by area (for the
 // environment a direction: uniformly on the sphere, or by the image's
-// importance sampler). Densities are returned in solid angle as seen from the
+// importance sampler). With `light_sampling: solid_angle` (the scene's
+// RenderSettings) a triangle is sampled uniformly in the solid angle it
+// subtends (Arvo's spherical triangles) and a sphere seen from outside
+// uniformly in its cone (core/sampling_spherical.h), unless the rule there
+// sends that (shading point, light) pair to area sampling; pdf() applies
+// the same rule to the same pair. Densities are returned in solid angle as seen from the
 // shading point and include the probability of picking that light, so
 // `pdf()` of an emitter that a BSDF-sampled ray hits is directly comparable
 // with the BSDF's pdf (MIS).
@@ -24,6 +29,7 @@
 
 #include "core/geometry.h"
 #include "core/path_observer.h"
+#include "core/sampling_spherical.h"
 #include "core/scene.h"
 #include "core/surfel.h"
 
@@ -130,9 +136,13 @@ class LightSampler {
   // among the non-black ones, LightSample::light).
   std::span<const float> delta_pmf() const { return delta_pmf_; }
 
+  // How sample() places a point on an area light (the scene's
+  // render.light_sampling when it was made).
+  LightSampling light_sampling() const { return light_sampling_; }
+
   // The area-light distribution itself, for code that samples lights in
   // bulk (the wavefront's vectorised stages) and must pick exactly as
-  // sample() does: entry i is chosen when cdf[i - 1] <= u_choice < cdf[i]
+  // sample() does (under LightSampling::Area only): entry i is chosen when cdf[i - 1] <= u_choice < cdf[i]
   // (the first entry whose cdf exceeds u; the last one if none does), with
   // probability pmf[i]; its density on the light is 1 / area.
   struct Entry {
@@ -152,6 +162,17 @@ class LightSampler {
 
  private:
   static std::size_t pick(const std::vector<float>& cdf, float u);
+
+  // Whether entry `e` (a triangle or sphere) is sampled in solid angle from
+  // `ref` (the fallback rule of core/sampling_spherical.h), and with which
+  // density: density 0 means by area. sample() and pdf() both ask this, so
+  // they cannot apply different rules.
+  struct SolidAngleView {
+    double density = 0.0;  // 1 / solid angle, without the pick probability; 0: by area
+    double omega = 0.0;    // a triangle's solid angle
+    SphereCone cone;       // a sphere's cone
+  };
+  SolidAngleView solid_angle_view(const Entry& e, const vec3& ref) const;
   static float area_density(const Entry& e);  // 1 / area
 
   // A sun disk: radiance Le within the cone of half-angle alpha about frame.n
@@ -171,6 +192,7 @@ class LightSampler {
 
   const Scene* scene_;
   const Textures* textures_;
+  LightSampling light_sampling_ = LightSampling::Area;
   std::vector<Entry> entries_;           // area lights, then the environment, then the sun disks
   std::vector<SunDisk> suns_;
   std::vector<float> pmf_, cdf_;         // over entries_

@@ -25,4 +25,12 @@ std::vector<std::string_view> strategy_names() {
   return names;
 }
 
+const char* light_sampling_name(LightSampling s) { return s == LightSampling::SolidAngle ? "solid_angle" : "area"; }
+
+std::optional<LightSampling> parse_light_sampling(std::string_view name) {
+  for (LightSampling s : {LightSampling::Area, LightSampling::SolidAngle})
+    if (name == light_sampling_name(s)) return s;
+  return std::nullopt;
+}
+
 }  // namespace pathlab

@@ -46,6 +46,15 @@ std::optional<Strategy> parse_strategy(std::string_view name);
 // Every strategy's name, in the order of kAllStrategies.
 std::vector<std::string_view> strategy_names();
 
+// How an area light's point is sampled for next-event estimation
+// (core/light_sampler.h; docs/scene-format.md, "Light sampling").
+enum class LightSampling : std::uint8_t {
+  Area,        // uniformly by area on the chosen triangle or sphere
+  SolidAngle,  // uniformly in the solid angle the emitter subtends, where the rule allows
+};
+const char* light_sampling_name(LightSampling s);
+std::optional<LightSampling> parse_light_sampling(std::string_view name);
+
 struct RenderSettings {
   int spp = 16;
   // Maximum number of scattering events on a path: 0 shows only emission
@@ -55,6 +64,8 @@ struct RenderSettings {
   // Russian roulette starts at the vertex after this many bounces.
   int rr_depth = 5;
   Strategy strategy = Strategy::Mis;
+  // How next-event estimation samples a point on the chosen area light.
+  LightSampling light_sampling = LightSampling::Area;
   std::uint64_t seed = 0;
   // How glossy lobes are sampled (core/shading.h).
   BsdfSampling bsdf_sampling = BsdfSampling::Vndf;

@@ -83,7 +83,7 @@ FilmDesc read_film(const Node& node) {
 
 RenderSettings read_render(const Node& node) {
   node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh",
-                   "texture_filter", "texture_cache_mb"});
+                   "texture_filter", "texture_cache_mb", "light_sampling"});
   RenderSettings r;
   if (node.has("spp")) {
     const std::int64_t spp = node.child("spp").integer();
@@ -130,6 +130,17 @@ RenderSettings read_render(const Node& node) {
       node.child("bsdf_sampling").fail("unknown BSDF sampling " + in_quotes(name) + (near.empty() ? " (expected vndf or cospow)" : near));
     }
     r.bsdf_sampling = *s;
+  }
+  if (node.has("light_sampling")) {
+    const std::string name = node.child("light_sampling").string();
+    const auto s = parse_light_sampling(name);
+    if (!s) {
+      const std::array<std::string_view, 2> names{"area", "solid_angle"};
+      const std::string near = suggestion(name, names);
+      node.child("light_sampling")
+          .fail("unknown light sampling " + in_quotes(name) + (near.empty() ? " (expected area or solid_angle)" : near));
+    }
+    r.light_sampling = *s;
   }
   if (node.has("bvh")) {
     const std::string name = node.child("bvh").string();

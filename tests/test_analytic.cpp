@@ -17,12 +17,14 @@ struct Case {
   std::string scene;
   Strategy strategy;
   bool wavefront;
+  LightSampling light_sampling = LightSampling::Area;
 };
 
 class AnalyticScenes : public testing::TestWithParam<Case> {};
 
 TEST_P(AnalyticScenes, PassCheck) {
   Scene scene = test::load_with_strategy(GetParam().scene, GetParam().strategy);
+  scene.render.light_sampling = GetParam().light_sampling;
   const CheckResult r = GetParam().wavefront ? test::run_check<WavefrontTracer>(std::move(scene))
                                              : test::run_check(std::move(scene));
   EXPECT_TRUE(r.pixels_pass) << r.failing << " pixel-channels beyond " << r.z_threshold << ", worst z "
@@ -35,6 +37,12 @@ std::vector<Case> all_cases() {
   for (const std::string& name : test::analytic_scene_names())
     for (Strategy s : test::kAllStrategies)
       for (bool wavefront : {false, true}) cases.push_back({name, s, wavefront});
+  // Solid-angle light sampling (a representative subset: triangle lights
+  // seen near and far, a textured emitter, a room-sized sphere light seen
+  // from inside) with the strategies that sample lights.
+  for (const char* name : {"penumbra-box.json", "textured-room.json", "white-sphere-emissive-room.json"})
+    for (Strategy s : {Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+      for (bool wavefront : {false, true}) cases.push_back({name, s, wavefront, LightSampling::SolidAngle});
   return cases;
 }
 
@@ -42,7 +50,8 @@ INSTANTIATE_TEST_SUITE_P(Reference, AnalyticScenes, testing::ValuesIn(all_cases(
                          [](const testing::TestParamInfo<Case>& p) {
                            std::string s = p.param.scene.substr(0, p.param.scene.size() - 5) + "_" +
                                            strategy_name(p.param.strategy) +
-                                           (p.param.wavefront ? "_wavefront" : "_reference");
+                                           (p.param.wavefront ? "_wavefront" : "_reference") +
+                                           (p.param.light_sampling == LightSampling::SolidAngle ? "_solid_angle" : "");
                            for (char& c : s)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return s;

@@ -387,6 +387,9 @@ TEST_F(BadInput, UnknownBsdfSamplingAndNegativeFireflyControls) {
   const std::string text = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"bsdf_sampling\": \"vndff\"}");
   expect_rejected(render(write("flavour.json", text)),
                   {"flavour.json:", "/render/bsdf_sampling", "unknown BSDF sampling 'vndff' (did you mean 'vndf'?)"});
+  const std::string light = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"light_sampling\": \"solid-angle\"}");
+  expect_rejected(render(write("light.json", light)),
+                  {"light.json:", "/render/light_sampling", "unknown light sampling 'solid-angle' (did you mean 'solid_angle'?)"});
   const std::string clamp = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"clamp\": -1}");
   expect_rejected(render(write("clamp.json", clamp)), {"clamp.json:", "/render/clamp", "clamp must not be negative"});
 }

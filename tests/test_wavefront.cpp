@@ -29,6 +29,7 @@ struct SameSeedCase {
   // "envmap" (below), else a file in analytic-scenes/
   std::string scene;
   Strategy strategy;
+  LightSampling light_sampling = LightSampling::Area;
 };
 
 // An environment image lighting a diffuse sphere on a rough metal ground,
@@ -51,6 +52,22 @@ Scene envmap_scene() {
   return s;
 }
 
+// The Cornell box with a small sphere light in the air, seen from outside
+// by every surface (cone sampling under light_sampling solid_angle). Not in
+// the SameSeed list (see same_seed_cases); used by the thread test below.
+Scene cornell_with_bulb() {
+  Scene scene = builtin_cornell_box();
+  Shape bulb;
+  bulb.description = "bulb";
+  bulb.kind = Shape::Kind::Sphere;
+  bulb.center = vec3(0.3f, 0.5f, 0.2f);
+  bulb.radius = 0.1f;
+  for (std::uint32_t m = 0; m < scene.materials.size(); ++m)
+    if (scene.materials[m].emits()) bulb.material = m;
+  scene.shapes.push_back(bulb);
+  return scene;
+}
+
 Scene load_case(const SameSeedCase& c) {
   Scene s = c.scene.empty()          ? builtin_cornell_box()
             : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
@@ -64,6 +81,7 @@ Scene load_case(const SameSeedCase& c) {
   s.film.height = std::min(s.film.height, 24);
   s.render.spp = 4;
   s.render.strategy = c.strategy;
+  s.render.light_sampling = c.light_sampling;
   return s;
 }
 
@@ -133,13 +151,24 @@ std::vector<SameSeedCase> same_seed_cases() {
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
+  // Solid-angle light sampling (the wavefront's scalar stages, the same
+  // LightSampler): triangle lights, a sphere light seen from inside
+  // (white-sphere-emissive-room's room), textured and delta lights. Not a
+  // sphere light seen from outside ("bulb"): there the light strategies
+  // part in 0.5-2.5 % of samples, under area sampling as well, all by
+  // rounding (Embree's one-ray and stream SPHERE_POINT kernels disagree on
+  // shadow rays that end on the sphere), above this test's 0.1 %.
+  for (const std::string& s : {std::string(""), std::string("penumbra-box.json"), std::string("white-sphere-emissive-room.json"),
+                               std::string("penumbra-emissive-polygon.json"), std::string("textured"), std::string("delta")})
+    for (Strategy st : test::kAllStrategies) cases.push_back({s, st, LightSampling::SolidAngle});
   return cases;
 }
 
 INSTANTIATE_TEST_SUITE_P(AllScenes, SameSeed, testing::ValuesIn(same_seed_cases()),
                          [](const testing::TestParamInfo<SameSeedCase>& p) {
                            std::string s = (p.param.scene.empty() ? std::string("cornell") : p.param.scene) + "_" +
-                                           strategy_name(p.param.strategy);
+                                           strategy_name(p.param.strategy) +
+                                           (p.param.light_sampling == LightSampling::SolidAngle ? "_solid_angle" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;
@@ -195,6 +224,44 @@ TEST(Wavefront, EnvironmentMapSameBitsForOneAndTwoThreads) {
   scene.film.height = 12;
   scene.render.spp = 4;
   expect_same_bits_for_one_and_two_threads(std::move(scene));
+}
+
+// Solid-angle light sampling: the wavefront runs its scalar stages (asserted
+// inside) and both tracers give the same bits for one thread and two, and the
+// wavefront for any wave size, on the Cornell box (triangle lights).
+TEST(Wavefront, SolidAngleLightSamplingSameBitsForOneAndTwoThreads) {
+  Scene scene = test::small_cornell(16, 4, FilterKind::Box);
+  scene.render.light_sampling = LightSampling::SolidAngle;
+  expect_same_bits_for_one_and_two_threads(std::move(scene));
+}
+
+// With a sphere light too (cone sampling), for one thread and two at one
+// wave size. Not across wave sizes: Embree's SPHERE_POINT hits differ in
+// their last bits between a full stream packet and a short one, under area
+// sampling as well (found here, left as it was: not a light-sampling matter).
+TEST(Wavefront, SolidAngleSphereLightSameBitsForOneAndTwoThreads) {
+  Scene scene = cornell_with_bulb();
+  scene.film.width = scene.film.height = 16;
+  scene.render.spp = 4;
+  scene.render.light_sampling = LightSampling::SolidAngle;
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  auto render_image = [&](bool wavefront, int threads) {
+    const ThreadLimit limit(threads);
+    Film film(16, 16, FilterKind::Box);
+    if (wavefront) {
+      const WavefrontTracer tracer(compiled, settings, 97);
+      EXPECT_FALSE(tracer.vectorised());
+      render(tracer, film);
+    } else {
+      render(ReferenceTracer(compiled, settings), film);
+    }
+    return film.image();
+  };
+  for (const bool wavefront : {false, true}) {
+    const Image a = render_image(wavefront, 1), b = render_image(wavefront, 2);
+    EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0) << wavefront;
+  }
 }
 
 // A textured scene (texture lookups, cones, normal maps, textured emission).
@@ -425,6 +492,9 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
 
   EXPECT_FALSE(vectorised(cornell, Strategy::Cosine));
   EXPECT_FALSE(vectorised(cornell, Strategy::Mis, true));  // --general-shading
+  Scene solid_angle = cornell;  // the stages sample lights by area only
+  solid_angle.render.light_sampling = LightSampling::SolidAngle;
+  EXPECT_FALSE(vectorised(solid_angle, Strategy::Mis));
   const auto analytic = std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes";
   Scene sphere_light = cornell;
   Shape bulb;

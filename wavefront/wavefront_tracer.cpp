@@ -189,6 +189,10 @@ struct WavefrontTracer::VectorStages {
     const LightSampler& lights = compiled.lights();
     if (lights.has_delta_lights()) return no("delta lights (point, spot, directional)");
     if (lights.samples_environment()) return no("an environment or sun disk light");
+    // The stages sample triangle lights by area; solid-angle sampling lives
+    // in LightSampler::sample() alone, which the scalar stages call.
+    if (lights.light_sampling() != LightSampling::Area)
+      return no(std::string("light_sampling ") + light_sampling_name(lights.light_sampling()));
     for (const LightSampler::Entry& e : lights.entries()) {
       const Shape& shape = scene.shapes[e.shape];
       if (shape.kind != Shape::Kind::Triangles) return no("a sphere light (" + shape.description + ")");

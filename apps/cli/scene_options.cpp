@@ -31,6 +31,10 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
   cmd.add_option("--resolution", resolution, "Image size WxH, e.g. 640x480");
   cmd.add_option("--bsdf-sampling", bsdf_sampling, "Glossy lobe sampling: vndf (exact GGX visible normals) or cospow")
       ->check(CLI::IsMember({"vndf", "cospow"}));
+  cmd.add_option("--light-sampling", light_sampling,
+                 "Area-light points for next-event estimation: area (uniform by area) or solid_angle (uniform in "
+                 "the solid angle a triangle or sphere subtends; same expectation, less variance near lights)")
+      ->check(CLI::IsMember({"area", "solid_angle"}));
   cmd.add_option("--clamp", clamp, "Clamp each sample's radiance to this maximum component (biased; 0 = off)")
       ->check(number_range(0.0, 3.4e38));
   cmd.add_option("--min-pdf", min_pdf, "Discard BSDF samples with a smaller density (biased; 0 = off)")
@@ -55,6 +59,7 @@ Scene SceneOptions::load() const {
   if (max_depth) r.max_depth = *max_depth;
   if (rr_depth) r.rr_depth = *rr_depth;
   if (bsdf_sampling) r.bsdf_sampling = *parse_bsdf_sampling(*bsdf_sampling);
+  if (light_sampling) r.light_sampling = *parse_light_sampling(*light_sampling);
   if (clamp) r.clamp = *clamp;
   if (min_pdf) r.min_pdf = *min_pdf;
   if (general_shading) r.force_general_shading = true;
@@ -92,6 +97,8 @@ std::string SceneOptions::trace_pixel_command(const Scene& scene, std::uint32_t 
       << tracer << " --strategy " << strategy_name(scene.render.strategy) << " --max-depth " << scene.render.max_depth
       << " --rr-depth " << scene.render.rr_depth << " --resolution " << scene.film.width << "x" << scene.film.height;
   if (scene.render.bsdf_sampling != BsdfSampling::Vndf) cmd << " --bsdf-sampling " << bsdf_sampling_name(scene.render.bsdf_sampling);
+  if (scene.render.light_sampling != LightSampling::Area)
+    cmd << " --light-sampling " << light_sampling_name(scene.render.light_sampling);
   if (scene.render.min_pdf > 0.0f) cmd << " --min-pdf " << scene.render.min_pdf;
   if (scene.render.force_general_shading) cmd << " --general-shading";
   if (scene.render.texture_filter != TextureFilter::Cone) cmd << " --texture-filter " << texture_filter_name(scene.render.texture_filter);

@@ -26,6 +26,7 @@ struct SceneOptions {
   std::optional<std::string> seed;  // parsed by load(): CLI11 would wrap "-1" around
   std::optional<std::string> resolution;  // "WxH"
   std::optional<std::string> bsdf_sampling;  // vndf | cospow
+  std::optional<std::string> light_sampling;  // area | solid_angle
   std::optional<std::string> bvh;            // fast | compact
   std::optional<float> clamp, min_pdf;       // firefly controls (biased; 0 = off)
   bool general_shading = false;              // force the general shading path
