@@ -2,68 +2,203 @@
 
 #include "core/parallel.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace pathlab {
 namespace {
 
-struct PixelIntegral {
-  dvec3 mean;
-  dvec3 footprint_variance;
+// An edge's image on the film (pixels): the segment p-q, and how far the
+// edge may stray from it (the curve's sagitta, float rounding of the rays).
+struct FilmEdge {
+  glm::dvec2 p, q;
+  double margin;
 };
 
-// Filter-weighted mean of the radiance over pixel (px, py)'s support, on an
-// n x n midpoint grid per pixel unit.
-PixelIntegral integrate_pixel(const AnalyticModel& model, const Camera& camera, const FilmDesc& film, int px, int py, int n) {
-  const bool box = film.filter == FilterKind::Box;
-  // Support in film coordinates, clipped to the image.
-  const double x0 = box ? px : std::max(0.0, px - 0.5), x1 = box ? px + 1.0 : std::min<double>(film.width, px + 1.5);
-  const double y0 = box ? py : std::max(0.0, py - 0.5), y1 = box ? py + 1.0 : std::min<double>(film.height, py + 1.5);
-  const int nx = static_cast<int>(std::lround((x1 - x0) * n)), ny = static_cast<int>(std::lround((y1 - y0) * n));
-  const double cx = px + 0.5, cy = py + 0.5;
-  dvec3 sum(0.0), sum_w2L(0.0), sum_w2L2(0.0);
-  double sum_w = 0.0, sum_w2 = 0.0;
-  for (int j = 0; j < ny; ++j) {
-    const double y = y0 + (j + 0.5) * (y1 - y0) / ny;
-    const double wy = box ? 1.0 : 1.0 - std::abs(y - cy);
-    for (int i = 0; i < nx; ++i) {
-      const double x = x0 + (i + 0.5) * (x1 - x0) / nx;
-      const double w = wy * (box ? 1.0 : 1.0 - std::abs(x - cx));
-      const Ray ray = camera.generate_ray(vec2(static_cast<float>(x), static_cast<float>(y)), vec2(0.5f));
-      const dvec3 L(model.radiance(ray));
-      sum += w * L;
-      sum_w += w;
-      sum_w2 += w * w;
-      sum_w2L += w * w * L;
-      sum_w2L2 += w * w * L * L;
+// Film position of view direction v (relative to the eye, in front of it),
+// inverting Camera::generate_ray.
+glm::dvec2 to_film(const Camera::Plane& c, const FilmDesc& film, const dvec3& v) {
+  const double f = glm::dot(v, dvec3(c.forward));
+  const double sx = glm::dot(v, dvec3(c.right)) / f, sy = glm::dot(v, dvec3(c.up)) / f;
+  return {(sx / (double(c.tan_half_fov) * c.aspect) + 1.0) * 0.5 * film.width,
+          (1.0 - sy / double(c.tan_half_fov)) * 0.5 * film.height};
+}
+
+double distance_to_segment(const glm::dvec2& x, const glm::dvec2& p, const glm::dvec2& q) {
+  const glm::dvec2 d = q - p;
+  const double len2 = glm::dot(d, d);
+  const double t = len2 > 0.0 ? std::clamp(glm::dot(x - p, d) / len2, 0.0, 1.0) : 0.0;
+  return glm::length(x - (p + t * d));
+}
+
+// Float rounding in generate_ray and the models' float inputs move an edge
+// by far less than this (pixels).
+constexpr double kRoundingMargin = 1e-4;
+
+std::vector<FilmEdge> project_edges(const EdgeList& edges, const Camera& camera, const FilmDesc& film) {
+  const Camera::Plane c = camera.plane();
+  const dvec3 fwd(c.forward);
+  std::vector<FilmEdge> out;
+  for (const EdgeArc& e : edges.arcs()) {
+    // Clip to the half-space in front of the eye (f > eps |v|): what lies
+    // behind is not on the film.
+    dvec3 a = e.a, b = e.b;
+    const double fa = glm::dot(a, fwd) - 1e-9 * glm::length(a), fb = glm::dot(b, fwd) - 1e-9 * glm::length(b);
+    if (fa <= 0.0 && fb <= 0.0) continue;
+    if (fa <= 0.0) a = a + (b - a) * (fa / (fa - fb)) + 1e-6 * (b - a);
+    if (fb <= 0.0) b = b + (a - b) * (fb / (fb - fa)) + 1e-6 * (a - b);
+    FilmEdge fe{to_film(c, film, a), to_film(c, film, b), kRoundingMargin};
+    if (e.mid) {
+      // The curve bulges at most about its bulge halfway (a short arc of a
+      // smooth curve lies within a parabola of its chord); twice that.
+      const bool clipped = a != e.a || b != e.b;
+      const double fm = glm::dot(*e.mid, fwd);
+      fe.margin += (!clipped && fm > 0.0) ? 2.0 * distance_to_segment(to_film(c, film, *e.mid), fe.p, fe.q) : 1.0;
+    }
+    if (std::isfinite(fe.p.x) && std::isfinite(fe.p.y) && std::isfinite(fe.q.x) && std::isfinite(fe.q.y))
+      out.push_back(fe);
+  }
+  return out;
+}
+
+// True if segment p-q meets the rectangle [x0, x1] x [y0, y1] (Liang-Barsky).
+bool segment_meets_box(const glm::dvec2& p, const glm::dvec2& q, double x0, double y0, double x1, double y1) {
+  double t0 = 0.0, t1 = 1.0;
+  const glm::dvec2 d = q - p;
+  const double pk[4] = {-d.x, d.x, -d.y, d.y};
+  const double qk[4] = {p.x - x0, x1 - p.x, p.y - y0, y1 - p.y};
+  for (int k = 0; k < 4; ++k) {
+    if (pk[k] == 0.0) {
+      if (qk[k] < 0.0) return false;
+    } else {
+      const double t = qk[k] / pk[k];
+      if (pk[k] < 0.0) t0 = std::max(t0, t);
+      else t1 = std::min(t1, t);
+      if (t0 > t1) return false;
     }
   }
-  // Cell areas cancel in the ratio below, except one: Int w^2 (L - m)^2 dA
-  // carries one cell area, (Int w dA)^2 two.
-  const double cell = ((x1 - x0) / nx) * ((y1 - y0) / ny);
-  const dvec3 m = sum / sum_w;
-  const dvec3 spread = glm::max(sum_w2L2 - 2.0 * m * sum_w2L + m * m * sum_w2, dvec3(0.0));
-  return {m, spread / (cell * sum_w * sum_w)};
+  return true;
+}
+
+// Cells crossed by an edge are halved down to this side (pixels).
+constexpr double kFinestCell = 1.0 / 1024.0;
+
+struct Sums {
+  dvec3 wL{0.0}, w2L{0.0}, w2L2{0.0}, edge_error{0.0};
+  double w = 0.0, w2 = 0.0;
+};
+
+class PixelIntegrator {
+ public:
+  PixelIntegrator(const AnalyticModel& model, const Camera& camera, const FilmDesc& film, int px, int py,
+                  const std::vector<FilmEdge>& edges)
+      : model_(model), camera_(camera), box_(film.filter == FilterKind::Box), cx_(px + 0.5), cy_(py + 0.5) {
+    x0_ = box_ ? px : std::max(0.0, px - 0.5);
+    x1_ = box_ ? px + 1.0 : std::min<double>(film.width, px + 1.5);
+    y0_ = box_ ? py : std::max(0.0, py - 0.5);
+    y1_ = box_ ? py + 1.0 : std::min<double>(film.height, py + 1.5);
+    for (const FilmEdge& e : edges)
+      if (segment_meets_box(e.p, e.q, x0_ - e.margin, y0_ - e.margin, x1_ + e.margin, y1_ + e.margin))
+        edges_.push_back(&e);
+  }
+  bool crossed() const { return !edges_.empty(); }
+
+  // Midpoint rule on cells of side 1/n, each cell that an edge (widened by
+  // its margin) meets split in four down to kFinestCell.
+  Sums integrate(int n) {
+    Sums s;
+    const int nx = static_cast<int>(std::lround((x1_ - x0_) * n)), ny = static_cast<int>(std::lround((y1_ - y0_) * n));
+    std::vector<const FilmEdge*> all(edges_);
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+        cell(s, x0_ + i * (x1_ - x0_) / nx, y0_ + j * (y1_ - y0_) / ny, (x1_ - x0_) / nx, (y1_ - y0_) / ny, all);
+    return s;
+  }
+
+ private:
+  double weight(double x, double y) const {
+    return box_ ? 1.0 : std::max(0.0, 1.0 - std::abs(x - cx_)) * std::max(0.0, 1.0 - std::abs(y - cy_));
+  }
+  dvec3 L(double x, double y) const {
+    return dvec3(model_.radiance(camera_.generate_ray(vec2(static_cast<float>(x), static_cast<float>(y)), vec2(0.5f))));
+  }
+
+  void cell(Sums& s, double x, double y, double hx, double hy, const std::vector<const FilmEdge*>& candidates) {
+    std::vector<const FilmEdge*> near;
+    for (const FilmEdge* e : candidates)
+      if (segment_meets_box(e->p, e->q, x - e->margin, y - e->margin, x + hx + e->margin, y + hy + e->margin))
+        near.push_back(e);
+    const bool finest = std::max(hx, hy) <= kFinestCell * 1.000001;
+    if (!near.empty() && !finest) {
+      for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) cell(s, x + i * hx / 2, y + j * hy / 2, hx / 2, hy / 2, near);
+      return;
+    }
+    const double xm = x + hx / 2, ym = y + hy / 2, area = hx * hy, w = weight(xm, ym) * area;
+    const dvec3 Lm = L(xm, ym);
+    s.wL += w * Lm;
+    s.w += w;
+    s.w2 += w * w / area;
+    s.w2L += w * w / area * Lm;
+    s.w2L2 += w * w / area * Lm * Lm;
+    if (!near.empty()) {
+      // An edge crosses this finest cell: the midpoint may stand on either
+      // side of it, so the cell's share can be off by up to its area times
+      // the spread of the radiance over it, read at its corners and
+      // midpoint (a straight edge through the cell leaves corners on both
+      // sides of it).
+      dvec3 lo = Lm, hi = Lm;
+      for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+          const dvec3 Lc = L(x + i * hx, y + j * hy);
+          lo = glm::min(lo, Lc);
+          hi = glm::max(hi, Lc);
+        }
+      s.edge_error += (weight(xm, ym) + hx + hy) * area * (hi - lo);
+    }
+  }
+
+  const AnalyticModel& model_;
+  const Camera& camera_;
+  bool box_;
+  double cx_, cy_, x0_ = 0, x1_ = 0, y0_ = 0, y1_ = 0;
+  std::vector<const FilmEdge*> edges_;
+};
+
+struct PixelIntegral {
+  dvec3 mean, footprint_variance, edge_error;
+};
+
+PixelIntegral finish(const Sums& s) {
+  const dvec3 m = s.wL / s.w;
+  // Int w^2 (L - m)^2 dA / (Int w dA)^2, with the w2 sums already per unit area.
+  const dvec3 spread = glm::max(s.w2L2 - 2.0 * m * s.w2L + m * m * s.w2, dvec3(0.0));
+  return {m, spread / (s.w * s.w), s.edge_error / s.w};
 }
 
 }  // namespace
 
 ExpectedImage expected_image(const AnalyticModel& model, const Camera& camera, const FilmDesc& film) {
   ExpectedImage out{Image(film.width, film.height), Image(film.width, film.height), Image(film.width, film.height)};
+  EdgeList edge_list(dvec3(camera.desc().position));
+  model.edges(edge_list);
+  const std::vector<FilmEdge> edges = project_edges(edge_list, camera, film);
   parallel_for(0, static_cast<std::size_t>(film.height), 1, [&](std::size_t y0, std::size_t y1) {
     for (int y = static_cast<int>(y0); y < static_cast<int>(y1); ++y)
       for (int x = 0; x < film.width; ++x) {
-        PixelIntegral prev = integrate_pixel(model, camera, film, x, y, 4), cur = prev;
+        PixelIntegrator pixel(model, camera, film, x, y, edges);
+        PixelIntegral prev = finish(pixel.integrate(4)), cur = prev;
+        dvec3 diff(0.0);
         for (int n = 8; n <= 128; n *= 2) {
-          cur = integrate_pixel(model, camera, film, x, y, n);
-          const dvec3 diff = glm::abs(cur.mean - prev.mean);
+          cur = finish(pixel.integrate(n));
+          diff = glm::abs(cur.mean - prev.mean);
           prev = cur;
-          if (glm::all(glm::lessThanEqual(diff, 1e-5 * glm::abs(cur.mean) + 1e-12))) {
-            // Converged: the last difference bounds the remaining error.
-            out.quadrature_error.at(x, y) = vec3(diff);
-            break;
-          }
-          out.quadrature_error.at(x, y) = vec3(diff);
+          if (glm::all(glm::lessThanEqual(diff, 1e-5 * glm::abs(cur.mean) + 1e-12))) break;
         }
         out.mean.at(x, y) = vec3(cur.mean);
+        // The last difference bounds the error of the smooth part (both
+        // grids resolve the edges alike); the edge cells add their bound.
+        out.quadrature_error.at(x, y) = vec3(diff + cur.edge_error);
         out.footprint_variance.at(x, y) = vec3(cur.footprint_variance);
       }
   });

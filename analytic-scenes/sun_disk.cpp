@@ -40,6 +40,11 @@ class PlaneUnderSun final : public AnalyticModel {
       if (hit_triangle(o, d, t[0], t[1], t[2])) return on_plane_;
     return glm::dot(glm::normalize(d), to_sun_) >= cos_alpha_ ? Spectrum(sun_radiance_) : Spectrum(0.0f);
   }
+  void edges(EdgeList& out) const override {
+    for (const auto& t : triangles_)
+      for (int e = 0; e < 3; ++e) out.segment(t[e], t[(e + 1) % 3]);
+    out.cone(to_sun_, cos_alpha_);
+  }
   std::string describe() const override { return description_; }
 
  private:

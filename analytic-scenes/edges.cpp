@@ -1,0 +1,50 @@
+#include "analytic-scenes/edges.h"
+
+#include <cmath>
+
+namespace pathlab {
+
+void EdgeList::segment(const dvec3& p0, const dvec3& p1) { arcs_.push_back({p0 - eye_, p1 - eye_, std::nullopt}); }
+
+void EdgeList::mesh_edges(const Shape& shape) {
+  const TriangleMesh& m = shape.mesh;
+  for (const glm::uvec3& t : m.triangles)
+    for (int e = 0; e < 3; ++e) segment(dvec3(m.positions[t[e]]), dvec3(m.positions[t[(e + 1) % 3]]));
+}
+
+void EdgeList::sphere_silhouette(const dvec3& centre, double radius) {
+  const dvec3 to_eye = eye_ - centre;
+  const double d = glm::length(to_eye);
+  if (!(d > radius)) return;  // the eye inside (or on) the sphere sees no silhouette
+  // The points of tangency: a circle in the plane normal to to_eye, r^2 / d
+  // from the centre towards the eye, of radius r sqrt(1 - r^2 / d^2).
+  const dvec3 u = to_eye / d;
+  const dvec3 c = centre + u * (radius * radius / d);
+  const double rho = radius * std::sqrt(std::max(0.0, 1.0 - (radius / d) * (radius / d)));
+  const dvec3 s = glm::normalize(std::abs(u.x) < 0.9 ? glm::cross(u, dvec3(1, 0, 0)) : glm::cross(u, dvec3(0, 1, 0)));
+  const dvec3 t = glm::cross(u, s);
+  constexpr int kPieces = 128;
+  const auto at = [&](double phi) { return c + rho * (std::cos(phi) * s + std::sin(phi) * t) - eye_; };
+  for (int i = 0; i < kPieces; ++i) {
+    const double p0 = 2.0 * M_PI * i / kPieces, p1 = 2.0 * M_PI * (i + 1) / kPieces;
+    arcs_.push_back({at(p0), at(p1), at(0.5 * (p0 + p1))});
+  }
+}
+
+void EdgeList::cone(const dvec3& axis, double cos_alpha) {
+  const dvec3 u = glm::normalize(axis);
+  const dvec3 s = glm::normalize(std::abs(u.x) < 0.9 ? glm::cross(u, dvec3(1, 0, 0)) : glm::cross(u, dvec3(0, 1, 0)));
+  const dvec3 t = glm::cross(u, s);
+  const double sin_alpha = std::sqrt(std::max(0.0, 1.0 - cos_alpha * cos_alpha));
+  direction_curve([&](double phi) { return cos_alpha * u + sin_alpha * (std::cos(phi) * s + std::sin(phi) * t); }, 0.0,
+                  2.0 * M_PI, 128);
+}
+
+void EdgeList::direction_curve(const std::function<dvec3(double)>& dir, double s0, double s1, int pieces) {
+  for (int i = 0; i < pieces; ++i) {
+    const double a = s0 + (s1 - s0) * i / pieces, b = s0 + (s1 - s0) * (i + 1) / pieces;
+    arcs_.push_back({dir(a), dir(b), dir(0.5 * (a + b))});
+  }
+}
+
+}  // namespace pathlab
