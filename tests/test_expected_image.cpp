@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace pathlab {
@@ -106,12 +107,17 @@ void expect_agreement(const std::string& name, int max_edges) {
     if (std::abs(found[e] - 0.5 * base.film.height) < 1.5) continue;  // too near the centre to move by zooming
     ++tested;
     for (double offset : {0.05, -0.05, 0.003, -0.003}) {
-      // The row boundary one row further from the centre than the edge.
-      const double boundary = found[e] < 0.5 * base.film.height ? std::floor(found[e]) : std::ceil(found[e]);
+      // The row boundary one row further from the centre than the edge, or,
+      // where that is the image's border (an edge in the first or last
+      // row), the one nearer the centre: the pixel compared is the one the
+      // edge then crosses, which must be a pixel of the image.
+      const double outward = found[e] < 0.5 * base.film.height ? std::floor(found[e]) : std::ceil(found[e]);
+      const double boundary = std::clamp(outward, 1.0, base.film.height - 1.0);
       Scene s = base;
       s.camera.fov_y_degrees = fov_moving(base, found[e], boundary + offset);
       const Camera camera(s.camera, s.film.width, s.film.height);
       const int py = static_cast<int>(std::floor(boundary + offset));
+      ASSERT_TRUE(py >= 0 && py < s.film.height) << name << " edge " << e << " moved to row " << boundary + offset;
       for (FilterKind filter : {FilterKind::Box, FilterKind::Bilinear}) {
         s.film.filter = filter;
         const ExpectedImage expected = expected_image(*model, camera, s.film);
