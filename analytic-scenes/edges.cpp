@@ -23,7 +23,7 @@ void EdgeList::sphere_silhouette(const dvec3& centre, double radius) {
   const double rho = radius * std::sqrt(std::max(0.0, 1.0 - (radius / d) * (radius / d)));
   const dvec3 s = glm::normalize(std::abs(u.x) < 0.9 ? glm::cross(u, dvec3(1, 0, 0)) : glm::cross(u, dvec3(0, 1, 0)));
   const dvec3 t = glm::cross(u, s);
-  constexpr int kPieces = 128;
+  constexpr int kPieces = 1024;
   const auto at = [&](double phi) { return c + rho * (std::cos(phi) * s + std::sin(phi) * t) - eye_; };
   for (int i = 0; i < kPieces; ++i) {
     const double p0 = 2.0 * M_PI * i / kPieces, p1 = 2.0 * M_PI * (i + 1) / kPieces;
@@ -37,7 +37,7 @@ void EdgeList::cone(const dvec3& axis, double cos_alpha) {
   const dvec3 t = glm::cross(u, s);
   const double sin_alpha = std::sqrt(std::max(0.0, 1.0 - cos_alpha * cos_alpha));
   direction_curve([&](double phi) { return cos_alpha * u + sin_alpha * (std::cos(phi) * s + std::sin(phi) * t); }, 0.0,
-                  2.0 * M_PI, 128);
+                  2.0 * M_PI, 1024);
 }
 
 void EdgeList::direction_curve(const std::function<dvec3(double)>& dir, double s0, double s1, int pieces) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace pathlab {
 namespace {
@@ -88,81 +89,130 @@ struct Sums {
   double w = 0.0, w2 = 0.0;
 };
 
+// The cells of one pixel's footprint as a quadtree that outlives the grids
+// of the doubling: at grid n a cell is split if it is larger than 1/n, or
+// if an edge (widened by its margin) meets it and it is larger than
+// kFinestCell; every other cell counts its midpoint. A cell an edge meets
+// is split on every grid alike, so its subtree - the cells along the edges,
+// their midpoints, the finest cells' corners - is built and evaluated once
+// and read again by each finer grid; only the cells no edge meets are
+// evaluated anew (a midpoint grid of 1/n is not nested in one of 1/(2n)).
 class PixelIntegrator {
  public:
   PixelIntegrator(const AnalyticModel& model, const Camera& camera, const FilmDesc& film, int px, int py,
                   const std::vector<FilmEdge>& edges)
       : model_(model), camera_(camera), box_(film.filter == FilterKind::Box), cx_(px + 0.5), cy_(py + 0.5) {
-    x0_ = box_ ? px : std::max(0.0, px - 0.5);
-    x1_ = box_ ? px + 1.0 : std::min<double>(film.width, px + 1.5);
-    y0_ = box_ ? py : std::max(0.0, py - 0.5);
-    y1_ = box_ ? py + 1.0 : std::min<double>(film.height, py + 1.5);
+    const double x0 = box_ ? px : std::max(0.0, px - 0.5);
+    const double x1 = box_ ? px + 1.0 : std::min<double>(film.width, px + 1.5);
+    const double y0 = box_ ? py : std::max(0.0, py - 0.5);
+    const double y1 = box_ ? py + 1.0 : std::min<double>(film.height, py + 1.5);
+    std::vector<const FilmEdge*> near;
     for (const FilmEdge& e : edges)
-      if (segment_meets_box(e.p, e.q, x0_ - e.margin, y0_ - e.margin, x1_ + e.margin, y1_ + e.margin))
-        edges_.push_back(&e);
+      if (segment_meets_box(e.p, e.q, x0 - e.margin, y0 - e.margin, x1 + e.margin, y1 + e.margin)) near.push_back(&e);
+    crossed_ = !near.empty();
+    // The roots: the grid of side 1/kFirstGrid over the footprint.
+    const int nx = static_cast<int>(std::lround((x1 - x0) * kFirstGrid));
+    const int ny = static_cast<int>(std::lround((y1 - y0) * kFirstGrid));
+    const double h = 1.0 / kFirstGrid;
+    roots_.reserve(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) roots_.push_back(make_cell(x0 + i * h, y0 + j * h, h, near));
   }
-  bool crossed() const { return !edges_.empty(); }
+  bool crossed() const { return crossed_; }
 
-  // Midpoint rule on cells of side 1/n, each cell that an edge (widened by
-  // its margin) meets split in four down to kFinestCell.
+  // The midpoint rule on the grid of side 1/n (n a power of two, at least
+  // kFirstGrid), refined along the edges as above.
   Sums integrate(int n) {
     Sums s;
-    const int nx = static_cast<int>(std::lround((x1_ - x0_) * n)), ny = static_cast<int>(std::lround((y1_ - y0_) * n));
-    std::vector<const FilmEdge*> all(edges_);
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        cell(s, x0_ + i * (x1_ - x0_) / nx, y0_ + j * (y1_ - y0_) / ny, (x1_ - x0_) / nx, (y1_ - y0_) / ny, all);
+    for (Cell& c : roots_) visit(s, c, 1.0 / n);
     return s;
   }
 
+  static constexpr int kFirstGrid = 4;
+
  private:
+  struct Cell {
+    double x, y, h;                       // corner and side (pixels)
+    std::vector<const FilmEdge*> near;    // the edges that meet it (empty: none)
+    std::optional<dvec3> mid;             // radiance at the midpoint, once read
+    std::optional<dvec3> corner_spread;   // finest cells an edge meets: max - min over corners and midpoint
+    std::vector<Cell> children;           // cells an edge meets, once split
+  };
+
+  Cell make_cell(double x, double y, double h, const std::vector<const FilmEdge*>& candidates) const {
+    Cell c{x, y, h, {}, std::nullopt, std::nullopt, {}};
+    for (const FilmEdge* e : candidates)
+      if (segment_meets_box(e->p, e->q, x - e->margin, y - e->margin, x + h + e->margin, y + h + e->margin))
+        c.near.push_back(e);
+    return c;
+  }
+
   double weight(double x, double y) const {
     return box_ ? 1.0 : std::max(0.0, 1.0 - std::abs(x - cx_)) * std::max(0.0, 1.0 - std::abs(y - cy_));
   }
   dvec3 L(double x, double y) const {
     return dvec3(model_.radiance(camera_.generate_ray(vec2(static_cast<float>(x), static_cast<float>(y)), vec2(0.5f))));
   }
+  static void add(Sums& s, double w, double area, const dvec3& Lm) {
+    s.wL += w * area * Lm;
+    s.w += w * area;
+    s.w2 += w * w * area;
+    s.w2L += w * w * area * Lm;
+    s.w2L2 += w * w * area * Lm * Lm;
+  }
 
-  void cell(Sums& s, double x, double y, double hx, double hy, const std::vector<const FilmEdge*>& candidates) {
-    std::vector<const FilmEdge*> near;
-    for (const FilmEdge* e : candidates)
-      if (segment_meets_box(e->p, e->q, x - e->margin, y - e->margin, x + hx + e->margin, y + hy + e->margin))
-        near.push_back(e);
-    const bool finest = std::max(hx, hy) <= kFinestCell * 1.000001;
-    if (!near.empty() && !finest) {
-      for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i) cell(s, x + i * hx / 2, y + j * hy / 2, hx / 2, hy / 2, near);
+  void visit(Sums& s, Cell& c, double grid) {
+    const bool finest = c.h <= kFinestCell * 1.000001;
+    if (!c.near.empty() && !finest) {
+      if (c.children.empty()) {
+        const double h = c.h / 2;
+        c.children.reserve(4);
+        for (int j = 0; j < 2; ++j)
+          for (int i = 0; i < 2; ++i) c.children.push_back(make_cell(c.x + i * h, c.y + j * h, h, c.near));
+        c.near.shrink_to_fit();
+      }
+      for (Cell& k : c.children) visit(s, k, grid);
       return;
     }
-    const double xm = x + hx / 2, ym = y + hy / 2, area = hx * hy, w = weight(xm, ym) * area;
-    const dvec3 Lm = L(xm, ym);
-    s.wL += w * Lm;
-    s.w += w;
-    s.w2 += w * w / area;
-    s.w2L += w * w / area * Lm;
-    s.w2L2 += w * w / area * Lm * Lm;
-    if (!near.empty()) {
+    if (c.near.empty() && c.h > grid * 1.000001) {
+      // No edge here: this grid's midpoints, read afresh.
+      const int m = static_cast<int>(std::lround(c.h / grid));
+      for (int j = 0; j < m; ++j)
+        for (int i = 0; i < m; ++i) {
+          const double xm = c.x + (i + 0.5) * grid, ym = c.y + (j + 0.5) * grid;
+          add(s, weight(xm, ym), grid * grid, L(xm, ym));
+        }
+      return;
+    }
+    const double xm = c.x + c.h / 2, ym = c.y + c.h / 2, area = c.h * c.h;
+    if (!c.mid) c.mid = L(xm, ym);
+    add(s, weight(xm, ym), area, *c.mid);
+    if (!c.near.empty()) {
       // An edge crosses this finest cell: the midpoint may stand on either
       // side of it, so the cell's share can be off by up to its area times
       // the spread of the radiance over it, read at its corners and
       // midpoint (a straight edge through the cell leaves corners on both
       // sides of it).
-      dvec3 lo = Lm, hi = Lm;
-      for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i) {
-          const dvec3 Lc = L(x + i * hx, y + j * hy);
-          lo = glm::min(lo, Lc);
-          hi = glm::max(hi, Lc);
-        }
-      s.edge_error += (weight(xm, ym) + hx + hy) * area * (hi - lo);
+      if (!c.corner_spread) {
+        dvec3 lo = *c.mid, hi = *c.mid;
+        for (int j = 0; j < 2; ++j)
+          for (int i = 0; i < 2; ++i) {
+            const dvec3 Lc = L(c.x + i * c.h, c.y + j * c.h);
+            lo = glm::min(lo, Lc);
+            hi = glm::max(hi, Lc);
+          }
+        c.corner_spread = hi - lo;
+      }
+      s.edge_error += (weight(xm, ym) + 2.0 * c.h) * area * *c.corner_spread;
     }
   }
 
   const AnalyticModel& model_;
   const Camera& camera_;
   bool box_;
-  double cx_, cy_, x0_ = 0, x1_ = 0, y0_ = 0, y1_ = 0;
-  std::vector<const FilmEdge*> edges_;
+  double cx_, cy_;
+  bool crossed_ = false;
+  std::vector<Cell> roots_;
 };
 
 struct PixelIntegral {
@@ -176,33 +226,48 @@ PixelIntegral finish(const Sums& s) {
   return {m, spread / (s.w * s.w), s.edge_error / s.w};
 }
 
+// One pixel: the doubling from kFirstGrid until two grids agree.
+ExpectedPixel integrate_pixel(const AnalyticModel& model, const Camera& camera, const FilmDesc& film, int x, int y,
+                              const std::vector<FilmEdge>& edges) {
+  PixelIntegrator pixel(model, camera, film, x, y, edges);
+  PixelIntegral prev = finish(pixel.integrate(PixelIntegrator::kFirstGrid)), cur = prev;
+  dvec3 diff(0.0);
+  for (int n = 2 * PixelIntegrator::kFirstGrid; n <= 128; n *= 2) {
+    cur = finish(pixel.integrate(n));
+    diff = glm::abs(cur.mean - prev.mean);
+    prev = cur;
+    if (glm::all(glm::lessThanEqual(diff, 1e-5 * glm::abs(cur.mean) + 1e-12))) break;
+  }
+  // The last difference bounds the error of the smooth part (both grids
+  // resolve the edges alike); the edge cells add their bound.
+  return {vec3(cur.mean), vec3(diff + cur.edge_error), vec3(cur.footprint_variance)};
+}
+
+std::vector<FilmEdge> film_edges(const AnalyticModel& model, const Camera& camera, const FilmDesc& film) {
+  EdgeList edge_list(dvec3(camera.desc().position));
+  model.edges(edge_list);
+  return project_edges(edge_list, camera, film);
+}
+
 }  // namespace
 
 ExpectedImage expected_image(const AnalyticModel& model, const Camera& camera, const FilmDesc& film) {
   ExpectedImage out{Image(film.width, film.height), Image(film.width, film.height), Image(film.width, film.height)};
-  EdgeList edge_list(dvec3(camera.desc().position));
-  model.edges(edge_list);
-  const std::vector<FilmEdge> edges = project_edges(edge_list, camera, film);
+  const std::vector<FilmEdge> edges = film_edges(model, camera, film);
   parallel_for(0, static_cast<std::size_t>(film.height), 1, [&](std::size_t y0, std::size_t y1) {
     for (int y = static_cast<int>(y0); y < static_cast<int>(y1); ++y)
       for (int x = 0; x < film.width; ++x) {
-        PixelIntegrator pixel(model, camera, film, x, y, edges);
-        PixelIntegral prev = finish(pixel.integrate(4)), cur = prev;
-        dvec3 diff(0.0);
-        for (int n = 8; n <= 128; n *= 2) {
-          cur = finish(pixel.integrate(n));
-          diff = glm::abs(cur.mean - prev.mean);
-          prev = cur;
-          if (glm::all(glm::lessThanEqual(diff, 1e-5 * glm::abs(cur.mean) + 1e-12))) break;
-        }
-        out.mean.at(x, y) = vec3(cur.mean);
-        // The last difference bounds the error of the smooth part (both
-        // grids resolve the edges alike); the edge cells add their bound.
-        out.quadrature_error.at(x, y) = vec3(diff + cur.edge_error);
-        out.footprint_variance.at(x, y) = vec3(cur.footprint_variance);
+        const ExpectedPixel p = integrate_pixel(model, camera, film, x, y, edges);
+        out.mean.at(x, y) = p.mean;
+        out.quadrature_error.at(x, y) = p.quadrature_error;
+        out.footprint_variance.at(x, y) = p.footprint_variance;
       }
   });
   return out;
+}
+
+ExpectedPixel expected_pixel(const AnalyticModel& model, const Camera& camera, const FilmDesc& film, int x, int y) {
+  return integrate_pixel(model, camera, film, x, y, film_edges(model, camera, film));
 }
 
 }  // namespace pathlab

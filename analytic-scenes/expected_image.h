@@ -32,4 +32,11 @@ struct ExpectedImage {
 // guarantee). Parallel over rows.
 ExpectedImage expected_image(const AnalyticModel& model, const Camera& camera, const FilmDesc& film);
 
+// One pixel of expected_image(), computed alone (the same integrator: for
+// tests that look at one pixel of many camera poses).
+struct ExpectedPixel {
+  vec3 mean, quadrature_error, footprint_variance;
+};
+ExpectedPixel expected_pixel(const AnalyticModel& model, const Camera& camera, const FilmDesc& film, int x, int y);
+
 }  // namespace pathlab

@@ -120,14 +120,14 @@ void expect_agreement(const std::string& name, int max_edges) {
       ASSERT_TRUE(py >= 0 && py < s.film.height) << name << " edge " << e << " moved to row " << boundary + offset;
       for (FilterKind filter : {FilterKind::Box, FilterKind::Bilinear}) {
         s.film.filter = filter;
-        const ExpectedImage expected = expected_image(*model, camera, s.film);
         const bool box = filter == FilterKind::Box;
         {
           // The row the edge now lies in: a sliver of one side of it.
           const int y = py, px = static_cast<int>(x);
+          const ExpectedPixel expected = expected_pixel(*model, camera, s.film, px, y);
           const Reference ref = fine_grid(*model, camera, s.film, px, y, box ? 256 : 128, box ? 3.0 : 6.0);
           for (int c = 0; c < 3; ++c) {
-            const double got = expected.mean.at(px, y)[c], q = expected.quadrature_error.at(px, y)[c];
+            const double got = expected.mean[c], q = expected.quadrature_error[c];
             EXPECT_LE(std::abs(got - ref.mean[c]), q + ref.bound[c])
                 << name << " edge " << e << " at row " << found[e] << " moved to " << boundary + offset << ", "
                 << (box ? "box" : "bilinear") << " pixel (" << px << ", " << y << ") channel " << c << ": expected image "
@@ -170,6 +170,11 @@ TEST(ExpectedImageEdges, CheckPassesWithTheFarEdgeInASliver) {
     // The sliver holds about 5 % of the ground's radiance just below it.
     const double below = radiance_at(*model, moved, px + 0.25, row + 1.02).x;
     EXPECT_GT(e.mean.at(static_cast<int>(px), row).x, 0.03 * below) << "the far edge's sliver was missed";
+    // expected_pixel() is the same integrator, one pixel at a time.
+    const ExpectedPixel alone = expected_pixel(*model, moved, s.film, static_cast<int>(px), row);
+    EXPECT_EQ(alone.mean, e.mean.at(static_cast<int>(px), row));
+    EXPECT_EQ(alone.quadrature_error, e.quadrature_error.at(static_cast<int>(px), row));
+    EXPECT_EQ(alone.footprint_variance, e.footprint_variance.at(static_cast<int>(px), row));
   }
   const CheckResult r = test::run_check(std::move(s));
   EXPECT_TRUE(r.pass) << r.failing << " pixel-channels beyond " << r.z_threshold << ", worst z " << r.worst.front().z
