@@ -1,6 +1,11 @@
 #include "analytic-scenes/edges.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <map>
+#include <utility>
+#include <vector>
 
 namespace pathlab {
 
@@ -8,8 +13,31 @@ void EdgeList::segment(const dvec3& p0, const dvec3& p1) { arcs_.push_back({p0 -
 
 void EdgeList::mesh_edges(const Shape& shape) {
   const TriangleMesh& m = shape.mesh;
-  for (const glm::uvec3& t : m.triangles)
-    for (int e = 0; e < 3; ++e) segment(dvec3(m.positions[t[e]]), dvec3(m.positions[t[(e + 1) % 3]]));
+  // Each edge once, by its vertex indices, with the triangles that have it.
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::size_t>> users;
+  for (std::size_t i = 0; i < m.triangles.size(); ++i)
+    for (int e = 0; e < 3; ++e) {
+      const std::uint32_t a = m.triangles[i][e], b = m.triangles[i][(e + 1) % 3];
+      users[{std::min(a, b), std::max(a, b)}].push_back(i);
+    }
+  const auto normal = [&](std::size_t i) {
+    const glm::uvec3& t = m.triangles[i];
+    const dvec3 p0(m.positions[t[0]]), p1(m.positions[t[1]]), p2(m.positions[t[2]]);
+    const dvec3 n = glm::cross(p1 - p0, p2 - p0);
+    const double len = glm::length(n);
+    return len > 0.0 ? n / len : dvec3(0.0);
+  };
+  const auto material = [&](std::size_t i) { return m.face_material.empty() ? 0u : m.face_material[i]; };
+  for (const auto& [edge, tris] : users) {
+    // Inside one flat face: two triangles with the same vertices on the
+    // edge (so the same interpolated attributes), the same plane, the same
+    // side and the same material. The surface and everything read from it
+    // are continuous there: nothing jumps.
+    if (tris.size() == 2 && material(tris[0]) == material(tris[1]) &&
+        glm::dot(normal(tris[0]), normal(tris[1])) > 1.0 - 1e-12)
+      continue;
+    segment(dvec3(m.positions[edge.first]), dvec3(m.positions[edge.second]));
+  }
 }
 
 void EdgeList::sphere_silhouette(const dvec3& centre, double radius) {

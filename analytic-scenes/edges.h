@@ -39,8 +39,10 @@ class EdgeList {
 
   // A straight world segment.
   void segment(const dvec3& p0, const dvec3& p1);
-  // Every edge of every triangle of a mesh (its outline, its silhouette
-  // from any eye, and some edges across which nothing jumps).
+  // Every edge of a mesh's triangles (its outline, its silhouette from any
+  // eye, its creases) except those inside one flat face: shared, by vertex
+  // index, by exactly two triangles of the same plane, side and material
+  // (a quad's diagonal), across which nothing jumps.
   void mesh_edges(const Shape& shape);
   // The silhouette of a sphere seen from the eye (nothing from inside).
   void sphere_silhouette(const dvec3& centre, double radius);
