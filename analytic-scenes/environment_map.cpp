@@ -67,6 +67,7 @@ class EnvironmentMapModel final : public AnalyticModel {
       center_ = shape->center;
       radius_ = shape->radius;
     } else if (shape) {
+      plane_shape_ = *shape;
       for (const glm::uvec3& t : shape->mesh.triangles)
         plane_.push_back({dvec3(shape->mesh.positions[t.x]), dvec3(shape->mesh.positions[t.y]),
                           dvec3(shape->mesh.positions[t.z])});
@@ -96,8 +97,7 @@ class EnvironmentMapModel final : public AnalyticModel {
   // map's texel edges where the sky is seen directly. Their reflections in
   // the mirror sphere are curves this model does not list.
   void edges(EdgeList& out) const override {
-    for (const auto& t : plane_)
-      for (int e = 0; e < 3; ++e) out.segment(t[e], t[(e + 1) % 3]);
+    if (!plane_.empty()) out.mesh_edges(plane_shape_);
     if (has_sphere_) {
       out.sphere_silhouette(dvec3(center_), radius_);
       if (!map_->constant() || !suns_.empty()) out.note_unlisted("the map's texel edges and sun disks mirrored in the sphere");
@@ -114,7 +114,7 @@ class EnvironmentMapModel final : public AnalyticModel {
     for (int j = 0; j < w; ++j)
       out.direction_curve([&](double v) { return dir(static_cast<double>(j) / w, v); }, 0.0, 1.0, 2 * h);
     for (int i = 1; i < h; ++i)
-      out.direction_curve([&](double u) { return dir(u, static_cast<double>(i) / h); }, 0.0, 1.0, std::max(128, 4 * w));
+      out.direction_curve([&](double u) { return dir(u, static_cast<double>(i) / h); }, 0.0, 1.0, std::max(1024, 4 * w));
   }
 
  private:
@@ -130,6 +130,7 @@ class EnvironmentMapModel final : public AnalyticModel {
   std::string description_;
   Spectrum surface_{0.0f};  // the sphere's reflectance, or the plane's radiance
   std::vector<std::array<dvec3, 3>> plane_;  // the plane's triangles
+  Shape plane_shape_;                        // and the plane itself, for its edges
   bool has_sphere_ = false;
   vec3 center_{0.0f};
   float radius_ = 0.0f;

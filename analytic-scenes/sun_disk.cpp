@@ -29,7 +29,8 @@ class PlaneUnderSun final : public AnalyticModel {
         cos_alpha_(std::cos(double(sun.angular_radius))),
         sun_radiance_(dvec3(sun.intensity) / (M_PI * std::pow(std::sin(double(sun.angular_radius)), 2))),
         on_plane_(on_plane),
-        description_(std::move(description)) {
+        description_(std::move(description)),
+        plane_(plane) {
     for (const glm::uvec3& t : plane.mesh.triangles)
       triangles_.push_back({dvec3(plane.mesh.positions[t.x]), dvec3(plane.mesh.positions[t.y]), dvec3(plane.mesh.positions[t.z])});
   }
@@ -41,8 +42,7 @@ class PlaneUnderSun final : public AnalyticModel {
     return glm::dot(glm::normalize(d), to_sun_) >= cos_alpha_ ? Spectrum(sun_radiance_) : Spectrum(0.0f);
   }
   void edges(EdgeList& out) const override {
-    for (const auto& t : triangles_)
-      for (int e = 0; e < 3; ++e) out.segment(t[e], t[(e + 1) % 3]);
+    out.mesh_edges(plane_);
     out.cone(to_sun_, cos_alpha_);
   }
   std::string describe() const override { return description_; }
@@ -54,6 +54,7 @@ class PlaneUnderSun final : public AnalyticModel {
   dvec3 sun_radiance_;
   Spectrum on_plane_;
   std::string description_;
+  Shape plane_;  // for its edges
 };
 
 }  // namespace
