@@ -26,9 +26,11 @@ struct ExpectedImage {
 // Midpoint quadrature on an n x n grid per pixel unit, every cell that an
 // edge of the model (AnalyticModel::edges) meets split down to 1/1024
 // pixel, doubling n from 4 until two successive estimates agree to 1e-5
-// (relative) or n = 128. The quadrature error is the last difference plus,
-// per finest cell an edge crosses, its weight x area x the radiance's
-// spread over its midpoint and corners (docs/analytic-scenes.md states the
+// (relative) or n = 128. The cells along the edges are the same on every
+// grid: they are built and evaluated once per pixel and read again by
+// each finer grid. The quadrature error is the last difference plus, per
+// finest cell an edge crosses, its weight x area x the radiance's spread
+// over its midpoint and corners (docs/analytic-scenes.md states the
 // guarantee). Parallel over rows.
 ExpectedImage expected_image(const AnalyticModel& model, const Camera& camera, const FilmDesc& film);
 
