@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 
 namespace pathlab {
 namespace {
@@ -89,69 +88,140 @@ struct Sums {
   double w = 0.0, w2 = 0.0;
 };
 
-// The cells of one pixel's footprint as a quadtree that outlives the grids
-// of the doubling: at grid n a cell is split if it is larger than 1/n, or
-// if an edge (widened by its margin) meets it and it is larger than
-// kFinestCell; every other cell counts its midpoint. A cell an edge meets
-// is split on every grid alike, so its subtree - the cells along the edges,
-// their midpoints, the finest cells' corners - is built and evaluated once
-// and read again by each finer grid; only the cells no edge meets are
-// evaluated anew (a midpoint grid of 1/n is not nested in one of 1/(2n)).
+constexpr int kFirstGrid = 4;  // the first grid's cells per pixel unit
+
+// The film's cells of side 1/kFirstGrid, each the root of a quadtree that
+// outlives the grids of the doubling: at grid n a cell is split if it is
+// larger than 1/n, or if an edge (widened by its margin) meets it and it is
+// larger than kFinestCell; every other cell counts its midpoint. A cell an
+// edge meets is split on every grid alike, so its subtree - the cells along
+// the edges, their midpoints, the finest cells' corners - is built and
+// evaluated once, before any pixel is integrated, and read by every grid of
+// every pixel whose footprint holds it (the tent's footprints overlap: each
+// cell lies in up to four). Only the cells no edge meets are evaluated anew
+// per grid (a midpoint grid of 1/n is not nested in one of 1/(2n)). The
+// footprints' corners (integers for the box, half-integers or the image's
+// border for the tent) lie on the roots' grid.
+class CellTree {
+ public:
+  struct Cell {
+    double x = 0, y = 0, h = 0;  // corner and side (pixels)
+    bool crossed = false;        // an edge meets it
+    vec3 mid{0.0f};              // radiance at the midpoint (cells not split because of an edge)
+    vec3 lo{0.0f}, hi{0.0f};     // finest cells an edge meets: the range over corners and midpoint
+    std::vector<Cell> children;  // cells an edge meets
+  };
+
+  CellTree(const AnalyticModel& model, const Camera& camera, const FilmDesc& film)
+      : model_(model), camera_(camera), rw_(film.width * kFirstGrid), rh_(film.height * kFirstGrid),
+        roots_(static_cast<std::size_t>(rw_) * static_cast<std::size_t>(rh_)) {}
+
+  // Builds and evaluates the roots of film pixels [ux0, ux1) x [uy0, uy1);
+  // parallel over their rows (each root is written by one thread only).
+  void build(const std::vector<FilmEdge>& edges, int ux0, int uy0, int ux1, int uy1) {
+    parallel_for(static_cast<std::size_t>(uy0), static_cast<std::size_t>(uy1), 1, [&](std::size_t r0, std::size_t r1) {
+      std::vector<const FilmEdge*> near;
+      for (int uy = static_cast<int>(r0); uy < static_cast<int>(r1); ++uy)
+        for (int ux = ux0; ux < ux1; ++ux) {
+          near.clear();
+          for (const FilmEdge& e : edges)
+            if (segment_meets_box(e.p, e.q, ux - e.margin, uy - e.margin, ux + 1 + e.margin, uy + 1 + e.margin))
+              near.push_back(&e);
+          const double h = 1.0 / kFirstGrid;
+          for (int j = 0; j < kFirstGrid; ++j)
+            for (int i = 0; i < kFirstGrid; ++i) {
+              Cell& c = root(ux * kFirstGrid + i, uy * kFirstGrid + j);
+              c.x = ux + i * h;
+              c.y = uy + j * h;
+              c.h = h;
+              grow(c, near);
+            }
+        }
+    });
+  }
+
+  const Cell& root(int rx, int ry) const {
+    return roots_[static_cast<std::size_t>(ry) * static_cast<std::size_t>(rw_) + static_cast<std::size_t>(rx)];
+  }
+  dvec3 L(double x, double y) const {
+    return dvec3(model_.radiance(camera_.generate_ray(vec2(static_cast<float>(x), static_cast<float>(y)), vec2(0.5f))));
+  }
+
+ private:
+  Cell& root(int rx, int ry) {
+    return roots_[static_cast<std::size_t>(ry) * static_cast<std::size_t>(rw_) + static_cast<std::size_t>(rx)];
+  }
+
+  // Splits c down along the edges among `candidates` that meet it and reads
+  // every midpoint and finest corner the grids will need.
+  void grow(Cell& c, const std::vector<const FilmEdge*>& candidates) const {
+    std::vector<const FilmEdge*> near;
+    for (const FilmEdge* e : candidates)
+      if (segment_meets_box(e->p, e->q, c.x - e->margin, c.y - e->margin, c.x + c.h + e->margin, c.y + c.h + e->margin))
+        near.push_back(e);
+    c.crossed = !near.empty();
+    const bool finest = c.h <= kFinestCell * 1.000001;
+    if (c.crossed && !finest) {
+      const double h = c.h / 2;
+      c.children.resize(4);
+      for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+          Cell& k = c.children[static_cast<std::size_t>(2 * j + i)];
+          k.x = c.x + i * h;
+          k.y = c.y + j * h;
+          k.h = h;
+          grow(k, near);
+        }
+      return;
+    }
+    const dvec3 m = L(c.x + c.h / 2, c.y + c.h / 2);
+    c.mid = vec3(m);
+    if (c.crossed) {
+      dvec3 lo = m, hi = m;
+      for (int j = 0; j < 2; ++j)
+        for (int i = 0; i < 2; ++i) {
+          const dvec3 Lc = L(c.x + i * c.h, c.y + j * c.h);
+          lo = glm::min(lo, Lc);
+          hi = glm::max(hi, Lc);
+        }
+      c.lo = vec3(lo);
+      c.hi = vec3(hi);
+    }
+  }
+
+  const AnalyticModel& model_;
+  const Camera& camera_;
+  int rw_, rh_;
+  std::vector<Cell> roots_;
+};
+
+// One pixel's footprint on the tree: the roots it holds, visited on grid n.
 class PixelIntegrator {
  public:
-  PixelIntegrator(const AnalyticModel& model, const Camera& camera, const FilmDesc& film, int px, int py,
-                  const std::vector<FilmEdge>& edges)
-      : model_(model), camera_(camera), box_(film.filter == FilterKind::Box), cx_(px + 0.5), cy_(py + 0.5) {
+  PixelIntegrator(const CellTree& tree, const FilmDesc& film, int px, int py)
+      : tree_(tree), box_(film.filter == FilterKind::Box), cx_(px + 0.5), cy_(py + 0.5) {
     const double x0 = box_ ? px : std::max(0.0, px - 0.5);
     const double x1 = box_ ? px + 1.0 : std::min<double>(film.width, px + 1.5);
     const double y0 = box_ ? py : std::max(0.0, py - 0.5);
     const double y1 = box_ ? py + 1.0 : std::min<double>(film.height, py + 1.5);
-    std::vector<const FilmEdge*> near;
-    for (const FilmEdge& e : edges)
-      if (segment_meets_box(e.p, e.q, x0 - e.margin, y0 - e.margin, x1 + e.margin, y1 + e.margin)) near.push_back(&e);
-    crossed_ = !near.empty();
-    // The roots: the grid of side 1/kFirstGrid over the footprint.
-    const int nx = static_cast<int>(std::lround((x1 - x0) * kFirstGrid));
-    const int ny = static_cast<int>(std::lround((y1 - y0) * kFirstGrid));
-    const double h = 1.0 / kFirstGrid;
-    roots_.reserve(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) roots_.push_back(make_cell(x0 + i * h, y0 + j * h, h, near));
+    rx0_ = static_cast<int>(std::lround(x0 * kFirstGrid));
+    rx1_ = static_cast<int>(std::lround(x1 * kFirstGrid));
+    ry0_ = static_cast<int>(std::lround(y0 * kFirstGrid));
+    ry1_ = static_cast<int>(std::lround(y1 * kFirstGrid));
   }
-  bool crossed() const { return crossed_; }
 
   // The midpoint rule on the grid of side 1/n (n a power of two, at least
   // kFirstGrid), refined along the edges as above.
-  Sums integrate(int n) {
+  Sums integrate(int n) const {
     Sums s;
-    for (Cell& c : roots_) visit(s, c, 1.0 / n);
+    for (int ry = ry0_; ry < ry1_; ++ry)
+      for (int rx = rx0_; rx < rx1_; ++rx) visit(s, tree_.root(rx, ry), 1.0 / n);
     return s;
   }
 
-  static constexpr int kFirstGrid = 4;
-
  private:
-  struct Cell {
-    double x, y, h;                       // corner and side (pixels)
-    std::vector<const FilmEdge*> near;    // the edges that meet it (empty: none)
-    std::optional<dvec3> mid;             // radiance at the midpoint, once read
-    std::optional<dvec3> corner_spread;   // finest cells an edge meets: max - min over corners and midpoint
-    std::vector<Cell> children;           // cells an edge meets, once split
-  };
-
-  Cell make_cell(double x, double y, double h, const std::vector<const FilmEdge*>& candidates) const {
-    Cell c{x, y, h, {}, std::nullopt, std::nullopt, {}};
-    for (const FilmEdge* e : candidates)
-      if (segment_meets_box(e->p, e->q, x - e->margin, y - e->margin, x + h + e->margin, y + h + e->margin))
-        c.near.push_back(e);
-    return c;
-  }
-
   double weight(double x, double y) const {
     return box_ ? 1.0 : std::max(0.0, 1.0 - std::abs(x - cx_)) * std::max(0.0, 1.0 - std::abs(y - cy_));
-  }
-  dvec3 L(double x, double y) const {
-    return dvec3(model_.radiance(camera_.generate_ray(vec2(static_cast<float>(x), static_cast<float>(y)), vec2(0.5f))));
   }
   static void add(Sums& s, double w, double area, const dvec3& Lm) {
     s.wL += w * area * Lm;
@@ -161,58 +231,37 @@ class PixelIntegrator {
     s.w2L2 += w * w * area * Lm * Lm;
   }
 
-  void visit(Sums& s, Cell& c, double grid) {
-    const bool finest = c.h <= kFinestCell * 1.000001;
-    if (!c.near.empty() && !finest) {
-      if (c.children.empty()) {
-        const double h = c.h / 2;
-        c.children.reserve(4);
-        for (int j = 0; j < 2; ++j)
-          for (int i = 0; i < 2; ++i) c.children.push_back(make_cell(c.x + i * h, c.y + j * h, h, c.near));
-        c.near.shrink_to_fit();
-      }
-      for (Cell& k : c.children) visit(s, k, grid);
+  void visit(Sums& s, const CellTree::Cell& c, double grid) const {
+    if (!c.children.empty()) {
+      for (const CellTree::Cell& k : c.children) visit(s, k, grid);
       return;
     }
-    if (c.near.empty() && c.h > grid * 1.000001) {
+    if (!c.crossed && c.h > grid * 1.000001) {
       // No edge here: this grid's midpoints, read afresh.
       const int m = static_cast<int>(std::lround(c.h / grid));
       for (int j = 0; j < m; ++j)
         for (int i = 0; i < m; ++i) {
           const double xm = c.x + (i + 0.5) * grid, ym = c.y + (j + 0.5) * grid;
-          add(s, weight(xm, ym), grid * grid, L(xm, ym));
+          add(s, weight(xm, ym), grid * grid, tree_.L(xm, ym));
         }
       return;
     }
     const double xm = c.x + c.h / 2, ym = c.y + c.h / 2, area = c.h * c.h;
-    if (!c.mid) c.mid = L(xm, ym);
-    add(s, weight(xm, ym), area, *c.mid);
-    if (!c.near.empty()) {
+    add(s, weight(xm, ym), area, dvec3(c.mid));
+    if (c.crossed) {
       // An edge crosses this finest cell: the midpoint may stand on either
       // side of it, so the cell's share can be off by up to its area times
       // the spread of the radiance over it, read at its corners and
       // midpoint (a straight edge through the cell leaves corners on both
       // sides of it).
-      if (!c.corner_spread) {
-        dvec3 lo = *c.mid, hi = *c.mid;
-        for (int j = 0; j < 2; ++j)
-          for (int i = 0; i < 2; ++i) {
-            const dvec3 Lc = L(c.x + i * c.h, c.y + j * c.h);
-            lo = glm::min(lo, Lc);
-            hi = glm::max(hi, Lc);
-          }
-        c.corner_spread = hi - lo;
-      }
-      s.edge_error += (weight(xm, ym) + 2.0 * c.h) * area * *c.corner_spread;
+      s.edge_error += (weight(xm, ym) + 2.0 * c.h) * area * (dvec3(c.hi) - dvec3(c.lo));
     }
   }
 
-  const AnalyticModel& model_;
-  const Camera& camera_;
+  const CellTree& tree_;
   bool box_;
   double cx_, cy_;
-  bool crossed_ = false;
-  std::vector<Cell> roots_;
+  int rx0_ = 0, rx1_ = 0, ry0_ = 0, ry1_ = 0;
 };
 
 struct PixelIntegral {
@@ -227,12 +276,11 @@ PixelIntegral finish(const Sums& s) {
 }
 
 // One pixel: the doubling from kFirstGrid until two grids agree.
-ExpectedPixel integrate_pixel(const AnalyticModel& model, const Camera& camera, const FilmDesc& film, int x, int y,
-                              const std::vector<FilmEdge>& edges) {
-  PixelIntegrator pixel(model, camera, film, x, y, edges);
-  PixelIntegral prev = finish(pixel.integrate(PixelIntegrator::kFirstGrid)), cur = prev;
+ExpectedPixel integrate_pixel(const CellTree& tree, const FilmDesc& film, int x, int y) {
+  const PixelIntegrator pixel(tree, film, x, y);
+  PixelIntegral prev = finish(pixel.integrate(kFirstGrid)), cur = prev;
   dvec3 diff(0.0);
-  for (int n = 2 * PixelIntegrator::kFirstGrid; n <= 128; n *= 2) {
+  for (int n = 2 * kFirstGrid; n <= 128; n *= 2) {
     cur = finish(pixel.integrate(n));
     diff = glm::abs(cur.mean - prev.mean);
     prev = cur;
@@ -253,11 +301,12 @@ std::vector<FilmEdge> film_edges(const AnalyticModel& model, const Camera& camer
 
 ExpectedImage expected_image(const AnalyticModel& model, const Camera& camera, const FilmDesc& film) {
   ExpectedImage out{Image(film.width, film.height), Image(film.width, film.height), Image(film.width, film.height)};
-  const std::vector<FilmEdge> edges = film_edges(model, camera, film);
+  CellTree tree(model, camera, film);
+  tree.build(film_edges(model, camera, film), 0, 0, film.width, film.height);
   parallel_for(0, static_cast<std::size_t>(film.height), 1, [&](std::size_t y0, std::size_t y1) {
     for (int y = static_cast<int>(y0); y < static_cast<int>(y1); ++y)
       for (int x = 0; x < film.width; ++x) {
-        const ExpectedPixel p = integrate_pixel(model, camera, film, x, y, edges);
+        const ExpectedPixel p = integrate_pixel(tree, film, x, y);
         out.mean.at(x, y) = p.mean;
         out.quadrature_error.at(x, y) = p.quadrature_error;
         out.footprint_variance.at(x, y) = p.footprint_variance;
@@ -267,7 +316,13 @@ ExpectedImage expected_image(const AnalyticModel& model, const Camera& camera, c
 }
 
 ExpectedPixel expected_pixel(const AnalyticModel& model, const Camera& camera, const FilmDesc& film, int x, int y) {
-  return integrate_pixel(model, camera, film, x, y, film_edges(model, camera, film));
+  CellTree tree(model, camera, film);
+  // The pixels whose cells the footprint holds (the tent's reaches half a
+  // pixel into each neighbour).
+  const int r = film.filter == FilterKind::Box ? 0 : 1;
+  tree.build(film_edges(model, camera, film), std::max(0, x - r), std::max(0, y - r), std::min(film.width, x + r + 1),
+             std::min(film.height, y + r + 1));
+  return integrate_pixel(tree, film, x, y);
 }
 
 }  // namespace pathlab
