@@ -27,8 +27,8 @@ struct ExpectedImage {
 // edge of the model (AnalyticModel::edges) meets split down to 1/1024
 // pixel, doubling n from 4 until two successive estimates agree to 1e-5
 // (relative) or n = 128. The cells along the edges are the same on every
-// grid: they are built and evaluated once per pixel and read again by
-// each finer grid. The quadrature error is the last difference plus, per
+// grid and for every footprint that holds them: they are built and
+// evaluated once per film and read by every grid of every pixel. The quadrature error is the last difference plus, per
 // finest cell an edge crosses, its weight x area x the radiance's spread
 // over its midpoint and corners (docs/analytic-scenes.md states the
 // guarantee). Parallel over rows.
