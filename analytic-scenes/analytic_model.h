@@ -8,6 +8,7 @@
 // docs/analytic-scenes.md for each model's assumptions).
 #pragma once
 
+#include "analytic-scenes/edges.h"
 #include "core/math.h"
 #include "core/ray.h"
 #include "core/scene.h"
@@ -26,6 +27,11 @@ class AnalyticModel {
   // Expected radiance arriving at the camera along `ray` (a camera ray of
   // the scene: unit direction, starting at the camera).
   virtual Spectrum radiance(const Ray& ray) const = 0;
+  // Every curve across which radiance() may jump, seen from out.eye()
+  // (edges.h): expected_image() refines the pixel footprints they cross.
+  // Where radiance() is continuous (a penumbra, a bilinear texture) nothing
+  // need be listed; what a model cannot list it names with note_unlisted().
+  virtual void edges(EdgeList& out) const = 0;
   // One line describing the model's parameters as read from the scene.
   virtual std::string describe() const = 0;
 };

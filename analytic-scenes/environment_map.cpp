@@ -19,10 +19,12 @@
 // plane, which the model requires).
 //
 // The map is piecewise constant, so the expected pixel values have edges
-// wherever a pixel straddles a texel boundary; expected_image() refines its
-// midpoint grid to 128^2 per pixel and reports the last difference as the
-// quadrature error, which check() adds to each pixel's tolerance (measured
-// for the committed scenes in docs/analytic-scenes.md: far below the noise).
+// wherever a pixel straddles a texel boundary. Seen directly, those edges
+// are listed (edges()) and expected_image() refines along them; mirrored in
+// the sphere they are not, and there it refines its midpoint grid up to
+// 128^2 per pixel and reports the last difference as the quadrature error,
+// which check() adds to each pixel's tolerance (measured for the committed
+// scenes in docs/analytic-scenes.md: far below the noise).
 #include "analytic-scenes/models.h"
 #include "analytic-scenes/room.h"
 #include "core/environment_map.h"
@@ -65,6 +67,7 @@ class EnvironmentMapModel final : public AnalyticModel {
       center_ = shape->center;
       radius_ = shape->radius;
     } else if (shape) {
+      plane_shape_ = *shape;
       for (const glm::uvec3& t : shape->mesh.triangles)
         plane_.push_back({dvec3(shape->mesh.positions[t.x]), dvec3(shape->mesh.positions[t.y]),
                           dvec3(shape->mesh.positions[t.z])});
@@ -90,6 +93,29 @@ class EnvironmentMapModel final : public AnalyticModel {
     return sky(ray.dir);
   }
   std::string describe() const override { return description_; }
+  // The plane's outline or the sphere's silhouette; the suns' disks and the
+  // map's texel edges where the sky is seen directly. Their reflections in
+  // the mirror sphere are curves this model does not list.
+  void edges(EdgeList& out) const override {
+    if (!plane_.empty()) out.mesh_edges(plane_shape_);
+    if (has_sphere_) {
+      out.sphere_silhouette(dvec3(center_), radius_);
+      if (!map_->constant() || !suns_.empty()) out.note_unlisted("the map's texel edges and sun disks mirrored in the sphere");
+    }
+    for (const Sun& sun : suns_) out.cone(sun.to_sun, sun.cos_alpha);
+    if (map_->constant()) return;
+    const glm::dmat3 to_world(map_->to_world());
+    const int w = map_->width(), h = map_->height();
+    const auto dir = [&](double u, double v) {
+      return to_world * dvec3(EnvironmentMap::uv_to_direction(vec2(static_cast<float>(u), static_cast<float>(v))));
+    };
+    // Columns' edges: half great circles from pole to pole, in pieces under
+    // 180 degrees; rows' edges: circles of constant polar angle.
+    for (int j = 0; j < w; ++j)
+      out.direction_curve([&](double v) { return dir(static_cast<double>(j) / w, v); }, 0.0, 1.0, 2 * h);
+    for (int i = 1; i < h; ++i)
+      out.direction_curve([&](double u) { return dir(u, static_cast<double>(i) / h); }, 0.0, 1.0, std::max(1024, 4 * w));
+  }
 
  private:
   Spectrum sky(const vec3& dir) const {
@@ -104,6 +130,7 @@ class EnvironmentMapModel final : public AnalyticModel {
   std::string description_;
   Spectrum surface_{0.0f};  // the sphere's reflectance, or the plane's radiance
   std::vector<std::array<dvec3, 3>> plane_;  // the plane's triangles
+  Shape plane_shape_;                        // and the plane itself, for its edges
   bool has_sphere_ = false;
   vec3 center_{0.0f};
   float radius_ = 0.0f;

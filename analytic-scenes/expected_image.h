@@ -23,9 +23,22 @@ struct ExpectedImage {
   Image footprint_variance;
 };
 
-// Midpoint quadrature on an n x n grid per pixel unit, doubling n from 4
-// until two successive estimates agree to 1e-5 (relative) or n = 128; the
-// last difference is reported as the quadrature error. Parallel over rows.
+// Midpoint quadrature on an n x n grid per pixel unit, every cell that an
+// edge of the model (AnalyticModel::edges) meets split down to 1/1024
+// pixel, doubling n from 4 until two successive estimates agree to 1e-5
+// (relative) or n = 128. The cells along the edges are the same on every
+// grid and for every footprint that holds them: they are built and
+// evaluated once per film and read by every grid of every pixel. The quadrature error is the last difference plus, per
+// finest cell an edge crosses, its weight x area x the radiance's spread
+// over its midpoint and corners (docs/analytic-scenes.md states the
+// guarantee). Parallel over rows.
 ExpectedImage expected_image(const AnalyticModel& model, const Camera& camera, const FilmDesc& film);
+
+// One pixel of expected_image(), computed alone (the same integrator: for
+// tests that look at one pixel of many camera poses).
+struct ExpectedPixel {
+  vec3 mean, quadrature_error, footprint_variance;
+};
+ExpectedPixel expected_pixel(const AnalyticModel& model, const Camera& camera, const FilmDesc& film, int x, int y);
 
 }  // namespace pathlab

@@ -30,6 +30,7 @@ class Furnace final : public AnalyticModel {
   Furnace(Spectrum L, std::string description) : L_(L), description_(std::move(description)) {}
   std::string_view name() const override { return "furnace"; }
   Spectrum radiance(const Ray&) const override { return L_; }
+  void edges(EdgeList&) const override {}  // the same radiance everywhere
   std::string describe() const override { return description_; }
 
  private:

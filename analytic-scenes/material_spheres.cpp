@@ -98,6 +98,9 @@ class RoughSphere final : public AnalyticModel {
     const int i = std::min(kTable - 2, static_cast<int>(x));
     return L_ * glm::mix(albedo_[i], albedo_[i + 1], x - static_cast<float>(i));
   }
+  // The sphere's silhouette; inside it the radiance is a continuous
+  // function of the view cosine, outside it uniform.
+  void edges(EdgeList& out) const override { out.sphere_silhouette(dvec3(center_), radius_); }
   std::string describe() const override { return description_; }
 
  private:
@@ -128,6 +131,9 @@ class GlassSphere final : public AnalyticModel {
     }
     return out;
   }
+  // The sphere's silhouette; inside it the radiance is a continuous
+  // function of the view cosine, outside it uniform.
+  void edges(EdgeList& out) const override { out.sphere_silhouette(dvec3(center_), radius_); }
   std::string describe() const override { return description_; }
 
  private:

@@ -115,6 +115,14 @@ class Penumbra final : public AnalyticModel {
 
   std::string_view name() const override { return "penumbra"; }
   std::string describe() const override { return description; }
+  // The outlines of the emitter, the ground and the occluder. The shadow's
+  // edges need nothing: lit by an area emitter, the ground's radiance is
+  // continuous across them (only its derivative jumps).
+  void edges(EdgeList& out) const override {
+    out.mesh_edges(*emitter);
+    out.mesh_edges(*ground);
+    if (occluder) out.mesh_edges(*occluder);
+  }
 
   glm::dvec2 to_2d(const dvec3& p) const { return {glm::dot(p - emitter_plane.point, eu), glm::dot(p - emitter_plane.point, ev)}; }
   dvec3 to_3d(const glm::dvec2& p) const { return emitter_plane.point + p.x * eu + p.y * ev; }

@@ -27,6 +27,7 @@ class SphereInUniformLight final : public AnalyticModel {
       : center_(sphere.center), radius_(sphere.radius), on_(on), off_(off), description_(std::move(description)) {}
   std::string_view name() const override { return "sphere-in-uniform-light"; }
   Spectrum radiance(const Ray& ray) const override { return hit_sphere(center_, radius_, ray) ? on_ : off_; }
+  void edges(EdgeList& out) const override { out.sphere_silhouette(dvec3(center_), radius_); }
   std::string describe() const override { return description_; }
 
  private:

@@ -29,7 +29,8 @@ class PlaneUnderSun final : public AnalyticModel {
         cos_alpha_(std::cos(double(sun.angular_radius))),
         sun_radiance_(dvec3(sun.intensity) / (M_PI * std::pow(std::sin(double(sun.angular_radius)), 2))),
         on_plane_(on_plane),
-        description_(std::move(description)) {
+        description_(std::move(description)),
+        plane_(plane) {
     for (const glm::uvec3& t : plane.mesh.triangles)
       triangles_.push_back({dvec3(plane.mesh.positions[t.x]), dvec3(plane.mesh.positions[t.y]), dvec3(plane.mesh.positions[t.z])});
   }
@@ -40,6 +41,10 @@ class PlaneUnderSun final : public AnalyticModel {
       if (hit_triangle(o, d, t[0], t[1], t[2])) return on_plane_;
     return glm::dot(glm::normalize(d), to_sun_) >= cos_alpha_ ? Spectrum(sun_radiance_) : Spectrum(0.0f);
   }
+  void edges(EdgeList& out) const override {
+    out.mesh_edges(plane_);
+    out.cone(to_sun_, cos_alpha_);
+  }
   std::string describe() const override { return description_; }
 
  private:
@@ -49,6 +54,7 @@ class PlaneUnderSun final : public AnalyticModel {
   dvec3 sun_radiance_;
   Spectrum on_plane_;
   std::string description_;
+  Shape plane_;  // for its edges
 };
 
 }  // namespace

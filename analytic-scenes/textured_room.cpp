@@ -33,6 +33,9 @@ class TexturedRoom final : public AnalyticModel {
                     : 0.0f) {}
 
   std::string_view name() const override { return kName; }
+  // The room's edges, where the texture coordinates and the footprint jump;
+  // the bilinear texture is continuous within a wall.
+  void edges(EdgeList& out) const override { out.mesh_edges(room_); }
   std::string describe() const override {
     std::ostringstream s;
     s << "room of " << room_.mesh.triangles.size() << " triangles emitting Le = (" << Le_.x << ", " << Le_.y << ", "

@@ -3,6 +3,7 @@
 #include "analytic-scenes/analytic_model.h"
 #include "analytic-scenes/expected_image.h"
 #include "core/compiled_scene.h"
+#include "core/film.h"
 #include "core/error.h"
 #include "core/render.h"
 #include "core/tracer.h"
@@ -89,19 +90,11 @@ struct Measure {
 // Excluded pixels are NaN in both images, which compare_images leaves out.
 Measure measure(const Film& film, const Image& truth) {
   Image est = film.image();
-  double sum_var = 0.0;
   for (int y = 0; y < est.height; ++y)
-    for (int x = 0; x < est.width; ++x) {
-      if (!std::isfinite(truth.at(x, y).x)) {
-        est.at(x, y) = vec3(std::numeric_limits<float>::quiet_NaN());
-        continue;
-      }
-      const Spectrum v = film.variance_of_mean(x, y);
-      sum_var += static_cast<double>(v.x) + v.y + v.z;
-    }
+    for (int x = 0; x < est.width; ++x)
+      if (!std::isfinite(truth.at(x, y).x)) est.at(x, y) = vec3(std::numeric_limits<float>::quiet_NaN());
   const ImageMetrics m = compare_images(est, truth);
-  const double n = 3.0 * static_cast<double>(m.compared);
-  return {m.rmse, m.rel_mse, m.mean_a - m.mean_b, std::sqrt(sum_var) / n};
+  return {m.rmse, m.rel_mse, m.mean_a - m.mean_b, one_film_bias_se(film, truth)};
 }
 
 double mean(const std::vector<double>& v) {
@@ -116,6 +109,34 @@ double sample_sd(const std::vector<double>& v) {
   double s = 0.0;
   for (double x : v) s += (x - m) * (x - m);
   return std::sqrt(s / static_cast<double>(v.size() - 1));
+}
+
+// Regularised incomplete beta I_x(a, b) by its continued fraction
+// (Numerical Recipes' betacf), for Student's t tail.
+double incomplete_beta(double a, double b, double x) {
+  if (x <= 0.0) return 0.0;
+  if (x >= 1.0) return 1.0;
+  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x));
+  const auto cf = [](double aa, double bb, double xx) {
+    double c = 1.0, d = 1.0 - (aa + bb) * xx / (aa + 1.0);
+    d = 1.0 / (std::abs(d) < 1e-300 ? 1e-300 : d);
+    double h = d;
+    for (int m = 1; m < 300; ++m) {
+      const double m2 = 2.0 * m;
+      double num = m * (bb - m) * xx / ((aa + m2 - 1.0) * (aa + m2));
+      d = 1.0 + num * d, c = 1.0 + num / c;
+      d = 1.0 / (std::abs(d) < 1e-300 ? 1e-300 : d);
+      h *= d * c;
+      num = -(aa + m) * (aa + bb + m) * xx / ((aa + m2) * (aa + m2 + 1.0));
+      d = 1.0 + num * d, c = 1.0 + num / c;
+      d = 1.0 / (std::abs(d) < 1e-300 ? 1e-300 : d);
+      const double del = d * c;
+      h *= del;
+      if (std::abs(del - 1.0) < 1e-15) break;
+    }
+    return h;
+  };
+  return x < (a + 1.0) / (a + b + 2.0) ? front * cf(a, b, x) / a : 1.0 - front * cf(b, a, 1.0 - x) / b;
 }
 
 struct SeedPoint {
@@ -133,6 +154,7 @@ ConvergeRow summarise(std::size_t config, bool time_budget, double budget, const
     sec.push_back(p.seconds);
     samples.push_back(p.samples);
     r.rmse_per_seed.push_back(p.rmse);
+    r.seconds_per_seed.push_back(p.seconds);
     rel.push_back(p.rel_mse);
     bias.push_back(p.bias);
   }
@@ -145,8 +167,7 @@ ConvergeRow summarise(std::size_t config, bool time_budget, double budget, const
   r.bias = mean(bias);
   // With two or more seeds the standard error comes from their spread; with
   // one, from the film's per-pixel variances.
-  r.bias_se = seeds.size() >= 2 ? sample_sd(bias) / std::sqrt(static_cast<double>(seeds.size()))
-                                : seeds.front().bias_se_pixels;
+  r.bias_se = seeds.size() >= 2 ? seed_spread(bias).se : seeds.front().bias_se_pixels;
   r.efficiency = 1.0 / std::max(r.rel_mse * r.seconds, 1e-300);
   return r;
 }
@@ -169,6 +190,87 @@ void validate(const ConvergeOptions& o) {
 }
 
 }  // namespace
+
+double one_film_bias_se(const Film& film, const Image& truth) {
+  double sum_var = 0.0, n = 0.0;
+  for (int y = 0; y < film.height(); ++y)
+    for (int x = 0; x < film.width(); ++x) {
+      if (!std::isfinite(truth.at(x, y).x)) continue;
+      const Spectrum v = film.variance_of_mean(x, y);
+      const double sd_sum = std::sqrt(double(v.x)) + std::sqrt(double(v.y)) + std::sqrt(double(v.z));
+      sum_var += sd_sum * sd_sum;
+      n += 3.0;
+    }
+  const double k = film.filter() == FilterKind::Bilinear ? 3.0 : 1.0;
+  return n > 0.0 ? k * std::sqrt(sum_var) / n : 0.0;
+}
+
+SeedSpread seed_spread(const std::vector<double>& values) {
+  SeedSpread s;
+  if (values.empty()) return s;
+  s.mean = mean(values);
+  s.sd = sample_sd(values);
+  s.se = s.sd / std::sqrt(static_cast<double>(values.size()));
+  return s;
+}
+
+double student_two_sided_quantile(double p, int dof) {
+  // P(|T| > t) = I_{dof / (dof + t^2)}(dof / 2, 1 / 2), decreasing in t:
+  // bisection.
+  double lo = 0.0, hi = 1e6;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (incomplete_beta(0.5 * dof, 0.5, dof / (dof + mid * mid)) > p ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+std::vector<std::size_t> indistinguishable_from(const ConvergeResult& result, std::size_t config) {
+  std::vector<std::size_t> out;
+  const std::size_t budgets = [&] {
+    std::size_t k = 0;
+    for (const ConvergeRow& r : result.rows) k += r.config == config;
+    return std::max<std::size_t>(k, 1);
+  }();
+  const double alpha = -std::expm1(std::log1p(-0.01) / static_cast<double>(budgets));
+  for (std::size_t other = 0; other < result.configs.size(); ++other) {
+    if (other == config) continue;
+    bool same = true, any = false;
+    for (const ConvergeRow& a : result.rows) {
+      if (a.config != config) continue;
+      const auto b = std::find_if(result.rows.begin(), result.rows.end(), [&](const ConvergeRow& r) {
+        return r.config == other && r.time_budget == a.time_budget && r.budget == a.budget;
+      });
+      if (b == result.rows.end() || b->rmse_per_seed.size() != a.rmse_per_seed.size()) {
+        same = false;
+        break;
+      }
+      any = true;
+      std::vector<double> diff;
+      for (std::size_t s = 0; s < a.rmse_per_seed.size(); ++s) diff.push_back(a.rmse_per_seed[s] - b->rmse_per_seed[s]);
+      const SeedSpread d = seed_spread(diff);
+      const std::size_t R = diff.size();
+      if (R < 2) {
+        if (d.mean != 0.0) same = false;
+        if (!same) break;
+        continue;
+      }
+      const double t = student_two_sided_quantile(alpha, static_cast<int>(R) - 1);
+      // The RMSEs; then, for spp rungs, the times (a time budget's time is
+      // the budget itself, and its RMSE already carries the speed).
+      const bool rmse_differs = d.sd == 0.0 ? d.mean != 0.0 : std::abs(d.mean) > t * d.se;
+      const SeedSpread ta = seed_spread(a.seconds_per_seed), tb = seed_spread(b->seconds_per_seed);
+      const bool time_differs =
+          !a.time_budget && std::abs(ta.mean - tb.mean) > t * std::sqrt(ta.se * ta.se + tb.se * tb.se);
+      if (rmse_differs || time_differs) {
+        same = false;
+        break;
+      }
+    }
+    if (same && any) out.push_back(other);
+  }
+  return out;
+}
 
 ConvergeResult run_converge(const Scene& scene, const ConvergeOptions& options, const TracerFactory& make_tracer,
                             const std::function<void(const std::string&)>& log) {
@@ -291,11 +393,27 @@ std::string converge_markdown(const ConvergeResult& result) {
         << " | " << fmt(r.rel_mse) << " | " << fmt(r.bias) << " ± " << fmt(r.bias_se) << " | " << fmt(r.efficiency)
         << " |\n";
   const double target = default_target_rmse(result);
-  if (const auto first = first_to_reach(result, target))
-    out << "\nFirst to reach RMSE " << fmt(target) << ": **"
-        << result.configs[first->config].label << "**, in " << (first->at_first_budget ? "at most " : "about ")
-        << fmt(first->seconds) << " s" << (first->at_first_budget ? " (already at its first budget)" : "") << ".\n";
+  std::string first = first_to_reach_text(result, target);
+  first[0] = 'F';
+  out << "\n" << first << ".\n";
   return out.str();
+}
+
+std::string first_to_reach_text(const ConvergeResult& result, double target_rmse) {
+  const auto first = first_to_reach(result, target_rmse);
+  if (!first) return "no configuration reached RMSE " + fmt(target_rmse) + " within its budgets";
+  const std::string when = std::string(first->at_first_budget ? "at most " : "about ") + fmt(first->seconds) + " s" +
+                           (first->at_first_budget ? " (already at its first budget)" : "");
+  const std::vector<std::size_t> same = indistinguishable_from(result, first->config);
+  if (same.empty())
+    return "first to reach RMSE " + fmt(target_rmse) + ": **" + result.configs[first->config].label + "**, in " + when;
+  std::string names = result.configs[first->config].label;
+  for (std::size_t c : same) names += ", " + result.configs[c].label;
+  return "first to reach RMSE " + fmt(target_rmse) + ": no winner among **" + names +
+         "**, statistically indistinguishable (" +
+         (result.seeds >= 2 ? "RMSE and time within the seeds' spread at every budget"
+                            : "the same RMSE at every budget; one seed cannot judge their times") +
+         "); the first of them in " + when;
 }
 
 namespace {

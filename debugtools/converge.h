@@ -26,9 +26,13 @@ class CompiledScene;
 using TracerFactory =
     std::function<std::unique_ptr<Tracer>(const std::string& name, const CompiledScene&, const RenderSettings&)>;
 
+class Film;
+
 struct ConvergeOptions {
-  std::vector<std::string> tracers{"reference"};
-  std::vector<Strategy> strategies;     // empty: the scene's strategy
+  // By default both tracers and all five strategies: the choices a user has.
+  std::vector<std::string> tracers{"reference", "wavefront"};
+  // Empty strategies: the scene's.
+  std::vector<Strategy> strategies{std::begin(kAllStrategies), std::end(kAllStrategies)};
   std::vector<int> spp{1, 4, 16, 64, 256, 1024};  // the ladder (progressive: each rung extends the last)
   std::vector<double> time_budgets;     // seconds, each rendered from scratch with render_until()
   int seeds = 4;                        // R: seeds scene.render.seed, +1, ..., +R-1
@@ -60,6 +64,7 @@ struct ConvergeRow {
   double bias = 0.0, bias_se = 0.0;
   double efficiency = 0.0;      // 1 / (rel_mse * seconds)
   std::vector<double> rmse_per_seed;
+  std::vector<double> seconds_per_seed;
 };
 
 struct ConvergeResult {
@@ -97,6 +102,45 @@ std::optional<FirstToReach> first_to_reach(const ConvergeResult& result, double 
 // measured time and every other one either crosses it between two measured
 // points or never reaches it.
 double default_target_rmse(const ConvergeResult& result);
+
+// Configurations whose curves the seeds cannot tell apart from `config`'s:
+// at every budget the paired per-seed RMSE differences (same seeds, so
+// paired) have a mean within t * their standard error, and at every spp
+// rung the mean times differ by less than t * the standard error of that
+// difference (Welch), t the two-sided Student quantile at R - 1 degrees of
+// freedom for alpha = 0.01, Sidak-corrected over the budgets. With R = 1
+// there is no spread to judge by: only configurations with the same RMSE at
+// every budget (the same paths) are listed, whatever their times.
+std::vector<std::size_t> indistinguishable_from(const ConvergeResult& result, std::size_t config);
+
+// "first to reach RMSE X: **label**, in about T s", or, when configurations
+// are indistinguishable_from() the first, "no winner among **a, b**,
+// statistically indistinguishable (...)", or that none reached it.
+std::string first_to_reach_text(const ConvergeResult& result, double target_rmse);
+
+// The standard error of the bias measured on one film (the mean over its
+// compared pixels and channels of est - truth; pixels where `truth` is NaN
+// are left out), from the film's per-pixel variances of the mean:
+//   SE = k sqrt(sum_pixels (sum_c sd_c)^2) / N,
+// N the pixel-channels compared. A path's three channels are correlated,
+// so each pixel's channel sum has variance at most (sum_c sd_c)^2 (exact
+// when the channels move together, as in a white scene); with the bilinear
+// filter a sample reaches up to 4 pixels, so each pixel correlates with its
+// 8 neighbours and k = 3 bounds the inflation (the covariances bounded by
+// the variances, as check.h does); k = 1 for the box filter. An upper bound
+// then, exact for a box film whose channels are equal.
+double one_film_bias_se(const Film& film, const Image& truth);
+
+// Mean, sample standard deviation and standard error of the mean of
+// values drawn independently (the seeds).
+struct SeedSpread {
+  double mean = 0.0, sd = 0.0, se = 0.0;
+};
+SeedSpread seed_spread(const std::vector<double>& values);
+
+// Two-sided Student t quantile: |T| beyond it has probability p, with dof
+// degrees of freedom.
+double student_two_sided_quantile(double p, int dof);
 
 // Least-squares slope of log y against log x (points with x, y > 0).
 double loglog_slope(const std::vector<double>& x, const std::vector<double>& y);

@@ -28,20 +28,31 @@ inline std::vector<std::string> analytic_scene_names() {
 }
 
 // Renders `scene` with the reference tracer (or `TracerT`) and checks it
-// against its model; on failure, writes the check's images into
-// `failure_dir` if given.
+// against its model (or against `expected`, an expected image of the same
+// model, camera and film computed before); on failure, writes the check's
+// images into `failure_dir` if given.
 template <typename TracerT = ReferenceTracer>
-CheckResult run_check(Scene scene, const std::filesystem::path& failure_dir = {}) {
+CheckResult run_check(Scene scene, const std::filesystem::path& failure_dir = {},
+                      const ExpectedImage* expected = nullptr) {
   const auto model = make_analytic_model(scene);
   const RenderSettings settings = scene.render;
   const CompiledScene compiled(std::move(scene));
   const TracerT tracer(compiled, settings);
   Film film(compiled.scene().film.width, compiled.scene().film.height, compiled.scene().film.filter);
   render(tracer, film);
-  const ExpectedImage expected = expected_image(*model, compiled.camera(), compiled.scene().film);
-  CheckResult r = check_against_expected(film, expected);
-  if (!r.pass && !failure_dir.empty()) write_check_images(failure_dir, film, expected, r, {});
+  const ExpectedImage computed =
+      expected ? ExpectedImage{} : expected_image(*model, compiled.camera(), compiled.scene().film);
+  const ExpectedImage& e = expected ? *expected : computed;
+  CheckResult r = check_against_expected(film, e);
+  if (!r.pass && !failure_dir.empty()) write_check_images(failure_dir, film, e, r, {});
   return r;
+}
+
+// The expected image `run_check` would compute for `scene`.
+inline ExpectedImage expected_image_of(const Scene& scene) {
+  const auto model = make_analytic_model(scene);
+  const CompiledScene compiled{Scene(scene)};
+  return expected_image(*model, compiled.camera(), compiled.scene().film);
 }
 
 // PATHLAB_STAT_SCALE multiplies the scenes' sample counts (1 in CI; the

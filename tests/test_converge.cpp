@@ -121,6 +121,8 @@ TEST(ConvergeDepthCaps, ShowTheirTruncationBias) {
   scene.film.width = 16;
   scene.film.height = 12;
   ConvergeOptions o;
+  o.tracers = {"reference"};
+  o.strategies = {};  // the scene's
   o.spp = {16 * test::stat_scale()};
   o.seeds = kSeeds;
   o.max_depths = {1, 2, -1};
@@ -138,6 +140,38 @@ TEST(ConvergeDepthCaps, ShowTheirTruncationBias) {
     for (int c = 0; c < 3; ++c) missed += Le[c] * std::pow(rho[c], D + 1) / (1 - rho[c]) / 3;
     EXPECT_NEAR(row.bias, -missed, kT7 * row.bias_se + 1e-5 * missed) << "depth " << D;
   }
+}
+
+// The one-seed standard error of the bias on white-sphere-emissive-room.json
+// (bilinear film, white: the three channels of a path move together)
+// against the spread of the bias over R = 40 seeds. With the true standard
+// error sigma, the seeds' sd s has (R - 1) s^2 / sigma^2 ~ chi^2(39), whose
+// 0.999 quantile is 72.05: the one-film value (an upper bound) must not be
+// below s / sqrt(72.05 / 39). Taking channels and pixels as independent
+// gave about half of s, which this catches.
+TEST(ConvergeBiasSe, OneSeedIsNotBelowTheSpreadOverSeedsOnTheWhiteSphere) {
+  Scene scene = load_scene(test::analytic_scene("white-sphere-emissive-room.json"));
+  ASSERT_EQ(scene.film.filter, FilterKind::Bilinear);
+  ConvergeOptions o;
+  o.tracers = {"reference"};
+  o.strategies = {};
+  o.spp = {16 * test::stat_scale()};
+  o.seeds = 40;
+  const ConvergeResult r = run_converge(scene, o, make);
+  ASSERT_EQ(r.rows.size(), 1u);
+  // The one-film standard error of each seed, as a one-seed run reports it.
+  double one_film = 0.0;
+  for (int seed = 0; seed < 8; ++seed) {  // eight one-seed runs give its typical size
+    ConvergeOptions one = o;
+    one.seeds = 1;
+    Scene s = scene;
+    s.render.seed += static_cast<std::uint64_t>(seed);
+    one_film += run_converge(s, one, make).rows.front().bias_se / 8.0;
+  }
+  const double s_seeds = r.rows.front().bias_se * std::sqrt(static_cast<double>(o.seeds));
+  RecordProperty("one_film_se", std::to_string(one_film));
+  RecordProperty("seeds_sd", std::to_string(s_seeds));
+  EXPECT_GE(one_film, s_seeds / std::sqrt(72.05 / 39.0)) << "one-film " << one_film << ", spread over seeds " << s_seeds;
 }
 
 // render_until with a time budget: stops at a whole pass, within one pass of

@@ -72,13 +72,32 @@ TEST_F(ConvergeCli, WritesTheTableAndPlotsWithOneRowPerConfigurationAndBudget) {
 }
 
 // A scene with no analytic model is measured against a reference EXR.
+// Without axes: both tracers x all five strategies, one curve each.
+TEST_F(ConvergeCli, ComparesBothTracersAndAllStrategiesByDefault) {
+  const fs::path out = dir_ / "default";
+  const auto r = run_cli({"converge", kScenes + "penumbra-box.json", "--spp", "1,4", "--seeds", "2", "--resolution",
+                          "8x6", "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string csv = read_text(out / "converge.csv");
+  ASSERT_EQ(lines(csv).size(), 1u + 2 * 5 * 2) << csv;
+  for (const char* t : {"reference", "wavefront"})
+    for (const char* s : {"cosine", "bsdf", "light", "light+bsdf", "mis"})
+      EXPECT_EQ(count(csv, std::string("\n") + t + "," + s + ","), 2u) << t << " " << s;
+  // Giving an axis replaces its default.
+  const auto one = run_cli({"converge", kScenes + "penumbra-box.json", "--tracers", "wavefront", "--strategies", "light",
+                            "--spp", "1", "--seeds", "1", "--resolution", "8x6", "--out", (dir_ / "one").string()});
+  ASSERT_EQ(one.code, 0) << one.err;
+  EXPECT_EQ(lines(read_text(dir_ / "one" / "converge.csv")).size(), 2u);
+}
+
 TEST_F(ConvergeCli, UsesAReferenceExrAsTheTruth) {
   const std::string scene = std::string(PATHLAB_SOURCE_DIR) + "/scenes/cornell-box.json";
   const fs::path ref = dir_ / "ref.exr";
   ASSERT_EQ(run_cli({"render", scene, "-o", ref.string(), "--spp", "256", "--resolution", "8x6", "--seed", "99",
                      "--quiet"}).code, 0);
-  const auto r = run_cli({"converge", scene, "--reference", ref.string(), "--spp", "1,16", "--seeds", "2",
-                          "--resolution", "8x6", "--out", (dir_ / "report").string()});
+  const auto r = run_cli({"converge", scene, "--reference", ref.string(), "--tracers", "reference", "--strategies",
+                          "mis", "--spp", "1,16", "--seeds", "2", "--resolution", "8x6", "--out",
+                          (dir_ / "report").string()});
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string md = read_text(dir_ / "report" / "converge.md");
   EXPECT_NE(md.find("Ground truth: reference " + ref.string()), std::string::npos) << md;

@@ -106,6 +106,14 @@ class BoundModel final : public AnalyticModel {
   BoundModel(const Bounds& b, bool upper) : b_(b), upper_(upper) {}
   std::string_view name() const override { return upper_ ? "tessellated sphere, upper" : "tessellated sphere, lower"; }
   std::string describe() const override { return std::string(name()); }
+  // The bounds jump where the impact parameter is b_in or R: two cones of
+  // rays about the direction to the centre.
+  void edges(EdgeList& out) const override {
+    const dvec3 to_c = b_.c - out.eye();
+    const double D = glm::length(to_c);
+    for (const double b : {b_.b_in(), b_.R * (1.0 + 1e-6)})
+      if (b < D) out.cone(to_c, std::sqrt(1.0 - (b / D) * (b / D)));
+  }
   Spectrum radiance(const Ray& ray) const override {
     const dvec3 oc = b_.c - dvec3(ray.origin), d(ray.dir);
     const double along = glm::dot(oc, d);

@@ -11,7 +11,7 @@
 #include "core/tracer.h"
 #include "debugtools/converge.h"
 
-#include <cstdio>
+#include <string>
 #include <ostream>
 
 namespace pathlab::cli {
@@ -20,8 +20,8 @@ void ConvergeCommand::add_to(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("converge", "Speed-accuracy sweep: error against time and spp, table and plots");
   cmd->add_option("scene", scene_file, "Scene file (JSON)")->required();
   cmd->add_option("--reference", reference, "Ground-truth EXR (default: the scene's analytic expected image)");
-  cmd->add_option("--tracers", options.tracers, "Tracers, comma-separated: reference, wavefront")->delimiter(',');
-  cmd->add_option("--strategies", strategies, "Strategies, comma-separated (default: the scene's)")->delimiter(',');
+  cmd->add_option("--tracers", options.tracers, "Tracers, comma-separated: reference, wavefront (default: both)")->delimiter(',');
+  cmd->add_option("--strategies", strategies, "Strategies, comma-separated (default: all five)")->delimiter(',');
   cmd->add_option("--spp", options.spp, "The samples-per-pixel ladder, increasing, comma-separated")
       ->delimiter(',')
       ->check(CLI::Range(1, 1 << 24));
@@ -46,6 +46,7 @@ void ConvergeCommand::add_to(CLI::App& app) {
 int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   ConvergeOptions o = options;
   o.reference = reference;
+  if (!strategies.empty()) o.strategies.clear();
   for (const std::string& s : strategies) {
     const auto st = parse_strategy(s);
     if (!st) throw InputError("--strategies: unknown strategy '" + s + "' (expected cosine, bsdf, light, light+bsdf or mis)");
@@ -72,14 +73,10 @@ int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   }
 
   const double target = target_rmse.value_or(default_target_rmse(result));
-  char line[512];
-  if (const auto first = first_to_reach(result, target))
-    std::snprintf(line, sizeof line, "first to reach RMSE %.4g: %s, in %s%.3g s%s", target,
-                  result.configs[first->config].label.c_str(), first->at_first_budget ? "at most " : "about ",
-                  first->seconds, first->at_first_budget ? " (already at its first budget)" : "");
-  else
-    std::snprintf(line, sizeof line, "no configuration reached RMSE %.4g within its budgets", target);
-  err << "pathlab: converge: " << line << "\n"
+  std::string first = first_to_reach_text(result, target);
+  std::erase(first, '*');
+  err << "pathlab: converge: " << first << "\n";
+  err
       << "pathlab: wrote " << (dir / "converge.csv").string()
       << ", converge.md, rmse-vs-time.svg and rmse-vs-spp.svg (truth: "
       << result.truth << ")\n";
