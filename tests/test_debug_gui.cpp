@@ -386,7 +386,11 @@ TEST(DebugViews, LinearAndLogRangesMapOntoTheRamp) {
 std::filesystem::path write_nan_scene(const std::filesystem::path& dir, int res) {
   std::ifstream in(std::string(PATHLAB_SOURCE_DIR) + "/scenes/cornell-box.json");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  text = std::regex_replace(text, std::regex(R"("radiance": \[17, 12, 4\])"), R"("radiance": [3e38, 3e38, 3e38])");
+  // Radiance near FLT_MAX on the lamp and the white walls: a path that
+  // gathers two such contributions overflows to infinity.
+  text = std::regex_replace(text, std::regex(R"("radiance": \[17, 12, 4\])"), R"("radiance": [3.4e38, 3.4e38, 3.4e38])");
+  text = std::regex_replace(text, std::regex(R"("white": \{ "type": "diffuse", "albedo": (\[[^\]]*\]) \})"),
+                            R"("white": { "type": "diffuse", "albedo": $1, "emission": [3.4e38, 3.4e38, 3.4e38] })");
   text = std::regex_replace(text, std::regex(R"(\[512, 512\])"), "[" + std::to_string(res) + ", " + std::to_string(res) + "]");
   const auto file = dir / "nan-box.json";
   std::ofstream(file) << text;
