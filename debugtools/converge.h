@@ -29,6 +29,7 @@ using TracerFactory =
 struct ConvergeOptions {
   std::vector<std::string> tracers{"reference"};
   std::vector<Strategy> strategies;     // empty: the scene's strategy
+  std::vector<SamplerKind> samplers;    // empty: the scene's sampler
   std::vector<int> spp{1, 4, 16, 64, 256, 1024};  // the ladder (progressive: each rung extends the last)
   std::vector<double> time_budgets;     // seconds, each rendered from scratch with render_until()
   int seeds = 4;                        // R: seeds scene.render.seed, +1, ..., +R-1
@@ -44,7 +45,8 @@ struct ConvergeConfig {
   Strategy strategy = Strategy::Mis;
   float clamp = 0.0f;
   int max_depth = 0;
-  std::string label;  // "reference mis", "+ clamp 4", "+ depth 2" when the sweep varies them
+  std::string label;  // "reference mis", "+ clamp 4", "+ depth 2", "+ zsobol" when the sweep varies them
+  SamplerKind sampler = SamplerKind::Independent;
 };
 
 // One budget of one configuration, averaged over the seeds.
