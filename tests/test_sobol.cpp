@@ -462,6 +462,29 @@ TEST(ZSobolConvergence, SmoothIntegrandErrorFallsFasterThanMonteCarlo) {
             << dir.se << "; independent " << ind.slope << " +- " << ind.se << "\n";
 }
 
+// --- the setting ---------------------------------------------------------------------------
+
+TEST(ZSobolSetting, SceneKeyAndRecordedSettings) {
+  const char* text = R"({"pathlab_scene": 1, "camera": {"position": [0, 0, 4], "look_at": [0, 0, 0]},
+    "materials": {"white": {"type": "diffuse", "albedo": 0.5}},
+    "shapes": [{"type": "sphere", "material": "white"}], "render": {"sampler": "zsobol", "spp": 10}})";
+  const Scene s = parse_scene(text, "zsobol.json");
+  EXPECT_EQ(s.render.sampler, SamplerKind::ZSobol);
+  EXPECT_EQ(RenderSettings{}.sampler, SamplerKind::Independent);
+  bool sampler = false, block = false;
+  for (const auto& [key, value] : sample_settings(s.render)) {
+    if (key == "sampler") sampler = value == "zsobol";
+    if (key == "zsobol_spp") block = value == "16";  // 10 rounded up
+  }
+  EXPECT_TRUE(sampler && block);
+  for (const auto& [key, value] : sample_settings(RenderSettings{})) {
+    if (key == "sampler") {
+      EXPECT_EQ(value, "independent");
+    }
+    EXPECT_NE(key, "zsobol_spp");
+  }
+}
+
 // --- the tracers under zsobol ------------------------------------------------------------
 
 Scene small_scene(const std::string& file, int spp) {
