@@ -44,9 +44,10 @@ Spectrum clamp_radiance(const Spectrum& L, float limit) {
 }
 
 std::vector<std::pair<std::string, std::string>> sample_settings(const RenderSettings& r) {
-  return {
+  std::vector<std::pair<std::string, std::string>> out{
       {"strategy", strategy_name(r.strategy)},
       {"seed", std::to_string(r.seed)},
+      {"sampler", sampler_name(r.sampler)},
       {"max_depth", std::to_string(r.max_depth)},
       {"rr_depth", std::to_string(r.rr_depth)},
       {"bsdf_sampling", bsdf_sampling_name(r.bsdf_sampling)},
@@ -57,6 +58,12 @@ std::vector<std::pair<std::string, std::string>> sample_settings(const RenderSet
       {"texture_filter", texture_filter_name(r.texture_filter)},
       {"bvh", r.compact_bvh ? "compact" : "fast"},
   };
+  // zsobol's numbers depend on spp rounded up to a power of two (core/rng.h).
+  if (r.sampler == SamplerKind::ZSobol) {
+    const SamplerSetup s(r.sampler, r.seed, 1, 1, static_cast<std::uint32_t>(std::max(r.spp, 1)));
+    out.emplace_back("zsobol_spp", std::to_string(1ull << s.log2_spp()));
+  }
+  return out;
 }
 
 const char* git_revision() { return PATHLAB_GIT_COMMIT; }

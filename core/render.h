@@ -128,13 +128,15 @@ class SampleBuffer {
 Spectrum clamp_radiance(const Spectrum& L, float limit);
 
 // Every setting that changes a sample's bits, as (key, value) text, in a
-// fixed order: strategy, seed, max_depth, rr_depth, bsdf_sampling,
-// light_sampling, clamp,
-// min_pdf, general_shading, texture_filter (and bvh, which changes no bit
-// but names the build). Floats are written with 9 significant digits (they
-// read back to the same float). Recorded in a render's EXR header
+// fixed order: strategy, seed, sampler, max_depth, rr_depth, bsdf_sampling,
+// light_sampling, clamp, min_pdf, general_shading, texture_filter (and bvh,
+// which changes no bit but names the build). Floats are written with 9
+// significant digits (they read back to the same float). Recorded in a
+// render's EXR header
 // ("pathlab:<key>") and in trace-pixel's header and JSON. Not in it: spp
-// and the tracer, which the caller records.
+// and the tracer, which the caller records (the zsobol sampler's numbers
+// depend on spp too, rounded up to a power of two: core/rng.h; under it a
+// last key, zsobol_spp, gives that power of two).
 std::vector<std::pair<std::string, std::string>> sample_settings(const RenderSettings& settings);
 
 // The git commit pathlab was built from (12 hex digits, "unknown" outside a

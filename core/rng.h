@@ -4,8 +4,12 @@
 #pragma once
 
 #include "core/sample_dims.h"
+#include "core/sobol.h"
 
+#include <bit>
 #include <cstdint>
+#include <optional>
+#include <string_view>
 
 namespace pathlab {
 
@@ -23,10 +27,60 @@ constexpr float to_unit_float(std::uint64_t h) {
   return static_cast<float>(h >> 40) * 0x1p-24f;
 }
 
+// Where the numbers of get() come from (RenderSettings::sampler, the scene
+// key "sampler"; docs/scene-format.md, Samplers). bits() and the Alpha
+// dimension are the hash under every sampler.
+enum class SamplerKind : std::uint8_t {
+  Independent,  // every number a hash of its key
+  ZSobol,       // Owen-scrambled Sobol' points, pixels in Morton order (pbrt-v4's ZSobolSampler)
+};
+constexpr const char* sampler_name(SamplerKind k) { return k == SamplerKind::ZSobol ? "zsobol" : "independent"; }
+constexpr std::optional<SamplerKind> parse_sampler(std::string_view name) {
+  if (name == "independent") return SamplerKind::Independent;
+  if (name == "zsobol") return SamplerKind::ZSobol;
+  return std::nullopt;
+}
+
+// The zsobol sampler's dimensions. Each named dimension of a vertex belongs
+// to one of kSobolSlotsPerVertex slots, a 2D pair (FilmX/Y, LensX/Y,
+// LightX/Y, DirectionX/Y) or a 1D dimension alone, and a slot of vertex k is
+// number kSobolSlotsPerVertex * k + entity: consecutive per vertex. A pair
+// draws Sobol' dimensions 0 and 1 of the same index, a 1D slot dimension 0;
+// every slot has its own index permutation and scrambling (padding), so the
+// slots are decorrelated and there is no last dimension.
+struct SobolSlot {
+  std::uint32_t entity;  // 0 .. kSobolSlotsPerVertex - 1
+  int axis;              // Sobol' dimension: 0 or 1
+};
+inline constexpr std::uint32_t kSobolSlotsPerVertex = 9;
+constexpr SobolSlot sobol_slot(Dim dim) {
+  switch (dim) {
+    case Dim::FilmX: return {0, 0};
+    case Dim::FilmY: return {0, 1};
+    case Dim::LensX: return {1, 0};
+    case Dim::LensY: return {1, 1};
+    case Dim::DeltaLightChoice: return {2, 0};
+    case Dim::LightChoice: return {3, 0};
+    case Dim::LightX: return {4, 0};
+    case Dim::LightY: return {4, 1};
+    case Dim::Technique: return {5, 0};
+    case Dim::LobeChoice: return {6, 0};
+    case Dim::DirectionX: return {7, 0};
+    case Dim::DirectionY: return {7, 1};
+    case Dim::Roulette: return {8, 0};
+    case Dim::Alpha:  // drawn by bits(), the hash, under every sampler
+    case Dim::Count: break;
+  }
+  return {kSobolSlotsPerVertex, 0};
+}
+
 // The random numbers of one pixel sample. The key is hashed in a chain,
 // each link injecting 64 bits of key into a fully mixed state:
 //   h1 = mix(mix(seed + golden) ^ (pixel << 32 | sample))
 //   u  = mix(h1 ^ (bounce << 32 | dim))
+// Under the zsobol sampler (made by SamplerSetup::stream) get() is instead
+// point `index` of a 2D Sobol' sequence, its index's digits permuted and its
+// value scrambled per slot (see SamplerSetup); bits() stays the hash.
 class SampleStream {
  public:
   constexpr SampleStream(std::uint64_t seed, std::uint32_t pixel, std::uint32_t sample)
@@ -35,24 +89,99 @@ class SampleStream {
   // key() is mix64(seed_key(seed) ^ (pixel << 32 | sample)).
   static constexpr std::uint64_t seed_key(std::uint64_t seed) { return mix64(seed + 0x9e3779b97f4a7c15ull); }
 
-  constexpr float get(std::uint32_t bounce, Dim dim) const { return to_unit_float(bits(bounce, dim)); }
+  constexpr float get(std::uint32_t bounce, Dim dim) const {
+    if (index_bits_ != kHash) {
+      const SobolSlot s = sobol_slot(dim);
+      if (s.entity < kSobolSlotsPerVertex) return zsobol(bounce * kSobolSlotsPerVertex + s.entity, s.axis);
+    }
+    return to_unit_float(bits(bounce, dim));
+  }
   // The whole 64-bit hash get() takes its top 24 bits from, for a decision
   // that needs more than one float's worth (a ray's alpha key, core/alpha.h).
   constexpr std::uint64_t bits(std::uint32_t bounce, Dim dim) const {
     return mix64(key_ ^ ((static_cast<std::uint64_t>(bounce) << 32) | static_cast<std::uint32_t>(dim)));
   }
-  // The hashed (seed, pixel, sample): get() is to_unit_float(mix64(key() ^
-  // (bounce << 32 | dim))), for code that draws many streams' numbers at once.
+  // The hashed (seed, pixel, sample): under the independent sampler get() is
+  // to_unit_float(mix64(key() ^ (bounce << 32 | dim))), for code that draws
+  // many streams' numbers at once.
   constexpr std::uint64_t key() const { return key_; }
+  // False under zsobol: get() is then no function of key() alone.
+  constexpr bool independent() const { return index_bits_ == kHash; }
+
+  // Point `slot` of the zsobol sequence in Sobol' dimension `axis`, as get()
+  // draws it (public for the tests of its parts).
+  constexpr float zsobol(std::uint32_t slot, int axis) const {
+    const std::uint64_t h = mix64(sobol_key_ ^ (static_cast<std::uint64_t>(slot) * 0xd1b54a32d192ed03ull));
+    const std::uint64_t index = sobol::permute_digits(index_, index_bits_, h);
+    const std::uint32_t v = sobol::scramble(sobol::sample(index, axis), mix64(h + 1 + static_cast<std::uint64_t>(axis)));
+    return sobol::to_float(v);
+  }
 
  private:
+  friend class SamplerSetup;
+  static constexpr std::uint32_t kHash = 0xffffffffu;
   std::uint64_t key_;
+  std::uint64_t index_ = 0;       // zsobol: morton(x, y) << log2_spp | sample mod 2^log2_spp
+  std::uint64_t sobol_key_ = 0;   // zsobol: a hash of the seed and the sample's replicate
+  std::uint32_t index_bits_ = kHash;  // zsobol: the bits of index_ that are permuted; kHash: independent
 };
 
-// The same number without building a stream first.
+// What a sampler needs to know of the render to make the streams of its
+// samples: the kind, the seed, the resolution and spp. Made once per render
+// (Tracer holds one); stream() is a pure function of it and (x, y, sample).
+//
+// zsobol lays the samples of the image out on one Sobol' index:
+//   index = morton(x, y) << L | (sample mod 2^L),  L = ceil(log2(spp))
+// so a pixel's samples are an aligned run of 2^L indices (a (0, L, 2)-net
+// in each pair) and neighbouring pixels' runs are neighbours (their union is
+// a net too: the error is spread as blue noise over the screen). With spp
+// not a power of two a pixel takes the first spp of its 2^L points
+// (unbiased; the net is complete only at 2^L). A sample past 2^L (a
+// progressive render going on past its spp: render --time, converge's
+// ladder) starts a new replicate, q = sample >> L: the same design under an
+// independent permutation and scrambling, seeded by (seed, q).
+class SamplerSetup {
+ public:
+  SamplerSetup() = default;
+  constexpr SamplerSetup(SamplerKind kind, std::uint64_t seed, std::uint32_t width, std::uint32_t height,
+                         std::uint32_t spp)
+      : kind_(kind), seed_(seed), width_(width) {
+    const std::uint32_t side = width > height ? width : height;
+    morton_bits_ = 2 * static_cast<std::uint32_t>(std::bit_width(side > 1 ? side - 1 : 0u));
+    log2_spp_ = static_cast<std::uint32_t>(std::bit_width(spp > 1 ? spp - 1 : 0u));
+  }
+
+  constexpr SampleStream stream(std::uint32_t x, std::uint32_t y, std::uint32_t sample) const {
+    SampleStream s(seed_, y * width_ + x, sample);
+    if (kind_ == SamplerKind::ZSobol) {
+      const std::uint64_t low = (1ull << log2_spp_) - 1;
+      s.index_ = (sobol::morton(x, y) << log2_spp_) | (sample & low);
+      s.index_bits_ = morton_bits_ + log2_spp_;
+      s.sobol_key_ = mix64(SampleStream::seed_key(seed_) ^ mix64((sample >> log2_spp_) + 0x5851f42d4c957f2dull));
+    }
+    return s;
+  }
+  constexpr SamplerKind kind() const { return kind_; }
+  constexpr std::uint32_t log2_spp() const { return log2_spp_; }
+
+ private:
+  SamplerKind kind_ = SamplerKind::Independent;
+  std::uint64_t seed_ = 0;
+  std::uint32_t width_ = 1;
+  std::uint32_t morton_bits_ = 0;
+  std::uint32_t log2_spp_ = 0;
+};
+
+// The same number without building a stream first (independent sampler).
 constexpr float sample_u(std::uint64_t seed, std::uint32_t pixel, std::uint32_t sample,
                          std::uint32_t bounce, Dim dim) {
   return SampleStream(seed, pixel, sample).get(bounce, dim);
+}
+
+// Under any sampler.
+constexpr float sample_u(const SamplerSetup& sampler, std::uint32_t x, std::uint32_t y, std::uint32_t sample,
+                         std::uint32_t bounce, Dim dim) {
+  return sampler.stream(x, y, sample).get(bounce, dim);
 }
 
 }  // namespace pathlab

@@ -7,6 +7,7 @@
 #include "core/camera.h"
 #include "core/material.h"
 #include "core/mesh.h"
+#include "core/rng.h"
 
 #include <cstdint>
 #include <filesystem>
@@ -67,6 +68,10 @@ struct RenderSettings {
   // How next-event estimation samples a point on the chosen area light.
   LightSampling light_sampling = LightSampling::Area;
   std::uint64_t seed = 0;
+  // Where the random numbers come from (core/rng.h; docs/scene-format.md,
+  // Samplers). zsobol's numbers depend on spp too (rounded up to a power of
+  // two).
+  SamplerKind sampler = SamplerKind::Independent;
   // How glossy lobes are sampled (core/shading.h).
   BsdfSampling bsdf_sampling = BsdfSampling::Vndf;
   // Firefly controls, both biased and off (0) by default; never on in a test

@@ -83,7 +83,7 @@ FilmDesc read_film(const Node& node) {
 
 RenderSettings read_render(const Node& node) {
   node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh",
-                   "texture_filter", "texture_cache_mb", "light_sampling"});
+                   "texture_filter", "texture_cache_mb", "light_sampling", "sampler"});
   RenderSettings r;
   if (node.has("spp")) {
     const std::int64_t spp = node.child("spp").integer();
@@ -152,6 +152,16 @@ RenderSettings read_render(const Node& node) {
     const auto f = parse_texture_filter(name);
     if (!f) node.child("texture_filter").fail("unknown texture_filter " + in_quotes(name) + " (expected cone or point)");
     r.texture_filter = *f;
+  }
+  if (node.has("sampler")) {
+    const std::string name = node.child("sampler").string();
+    const auto k = parse_sampler(name);
+    if (!k) {
+      const std::array<std::string_view, 2> names{"independent", "zsobol"};
+      const std::string near = suggestion(name, names);
+      node.child("sampler").fail("unknown sampler " + in_quotes(name) + (near.empty() ? " (expected independent or zsobol)" : near));
+    }
+    r.sampler = *k;
   }
   if (node.has("texture_cache_mb")) {
     r.texture_cache_mb = static_cast<float>(node.child("texture_cache_mb").number());

@@ -16,7 +16,12 @@ namespace pathlab {
 
 class Tracer {
  public:
-  Tracer(const CompiledScene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {}
+  Tracer(const CompiledScene& scene, const RenderSettings& settings)
+      : scene_(scene),
+        settings_(settings),
+        sampler_(settings.sampler, settings.seed, static_cast<std::uint32_t>(scene.scene().film.width),
+                 static_cast<std::uint32_t>(scene.scene().film.height),
+                 static_cast<std::uint32_t>(settings.spp > 1 ? settings.spp : 1)) {}
   virtual ~Tracer() = default;
 
   virtual std::string_view name() const = 0;
@@ -34,10 +39,16 @@ class Tracer {
 
   const CompiledScene& scene() const { return scene_; }
   const RenderSettings& settings() const { return settings_; }
+  // The random numbers of one pixel sample, as both tracers draw them.
+  SampleStream stream(std::uint32_t x, std::uint32_t y, std::uint32_t sample) const {
+    return sampler_.stream(x, y, sample);
+  }
+  const SamplerSetup& sampler() const { return sampler_; }
 
  protected:
   const CompiledScene& scene_;
   RenderSettings settings_;
+  SamplerSetup sampler_;  // made from settings_ and the film
 };
 
 }  // namespace pathlab

@@ -6,6 +6,7 @@
 #include "core/sample_dims.h"
 #include "core/surfel.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace pathlab {
@@ -57,6 +58,8 @@ AovAccumulator::AovAccumulator(const CompiledScene& scene, const RenderSettings&
 void AovAccumulator::add_batch(std::uint32_t first, std::uint32_t count, std::span<const FilmSample> samples) {
   const Camera& camera = scene_.camera();
   const RayCone cone = scene_.camera_cone(settings_.texture_filter);
+  const SamplerSetup sampler(settings_.sampler, settings_.seed, static_cast<std::uint32_t>(width_),
+                             static_cast<std::uint32_t>(height_), static_cast<std::uint32_t>(std::max(settings_.spp, 1)));
   parallel_for(0, static_cast<std::size_t>(height_), 1, [&](std::size_t y0, std::size_t y1) {
     SurfaceParams params;  // a textured material's parameters at a hit, read with the camera's cone
     for (std::size_t y = y0; y < y1; ++y) {
@@ -69,7 +72,7 @@ void AovAccumulator::add_batch(std::uint32_t first, std::uint32_t count, std::sp
           px.nonfinite += is_finite(fs.L) ? 0u : 1u;
           ++px.samples;
           // The camera ray of this sample, as both tracers draw it.
-          const SampleStream u(settings_.seed, static_cast<std::uint32_t>(index), first + j);
+          const SampleStream u = sampler.stream(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), first + j);
           const vec2 film(static_cast<float>(x) + u.get(0, Dim::FilmX), static_cast<float>(y) + u.get(0, Dim::FilmY));
           Ray ray = camera.generate_ray(film, vec2(u.get(0, Dim::LensX), u.get(0, Dim::LensY)));
           ray.alpha_key = scene_.alpha_key(u, 0);  // sees through what the render saw through

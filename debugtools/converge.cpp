@@ -61,6 +61,7 @@ std::string config_label(const ConvergeConfig& c, const ConvergeOptions& o) {
     label += c.clamp > 0.0f ? s.str() : " no clamp";
   }
   if (!o.max_depths.empty()) label += " depth " + std::to_string(c.max_depth);
+  if (o.samplers.size() > 1 || c.sampler != SamplerKind::Independent) label += std::string(" ") + sampler_name(c.sampler);
   return label;
 }
 
@@ -299,14 +300,17 @@ ConvergeResult run_converge(const Scene& scene, const ConvergeOptions& options, 
   const std::vector<Strategy> strategies =
       options.strategies.empty() ? std::vector<Strategy>{scene.render.strategy} : options.strategies;
   const std::vector<int> depths = options.max_depths.empty() ? std::vector<int>{scene.render.max_depth} : options.max_depths;
+  const std::vector<SamplerKind> samplers =
+      options.samplers.empty() ? std::vector<SamplerKind>{scene.render.sampler} : options.samplers;
   for (const std::string& t : options.tracers)
     for (Strategy s : strategies)
       for (float c : options.clamps)
-        for (int d : depths) {
-          ConvergeConfig cfg{t, s, c, d, {}};
-          cfg.label = config_label(cfg, options);
-          result.configs.push_back(cfg);
-        }
+        for (int d : depths)
+          for (SamplerKind k : samplers) {
+            ConvergeConfig cfg{t, s, c, d, {}, k};
+            cfg.label = config_label(cfg, options);
+            result.configs.push_back(cfg);
+          }
 
   const std::size_t rungs = options.spp.size(), budgets = options.time_budgets.size();
   for (std::size_t ci = 0; ci < result.configs.size(); ++ci) {
@@ -318,6 +322,10 @@ ConvergeResult run_converge(const Scene& scene, const ConvergeOptions& options, 
       settings.strategy = cfg.strategy;
       settings.clamp = cfg.clamp;
       settings.max_depth = cfg.max_depth;
+      settings.sampler = cfg.sampler;
+      // zsobol lays each pixel's samples out for spp rounded up to a power of
+      // two: the ladder's last rung makes the whole ladder one run.
+      if (cfg.sampler != SamplerKind::Independent && !options.spp.empty()) settings.spp = options.spp.back();
       settings.seed = scene.render.seed + static_cast<std::uint64_t>(r);
       const auto tracer = make_tracer(cfg.tracer, compiled, settings);
       // The ladder: each rung extends the film of the last.
@@ -368,14 +376,14 @@ std::string budget_text(const ConvergeRow& r) { return r.time_budget ? fmt(r.bud
 std::string converge_csv(const ConvergeResult& result) {
   std::ostringstream out;
   out << "tracer,strategy,clamp,max_depth,budget_kind,budget,seeds,spp,seconds,samples_per_second,rmse,rmse_sd,rel_mse,"
-         "bias,bias_se,efficiency\n";
+         "bias,bias_se,efficiency,sampler\n";
   for (const ConvergeRow& r : result.rows) {
     const ConvergeConfig& c = result.configs[r.config];
     out << c.tracer << "," << strategy_name(c.strategy) << "," << fmt(c.clamp) << "," << c.max_depth << ","
         << (r.time_budget ? "time" : "spp") << "," << fmt(r.budget) << "," << r.rmse_per_seed.size() << ","
         << fmt(r.spp) << "," << fmt(r.seconds) << "," << fmt(r.samples_per_second) << "," << fmt(r.rmse) << ","
         << fmt(r.rmse_sd) << "," << fmt(r.rel_mse) << "," << fmt(r.bias) << "," << fmt(r.bias_se) << ","
-        << fmt(r.efficiency) << "\n";
+        << fmt(r.efficiency) << "," << sampler_name(c.sampler) << "\n";
   }
   return out.str();
 }

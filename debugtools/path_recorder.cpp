@@ -160,6 +160,8 @@ json path_to_json(const TraceHeader& h, const PathRecorder& path, const Scene& s
           {"sample", h.sample},
           {"seed", r.seed},
           {"strategy", strategy_name(r.strategy)},
+          {"sampler", sampler_name(r.sampler)},
+          {"spp", r.spp},
           {"max_depth", r.max_depth},
           {"rr_depth", r.rr_depth},
           {"bsdf_sampling", bsdf_sampling_name(r.bsdf_sampling)},

@@ -165,8 +165,7 @@ Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int verte
 
 FilmSample ReferenceTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::uint32_t sample,
                                          PathObserver* observer) const {
-  const std::uint32_t pixel = y * static_cast<std::uint32_t>(scene_.scene().film.width) + x;
-  Path path{SampleStream(settings_.seed, pixel, sample), observer};
+  Path path{stream(x, y, sample), observer};
   std::optional<SurfaceParams> params;
   if (scene_.has_textures()) {
     params.emplace();

@@ -451,6 +451,9 @@ TEST_F(BadInput, BadTextureKeys) {
   const std::string filter = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"texture_filter\": \"trilinear\"}");
   expect_rejected(render(write("filter.json", filter)),
                   {"filter.json:", "/render/texture_filter", "unknown texture_filter 'trilinear' (expected cone or point)"});
+  const std::string sampler = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"sampler\": \"zsobel\"}");
+  expect_rejected(render(write("sampler.json", sampler)),
+                  {"sampler.json:", "/render/sampler", "unknown sampler 'zsobel' (did you mean 'zsobol'?)"});
 }
 
 TEST_F(BadInput, AlbedoAboveOne) {

@@ -584,9 +584,9 @@ TEST(SceneLoaderErrors, UnknownKeysSuggestTheNearestValidOne) {
   const std::string top = R"({"pathlab_scene": 1, "camra": {}})";
   EXPECT_NE(error_of(top).find("/camra: unknown key 'camra' (did you mean 'camera'?)"), std::string::npos)
       << error_of(top);
-  const std::string far = scene_text("{}", "[]", R"("render": {"samples": 4})");
+  const std::string far = scene_text("{}", "[]", R"("render": {"photons": 4})");
   const std::string message = error_of(far);
-  EXPECT_NE(message.find("/render/samples: unknown key 'samples'"), std::string::npos) << message;
+  EXPECT_NE(message.find("/render/photons: unknown key 'photons'"), std::string::npos) << message;
   EXPECT_EQ(message.find("did you mean"), std::string::npos) << message;
   // Another material type's key gets a pointed message.
   const std::string mirror = scene_text(R"({"m": {"type": "mirror", "albedo": 0.5}})", "[]");

@@ -151,6 +151,10 @@ struct WavefrontTracer::VectorStages {
       return nullptr;
     };
     if (!vs::cpu_supported()) return no("the processor has no AVX-512");
+    // The vector stages draw the independent sampler's hashes in bulk from
+    // SampleStream::key(); any other sampler's numbers are the scalar stages'.
+    if (settings.sampler != SamplerKind::Independent)
+      return no(std::string("the ") + sampler_name(settings.sampler) + " sampler (the vector stages draw only independent's hashes)");
     auto v = std::make_unique<VectorStages>();
     vs::Scene& sc = v->scene;
     switch (settings.strategy) {
@@ -734,13 +738,13 @@ void WavefrontTracer::render_waves(std::uint32_t first, std::uint32_t count, std
       const std::size_t begin = k * wave_size;
       w.n = std::min(wave_size, out.size() - begin);
       fill(begin, w.n,
-           [&](std::size_t i, std::uint32_t slot, std::uint32_t x, std::uint32_t y, std::uint32_t pixel,
+           [&](std::size_t i, std::uint32_t slot, std::uint32_t x, std::uint32_t y, std::uint32_t /*pixel*/,
                std::uint32_t sample) {
              w.out_index[i] = slot;
              w.x[i] = x;
              w.y[i] = y;
              w.sample[i] = sample;
-             w.rng[i] = SampleStream(settings_.seed, pixel, sample);
+             w.rng[i] = stream(x, y, sample);
            });
       run_wave(w, out, nullptr);
     }
@@ -751,12 +755,11 @@ FilmSample WavefrontTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::
                                          PathObserver* observer) const {
   Wave w;
   w.resize(1);
-  const std::uint32_t pixel = y * static_cast<std::uint32_t>(scene_.scene().film.width) + x;
   w.out_index[0] = 0;
   w.x[0] = x;
   w.y[0] = y;
   w.sample[0] = sample;
-  w.rng[0] = SampleStream(settings_.seed, pixel, sample);
+  w.rng[0] = stream(x, y, sample);
   w.n = 1;
   FilmSample result;
   run_wave(w, std::span<FilmSample>(&result, 1), observer);

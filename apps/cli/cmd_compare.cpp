@@ -56,7 +56,8 @@ void CompareCommand::add_to(CLI::App& app) {
 
 namespace {
 
-// The scene options as arguments, for the other build (trace-pixel takes no --spp).
+// The scene options as arguments, for the other build (trace-pixel takes
+// --spp only for the zsobol sampler, whose numbers depend on it).
 std::vector<std::string> scene_args(const SceneOptions& o, bool with_spp) {
   std::vector<std::string> a;
   if (!o.scene_file.empty()) a.push_back(o.scene_file);
@@ -69,7 +70,8 @@ std::vector<std::string> scene_args(const SceneOptions& o, bool with_spp) {
     }
   };
   opt("--strategy", o.strategy);
-  if (with_spp) opt("--spp", o.spp);
+  if (with_spp || o.sampler) opt("--spp", o.spp);
+  opt("--sampler", o.sampler);
   opt("--max-depth", o.max_depth);
   opt("--rr-depth", o.rr_depth);
   opt("--seed", o.seed);

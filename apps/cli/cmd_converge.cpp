@@ -22,6 +22,13 @@ void ConvergeCommand::add_to(CLI::App& app) {
   cmd->add_option("--reference", reference, "Ground-truth EXR (default: the scene's analytic expected image)");
   cmd->add_option("--tracers", options.tracers, "Tracers, comma-separated: reference, wavefront (default: both)")->delimiter(',');
   cmd->add_option("--strategies", strategies, "Strategies, comma-separated (default: all five)")->delimiter(',');
+  CLI::Option* one_sampler =
+      cmd->add_option("--sampler", sampler, "Sampler of every render: independent or zsobol")
+          ->check(CLI::IsMember({"independent", "zsobol"}));
+  cmd->add_option("--samplers", samplers, "Samplers to compare, comma-separated: independent, zsobol (default: both)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"independent", "zsobol"}))
+      ->excludes(one_sampler);
   cmd->add_option("--spp", options.spp, "The samples-per-pixel ladder, increasing, comma-separated")
       ->delimiter(',')
       ->check(CLI::Range(1, 1 << 24));
@@ -52,6 +59,9 @@ int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     if (!st) throw InputError("--strategies: unknown strategy '" + s + "' (expected cosine, bsdf, light, light+bsdf or mis)");
     o.strategies.push_back(*st);
   }
+  // --samplers replaces the default pair; --sampler K renders everything with K.
+  if (!samplers.empty() || sampler) o.samplers.clear();
+  for (const std::string& s : samplers) o.samplers.push_back(*parse_sampler(s));  // checked by CLI11
   // Fail on an unwritable folder now, not after the sweep; on any failure
   // remove the folder again if this run made it and it is still empty.
   const std::filesystem::path dir(out_dir);
@@ -61,6 +71,7 @@ int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     ensure_writable(dir / "converge.csv");
     Scene scene = load_scene(scene_file);
     if (resolution) apply_resolution(*resolution, scene.film);
+    if (sampler) scene.render.sampler = *parse_sampler(*sampler);
     for (const std::string& w : scene.warnings) err << "pathlab: warning: " << w << "\n";
     const ThreadLimit limit(threads);
     result = run_converge(scene, o, make_tracer,

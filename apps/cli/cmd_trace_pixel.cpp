@@ -22,6 +22,9 @@ namespace pathlab::cli {
 void TracePixelCommand::add_to(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("trace-pixel", "Replay one pixel sample and print its path");
   scene.add_to(*cmd, false, true);
+  cmd->add_option("--spp", scene.spp,
+                  "The samples per pixel of the render replayed: only the zsobol sampler's numbers depend on it")
+      ->check(CLI::Range(1, 1 << 24));
   cmd->add_option("--pixel", pixel, "Pixel X,Y (0,0 = top left)")->required();
   CLI::Option* one = cmd->add_option("--sample", sample, "Sample index within the pixel");
   cmd->add_option("--samples", samples, "A range of samples A..B (inclusive), e.g. 0..15")->excludes(one);

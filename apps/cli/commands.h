@@ -116,6 +116,8 @@ struct ConvergeCommand {
   ConvergeOptions options;              // the options bind to its fields, but for these two:
   std::string reference;                // -> options.reference
   std::vector<std::string> strategies;  // -> options.strategies
+  std::vector<std::string> samplers;    // --samplers A,B -> options.samplers
+  std::optional<std::string> sampler;   // --sampler K: the scene's sampler
   std::optional<double> target_rmse;
   std::optional<std::string> resolution;  // "WxH"
   int threads = 0;

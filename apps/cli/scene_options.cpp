@@ -28,6 +28,10 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
   cmd.add_option("--rr-depth", rr_depth, "Bounces before Russian roulette starts")
       ->check(CLI::Range(0, kMaxVerticesUncapped));
   cmd.add_option("--seed", seed, "Random seed");
+  cmd.add_option("--sampler", sampler,
+                 "Random numbers: independent (a hash per number) or zsobol (Owen-scrambled Sobol' points, pixels in "
+                 "Morton order; depends on --spp rounded up to a power of two)")
+      ->check(CLI::IsMember({"independent", "zsobol"}));
   cmd.add_option("--resolution", resolution, "Image size WxH, e.g. 640x480");
   cmd.add_option("--bsdf-sampling", bsdf_sampling, "Glossy lobe sampling: vndf (exact GGX visible normals) or cospow")
       ->check(CLI::IsMember({"vndf", "cospow"}));
@@ -65,6 +69,7 @@ Scene SceneOptions::load() const {
   if (general_shading) r.force_general_shading = true;
   if (bvh) r.compact_bvh = *bvh == "compact";
   if (texture_filter) r.texture_filter = *parse_texture_filter(*texture_filter);
+  if (sampler) r.sampler = *parse_sampler(*sampler);
   if (texture_cache_mb) r.texture_cache_mb = *texture_cache_mb;
   if (seed) {
     std::uint64_t value = 0;
@@ -102,6 +107,9 @@ std::string SceneOptions::trace_pixel_command(const Scene& scene, std::uint32_t 
   if (scene.render.min_pdf > 0.0f) cmd << " --min-pdf " << scene.render.min_pdf;
   if (scene.render.force_general_shading) cmd << " --general-shading";
   if (scene.render.texture_filter != TextureFilter::Cone) cmd << " --texture-filter " << texture_filter_name(scene.render.texture_filter);
+  // zsobol's numbers depend on spp too.
+  if (scene.render.sampler != SamplerKind::Independent)
+    cmd << " --sampler " << sampler_name(scene.render.sampler) << " --spp " << scene.render.spp;
   return cmd.str();
 }
 

@@ -31,6 +31,7 @@ struct SceneOptions {
   std::optional<float> clamp, min_pdf;       // firefly controls (biased; 0 = off)
   bool general_shading = false;              // force the general shading path
   std::optional<std::string> texture_filter;  // cone | point
+  std::optional<std::string> sampler;         // independent | zsobol
   std::optional<float> texture_cache_mb;
 
   // Registers the options on `cmd`; `with_spp` for commands that render,

@@ -1,0 +1,148 @@
+// The parts of the zsobol sampler (core/rng.h), each a pure function: the
+// first two dimensions of Sobol's sequence, a nested (Owen-type) scrambling
+// of a 32-bit fixed-point value, the Morton index of a pixel and a nested
+// random permutation of an index's base-4 digits. The design is that of
+// pbrt-v4's ZSobolSampler (Ahmed & Wonka 2020, "Screen-space blue-noise
+// diffusion of Monte Carlo sampling error via hierarchical ordering of
+// pixels"); docs/scene-format.md (Samplers) says how pathlab uses it.
+//
+// Fixed point: a value v in [0, 2^32) stands for v / 2^32; bit 31 is the
+// first binary digit after the point.
+#pragma once
+
+#include <array>
+#include <bit>
+#include <cstdint>
+
+namespace pathlab::sobol {
+
+// splitmix64's finaliser (as mix64 in core/rng.h, kept here so this header
+// stands alone).
+constexpr std::uint64_t mix(std::uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+constexpr std::uint32_t reverse_bits(std::uint32_t v) {
+  v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
+  v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
+  v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
+  v = ((v >> 8) & 0x00ff00ffu) | ((v & 0x00ff00ffu) << 8);
+  return (v >> 16) | (v << 16);
+}
+
+// Generator matrices, column j being the image of index bit j. Dimension 0
+// is the identity (van der Corput: index bit j becomes digit j + 1 after the
+// point). Dimension 1 is Pascal's matrix mod 2 (Sobol's direction numbers
+// for the primitive polynomial x + 1): digit i + 1 of column j is
+// binomial(j, i) mod 2, which by Lucas's theorem is 1 exactly when the bits
+// of i are a subset of the bits of j. Index bits from 32 on only reach
+// digits past the 32nd, which a 32-bit value drops.
+constexpr std::uint32_t pascal_column(unsigned j) {
+  std::uint32_t c = 0;
+  for (unsigned i = 0; i <= j && i < 32; ++i)
+    if ((i & j) == i) c |= 0x80000000u >> i;
+  return c;
+}
+inline constexpr std::array<std::uint32_t, 32> kPascal = [] {
+  std::array<std::uint32_t, 32> m{};
+  for (unsigned j = 0; j < 32; ++j) m[j] = pascal_column(j);
+  return m;
+}();
+
+// Point `index` of Sobol's sequence in dimension 0 or 1, unscrambled.
+constexpr std::uint32_t sample(std::uint64_t index, int dim) {
+  const auto low = static_cast<std::uint32_t>(index);
+  if (dim == 0) return reverse_bits(low);
+  std::uint32_t v = 0;
+  for (std::uint32_t a = low; a != 0; a &= a - 1) v ^= kPascal[static_cast<unsigned>(std::countr_zero(a))];
+  return v;
+}
+
+// A nested scrambling of v seeded by `seed`: digit k of the result is digit
+// k of v flipped or not by a function of `seed` and v's digits before k, so
+// it maps each elementary interval [a / 2^k, (a + 1) / 2^k) onto one of the
+// same length (a bijection on each), as Owen's scrambling does, and keeps
+// every (t, m, s)-net a net. It works on the reversed value, where digit k
+// is bit k - 1 and "before" means "less significant": adding a constant,
+// multiplying by an odd one and v ^= v * even each make bit i depend only on
+// bits <= i, and each is a bijection (Laine & Karras 2011 describe the idea;
+// this is a chain of our own: two rounds of add, odd multiply, xor-multiply,
+// with four 32-bit keys drawn from the seed). The first add's key is
+// independent of the rest, so each value is scrambled to a uniform one.
+constexpr std::uint32_t scramble(std::uint32_t v, std::uint64_t seed) {
+  const std::uint64_t more = mix(seed ^ 0xa0761d6478bd642full);
+  const auto k0 = static_cast<std::uint32_t>(seed), k1 = static_cast<std::uint32_t>(seed >> 32);
+  const auto k2 = static_cast<std::uint32_t>(more), k3 = static_cast<std::uint32_t>(more >> 32);
+  v = reverse_bits(v);
+  v += k0;
+  v *= k1 | 1u;
+  v ^= v * 0x6b43a9b6u;  // even
+  v += k2;
+  v *= k3 | 1u;
+  v ^= v * 0x9e3779b8u;  // even
+  return reverse_bits(v);
+}
+
+// The 32-bit fixed-point value as a float in [0, 1): its top 24 bits, as
+// to_unit_float (core/rng.h) takes the hash's.
+constexpr float to_float(std::uint32_t v) { return static_cast<float>(v >> 8) * 0x1p-24f; }
+
+// x in the even bits, y in the odd bits: pixels close on the screen get
+// close indices, and each aligned 2^k x 2^k block of pixels is an aligned
+// run of 4^k indices.
+constexpr std::uint64_t morton(std::uint32_t x, std::uint32_t y) {
+  auto spread = [](std::uint64_t v) {
+    v &= 0xffffffffu;
+    v = (v | (v << 16)) & 0x0000ffff0000ffffull;
+    v = (v | (v << 8)) & 0x00ff00ff00ff00ffull;
+    v = (v | (v << 4)) & 0x0f0f0f0f0f0f0f0full;
+    v = (v | (v << 2)) & 0x3333333333333333ull;
+    v = (v | (v << 1)) & 0x5555555555555555ull;
+    return v;
+  };
+  return spread(x) | (spread(y) << 1);
+}
+
+// The 24 permutations of {0, 1, 2, 3}, each packed as four 2-bit images
+// (the image of d in bits 2d, 2d + 1), in lexicographic order.
+inline constexpr std::array<std::uint8_t, 24> kPermutations4 = [] {
+  std::array<std::uint8_t, 24> out{};
+  int n = 0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      for (int c = 0; c < 4; ++c)
+        for (int d = 0; d < 4; ++d)
+          if (a != b && a != c && a != d && b != c && b != d && c != d)
+            out[static_cast<std::size_t>(n++)] = static_cast<std::uint8_t>(a | (b << 2) | (c << 4) | (d << 6));
+  return out;
+}();
+
+// A nested random permutation of the `bits` low bits of `index` (bits above
+// them are kept): from the top, each base-4 digit goes through one of the 24
+// permutations, chosen by a hash of `seed`, the digit's place and the
+// original digits above it. With `bits` odd the lowest digit is a single bit,
+// flipped or not by such a hash. An aligned run of indices (the 2^k indices
+// that share all bits from k up, k even, or k odd when `bits` is odd) maps
+// onto an aligned run of the same length, so the points of a run of a
+// (0, 2)-sequence stay a (0, k, 2)-net.
+constexpr std::uint64_t permute_digits(std::uint64_t index, unsigned bits, std::uint64_t seed) {
+  const unsigned lone = bits & 1u;
+  std::uint64_t out = index & ~((bits >= 64 ? 0ull : (1ull << bits)) - 1ull);
+  for (unsigned p = bits - 2; p + 2 > lone && p < 64; p -= 2) {  // digit in bits [p, p + 1]
+    const std::uint64_t higher = index >> (p + 2);
+    const auto digit = static_cast<unsigned>((index >> p) & 3u);
+    const std::uint64_t h = mix((seed + (static_cast<std::uint64_t>(p) + 1) * 0x9e3779b97f4a7c15ull) ^ higher);
+    const unsigned perm = kPermutations4[static_cast<std::size_t>((h >> 32) % 24)];
+    out |= static_cast<std::uint64_t>((perm >> (2 * digit)) & 3u) << p;
+    if (p < 2) break;
+  }
+  if (lone) {
+    const std::uint64_t h = mix(seed ^ 0x3c6ef372fe94f82bull ^ (index >> 1));
+    out |= (index ^ (h >> 63)) & 1u;
+  }
+  return out;
+}
+
+}  // namespace pathlab::sobol
