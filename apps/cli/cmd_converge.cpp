@@ -25,7 +25,7 @@ void ConvergeCommand::add_to(CLI::App& app) {
   CLI::Option* one_sampler =
       cmd->add_option("--sampler", sampler, "Sampler of every render: independent or zsobol")
           ->check(CLI::IsMember({"independent", "zsobol"}));
-  cmd->add_option("--samplers", samplers, "Samplers to compare, comma-separated: independent, zsobol (default: both)")
+  cmd->add_option("--samplers", samplers, "Samplers to compare, comma-separated: independent, zsobol (default: the scene's)")
       ->delimiter(',')
       ->check(CLI::IsMember({"independent", "zsobol"}))
       ->excludes(one_sampler);
@@ -59,8 +59,6 @@ int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     if (!st) throw InputError("--strategies: unknown strategy '" + s + "' (expected cosine, bsdf, light, light+bsdf or mis)");
     o.strategies.push_back(*st);
   }
-  // --samplers replaces the default pair; --sampler K renders everything with K.
-  if (!samplers.empty() || sampler) o.samplers.clear();
   for (const std::string& s : samplers) o.samplers.push_back(*parse_sampler(s));  // checked by CLI11
   // Fail on an unwritable folder now, not after the sweep; on any failure
   // remove the folder again if this run made it and it is still empty.
