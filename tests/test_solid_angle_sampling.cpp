@@ -47,6 +47,18 @@ constexpr double kComparisons = 16 + 6 + 4 * 2 + 3 * 2;
 
 float uniform(std::uint64_t stream, std::uint64_t k) { return to_unit_float(mix64(mix64(stream) ^ k)); }
 
+// A second emitter (material 1, a triangle of area 0.5 in the plane x = 50,
+// which no ref lies in) of a quarter of the power of the light under test
+// (area `area`, radiance 1), so that the pick probability is not 1.
+void add_other_light(Scene& scene, double area) {
+  scene.materials.push_back(Material{"other", MaterialType::Emissive, Spectrum(0.0f), Spectrum(float(0.25 * area / 0.5)), true});
+  Shape o;
+  o.description = "other";
+  o.material = 1;
+  o.mesh = {{{50, 0, 0}, {50, 1, 0}, {50, 0, 1}}, {{0, 1, 2}}};
+  scene.shapes.push_back(o);
+}
+
 // A scene of one emitting triangle (material 0, two-sided unless told) and a
 // second light, a small triangle far to the side with a quarter of its power,
 // so that the first light's pick probability is about 0.8.
@@ -60,14 +72,7 @@ Scene triangle_scene(const std::array<vec3, 3>& tri, LightSampling mode, bool tw
   s.description = "light";
   s.mesh = {{tri[0], tri[1], tri[2]}, {{0, 1, 2}}};
   scene.shapes.push_back(s);
-  const double area = 0.5 * glm::length(glm::cross(dvec3(tri[1] - tri[0]), dvec3(tri[2] - tri[0])));
-  Material other{"other", MaterialType::Emissive, Spectrum(0.0f), Spectrum(float(0.25 * area / 0.5)), true};
-  scene.materials.push_back(other);
-  Shape o;
-  o.description = "other";
-  o.material = 1;
-  o.mesh = {{{50, 0, 0}, {50, 1, 0}, {50, 0, 1}}, {{0, 1, 2}}};  // in the plane x = 50, which no ref lies in
-  scene.shapes.push_back(o);
+  add_other_light(scene, 0.5 * glm::length(glm::cross(dvec3(tri[1] - tri[0]), dvec3(tri[2] - tri[0]))));
   return scene;
 }
 
@@ -82,13 +87,7 @@ Scene sphere_scene(vec3 center, float radius, LightSampling mode) {
   s.center = center;
   s.radius = radius;
   scene.shapes.push_back(s);
-  const double area = 4.0 * kPiD * radius * radius;
-  scene.materials.push_back(Material{"other", MaterialType::Emissive, Spectrum(0.0f), Spectrum(float(0.25 * area / 0.5)), true});
-  Shape o;
-  o.description = "other";
-  o.material = 1;
-  o.mesh = {{{50, 0, 0}, {50, 1, 0}, {50, 0, 1}}, {{0, 1, 2}}};  // in the plane x = 50, which no ref lies in
-  scene.shapes.push_back(o);
+  add_other_light(scene, 4.0 * kPiD * radius * radius);
   return scene;
 }
 
