@@ -59,10 +59,9 @@ std::vector<std::pair<std::string, std::string>> sample_settings(const RenderSet
       {"bvh", r.compact_bvh ? "compact" : "fast"},
   };
   // zsobol's numbers depend on spp rounded up to a power of two (core/rng.h).
-  if (r.sampler == SamplerKind::ZSobol) {
-    const SamplerSetup s(r.sampler, r.seed, 1, 1, static_cast<std::uint32_t>(std::max(r.spp, 1)));
-    out.emplace_back("zsobol_spp", std::to_string(1ull << s.log2_spp()));
-  }
+  if (r.sampler == SamplerKind::ZSobol)
+    out.emplace_back("zsobol_spp",
+                     std::to_string(1ull << SamplerSetup::log2_spp_of(static_cast<std::uint32_t>(std::max(r.spp, 1)))));
   return out;
 }
 

@@ -148,7 +148,11 @@ class SamplerSetup {
       : kind_(kind), seed_(seed), width_(width) {
     const std::uint32_t side = width > height ? width : height;
     morton_bits_ = 2 * static_cast<std::uint32_t>(std::bit_width(side > 1 ? side - 1 : 0u));
-    log2_spp_ = static_cast<std::uint32_t>(std::bit_width(spp > 1 ? spp - 1 : 0u));
+    log2_spp_ = log2_spp_of(spp);
+  }
+  // L = ceil(log2(spp)): zsobol lays each pixel's samples out for 2^L.
+  static constexpr std::uint32_t log2_spp_of(std::uint32_t spp) {
+    return static_cast<std::uint32_t>(std::bit_width(spp > 1 ? spp - 1 : 0u));
   }
 
   constexpr SampleStream stream(std::uint32_t x, std::uint32_t y, std::uint32_t sample) const {

@@ -81,6 +81,26 @@ FilmDesc read_film(const Node& node) {
   return f;
 }
 
+// A string that names one of `names`, parsed by `parse`: an unknown one
+// fails naming `what` and the nearest name, or else every name ("(expected a,
+// b or c)").
+template <typename Parse>
+auto read_choice(const Node& value, const char* what, std::span<const std::string_view> names, Parse parse) {
+  const std::string name = value.string();
+  const auto parsed = parse(name);
+  if (!parsed) {
+    std::string near = suggestion(name, names);
+    if (near.empty()) {
+      near = " (expected ";
+      for (std::size_t i = 0; i < names.size(); ++i)
+        near += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + std::string(names[i]);
+      near += ")";
+    }
+    value.fail(std::string("unknown ") + what + " " + in_quotes(name) + near);
+  }
+  return *parsed;
+}
+
 RenderSettings read_render(const Node& node) {
   node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh",
                    "texture_filter", "texture_cache_mb", "light_sampling", "sampler"});
@@ -100,16 +120,7 @@ RenderSettings read_render(const Node& node) {
     if (d < 0 || d > kMaxVerticesUncapped) node.child("rr_depth").fail("rr_depth must lie in [0, 1000]");
     r.rr_depth = static_cast<int>(d);
   }
-  if (node.has("strategy")) {
-    const std::string name = node.child("strategy").string();
-    const auto s = parse_strategy(name);
-    if (!s) {
-      const std::string near = suggestion(name, strategy_names());
-      node.child("strategy").fail("unknown strategy " + in_quotes(name) +
-                                  (near.empty() ? " (expected cosine, bsdf, light, light+bsdf or mis)" : near));
-    }
-    r.strategy = *s;
-  }
+  if (node.has("strategy")) r.strategy = read_choice(node.child("strategy"), "strategy", strategy_names(), parse_strategy);
   if (node.has("seed")) {
     // Any 64-bit unsigned value, as --seed takes.
     const Node s = node.child("seed");
@@ -122,25 +133,12 @@ RenderSettings read_render(const Node& node) {
     }
   }
   if (node.has("bsdf_sampling")) {
-    const std::string name = node.child("bsdf_sampling").string();
-    const auto s = parse_bsdf_sampling(name);
-    if (!s) {
-      const std::array<std::string_view, 2> names{"vndf", "cospow"};
-      const std::string near = suggestion(name, names);
-      node.child("bsdf_sampling").fail("unknown BSDF sampling " + in_quotes(name) + (near.empty() ? " (expected vndf or cospow)" : near));
-    }
-    r.bsdf_sampling = *s;
+    constexpr std::array<std::string_view, 2> names{"vndf", "cospow"};
+    r.bsdf_sampling = read_choice(node.child("bsdf_sampling"), "BSDF sampling", names, parse_bsdf_sampling);
   }
   if (node.has("light_sampling")) {
-    const std::string name = node.child("light_sampling").string();
-    const auto s = parse_light_sampling(name);
-    if (!s) {
-      const std::array<std::string_view, 2> names{"area", "solid_angle"};
-      const std::string near = suggestion(name, names);
-      node.child("light_sampling")
-          .fail("unknown light sampling " + in_quotes(name) + (near.empty() ? " (expected area or solid_angle)" : near));
-    }
-    r.light_sampling = *s;
+    constexpr std::array<std::string_view, 2> names{"area", "solid_angle"};
+    r.light_sampling = read_choice(node.child("light_sampling"), "light sampling", names, parse_light_sampling);
   }
   if (node.has("bvh")) {
     const std::string name = node.child("bvh").string();
@@ -154,14 +152,8 @@ RenderSettings read_render(const Node& node) {
     r.texture_filter = *f;
   }
   if (node.has("sampler")) {
-    const std::string name = node.child("sampler").string();
-    const auto k = parse_sampler(name);
-    if (!k) {
-      const std::array<std::string_view, 2> names{"independent", "zsobol"};
-      const std::string near = suggestion(name, names);
-      node.child("sampler").fail("unknown sampler " + in_quotes(name) + (near.empty() ? " (expected independent or zsobol)" : near));
-    }
-    r.sampler = *k;
+    constexpr std::array<std::string_view, 2> names{"independent", "zsobol"};
+    r.sampler = read_choice(node.child("sampler"), "sampler", names, parse_sampler);
   }
   if (node.has("texture_cache_mb")) {
     r.texture_cache_mb = static_cast<float>(node.child("texture_cache_mb").number());
