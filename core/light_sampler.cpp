@@ -41,6 +41,8 @@ void build_distribution(const std::vector<double>& weights, std::vector<float>* 
   }
 }
 
+constexpr std::uint32_t kGrid = 1u << 24;  // LightChoice numbers are multiples of 1 / kGrid
+
 // Test-only fault switches (core/faults.h); the identity in production.
 float faulty_distance(float dist) { return PATHLAB_FAULT(LightPdfWithoutDistance) ? 1.0f : dist; }
 
@@ -83,7 +85,10 @@ std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene) {
 float LightSampler::area_density(const Entry& e) { return PATHLAB_FAULT(LightPdfWithoutArea) ? 1.0f : 1.0f / e.area; }
 
 LightSampler::LightSampler(const Scene& scene, float scene_radius, const Textures* textures)
-    : scene_(&scene), textures_(textures), light_sampling_(scene.render.light_sampling) {
+    : scene_(&scene),
+      textures_(textures),
+      light_sampling_(scene.render.light_sampling),
+      kind_(scene.render.light_sampler) {
   std::vector<double> power;
   first_entry_.assign(scene.shapes.size(), -1);
   for (std::uint32_t s = 0; s < scene.shapes.size(); ++s) {
@@ -139,6 +144,7 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius, const Texture
     power.push_back(kPi * double(scene_radius) * scene_radius * luminance_double(dl.intensity));
   }
   build_distribution(power, &pmf_, &cdf_);
+  if (kind_ == LightSamplerKind::Bvh) build_bvh(power);
 
   // Delta lights by power (docs/scene-format.md, "How a light is picked"),
   // each divided by 4 pi so that a point light's weight is the luminance of
@@ -151,8 +157,87 @@ LightSampler::LightSampler(const Scene& scene, float scene_radius, const Texture
   build_distribution(intensity, &delta_pmf_, &delta_cdf_);
 }
 
+void LightSampler::build_bvh(const std::vector<double>& power) {
+  // The emitting triangles and spheres of positive power, each bounded by
+  // its box and its normals: a triangle's front normal (theta_o = 0), a
+  // sphere's every direction (theta_o = pi); Lambertian, so theta_e = pi/2.
+  entry_tree_.assign(entries_.size(), -1);
+  std::vector<LightBounds> bounds;
+  for (std::size_t i = 0; i < entries_.size(); ++i) {
+    const bool sky = static_cast<std::int64_t>(i) == env_index_ ||
+                     (!suns_.empty() && static_cast<std::int64_t>(i) >= suns_.front().entry);
+    if (sky || !(power[i] > 0.0) || !std::isfinite(power[i])) continue;
+    const Entry& e = entries_[i];
+    const Shape& shape = scene_->shapes[e.shape];
+    LightBounds b;
+    if (shape.kind == Shape::Kind::Sphere) {
+      b.lo = shape.center - vec3(shape.radius);
+      b.hi = shape.center + vec3(shape.radius);
+      b.cos_o = -1.0f;
+    } else {
+      b.lo = glm::min(e.triangle.p0, glm::min(e.triangle.p1, e.triangle.p2));
+      b.hi = glm::max(e.triangle.p0, glm::max(e.triangle.p1, e.triangle.p2));
+      b.axis = e.triangle.n;
+      b.cos_o = 1.0f;
+    }
+    b.cos_e = 0.0f;
+    b.phi = power[i];
+    b.two_sided = scene_->materials[shape.material].two_sided_emission;
+    entry_tree_[i] = static_cast<std::int64_t>(bounds.size());
+    tree_entry_.push_back(i);
+    bounds.push_back(b);
+  }
+  bvh_ = std::make_unique<const LightBvh>(std::move(bounds));
+  // The sky: each of its lights 1 / (n + 1) of the grid, the tree the rest
+  // (all of it without a sky; none without a tree), in whole grid points.
+  if (env_index_ >= 0) sky_entry_.push_back(static_cast<std::size_t>(env_index_));
+  for (const SunDisk& sun : suns_) sky_entry_.push_back(static_cast<std::size_t>(sun.entry));
+  const std::uint64_t tree_slots = bvh_->empty() ? 0 : 1, slots = sky_entry_.size() + tree_slots;
+  std::fill(pmf_.begin(), pmf_.end(), 0.0f);
+  cdf_.clear();  // nothing picks by it under bvh
+  sky_start_.clear();
+  for (std::uint64_t j = 0; j <= sky_entry_.size(); ++j)
+    sky_start_.push_back(slots == 0 ? kGrid : static_cast<std::uint32_t>((j + tree_slots) * kGrid / slots));
+  for (std::size_t j = 0; j < sky_entry_.size(); ++j)
+    pmf_[sky_entry_[j]] = static_cast<float>(sky_start_[j + 1] - sky_start_[j]) * 0x1p-24f;
+}
+
 std::size_t LightSampler::unsampled_light_count() const {
+  if (kind_ == LightSamplerKind::Bvh) {
+    // Outside the tree (no power) and no sky share; the tree's lights may
+    // be unpickable from some points and not others.
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < entries_.size(); ++i)
+      if (entry_tree_[i] < 0 && pmf_[i] == 0.0f) ++n;
+    return n;
+  }
   return static_cast<std::size_t>(std::count(pmf_.begin(), pmf_.end(), 0.0f));
+}
+
+std::optional<LightSampler::Pick> LightSampler::pick(const LightQuery& ref, float u_choice) const {
+  if (entries_.empty()) return std::nullopt;
+  if (kind_ == LightSamplerKind::Power) {
+    const std::size_t i = pick(cdf_, u_choice);
+    return Pick{i, pmf_[i]};
+  }
+  // The grid point of u (a multiple of 2^-24: core/rng.h).
+  const double scaled = std::floor(static_cast<double>(u_choice) * double(kGrid));
+  const std::uint32_t k = static_cast<std::uint32_t>(std::clamp(scaled, 0.0, double(kGrid - 1)));
+  const std::uint32_t tree_count = sky_start_[0];
+  if (k < tree_count) {
+    const std::optional<LightBvh::Pick> p = bvh_->pick(ref, k, tree_count);
+    if (!p) return std::nullopt;
+    return Pick{tree_entry_[p->light], static_cast<float>(p->share) * 0x1p-24f};
+  }
+  const std::size_t j =
+      static_cast<std::size_t>(std::upper_bound(sky_start_.begin(), sky_start_.end(), k) - sky_start_.begin()) - 1;
+  return Pick{sky_entry_[j], pmf_[sky_entry_[j]]};
+}
+
+float LightSampler::pick_pmf(const LightQuery& ref, std::size_t entry) const {
+  if (kind_ == LightSamplerKind::Power || entry_tree_[entry] < 0) return pmf_[entry];
+  const std::uint32_t light = static_cast<std::uint32_t>(entry_tree_[entry]);
+  return static_cast<float>(bvh_->share(ref, light, sky_start_[0])) * 0x1p-24f;
 }
 
 std::size_t LightSampler::pick(const std::vector<float>& cdf, float u) {
@@ -160,9 +245,12 @@ std::size_t LightSampler::pick(const std::vector<float>& cdf, float u) {
   return std::min<std::size_t>(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
 }
 
-std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice, vec2 u) const {
-  if (entries_.empty()) return std::nullopt;
-  const std::size_t i = pick(cdf_, u_choice);
+std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u_choice, vec2 u) const {
+  const std::optional<Pick> picked = pick(query, u_choice);
+  if (!picked) return std::nullopt;
+  const std::size_t i = picked->entry;
+  const float pmf = picked->pmf;
+  const vec3& ref = query.p;
   LightSample ls;
   ls.light = static_cast<std::uint32_t>(i);
   if (static_cast<std::int64_t>(i) == env_index_) {
@@ -173,11 +261,11 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
       if (!es) return std::nullopt;
       ls.wi = es->wi;
       ls.Le = es->radiance;
-      ls.pdf = pmf_[i] * es->pdf;
+      ls.pdf = pmf * es->pdf;
     } else {
       ls.wi = square_to_uniform_sphere(u);
       ls.Le = *scene_->environment;
-      ls.pdf = pmf_[i] * kInv4Pi;
+      ls.pdf = pmf * kInv4Pi;
     }
     // A sun disk in the same direction: the sample stands for every infinite
     // light there (their radiance summed, their densities summed: one
@@ -238,8 +326,8 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
   ls.wi = d / ls.dist;
   const float cos_light = glm::dot(ls.n, -ls.wi);
   if (!m.two_sided_emission && cos_light <= 0.0f) return std::nullopt;  // back of a one-sided emitter
-  ls.pdf = view.density > 0.0 ? pmf_[i] * static_cast<float>(view.density)
-                              : pmf_[i] * area_to_solid_angle(area_density(e), faulty_distance(ls.dist), cos_light);
+  ls.pdf = view.density > 0.0 ? pmf * static_cast<float>(view.density)
+                              : pmf * area_to_solid_angle(area_density(e), faulty_distance(ls.dist), cos_light);
   if (!(ls.pdf > 0.0f) || std::isinf(ls.pdf)) return std::nullopt;  // seen edge-on
   if (!textured) {
     ls.Le = m.emission;
@@ -252,18 +340,23 @@ std::optional<LightSample> LightSampler::sample(const vec3& ref, float u_choice,
   return ls;
 }
 
-float LightSampler::pdf(const vec3& ref, const Surfel& hit) const {
+float LightSampler::pdf(const LightQuery& query, const Surfel& hit) const {
   const std::int64_t first = first_entry_[hit.shape];
   if (first < 0) return 0.0f;
   const std::size_t i = static_cast<std::size_t>(first) + hit.prim;
+  const vec3& ref = query.p;
+  const float pmf = pick_pmf(query, i);
   if (light_sampling_ == LightSampling::SolidAngle) {
-    if (pmf_[i] == 0.0f) return 0.0f;
+    if (pmf == 0.0f) return 0.0f;
     const SolidAngleView view = solid_angle_view(entries_[i], ref);
-    if (view.density > 0.0) return pmf_[i] * static_cast<float>(view.density);
+    if (view.density > 0.0) return pmf * static_cast<float>(view.density);
   }
+  // Under bvh a light the tree gives nothing from here has density 0 (not
+  // 0 times a density that may be infinite edge-on).
+  if (kind_ == LightSamplerKind::Bvh && pmf == 0.0f) return 0.0f;
   const vec3 d = hit.p - ref;
   const float dist = glm::length(d);
-  return pmf_[i] * area_to_solid_angle(area_density(entries_[i]), faulty_distance(dist), glm::dot(hit.n, d) / dist);
+  return pmf * area_to_solid_angle(area_density(entries_[i]), faulty_distance(dist), glm::dot(hit.n, d) / dist);
 }
 
 LightSampler::SolidAngleView LightSampler::solid_angle_view(const Entry& e, const vec3& ref) const {

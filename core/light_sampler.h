@@ -21,6 +21,18 @@
 // pdf_environment(dir) sum them all, and a sample of any of them carries
 // those sums, so MIS weighs the sky as one light.
 //
+// Which light: `render.light_sampler` (LightSamplerKind). `power` (the
+// default) picks an entry in proportion to its power (docs/scene-format.md,
+// "How a light is picked"), wherever the shading point is. `bvh` picks the
+// emitting triangles and spheres down a light BVH (core/light_bvh.h) by
+// their importance for the shading point (position and the normal of the
+// side that receives light: LightQuery), and the environment and each sun
+// disk each with the fixed probability 1 / (number of them + 1), the tree
+// taking the rest, as pbrt-v4's BVHLightSampler does (the sky's pdf then
+// needs no shading point). Both rules cut the 2^24 grid of the LightChoice
+// number exactly, so the probability pdf() multiplies by is the one the pick
+// used.
+//
 // Point, spot and directional lights are delta lights: no ray can hit them,
 // so they live in a separate list that every strategy samples explicitly
 // (DESIGN: the strategies differ only on lights a ray can find). One is
@@ -28,12 +40,14 @@
 #pragma once
 
 #include "core/geometry.h"
+#include "core/light_bvh.h"
 #include "core/path_observer.h"
 #include "core/sampling_spherical.h"
 #include "core/scene.h"
 #include "core/surfel.h"
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -89,6 +103,17 @@ double delta_power_over_4pi(const DeltaLight& light, float scene_radius);
 // black ones.
 std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene);
 
+// The shading point `s`, seen along wo, as light selection sees it: its
+// position and the geometric normal turned to wo's side (a reflection in
+// pathlab never crosses the geometric surface, and a transmission is an
+// impulse NEE never connects through), or no normal when wo grazes. Both
+// tracers make the query of a vertex with this, for its light sample and
+// for the pdf of the emitter its BSDF ray finds (PreviousVertex::ref).
+inline LightQuery light_query(const Surfel& s, const vec3& wo) {
+  const float c = glm::dot(s.n, wo);
+  return {s.p, c > 0.0f ? s.n : c < 0.0f ? -s.n : vec3(0.0f)};
+}
+
 class LightSampler {
  public:
   // `scene_radius`: radius of a sphere bounding the scene, for the power of
@@ -110,11 +135,30 @@ class LightSampler {
   bool has_delta_lights() const { return !deltas_.empty(); }
 
   // An area or environment light sample as seen from `ref`. Nothing if the
-  // sample cannot contribute (back of a one-sided emitter, seen edge-on).
-  std::optional<LightSample> sample(const vec3& ref, float u_choice, vec2 u) const;
+  // sample cannot contribute (back of a one-sided emitter, seen edge-on,
+  // every light of the BVH unimportant there).
+  std::optional<LightSample> sample(const LightQuery& ref, float u_choice, vec2 u) const;
   // Density with which sample() would produce the emitter point `hit`
   // (reached from `ref`), in solid angle; 0 if `hit` is not on a light.
-  float pdf(const vec3& ref, const Surfel& hit) const;
+  float pdf(const LightQuery& ref, const Surfel& hit) const;
+  // The same from a bare point (no normal: LightQuery::n = 0).
+  std::optional<LightSample> sample(const vec3& ref, float u_choice, vec2 u) const {
+    return sample(LightQuery{ref, vec3(0.0f)}, u_choice, u);
+  }
+  float pdf(const vec3& ref, const Surfel& hit) const { return pdf(LightQuery{ref, vec3(0.0f)}, hit); }
+
+  // The entry (index into entries()) that sample() picks from `ref` with
+  // the number u_choice, and the probability of that pick; nothing when the
+  // light BVH has no light of importance there. sample() and pdf() go
+  // through these two, so they cannot disagree.
+  struct Pick {
+    std::size_t entry;
+    float pmf;
+  };
+  std::optional<Pick> pick(const LightQuery& ref, float u_choice) const;
+  // The probability with which pick() chooses entry `entry` from `ref`
+  // (under `power`, pmf()[entry] wherever ref is).
+  float pick_pmf(const LightQuery& ref, std::size_t entry) const;
   // Density with which sample() would produce direction `wi` towards the
   // environment or a sun disk (0 without them): the sum over those lights.
   float pdf_environment(const vec3& wi) const { return sky(wi).pdf; }
@@ -139,10 +183,17 @@ class LightSampler {
   // How sample() places a point on an area light (the scene's
   // render.light_sampling when it was made).
   LightSampling light_sampling() const { return light_sampling_; }
+  // How sample() picks the light (the scene's render.light_sampler).
+  LightSamplerKind light_sampler() const { return kind_; }
+  // The light BVH (null under `power`); its light i is entry bvh_entry(i).
+  const LightBvh* bvh() const { return bvh_.get(); }
+  std::size_t bvh_entry(std::uint32_t light) const { return tree_entry_[light]; }
 
   // The area-light distribution itself, for code that samples lights in
   // bulk (the wavefront's vectorised stages) and must pick exactly as
-  // sample() does (under LightSampling::Area only): entry i is chosen when cdf[i - 1] <= u_choice < cdf[i]
+  // sample() does (under LightSampling::Area and LightSamplerKind::Power
+  // only; under `bvh` pmf() holds the fixed probabilities of the sky's
+  // entries and 0 for the others): entry i is chosen when cdf[i - 1] <= u_choice < cdf[i]
   // (the first entry whose cdf exceeds u; the last one if none does), with
   // probability pmf[i]; its density on the light is 1 / area.
   struct Entry {
@@ -162,6 +213,10 @@ class LightSampler {
 
  private:
   static std::size_t pick(const std::vector<float>& cdf, float u);
+  // Under `bvh`: the entries of the sky (environment, then sun disks) and
+  // the grid points [sky_start_[j], sky_start_[j + 1]) of LightChoice that
+  // pick sky entry j; the tree takes [0, sky_start_[0]).
+  void build_bvh(const std::vector<double>& power);
 
   // Whether entry `e` (a triangle or sphere) is sampled in solid angle from
   // `ref` (the fallback rule of core/sampling_spherical.h), and with which
@@ -193,6 +248,12 @@ class LightSampler {
   const Scene* scene_;
   const Textures* textures_;
   LightSampling light_sampling_ = LightSampling::Area;
+  LightSamplerKind kind_ = LightSamplerKind::Power;
+  std::unique_ptr<const LightBvh> bvh_;
+  std::vector<std::size_t> tree_entry_;    // BVH light -> entry
+  std::vector<std::int64_t> entry_tree_;   // entry -> BVH light, or -1 (not in the tree)
+  std::vector<std::size_t> sky_entry_;     // the sky's entries, in order
+  std::vector<std::uint32_t> sky_start_;   // sky_entry_.size() + 1 bounds, the last 2^24
   std::vector<Entry> entries_;           // area lights, then the environment, then the sun disks
   std::vector<SunDisk> suns_;
   std::vector<float> pmf_, cdf_;         // over entries_

@@ -52,6 +52,7 @@ std::vector<std::pair<std::string, std::string>> sample_settings(const RenderSet
       {"rr_depth", std::to_string(r.rr_depth)},
       {"bsdf_sampling", bsdf_sampling_name(r.bsdf_sampling)},
       {"light_sampling", light_sampling_name(r.light_sampling)},
+      {"light_sampler", light_sampler_name(r.light_sampler)},
       {"clamp", float_text(r.clamp)},
       {"min_pdf", float_text(r.min_pdf)},
       {"general_shading", r.force_general_shading ? "on" : "off"},

@@ -33,4 +33,12 @@ std::optional<LightSampling> parse_light_sampling(std::string_view name) {
   return std::nullopt;
 }
 
+const char* light_sampler_name(LightSamplerKind k) { return k == LightSamplerKind::Bvh ? "bvh" : "power"; }
+
+std::optional<LightSamplerKind> parse_light_sampler(std::string_view name) {
+  for (LightSamplerKind k : {LightSamplerKind::Power, LightSamplerKind::Bvh})
+    if (name == light_sampler_name(k)) return k;
+  return std::nullopt;
+}
+
 }  // namespace pathlab

@@ -56,6 +56,15 @@ enum class LightSampling : std::uint8_t {
 const char* light_sampling_name(LightSampling s);
 std::optional<LightSampling> parse_light_sampling(std::string_view name);
 
+// How next-event estimation picks the area light (core/light_sampler.h;
+// docs/scene-format.md, "How a light is picked").
+enum class LightSamplerKind : std::uint8_t {
+  Power,  // in proportion to power, wherever the shading point is
+  Bvh,    // down a light BVH, by importance for the shading point (core/light_bvh.h)
+};
+const char* light_sampler_name(LightSamplerKind k);
+std::optional<LightSamplerKind> parse_light_sampler(std::string_view name);
+
 struct RenderSettings {
   int spp = 16;
   // Maximum number of scattering events on a path: 0 shows only emission
@@ -67,6 +76,8 @@ struct RenderSettings {
   Strategy strategy = Strategy::Mis;
   // How next-event estimation samples a point on the chosen area light.
   LightSampling light_sampling = LightSampling::Area;
+  // How next-event estimation picks the area light.
+  LightSamplerKind light_sampler = LightSamplerKind::Power;
   std::uint64_t seed = 0;
   // Where the random numbers come from (core/rng.h; docs/scene-format.md,
   // Samplers). zsobol's numbers depend on spp too (rounded up to a power of

@@ -103,7 +103,7 @@ auto read_choice(const Node& value, const char* what, std::span<const std::strin
 
 RenderSettings read_render(const Node& node) {
   node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh",
-                   "texture_filter", "texture_cache_mb", "light_sampling", "sampler"});
+                   "texture_filter", "texture_cache_mb", "light_sampling", "light_sampler", "sampler"});
   RenderSettings r;
   if (node.has("spp")) {
     const std::int64_t spp = node.child("spp").integer();
@@ -139,6 +139,10 @@ RenderSettings read_render(const Node& node) {
   if (node.has("light_sampling")) {
     constexpr std::array<std::string_view, 2> names{"area", "solid_angle"};
     r.light_sampling = read_choice(node.child("light_sampling"), "light sampling", names, parse_light_sampling);
+  }
+  if (node.has("light_sampler")) {
+    constexpr std::array<std::string_view, 2> names{"power", "bvh"};
+    r.light_sampler = read_choice(node.child("light_sampler"), "light sampler", names, parse_light_sampler);
   }
   if (node.has("bvh")) {
     const std::string name = node.child("bvh").string();

@@ -10,6 +10,7 @@
 #pragma once
 
 #include "core/faults.h"
+#include "core/light_bvh.h"
 #include "core/math.h"
 #include "core/sampling.h"
 #include "core/scene.h"
@@ -18,7 +19,9 @@ namespace pathlab {
 
 // How the ray now being traced was chosen at the vertex before it.
 struct PreviousVertex {
-  vec3 p{0.0f};
+  // The vertex as light selection saw it (light_query(): position and the
+  // normal of its lit side), for the light pdf of the emitter the ray finds.
+  LightQuery ref{};
   float pdf = 0.0f;            // solid-angle density of the direction
   bool impulse = true;         // camera ray or impulse: no other way to find the emitter
   bool bsdf_technique = true;  // light+bsdf: that vertex chose BSDF sampling

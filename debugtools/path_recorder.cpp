@@ -166,6 +166,7 @@ json path_to_json(const TraceHeader& h, const PathRecorder& path, const Scene& s
           {"rr_depth", r.rr_depth},
           {"bsdf_sampling", bsdf_sampling_name(r.bsdf_sampling)},
           {"light_sampling", light_sampling_name(r.light_sampling)},
+          {"light_sampler", light_sampler_name(r.light_sampler)},
           {"clamp", r.clamp},
           {"min_pdf", r.min_pdf},
           {"general_shading", r.force_general_shading},

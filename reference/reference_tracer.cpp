@@ -48,7 +48,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
   ++path.hits;
   const vec3 wo = -ray.dir;
   const Spectrum Le = s.emitted(wo);
-  const float w_e = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, scene.lights().pdf(prev.p, s));
+  const float w_e = is_black(Le) ? 0.0f : emission_weight(settings_.strategy, prev, scene.lights().pdf(prev.ref, s));
   Spectrum L = w_e * Le;
   if (path.observer)
     path.observer->on_hit({vertex, s.p, s.n, glm::dot(s.n, wo) > 0.0f,
@@ -104,7 +104,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
     path.observer->on_scatter(
         {vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, beta_next, next_ray});
 
-  const PreviousVertex next{s.p, bs->pdf, bs->impulse, !(strategy == Strategy::LightBsdf && u_technique < 0.5f)};
+  const PreviousVertex next{light_query(s, wo), bs->pdf, bs->impulse, !(strategy == Strategy::LightBsdf && u_technique < 0.5f)};
   if (path.params)
     path.cone = scattered_cone(path.cone, glm::length(s.p - ray.origin), bs->impulse, bs->pdf, settings_.texture_filter);
   return L + weight * Li(next_ray, vertex + 1, next, beta_next, path);
@@ -139,7 +139,7 @@ Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vert
 Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int vertex, const Spectrum& beta,
                                       Path& path) const {
   const std::optional<LightSample> ls = scene_.lights().sample(
-      s.p, path.u(vertex, Dim::LightChoice), vec2(path.u(vertex, Dim::LightX), path.u(vertex, Dim::LightY)));
+      light_query(s, wo), path.u(vertex, Dim::LightChoice), vec2(path.u(vertex, Dim::LightX), path.u(vertex, Dim::LightY)));
   if (!ls) {
     if (path.observer && scene_.lights().has_area_lights())
       path.observer->on_light(rejected_light_event(vertex, false, nullptr, LightRejection::NoSample));

@@ -113,6 +113,41 @@ inline Scene cornell_with_delta_lights() {
   return scene;
 }
 
+// An emitting triangle with its own emissive material (radiance `Le`,
+// `two_sided`), front side counter-clockwise, appended to `scene`.
+inline void add_light_triangle(Scene& scene, const vec3& p0, const vec3& p1, const vec3& p2, float Le,
+                               bool two_sided = false) {
+  Material m{"lamp" + std::to_string(scene.materials.size()), MaterialType::Emissive, Spectrum(0.0f),
+             Spectrum(Le, 0.8f * Le, 0.6f * Le), two_sided};
+  scene.materials.push_back(m);
+  Shape s;
+  s.description = "shapes[" + std::to_string(scene.shapes.size()) + "] (light triangle)";
+  s.material = static_cast<std::uint32_t>(scene.materials.size() - 1);
+  s.mesh = TriangleMesh({p0, p1, p2}, {glm::uvec3(0, 1, 2)});
+  scene.shapes.push_back(std::move(s));
+}
+
+// The built-in Cornell box lit by many small lights of unequal power and
+// orientation (for the light BVH, render.light_sampler bvh): a 5 x 5 grid
+// of triangles under the ceiling facing down, every third two-sided, and
+// four more: on the left wall facing the wall, on the right wall facing in, on
+// the floor facing up, on the back wall two-sided; besides the box's own lamp.
+inline Scene cornell_with_many_lights() {
+  Scene scene = builtin_cornell_box();
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) {
+      const float x = -0.8f + 0.4f * static_cast<float>(i), z = -0.8f + 0.4f * static_cast<float>(j);
+      const float Le = 2.0f + 6.0f * static_cast<float>((3 * i + 7 * j) % 5);
+      const vec3 c(x, 0.9f, z);
+      add_light_triangle(scene, c, c + vec3(0.06f, 0.0f, 0.0f), c + vec3(0.0f, 0.0f, 0.06f), Le, (i + j) % 3 == 0);
+    }
+  add_light_triangle(scene, vec3(-0.99f, 0.2f, 0.0f), vec3(-0.99f, 0.2f, 0.15f), vec3(-0.99f, 0.35f, 0.0f), 12.0f);
+  add_light_triangle(scene, vec3(0.99f, -0.3f, 0.2f), vec3(0.99f, -0.3f, 0.35f), vec3(0.99f, -0.15f, 0.2f), 8.0f);
+  add_light_triangle(scene, vec3(0.2f, -0.98f, 0.6f), vec3(0.35f, -0.98f, 0.6f), vec3(0.2f, -0.98f, 0.45f), 5.0f);
+  add_light_triangle(scene, vec3(-0.5f, 0.3f, -0.99f), vec3(-0.35f, 0.3f, -0.99f), vec3(-0.5f, 0.45f, -0.99f), 9.0f, true);
+  return scene;
+}
+
 // Three placements that exercise every part of an instance transform:
 // rotated and moved; mirrored with a non-uniform scale; sheared. They put a
 // unit-sized group inside the built-in Cornell box ([-1, 1]^3).

@@ -30,6 +30,7 @@ struct SameSeedCase {
   std::string scene;
   Strategy strategy;
   LightSampling light_sampling = LightSampling::Area;
+  LightSamplerKind light_sampler = LightSamplerKind::Power;
 };
 
 // An environment image lighting a diffuse sphere on a rough metal ground,
@@ -76,12 +77,14 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "envmap"    ? envmap_scene()
             : c.scene == "alpha"     ? test::cornell_with_alpha()
             : c.scene == "textured"  ? test::cornell_with_textures()
+            : c.scene == "many"      ? test::cornell_with_many_lights()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
   s.render.spp = 4;
   s.render.strategy = c.strategy;
   s.render.light_sampling = c.light_sampling;
+  s.render.light_sampler = c.light_sampler;
   return s;
 }
 
@@ -161,6 +164,15 @@ std::vector<SameSeedCase> same_seed_cases() {
   for (const std::string& s : {std::string(""), std::string("penumbra-box.json"), std::string("white-sphere-emissive-room.json"),
                                std::string("penumbra-emissive-polygon.json"), std::string("textured"), std::string("delta")})
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st, LightSampling::SolidAngle});
+  // The light BVH (scalar stages, the same LightSampler): many small lights
+  // of every orientation in the Cornell box, twelve lighting each other
+  // (furnace-box), the sky beside an empty tree (envmap), delta lights; and
+  // with solid-angle sampling.
+  for (const std::string& s : {std::string("many"), std::string("furnace-box.json"), std::string("envmap"),
+                               std::string("delta")})
+    for (Strategy st : test::kAllStrategies) cases.push_back({s, st, LightSampling::Area, LightSamplerKind::Bvh});
+  for (Strategy st : {Strategy::Light, Strategy::Mis})
+    cases.push_back({"many", st, LightSampling::SolidAngle, LightSamplerKind::Bvh});
   return cases;
 }
 
@@ -168,7 +180,8 @@ INSTANTIATE_TEST_SUITE_P(AllScenes, SameSeed, testing::ValuesIn(same_seed_cases(
                          [](const testing::TestParamInfo<SameSeedCase>& p) {
                            std::string s = (p.param.scene.empty() ? std::string("cornell") : p.param.scene) + "_" +
                                            strategy_name(p.param.strategy) +
-                                           (p.param.light_sampling == LightSampling::SolidAngle ? "_solid_angle" : "");
+                                           (p.param.light_sampling == LightSampling::SolidAngle ? "_solid_angle" : "") +
+                                           (p.param.light_sampler == LightSamplerKind::Bvh ? "_bvh" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;
@@ -232,6 +245,17 @@ TEST(Wavefront, EnvironmentMapSameBitsForOneAndTwoThreads) {
 TEST(Wavefront, SolidAngleLightSamplingSameBitsForOneAndTwoThreads) {
   Scene scene = test::small_cornell(16, 4, FilterKind::Box);
   scene.render.light_sampling = LightSampling::SolidAngle;
+  expect_same_bits_for_one_and_two_threads(std::move(scene));
+}
+
+// The light BVH: the wavefront runs its scalar stages (asserted inside) and
+// both tracers give the same bits for one thread and two, and the wavefront
+// for any wave size, on the Cornell box with many lights.
+TEST(Wavefront, LightBvhSameBitsForOneAndTwoThreads) {
+  Scene scene = test::cornell_with_many_lights();
+  scene.film.width = scene.film.height = 16;
+  scene.render.spp = 4;
+  scene.render.light_sampler = LightSamplerKind::Bvh;
   expect_same_bits_for_one_and_two_threads(std::move(scene));
 }
 

@@ -197,6 +197,9 @@ struct WavefrontTracer::VectorStages {
     // in LightSampler::sample() alone, which the scalar stages call.
     if (lights.light_sampling() != LightSampling::Area)
       return no(std::string("light_sampling ") + light_sampling_name(lights.light_sampling()));
+    // Likewise the light BVH's pick: LightSampler::sample() alone.
+    if (lights.light_sampler() != LightSamplerKind::Power)
+      return no(std::string("light_sampler ") + light_sampler_name(lights.light_sampler()));
     for (const LightSampler::Entry& e : lights.entries()) {
       const Shape& shape = scene.shapes[e.shape];
       if (shape.kind != Shape::Kind::Triangles) return no("a sphere light (" + shape.description + ")");
@@ -380,7 +383,7 @@ void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
     }
     const vec3 wo = -w.ray[i].dir;
     const Spectrum Le = s.emitted(wo);
-    float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf(w.prev[i].p, s));
+    float we = is_black(Le) ? 0.0f : emission_weight(strategy, w.prev[i], scene_.lights().pdf(w.prev[i].ref, s));
     if (PATHLAB_FAULT(WavefrontMisWeightLostAtDepth2) && w.vertex[i] == 3 && we > 0.0f) we = 1.0f;
     const Spectrum added = w.beta[i] * (we * Le);
     w.L[i] += added;
@@ -434,7 +437,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
       }
     }
     if (samples_area_lights(strategy, w.u(i, Dim::Technique))) {
-      const auto ls = lights.sample(s.p, w.u(i, Dim::LightChoice), vec2(w.u(i, Dim::LightX), w.u(i, Dim::LightY)));
+      const auto ls = lights.sample(light_query(s, wo), w.u(i, Dim::LightChoice), vec2(w.u(i, Dim::LightX), w.u(i, Dim::LightY)));
       if (!ls) {
         if (obs && lights.has_area_lights()) w.shadow_state[2 * i + 1] = rejected_state(LightRejection::NoSample);
         continue;
@@ -535,7 +538,7 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
     Ray next = s.spawn(bs->wi);
     next.alpha_key = scene_.alpha_key(w.rng[i], v);
     if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i], next});
-    w.prev[i] = PreviousVertex{s.p, bs->pdf, bs->impulse,
+    w.prev[i] = PreviousVertex{light_query(s, wo), bs->pdf, bs->impulse,
                                !(strategy == Strategy::LightBsdf && w.u(i, Dim::Technique) < 0.5f)};
     if (textured)
       w.cone[i] = scattered_cone(w.cone[i], glm::length(s.p - w.ray[i].origin), bs->impulse, bs->pdf,

@@ -78,6 +78,7 @@ std::vector<std::string> scene_args(const SceneOptions& o, bool with_spp) {
   opt("--resolution", o.resolution);
   opt("--bsdf-sampling", o.bsdf_sampling);
   opt("--light-sampling", o.light_sampling);
+  opt("--light-sampler", o.light_sampler);
   opt("--bvh", o.bvh);
   opt("--clamp", o.clamp);
   opt("--min-pdf", o.min_pdf);

@@ -39,6 +39,10 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
                  "Area-light points for next-event estimation: area (uniform by area) or solid_angle (uniform in "
                  "the solid angle a triangle or sphere subtends; same expectation, less variance near lights)")
       ->check(CLI::IsMember({"area", "solid_angle"}));
+  cmd.add_option("--light-sampler", light_sampler,
+                 "How next-event estimation picks the area light: power (in proportion to power) or bvh (down a "
+                 "light BVH, by each light's importance for the shading point; for many lights)")
+      ->check(CLI::IsMember({"power", "bvh"}));
   cmd.add_option("--clamp", clamp, "Clamp each sample's radiance to this maximum component (biased; 0 = off)")
       ->check(number_range(0.0, 3.4e38));
   cmd.add_option("--min-pdf", min_pdf, "Discard BSDF samples with a smaller density (biased; 0 = off)")
@@ -64,6 +68,7 @@ Scene SceneOptions::load() const {
   if (rr_depth) r.rr_depth = *rr_depth;
   if (bsdf_sampling) r.bsdf_sampling = *parse_bsdf_sampling(*bsdf_sampling);
   if (light_sampling) r.light_sampling = *parse_light_sampling(*light_sampling);
+  if (light_sampler) r.light_sampler = *parse_light_sampler(*light_sampler);
   if (clamp) r.clamp = *clamp;
   if (min_pdf) r.min_pdf = *min_pdf;
   if (general_shading) r.force_general_shading = true;
@@ -104,6 +109,8 @@ std::string SceneOptions::trace_pixel_command(const Scene& scene, std::uint32_t 
   if (scene.render.bsdf_sampling != BsdfSampling::Vndf) cmd << " --bsdf-sampling " << bsdf_sampling_name(scene.render.bsdf_sampling);
   if (scene.render.light_sampling != LightSampling::Area)
     cmd << " --light-sampling " << light_sampling_name(scene.render.light_sampling);
+  if (scene.render.light_sampler != LightSamplerKind::Power)
+    cmd << " --light-sampler " << light_sampler_name(scene.render.light_sampler);
   if (scene.render.min_pdf > 0.0f) cmd << " --min-pdf " << scene.render.min_pdf;
   if (scene.render.force_general_shading) cmd << " --general-shading";
   if (scene.render.texture_filter != TextureFilter::Cone) cmd << " --texture-filter " << texture_filter_name(scene.render.texture_filter);
