@@ -20,7 +20,8 @@ enum class Dim : std::uint32_t {
 
   // --- bounce k >= 1: one vertex of the path ----------------------------------
   DeltaLightChoice,  // which point light next-event estimation connects to
-  LightChoice,       // which area / environment light to sample (by power)
+  LightChoice,       // which area / environment light to sample (by power, or down the light BVH:
+                     // one number re-based at each level, core/light_bvh.h)
   LightX,            // point on that light (or direction, for the environment)
   LightY,
   Technique,         // strategy light+bsdf: light sampling or BSDF sampling

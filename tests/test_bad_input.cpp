@@ -390,6 +390,9 @@ TEST_F(BadInput, UnknownBsdfSamplingAndNegativeFireflyControls) {
   const std::string light = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"light_sampling\": \"solid-angle\"}");
   expect_rejected(render(write("light.json", light)),
                   {"light.json:", "/render/light_sampling", "unknown light sampling 'solid-angle' (did you mean 'solid_angle'?)"});
+  const std::string picker = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"light_sampler\": \"BVH\"}");
+  expect_rejected(render(write("picker.json", picker)),
+                  {"picker.json:", "/render/light_sampler", "unknown light sampler 'BVH'"});
   const std::string clamp = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"clamp\": -1}");
   expect_rejected(render(write("clamp.json", clamp)), {"clamp.json:", "/render/clamp", "clamp must not be negative"});
 }

@@ -109,7 +109,7 @@ TEST(LightBvh, PmfIsThePickFrequency) {
     }
     pmf[n] = std::max(0.0, 1.0 - sum);  // the walk ended with no light
     std::vector<double> observed(n + 1, 0.0), expected(n + 1, 0.0);
-    std::size_t disagree = 0, checked = 0;
+    std::size_t disagree = 0, checked = 0, pick_differs = 0;
     for (std::uint64_t k = 0; k < samples; ++k) {
       const float u = u_of(1, k);
       const auto p = lights.pick(place.q, u);
@@ -117,7 +117,7 @@ TEST(LightBvh, PmfIsThePickFrequency) {
       observed[cell] += 1.0;
       if (p) {
         ASSERT_GT(p->pmf, 0.0f) << place.name << ": picked entry " << p->entry << " with pmf 0";
-        ASSERT_EQ(p->pmf, lights.pick_pmf(place.q, p->entry)) << place.name << ": entry " << p->entry;
+        if (p->pmf != lights.pick_pmf(place.q, p->entry)) ++pick_differs;
       }
       if (k < 4000) {
         const auto ls = lights.sample(place.q, u, vec2(u_of(2, k), u_of(3, k)));
@@ -132,6 +132,7 @@ TEST(LightBvh, PmfIsThePickFrequency) {
         if (!(std::abs(pdf - ls->pdf) <= 1e-3f * ls->pdf)) ++disagree;
       }
     }
+    EXPECT_EQ(pick_differs, 0u) << place.name << ": the probability pick() reports is not pick_pmf()'s";
     EXPECT_EQ(disagree, 0u) << place.name << ": pdf() differs from the density of " << disagree << " of " << checked
                             << " samples";
     for (std::size_t i = 0; i <= n; ++i) {

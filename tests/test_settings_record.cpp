@@ -48,7 +48,7 @@ std::string joined(const std::vector<std::string>& args) {
 // Non-default values of every setting that changes a sample.
 const std::vector<std::string> kSettings = {
     "--tracer",         "wavefront", "--strategy", "light", "--seed", "77", "--max-depth", "3",
-    "--rr-depth",       "2",         "--bsdf-sampling", "cospow", "--light-sampling", "solid_angle", "--clamp", "0.375", "--min-pdf", "0.03125",
+    "--rr-depth",       "2",         "--bsdf-sampling", "cospow", "--light-sampling", "solid_angle", "--light-sampler", "bvh", "--clamp", "0.375", "--min-pdf", "0.03125",
     "--general-shading", "--texture-filter", "point", "--bvh", "compact", "--resolution", "8x6"};
 
 class SettingsRecord : public test::TempDirTest {};
@@ -63,7 +63,7 @@ TEST_F(SettingsRecord, RenderWritesEverySettingIntoTheExrHeader) {
   const std::map<std::string, std::string> want = {
       {"tracer", "wavefront"},     {"strategy", "light"},    {"seed", "77"},
       {"max_depth", "3"},          {"rr_depth", "2"},        {"bsdf_sampling", "cospow"},
-      {"light_sampling", "solid_angle"},
+      {"light_sampling", "solid_angle"}, {"light_sampler", "bvh"},
       {"clamp", "0.375"},          {"min_pdf", "0.03125"},   {"general_shading", "on"},
       {"texture_filter", "point"}, {"bvh", "compact"},       {"spp", "3"},
       {"resolution", "8x6"},       {"filter", "box"},        {"scene", "<built-in cornell>"},
@@ -93,6 +93,7 @@ TEST_F(SettingsRecord, UnclampedRenderSaysSo) {
   EXPECT_EQ(h.at("texture_filter"), "cone");
   EXPECT_EQ(h.at("bsdf_sampling"), "vndf");
   EXPECT_EQ(h.at("light_sampling"), "area");
+  EXPECT_EQ(h.at("light_sampler"), "power");
 }
 
 TEST_F(SettingsRecord, TracePixelRecordsEverySettingInJsonAndText) {
@@ -108,6 +109,7 @@ TEST_F(SettingsRecord, TracePixelRecordsEverySettingInJsonAndText) {
   EXPECT_EQ(j["rr_depth"], 2);
   EXPECT_EQ(j["bsdf_sampling"], "cospow");
   EXPECT_EQ(j["light_sampling"], "solid_angle");
+  EXPECT_EQ(j["light_sampler"], "bvh");
   EXPECT_EQ(j["clamp"], 0.375);
   EXPECT_EQ(j["min_pdf"], 0.03125);
   EXPECT_EQ(j["general_shading"], true);
@@ -124,7 +126,7 @@ TEST_F(SettingsRecord, TracePixelRecordsEverySettingInJsonAndText) {
   const CliResult t = run_cli(args);
   ASSERT_EQ(t.code, 0) << t.err;
   for (const char* part : {"strategy light", "seed 77", "max depth 3", "rr depth 2", "bsdf_sampling cospow",
-                           "light_sampling solid_angle", "clamp 0.375", "min_pdf 0.03125", "general_shading on", "texture_filter point",
+                           "light_sampling solid_angle", "light_sampler bvh", "clamp 0.375", "min_pdf 0.03125", "general_shading on", "texture_filter point",
                            "bvh compact", "tracer wavefront"})
     EXPECT_NE(t.err.find(part), std::string::npos) << part << "\n" << t.err;
   EXPECT_NE(t.err.find(std::string("pathlab ") + PATHLAB_VERSION + " (git " + git_revision() + ")"), std::string::npos)
