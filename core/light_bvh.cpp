@@ -106,7 +106,7 @@ double importance(const LightBounds& b, const LightQuery& q) {
   const double r2 = glm::dot(half, half);
   const dvec3 d = dvec3(q.p) - c;  // centre -> shading point
   const double d2 = glm::dot(d, d);
-  const double dist2 = std::max({d2, r2, DBL_MIN});
+  const double dist2 = std::max({d2, 0.25 * r2, DBL_MIN});
   // Inside the bounding sphere every direction is possible (theta_b = pi):
   // the cone and the surface's side cannot rule anything out.
   if (!(d2 > r2)) {

@@ -61,7 +61,8 @@ LightBounds merge(const LightBounds& a, const LightBounds& b);
 // The importance of bounds `b` for shading point `q` (>= 0, finite):
 //   phi * cos(theta') * cos(theta'_i) / d^2
 // with, for c the box's centre and r the radius of its bounding sphere,
-//   d^2 = max(|q.p - c|^2, r^2) (inside the sphere: as if on it);
+//   d^2 = max(|q.p - c|^2, r^2 / 4) (a point near the centre of a big node
+//     still tells its nearer child from the other; a tiny light's weight stays finite);
 //   theta_b the half-angle the sphere subtends at q.p (pi inside it);
 //   theta_w the angle between axis and c -> q.p (|cos| when two-sided);
 //   theta' = max(0, theta_w - theta_o - theta_b): 0 if theta' >= theta_e

@@ -186,7 +186,7 @@ double importance_by_hand(const std::array<vec3, 3>& t, double phi, const LightQ
   const double theta_i = std::acos(glm::dot(dvec3(q.n), -d / std::sqrt(d2)));
   const double theta_ip = std::max(0.0, theta_i - theta_b);
   if (theta_ip >= std::acos(-1.0) / 2.0) return 0.0;
-  return phi * std::cos(theta) * std::cos(theta_ip) / std::max(d2, r2);
+  return phi * std::cos(theta) * std::cos(theta_ip) / std::max(d2, r2 / 4.0);
 }
 
 // The same for a node holding two triangles of one normal (their box, theta_o = 0).
@@ -206,7 +206,7 @@ double importance_of_pair(const std::array<vec3, 3>& a, const std::array<vec3, 3
   if (theta >= std::acos(-1.0) / 2.0) return 0.0;
   const double theta_ip = std::max(0.0, std::acos(glm::dot(dvec3(q.n), -d / std::sqrt(d2))) - theta_b);
   if (theta_ip >= std::acos(-1.0) / 2.0) return 0.0;
-  return phi * std::cos(theta) * std::cos(theta_ip) / std::max(d2, r2);
+  return phi * std::cos(theta) * std::cos(theta_ip) / std::max(d2, r2 / 4.0);
 }
 
 double power_of(const std::array<vec3, 3>& t, float Le) {
