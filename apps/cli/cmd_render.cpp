@@ -241,7 +241,7 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   if (const std::size_t n = compiled.lights().unsampled_light_count(); n > 0 && chatty)
     err << "pathlab: warning: " << n << " light(s) are too dim next to the others ever to be picked for light "
         << "sampling; only rays that hit them count their light\n";
-  if (const LightBvh* bvh = compiled.lights().bvh(); bvh && chatty && !bvh->empty())
+  if (const LightBvh* bvh = compiled.lights().bvh(); bvh && chatty && !quiet && !bvh->empty())
     err << "pathlab: light BVH: " << (bvh->node_count() + 1) / 2 << " lights, " << bvh->node_count()
         << " nodes, depth " << bvh->depth() << "\n";
   // The second moments only if something reads them: progressive rendering
