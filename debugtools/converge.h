@@ -29,10 +29,11 @@ using TracerFactory =
 class Film;
 
 struct ConvergeOptions {
-  // By default both tracers and all five strategies: the choices a user has.
+  // By default both tracers, all five strategies and both samplers: the
+  // choices a user has. An empty strategies or samplers list: the scene's.
   std::vector<std::string> tracers{"reference", "wavefront"};
   std::vector<Strategy> strategies{std::begin(kAllStrategies), std::end(kAllStrategies)};
-  std::vector<SamplerKind> samplers;  // empty: the scene's sampler
+  std::vector<SamplerKind> samplers{SamplerKind::Independent, SamplerKind::ZSobol};
   std::vector<int> spp{1, 4, 16, 64, 256, 1024};  // the ladder (progressive: each rung extends the last)
   std::vector<double> time_budgets;     // seconds, each rendered from scratch with render_until()
   int seeds = 4;                        // R: seeds scene.render.seed, +1, ..., +R-1

@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -53,7 +55,7 @@ class ConvergeCli : public test::TempDirTest {};
 TEST_F(ConvergeCli, WritesTheTableAndPlotsWithOneRowPerConfigurationAndBudget) {
   const fs::path out = dir_ / "report";
   const auto r = run_cli({"converge", kScenes + "penumbra-box.json", "--tracers", "reference,wavefront", "--strategies",
-                          "mis,light", "--clamps", "0,2", "--spp", "1,4", "--time-budgets", "0.02", "--seeds", "2",
+                          "mis,light", "--sampler", "independent", "--clamps", "0,2", "--spp", "1,4", "--time-budgets", "0.02", "--seeds", "2",
                           "--resolution", "8x6", "--out", out.string()});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto csv = lines(read_text(out / "converge.csv"));
@@ -72,22 +74,34 @@ TEST_F(ConvergeCli, WritesTheTableAndPlotsWithOneRowPerConfigurationAndBudget) {
 }
 
 // A scene with no analytic model is measured against a reference EXR.
-// Without axes: both tracers x all five strategies, one curve each.
-TEST_F(ConvergeCli, ComparesBothTracersAndAllStrategiesByDefault) {
+// Without axes: both tracers x all five strategies x both samplers, one
+// curve each.
+TEST_F(ConvergeCli, ComparesBothTracersAllStrategiesAndBothSamplersByDefault) {
   const fs::path out = dir_ / "default";
   const auto r = run_cli({"converge", kScenes + "penumbra-box.json", "--spp", "1,4", "--seeds", "2", "--resolution",
                           "8x6", "--out", out.string()});
   ASSERT_EQ(r.code, 0) << r.err;
-  const std::string csv = read_text(out / "converge.csv");
-  ASSERT_EQ(lines(csv).size(), 1u + 2 * 5 * 2) << csv;
+  const auto csv = lines(read_text(out / "converge.csv"));
+  ASSERT_EQ(csv.size(), 1u + 2 * 5 * 2 * 2) << read_text(out / "converge.csv");
+  // The sampler is the last column.
   for (const char* t : {"reference", "wavefront"})
     for (const char* s : {"cosine", "bsdf", "light", "light+bsdf", "mis"})
-      EXPECT_EQ(count(csv, std::string("\n") + t + "," + s + ","), 2u) << t << " " << s;
-  // Giving an axis replaces its default.
+      for (const char* k : {"independent", "zsobol"}) {
+        const auto n = std::count_if(csv.begin(), csv.end(), [&](const std::string& line) {
+          return line.rfind(std::string(t) + "," + s + ",", 0) == 0 && line.size() > std::strlen(k) &&
+                 line.compare(line.size() - std::strlen(k) - 1, std::string::npos, std::string(",") + k) == 0;
+        });
+        EXPECT_EQ(n, 2) << t << " " << s << " " << k;
+      }
+  EXPECT_NE(read_text(out / "converge.md").find("| reference mis zsobol |"), std::string::npos);
+  // Giving an axis replaces its default; --sampler K is a one-value axis.
   const auto one = run_cli({"converge", kScenes + "penumbra-box.json", "--tracers", "wavefront", "--strategies", "light",
-                            "--spp", "1", "--seeds", "1", "--resolution", "8x6", "--out", (dir_ / "one").string()});
+                            "--sampler", "zsobol", "--spp", "1", "--seeds", "1", "--resolution", "8x6", "--out",
+                            (dir_ / "one").string()});
   ASSERT_EQ(one.code, 0) << one.err;
-  EXPECT_EQ(lines(read_text(dir_ / "one" / "converge.csv")).size(), 2u);
+  const auto one_csv = lines(read_text(dir_ / "one" / "converge.csv"));
+  ASSERT_EQ(one_csv.size(), 2u);
+  EXPECT_EQ(one_csv[1].substr(one_csv[1].rfind(',')), ",zsobol");
 }
 
 TEST_F(ConvergeCli, UsesAReferenceExrAsTheTruth) {
@@ -96,7 +110,7 @@ TEST_F(ConvergeCli, UsesAReferenceExrAsTheTruth) {
   ASSERT_EQ(run_cli({"render", scene, "-o", ref.string(), "--spp", "256", "--resolution", "8x6", "--seed", "99",
                      "--quiet"}).code, 0);
   const auto r = run_cli({"converge", scene, "--reference", ref.string(), "--tracers", "reference", "--strategies",
-                          "mis", "--spp", "1,16", "--seeds", "2", "--resolution", "8x6", "--out",
+                          "mis", "--sampler", "independent", "--spp", "1,16", "--seeds", "2", "--resolution", "8x6", "--out",
                           (dir_ / "report").string()});
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string md = read_text(dir_ / "report" / "converge.md");

@@ -23,9 +23,9 @@ void ConvergeCommand::add_to(CLI::App& app) {
   cmd->add_option("--tracers", options.tracers, "Tracers, comma-separated: reference, wavefront (default: both)")->delimiter(',');
   cmd->add_option("--strategies", strategies, "Strategies, comma-separated (default: all five)")->delimiter(',');
   CLI::Option* one_sampler =
-      cmd->add_option("--sampler", sampler, "Sampler of every render: independent or zsobol")
+      cmd->add_option("--sampler", sampler, "Sampler of every render: independent or zsobol (default: both, compared)")
           ->check(CLI::IsMember({"independent", "zsobol"}));
-  cmd->add_option("--samplers", samplers, "Samplers to compare, comma-separated: independent, zsobol (default: the scene's)")
+  cmd->add_option("--samplers", samplers, "Samplers to compare, comma-separated: independent, zsobol (default: both)")
       ->delimiter(',')
       ->check(CLI::IsMember({"independent", "zsobol"}))
       ->excludes(one_sampler);
@@ -59,7 +59,9 @@ int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     if (!st) throw InputError("--strategies: unknown strategy '" + s + "' (expected cosine, bsdf, light, light+bsdf or mis)");
     o.strategies.push_back(*st);
   }
+  if (!samplers.empty()) o.samplers.clear();
   for (const std::string& s : samplers) o.samplers.push_back(*parse_sampler(s));  // checked by CLI11
+  if (sampler) o.samplers = {*parse_sampler(*sampler)};
   // Fail on an unwritable folder now, not after the sweep; on any failure
   // remove the folder again if this run made it and it is still empty.
   const std::filesystem::path dir(out_dir);
