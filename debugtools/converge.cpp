@@ -173,7 +173,8 @@ ConvergeRow summarise(std::size_t config, bool time_budget, double budget, const
   // With two or more seeds the standard error comes from their spread; with
   // one, from the film's per-pixel variances.
   r.bias_se = seeds.size() >= 2 ? seed_spread(bias).se : seeds.front().bias_se_pixels;
-  r.efficiency = 1.0 / std::max(r.rel_mse * r.seconds, 1e-300);
+  // An exact estimator (relMSE 0) is infinitely efficient, and says so.
+  r.efficiency = r.rel_mse * r.seconds > 0.0 ? 1.0 / (r.rel_mse * r.seconds) : std::numeric_limits<double>::infinity();
   return r;
 }
 

@@ -142,6 +142,23 @@ TEST_F(ConvergeCli, LightSamplingsAreAnAxisEachRenderedWithItsOwnSampler) {
   EXPECT_NE(bad.err.find("--light-samplings"), std::string::npos) << bad.err;
 }
 
+// furnace-box-back.json is rendered exactly by every configuration (RMSE
+// 0 at every rung): the report is still written, its plots say why they
+// have no lines.
+TEST_F(ConvergeCli, AnExactEstimatorStillGetsItsReport) {
+  const fs::path out = dir_ / "exact";
+  const auto r = run_cli({"converge", kScenes + "furnace-box-back.json", "--tracers", "reference", "--strategies", "mis",
+                          "--sampler", "independent", "--spp", "1,4", "--seeds", "2", "--resolution", "8x6", "--out",
+                          out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto csv = lines(read_text(out / "converge.csv"));
+  ASSERT_EQ(csv.size(), 3u);
+  EXPECT_NE(csv[2].find(",4,2,4,"), std::string::npos) << csv[2];
+  EXPECT_NE(csv[2].find(",0,0,0,0,0,inf,"), std::string::npos) << "RMSE, sd, relMSE, bias, se 0; efficiency inf: " << csv[2];
+  for (const char* svg : {"rmse-vs-time.svg", "rmse-vs-spp.svg"})
+    EXPECT_NE(read_text(out / svg).find(kNothingToPlot), std::string::npos) << svg;
+}
+
 TEST_F(ConvergeCli, UsesAReferenceExrAsTheTruth) {
   const std::string scene = std::string(PATHLAB_SOURCE_DIR) + "/scenes/cornell-box.json";
   const fs::path ref = dir_ / "ref.exr";
@@ -289,7 +306,10 @@ TEST(ConvergeReport, SvgHasDecadeTicksLabelsLegendAndOneLinePerSeries) {
   EXPECT_NE(svg.find("RMSE (log scale)"), std::string::npos);
   EXPECT_NE(svg.find(">slope -1/2<"), std::string::npos);
   EXPECT_EQ(count(svg, "stroke-dasharray=\"7,4\""), 2u) << "the second series is dashed, line and legend";
-  EXPECT_THROW(loglog_svg({"t", "x", "y", {{"a", {0, 1}, {1, -1}}}, 0.0, ""}), InputError);
+  // Nothing with a logarithm (an exact estimator's RMSE is 0): a note, not axes.
+  const std::string none = loglog_svg({"t", "x", "y", {{"a", {0, 1}, {1, -1}}}, 0.0, ""});
+  EXPECT_NE(none.find(kNothingToPlot), std::string::npos) << none;
+  EXPECT_EQ(count(none, "<polyline"), 0u);
 }
 
 }  // namespace
