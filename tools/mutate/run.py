@@ -81,7 +81,10 @@ class Scratch:
         else:
             run(["git", "-C", str(self.path), "checkout", "--quiet", "--detach", head])
         self.reset()
-        self.log = open(self.path / "mutate.log", "w")  # untracked, beside build-mutate/
+        # Inside the (ignored) build folder: an untracked log in the tree would
+        # name this machine's paths and fail pathlab_portable.
+        self.build.mkdir(parents=True, exist_ok=True)
+        self.log = open(self.build / "mutate.log", "w")
         if not (self.build / "build.ninja").exists():
             rc, out = run(["cmake", "-S", str(self.path), "-B", str(self.build), "-G", "Ninja",
                            "-DPATHLAB_WERROR=ON"] + self.cmake_args)
@@ -205,7 +208,7 @@ def main():
     scratch_path.parent.mkdir(parents=True, exist_ok=True)
     scratch = Scratch(args.repo.resolve(), scratch_path, scratch_path / "build-mutate", cmake_args, args.jobs)
     head = scratch.prepare()
-    log_path = scratch_path / "mutate.log"
+    log_path = scratch_path / "build-mutate" / "mutate.log"
     done = {}
     if args.resume and args.results and args.results.exists():
         previous = json.loads(args.results.read_text())
