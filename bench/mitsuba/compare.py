@@ -38,6 +38,8 @@ import subprocess
 import sys
 import time
 
+import numpy as np
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, HERE)
@@ -135,7 +137,6 @@ def sidak(alpha, m):
 
 def bias_test(diff, var, keep, blocks):
     """z-scores of the mean of `diff` (H x W x 3) where `var` is its per-pixel variance."""
-    import numpy as np
     k3 = np.repeat(keep[:, :, None], 3, axis=2)
     z_chan = []
     for c in range(3):
@@ -162,8 +163,15 @@ def bias_test(diff, var, keep, blocks):
     return z_chan, zb
 
 
+def rel_diff(diff, var, ref, keep):
+    """The mean difference over the kept pixels and channels relative to the reference's mean, and
+    its standard error: the smallest bias the run can see is a few of these."""
+    k3 = np.repeat(keep[:, :, None], 3, axis=2)
+    total = ref[k3].sum()
+    return float(diff[k3].sum() / total), float(math.sqrt(var[k3].sum()) / total)
+
+
 def main():
-    import numpy as np
     ap = argparse.ArgumentParser(description="pathlab against Mitsuba 3 on mi.cornell_box()",
                                  formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
     ap.add_argument("--resolution", type=int, default=512, help="square film side (default 512)")
@@ -211,13 +219,14 @@ def main():
     extra = shlex.split(a.pathlab_args)
     run = Runner(a)
 
+    timed_scene = a.scene  # what the timed pathlab renders read; the reference reads a.scene
     if a.two_sided:
         with open(a.scene) as f:
             sc = json.load(f)
         for m in sc["materials"].values():
             m.pop("one_sided", None)
-        a.scene = os.path.join(a.out, "mitsuba-cornell-box-two-sided.json")
-        with open(a.scene, "w") as f:
+        timed_scene = os.path.join(a.out, "mitsuba-cornell-box-two-sided.json")
+        with open(timed_scene, "w") as f:
             json.dump(sc, f, indent=1)
     with open(a.scene, "rb") as f:
         scene_hash = hashlib.sha256(f.read()).hexdigest()[:12]
@@ -226,7 +235,7 @@ def main():
     print(f"CPU: {cpu['vendor']} family {cpu['family']} model {cpu['model']} ({cpu['model_name']}), "
           f"{cpu['cores']} logical cores, AVX-512: {'yes' if cpu['avx512f'] else 'no'}")
     print(f"load average (1 min) at the start: {load1():.2f}")
-    print(f"scene: {os.path.relpath(a.scene, REPO)}  {a.resolution}x{a.resolution}, {a.spp} spp, "
+    print(f"scene: {os.path.relpath(timed_scene, REPO)}  {a.resolution}x{a.resolution}, {a.spp} spp, "
           f"{a.rounds} rounds; Mitsuba max_depth {a.mitsuba_max_depth} = pathlab's "
           f"{a.mitsuba_max_depth - 1}; pathlab args: {a.pathlab_args or '(none)'}")
 
@@ -272,7 +281,8 @@ def main():
     ref_noise = float(ref_var[keep].mean())
 
     # --- warm-up, then the alternating rounds
-    kw = {r: ({"extra_pathlab": extra} if r.startswith("pathlab") else {"max_depth": a.mitsuba_max_depth})
+    kw = {r: ({"extra_pathlab": extra, "scene": timed_scene} if r.startswith("pathlab")
+              else {"max_depth": a.mitsuba_max_depth})
           for r in renderers}
     if not a.no_warmup:
         for r in renderers:
@@ -301,6 +311,7 @@ def main():
         mean = st.mean(axis=0)
         var = st.var(axis=0, ddof=1) / len(d["imgs"]) + ref_var
         z_chan, zb = bias_test(mean - ref, var, keep, a.blocks)
+        rd, rd_se = rel_diff(mean - ref, var, ref, keep)
         zb_bound = sidak(a.alpha, max(1, len(zb)))
         wall = statistics.median(d["wall"])
         mse = statistics.mean(d["mse"])
@@ -310,7 +321,7 @@ def main():
             "inproc_median_s": statistics.median(inproc) if inproc else None,
             "samples_per_s": samples / wall, "mse": mse, "mse_x_s": mse * wall,
             "mse_rounds": d["mse"], "wall_rounds": d["wall"],
-            "z_channels": z_chan, "z_bound": z_bound, "z_blocks_max": max(abs(x) for x in zb) if zb else 0.0,
+            "rel_diff": rd, "rel_diff_se": rd_se, "z_channels": z_chan, "z_bound": z_bound, "z_blocks_max": max(abs(x) for x in zb) if zb else 0.0,
             "z_blocks_bound": zb_bound, "blocks": len(zb),
             "same_image": all(abs(x) < z_bound for x in z_chan) and all(abs(x) < zb_bound for x in zb),
             "command": shlex.join(cmds[r]),
@@ -322,9 +333,9 @@ def main():
           f"MSE over {int(keep.sum())} pixels x 3 channels against {a.ref_renderer} at {a.ref_spp} spp "
           f"(its own noise {ref_noise:.3g} subtracted)")
     hdr = ("| renderer | wall s (median, range) | in-process render s | samples/s | MSE | MSE x s "
-           "| samples/s vs llvm | MSE x s vs llvm | z (R, G, B) | max block z |")
+           "| samples/s vs llvm | MSE x s vs llvm | mean diff. (rel.) | z (R, G, B) | max block z |")
     print(hdr)
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for r in renderers:
         x = rows[r]
         sp = f"{x['samples_per_s'] / base['samples_per_s']:.2f}x" if base else "-"
@@ -332,7 +343,7 @@ def main():
         ip = f"{x['inproc_median_s']:.2f}" if x["inproc_median_s"] is not None else "-"
         print(f"| {r} | {x['wall_median_s']:.2f} ({x['wall_min_s']:.2f}-{x['wall_max_s']:.2f}) | {ip} "
               f"| {x['samples_per_s'] / 1e6:.2f} M | {x['mse']:.3g} | {x['mse_x_s']:.3g} | {sp} | {me} "
-              f"| {', '.join(f'{z:+.2f}' for z in x['z_channels'])} | {x['z_blocks_max']:.2f} |")
+              f"| {x['rel_diff']:+.2%} ± {x['rel_diff_se']:.2%} | {', '.join(f'{z:+.2f}' for z in x['z_channels'])} | {x['z_blocks_max']:.2f} |")
     print()
     print(f"same image as the reference (|z| < {z_bound:.2f} per channel, block |z| < "
           f"{rows[renderers[0]]['z_blocks_bound']:.2f}; Sidak, family-wise alpha {a.alpha}):")
