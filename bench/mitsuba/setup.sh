@@ -6,13 +6,16 @@
 #      through DRJIT_LIBLLVM_PATH (Dr.Jit JIT-compiles its kernels with LLVM).
 #   2. mitsuba==3.9.1 (which brings drjit) and numpy from PyPI, into the Python that runs
 #      compare.py ($PYTHON, default python3), with --break-system-packages where pip wants it;
-#      if that pip refuses, into a venv at /work/venv-mitsuba (set PYTHON to its python then).
+#      if that pip refuses, into a venv at $MITSUBA_VENV (default out/venv-mitsuba in the checkout;
+#      then run compare.py with that venv's python).
 #   3. Prints the DRJIT_LIBLLVM_PATH to export (compare.py sets it itself when it is unset).
 #
 # Usage: bash bench/mitsuba/setup.sh            (as root, or with sudo for apt-get)
 set -euo pipefail
 
 PYTHON=${PYTHON:-python3}
+REPO=$(cd "$(dirname "$0")/../.." && pwd)
+MITSUBA_VENV=${MITSUBA_VENV:-$REPO/out/venv-mitsuba}
 MITSUBA_VERSION=3.9.1
 # Debian 12 libllvm19 (1:19.1.7-3~deb12u1) ships libLLVM.so.19.1 (libLLVM-19.so links to it).
 LLVM_LIB=${DRJIT_LIBLLVM_PATH:-/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1}
@@ -42,20 +45,25 @@ if have_mitsuba; then
 else
     say "installing mitsuba==$MITSUBA_VERSION and numpy with $PYTHON -m pip"
     if ! "$PYTHON" -m pip install --break-system-packages "mitsuba==$MITSUBA_VERSION" numpy; then
-        say "pip refused a system install; using a venv at /work/venv-mitsuba"
-        "$PYTHON" -m venv /work/venv-mitsuba
-        PYTHON=/work/venv-mitsuba/bin/python
+        say "pip refused a system install; using a venv at $MITSUBA_VENV"
+        "$PYTHON" -m venv "$MITSUBA_VENV"
+        PYTHON=$MITSUBA_VENV/bin/python
         "$PYTHON" -m pip install "mitsuba==$MITSUBA_VERSION" numpy
-        say "set PYTHON=/work/venv-mitsuba/bin/python to run compare.py"
+        say "run compare.py with $PYTHON (or pass --python $PYTHON)"
     fi
     have_mitsuba || { say "error: mitsuba $MITSUBA_VERSION still not importable by $PYTHON"; exit 1; }
 fi
 
 say "checking the variants scalar_rgb and llvm_ad_rgb"
 DRJIT_LIBLLVM_PATH=$LLVM_LIB "$PYTHON" - <<'PY'
+import drjit as dr
 import mitsuba as mi
 for v in ("scalar_rgb", "llvm_ad_rgb"):
     mi.set_variant(v)
+    if v.startswith("llvm"):
+        x = mi.Float([1.5, 2.5]) * 2  # JIT-compiles and runs a kernel through libLLVM
+        dr.eval(x)
+        assert list(x) == [3.0, 5.0], list(x)
     print(f"[setup] variant {v}: ok")
 PY
 say "done. compare.py sets DRJIT_LIBLLVM_PATH=$LLVM_LIB unless you export another."
