@@ -38,7 +38,10 @@ import subprocess
 import sys
 import time
 
-import numpy as np
+try:
+    import numpy as np
+except ImportError:
+    sys.exit(f"compare.py: numpy is not importable by {sys.executable}: run bench/mitsuba/setup.sh")
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(os.path.dirname(HERE))
@@ -79,7 +82,11 @@ class Runner:
         self.a = a
         self.env = dict(os.environ)
         self.env.setdefault("DRJIT_LIBLLVM_PATH", LLVM_DEFAULT)
-        import mitsuba as mi
+        try:
+            import mitsuba as mi
+        except ImportError:
+            sys.exit(f"compare.py: mitsuba is not importable by {sys.executable}: run bench/mitsuba/setup.sh "
+                     "and run compare.py with the Python it installed into")
         mi.set_variant("scalar_rgb")  # in this process only to read EXRs (mi.Bitmap)
         self.mi = mi
 
