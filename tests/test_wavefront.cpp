@@ -348,7 +348,19 @@ struct VectorCase {
   bool thin_lens = false;
   bool tilted = false;  // the whole scene turned off the axes, so that no normal is axis-aligned
   bool crowded = false;  // more than 16 shapes and lights (tables gathered, not permuted)
+  bool one_sided = false;  // every diffuse material one-sided, and every other mesh turned inside out
+                           // (its triangles' winding reversed), so that paths meet backs too
 };
+
+// Every diffuse material one-sided (black behind its geometric normal), and
+// every other mesh's triangles wound the other way round.
+void make_one_sided(Scene& scene) {
+  for (Material& m : scene.materials)
+    if (m.type == MaterialType::Diffuse) m.one_sided = true;
+  for (std::size_t i = 0; i < scene.shapes.size(); i += 2)
+    if (scene.shapes[i].kind == Shape::Kind::Triangles && !scene.materials[scene.shapes[i].material].emits())
+      for (glm::uvec3& t : scene.shapes[i].mesh.triangles) std::swap(t.y, t.z);
+}
 
 // The scene and its camera turned by 37 degrees about (1, 2, 3).
 void tilt(Scene& scene) {
@@ -412,6 +424,7 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   if (c.rr_depth >= 0) scene.render.rr_depth = c.rr_depth;
   if (c.tilted) tilt(scene);
   if (c.crowded) crowd(scene);
+  if (c.one_sided) make_one_sided(scene);
   if (c.thin_lens) {
     scene.camera.aperture_radius = 0.1f;
     scene.camera.focus_distance = 3.0f;
@@ -463,6 +476,9 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"", st, 0.0f, -1, false, false, true});
   cases.push_back({"white-sphere-emissive-room.json", Strategy::Mis, 0.0f, -1, false, false, true});
+  for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"", st, 0.0f, 0, false, false, false, true});
+  cases.push_back({"white-sphere-emissive-room.json", Strategy::Mis, 0.0f, 0, false, false, false, true});
   return cases;
 }
 
@@ -472,7 +488,7 @@ INSTANTIATE_TEST_SUITE_P(LambertScenes, VectorStages, testing::ValuesIn(vector_c
                                            strategy_name(p.param.strategy) + (p.param.min_pdf > 0 ? "_min_pdf" : "") +
                                            (p.param.rr_depth >= 0 ? "_rr" + std::to_string(p.param.rr_depth) : "") +
                                            (p.param.tilted ? "_tilted" : "") + (p.param.thin_lens ? "_thin_lens" : "") +
-                                           (p.param.crowded ? "_crowded" : "");
+                                           (p.param.crowded ? "_crowded" : "") + (p.param.one_sided ? "_one_sided" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;
