@@ -83,15 +83,16 @@ SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx);
 // ray's hit - whether, where, and which of the two crossings - is a function
 // of the ray alone. (Embree's own sphere kernels are not: its one-ray and
 // 16-wide kernels round t differently, by a few ulps, which moves hits across
-// a shadow ray's tmax; docs/ARCHITECTURE.md, Ray offsets.)
+// a shadow ray's tmax; docs/ARCHITECTURE.md, Ray offsets, Sphere hits.)
 // Computed in double from the float inputs, which are exact there: the
 // discriminant from the ray's perpendicular offset from the centre, as
 // (r - l)(r + l) (PBR 4th ed. 6.8.4; Haines et al., Ray Tracing Gems ch. 7),
 // and the two roots as q / a and c / q, so neither root is a difference of
 // near-equal numbers. Each root is then rounded to float once, and tested
 // against tnear and tfar as a float, as Embree stores t: a crossing at or
-// beyond tfar never counts (rounding is monotonic), so the sphere a shadow
-// ray ends just before does not stop it. Its error before that rounding is a
+// beyond tfar never counts (rounding is monotonic), nor one within half a
+// float below it (it rounds to tfar), so the sphere a shadow ray ends just
+// before does not stop it. Its error before that rounding is a
 // few double ulps of the distances involved, below the float offsets of
 // core/ray.h by ~2^29, so the crossing a ray just left (its origin offset off
 // the sphere) is never found again. A ray that touches the sphere (one

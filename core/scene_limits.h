@@ -40,7 +40,8 @@ std::uint64_t embree_rejected_rays();
 // that a ray leaving any point of the scene (a unit direction, an offset of
 // a few floats) stays acceptable. Sphere radii are at least kMinSphereRadius,
 // so that radius^2 (a sphere light's area; once Embree's float sphere test,
-// now sphere_crossing's, in double) is a normal float, not a denormal or zero. docs/scene-format.md ("Limits") states the same rule.
+// now sphere_crossing's, in double) is a normal float, not a denormal or
+// zero. docs/scene-format.md ("Limits") states the same rule.
 inline constexpr float kMaxSceneCoordinate = 1e16f;
 inline constexpr float kMinSphereRadius = 1e-18f;
 // True if every coordinate of `p` lies within +-kMaxSceneCoordinate (NaN does not).
