@@ -26,7 +26,7 @@ namespace {
 
 struct SameSeedCase {
   // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" / "alpha" / "textured" (test_scenes.h),
-  // "envmap" (below), else a file in analytic-scenes/
+  // "envmap" / "bulb" (below), else a file in analytic-scenes/
   std::string scene;
   Strategy strategy;
   LightSampling light_sampling = LightSampling::Area;
@@ -53,8 +53,8 @@ Scene envmap_scene() {
 }
 
 // The Cornell box with a small sphere light in the air, seen from outside
-// by every surface (cone sampling under light_sampling solid_angle). Not in
-// the SameSeed list (see same_seed_cases); used by the thread test below.
+// by every surface (cone sampling under light_sampling solid_angle): its
+// shadow rays end just before the sphere, some of them grazing it.
 Scene cornell_with_bulb() {
   Scene scene = builtin_cornell_box();
   Shape bulb;
@@ -76,6 +76,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "envmap"    ? envmap_scene()
             : c.scene == "alpha"     ? test::cornell_with_alpha()
             : c.scene == "textured"  ? test::cornell_with_textures()
+            : c.scene == "bulb"      ? cornell_with_bulb()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -148,18 +149,17 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("envmap");     // an environment image over a diffuse sphere and a metal ground (above)
   scenes.push_back("alpha");      // the instanced Cornell box with partial coverage (test_scenes.h)
   scenes.push_back("textured");   // the Cornell box reading textures everywhere (test_scenes.h)
+  scenes.push_back("bulb");       // the Cornell box with a sphere light seen from outside (above)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
   // Solid-angle light sampling (the wavefront's scalar stages, the same
   // LightSampler): triangle lights, a sphere light seen from inside
-  // (white-sphere-emissive-room's room), textured and delta lights. Not a
-  // sphere light seen from outside ("bulb"): there the light strategies
-  // part in 0.5-2.5 % of samples, under area sampling as well, all by
-  // rounding (Embree's one-ray and stream SPHERE_POINT kernels disagree on
-  // shadow rays that end on the sphere), above this test's 0.1 %.
+  // (white-sphere-emissive-room's room) and from outside ("bulb": cone
+  // sampling), textured and delta lights.
   for (const std::string& s : {std::string(""), std::string("penumbra-box.json"), std::string("white-sphere-emissive-room.json"),
-                               std::string("penumbra-emissive-polygon.json"), std::string("textured"), std::string("delta")})
+                               std::string("penumbra-emissive-polygon.json"), std::string("textured"), std::string("delta"),
+                               std::string("bulb")})
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st, LightSampling::SolidAngle});
   return cases;
 }
@@ -235,33 +235,83 @@ TEST(Wavefront, SolidAngleLightSamplingSameBitsForOneAndTwoThreads) {
   expect_same_bits_for_one_and_two_threads(std::move(scene));
 }
 
-// With a sphere light too (cone sampling), for one thread and two at one
-// wave size. Not across wave sizes: Embree's SPHERE_POINT hits differ in
-// their last bits between a full stream packet and a short one, under area
-// sampling as well (found here, left as it was: not a light-sampling matter).
-TEST(Wavefront, SolidAngleSphereLightSameBitsForOneAndTwoThreads) {
-  Scene scene = cornell_with_bulb();
-  scene.film.width = scene.film.height = 16;
-  scene.render.spp = 4;
-  scene.render.light_sampling = LightSampling::SolidAngle;
+// The wavefront's image is the same bits for 1 and 2 threads and wave sizes
+// 17, 97 and 4096 (short stream batches, odd packets, full ones), on scenes
+// with true spheres: a sphere light seen from outside (its shadow rays end on
+// the sphere, some grazing it) under area and cone sampling, and a diffuse
+// sphere as ordinary geometry (the vectorised stages where the processor has
+// them, and the scalar ones). Each image is compared with the first, and the
+// count of differing pixels printed.
+// `vectorised_stages`: the scene is one the vectorised stages take (asserted
+// where the processor has AVX-512).
+void expect_same_bits_for_any_wave_size(const Scene& scene_in, WavefrontStages stages, bool vectorised_stages = false) {
+  Scene scene = scene_in;
+  const int width = scene.film.width, height = scene.film.height;
   const RenderSettings settings = scene.render;
   const CompiledScene compiled(std::move(scene));
-  auto render_image = [&](bool wavefront, int threads) {
+  auto render_image = [&](int threads, std::size_t wave) {
     const ThreadLimit limit(threads);
-    Film film(16, 16, FilterKind::Box);
-    if (wavefront) {
-      const WavefrontTracer tracer(compiled, settings, 97);
-      EXPECT_FALSE(tracer.vectorised());
-      render(tracer, film);
-    } else {
-      render(ReferenceTracer(compiled, settings), film);
+    Film film(width, height, FilterKind::Box);
+    const WavefrontTracer tracer(compiled, settings, wave, {}, stages);
+    if (stages == WavefrontStages::Auto && vectorised_stages) {
+      EXPECT_EQ(tracer.vectorised(), vector_stages::cpu_supported()) << tracer.scalar_reason();
     }
+    render(tracer, film);
     return film.image();
   };
-  for (const bool wavefront : {false, true}) {
-    const Image a = render_image(wavefront, 1), b = render_image(wavefront, 2);
-    EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0) << wavefront;
-  }
+  const Image first = render_image(1, WavefrontTracer::kDefaultWaveSize);
+  for (const std::size_t wave : {std::size_t{17}, std::size_t{97}, WavefrontTracer::kDefaultWaveSize})
+    for (const int threads : {1, 2}) {
+      if (wave == WavefrontTracer::kDefaultWaveSize && threads == 1) continue;
+      const Image other = render_image(threads, wave);
+      std::size_t differing = 0;
+      for (std::size_t i = 0; i < first.pixels.size(); ++i)
+        differing += std::memcmp(&first.pixels[i], &other.pixels[i], sizeof(vec3)) != 0 ? 1 : 0;
+      EXPECT_EQ(differing, 0u) << (stages == WavefrontStages::Scalar ? "scalar stages" : "stages as the scene allows")
+                               << ", wave size " << wave << ", " << threads << " thread(s): " << differing << " of "
+                               << first.pixels.size() << " pixels differ from 1 thread at wave size 4096";
+    }
+}
+
+Scene small_bulb(LightSampling sampling) {
+  Scene scene = cornell_with_bulb();
+  scene.film.width = scene.film.height = 32;
+  scene.render.spp = 4;
+  scene.render.light_sampling = sampling;
+  return scene;
+}
+
+TEST(Wavefront, SphereLightSameBitsForAnyWaveSizeAndThreads) {
+  expect_same_bits_for_any_wave_size(small_bulb(LightSampling::Area), WavefrontStages::Auto);
+}
+
+TEST(Wavefront, SolidAngleSphereLightSameBitsForAnyWaveSizeAndThreads) {
+  expect_same_bits_for_any_wave_size(small_bulb(LightSampling::SolidAngle), WavefrontStages::Auto);
+}
+
+// The Cornell box with a diffuse true sphere on its floor (not a light).
+Scene cornell_with_ball() {
+  Scene scene = builtin_cornell_box();
+  Shape ball;
+  ball.description = "ball";
+  ball.kind = Shape::Kind::Sphere;
+  ball.center = vec3(-0.35f, -0.6f, 0.15f);
+  ball.radius = 0.4f;
+  ball.material = scene.shapes.front().material;
+  scene.shapes.push_back(ball);
+  scene.film.width = scene.film.height = 32;
+  scene.render.spp = 8;
+  return scene;
+}
+
+TEST(Wavefront, DiffuseSphereSameBitsForAnyWaveSizeAndThreads) {
+  expect_same_bits_for_any_wave_size(cornell_with_ball(), WavefrontStages::Auto, true);
+  expect_same_bits_for_any_wave_size(cornell_with_ball(), WavefrontStages::Scalar);
+}
+
+// And the reference tracer for one thread and two on the bulb.
+TEST(Wavefront, SolidAngleSphereLightSameBitsForOneAndTwoThreads) {
+  expect_same_bits_for_one_and_two_threads(small_bulb(LightSampling::SolidAngle));
 }
 
 // A textured scene (texture lookups, cones, normal maps, textured emission).

@@ -24,6 +24,7 @@ using I = __m512i;
 using M = __mmask16;
 
 constexpr float kInvPi = 1.0f / 3.14159265358979323846f;  // core/math.h
+constexpr float kGamma3 = (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);  // gamma_bound(3), core/geometry.h
 constexpr float kGamma7 = (7.0f * 0x1p-24f) / (1.0f - 7.0f * 0x1p-24f);  // gamma_bound(7), core/geometry.h
 
 F k(float v) { return _mm512_set1_ps(v); }
@@ -494,7 +495,8 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     // path order (add_light() finds them again by kHasQuery).
     const V3 err = load3(w, kErrX, i0, ok);
     const V3 origin = offset_ray_origin(sp, err, select(ge(dot(d, n), k(0.0f)), n, neg(n)));
-    const V3 end = offset_ray_origin(lp, lerr, select(ge(dot(sub(origin, lp), ln), k(0.0f)), ln, neg(ln)));
+    const V3 reach = mul(k(kGamma3), abs(sub(lp, origin)));  // the float ray's own reach error
+    const V3 end = offset_ray_origin(lp, add(lerr, reach), select(ge(dot(sub(origin, lp), ln), k(0.0f)), ln, neg(ln)));
     const V3 dd = sub(end, origin);
     const F len = _mm512_sqrt_ps(dot(dd, dd));
     const V3 dir = div(dd, len);
