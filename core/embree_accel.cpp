@@ -2,6 +2,7 @@
 
 #include "core/alpha.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/scene_limits.h"
 #include "core/texture.h"
 
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <mutex>
@@ -83,6 +85,74 @@ void alpha_filter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
+// A sphere as Embree user geometry (its user data): Embree's traversal
+// finds the candidates through the box, and every ray - whichever of
+// rtcIntersect1/16/1M/Np or rtcOccluded* brought it - is decided by the same
+// scalar function, sphere_crossing (core/geometry.h). Embree's own
+// RTC_GEOMETRY_TYPE_SPHERE_POINT kernels round t differently in their
+// one-ray and 16-wide forms, so the hits, and shadow rays ending on a
+// sphere, depended on how many rays shared a batch.
+struct SphereGeometry {
+  vec3 center{0.0f};
+  float radius = 0.0f;
+};
+
+// The sphere's box, widened by 1e-5 of the radius and four floats of its
+// largest coordinate: every ray sphere_crossing lets hit passes through the
+// box's interior, well clear of any kernel's rounding of the box test.
+void sphere_bounds(const RTCBoundsFunctionArguments* args) {
+  const auto* s = static_cast<const SphereGeometry*>(args->geometryUserPtr);
+  const vec3 c = s->center;
+  const float largest = std::max({std::abs(c.x), std::abs(c.y), std::abs(c.z)}) + s->radius;
+  const float margin = s->radius * (1.0f + 1e-5f) + 4.0f * largest * 0x1p-23f;
+  RTCBounds* b = args->bounds_o;
+  b->lower_x = c.x - margin, b->lower_y = c.y - margin, b->lower_z = c.z - margin;
+  b->upper_x = c.x + margin, b->upper_y = c.y + margin, b->upper_z = c.z + margin;
+}
+
+float crossing(const SphereGeometry& s, RTCRayN* ray, unsigned n, unsigned i) {
+  const vec3 o(RTCRayN_org_x(ray, n, i), RTCRayN_org_y(ray, n, i), RTCRayN_org_z(ray, n, i));
+  const vec3 d(RTCRayN_dir_x(ray, n, i), RTCRayN_dir_y(ray, n, i), RTCRayN_dir_z(ray, n, i));
+  return sphere_crossing(o, d, RTCRayN_tnear(ray, n, i), RTCRayN_tfar(ray, n, i), s.center, s.radius);
+}
+
+// Closest hit: a crossing nearer than the ray's tfar becomes the hit. No
+// filter runs (spheres take no alpha, and our contexts carry no filter).
+// u, v are 0, as Embree's sphere kernels gave; Ng points outwards from the
+// centre (pathlab reads neither: CompiledScene::resolve reprojects).
+void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
+  const auto& s = *static_cast<const SphereGeometry*>(args->geometryUserPtr);
+  RTCRayN* ray = RTCRayHitN_RayN(args->rayhit, args->N);
+  RTCHitN* hit = RTCRayHitN_HitN(args->rayhit, args->N);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const float t = crossing(s, ray, args->N, i);
+    if (std::isnan(t)) continue;
+    RTCRayN_tfar(ray, args->N, i) = t;
+    const vec3 o(RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i), RTCRayN_org_z(ray, args->N, i));
+    const vec3 d(RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i), RTCRayN_dir_z(ray, args->N, i));
+    const vec3 ng = o + t * d - s.center;
+    RTCHitN_Ng_x(hit, args->N, i) = ng.x;
+    RTCHitN_Ng_y(hit, args->N, i) = ng.y;
+    RTCHitN_Ng_z(hit, args->N, i) = ng.z;
+    RTCHitN_u(hit, args->N, i) = 0.0f;
+    RTCHitN_v(hit, args->N, i) = 0.0f;
+    RTCHitN_primID(hit, args->N, i) = args->primID;
+    RTCHitN_geomID(hit, args->N, i) = args->geomID;
+    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+  }
+}
+
+// Any hit: a crossing before tfar occludes (Embree's convention: tfar = -inf).
+void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
+  const auto& s = *static_cast<const SphereGeometry*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    if (!std::isnan(crossing(s, args->ray, args->N, i)))
+      RTCRayN_tfar(args->ray, args->N, i) = -std::numeric_limits<float>::infinity();
+  }
+}
+
 }  // namespace
 
 namespace {
@@ -108,6 +178,8 @@ struct EmbreeAccel::Impl {
   // The alpha filters' user data, one per shape with alpha (a group's shape
   // once, whatever places it); Embree holds pointers to them.
   std::vector<std::unique_ptr<AlphaGeometry>> alpha_geometries;
+  // The spheres' user data, one per sphere shape (a group's once).
+  std::vector<std::unique_ptr<SphereGeometry>> sphere_geometries;
   ~Impl() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
@@ -215,15 +287,13 @@ void EmbreeAccel::Impl::attach(RTCScene target, const Shape& shape, std::uint32_
     rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.triangles.data(), 0,
                                sizeof(glm::uvec3), m.triangles.size());
   } else {
-    geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-    auto* v = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 1));
-    if (v) {
-      v[0] = shape.center.x;
-      v[1] = shape.center.y;
-      v[2] = shape.center.z;
-      v[3] = shape.radius;
-    }
+    geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
+    sphere_geometries.push_back(std::make_unique<SphereGeometry>(SphereGeometry{shape.center, shape.radius}));
+    rtcSetGeometryUserPrimitiveCount(geom, 1);
+    rtcSetGeometryUserData(geom, sphere_geometries.back().get());
+    rtcSetGeometryBoundsFunction(geom, &sphere_bounds, nullptr);
+    rtcSetGeometryIntersectFunction(geom, &sphere_intersect);
+    rtcSetGeometryOccludedFunction(geom, &sphere_occluded);
   }
   errors.check(shape.description.c_str());
   if (has_alpha) {

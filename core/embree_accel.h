@@ -1,5 +1,7 @@
 // The Embree 3 BVH over a scene's shapes: triangle meshes as Embree
-// triangles, spheres as Embree's true (analytic) spheres. Embree geometry ID
+// triangles, spheres as Embree user geometry whose every ray is decided by
+// sphere_crossing (core/geometry.h), so that one-ray, packet and stream
+// queries give a ray the same hit, bit for bit. Embree geometry ID
 // equals the shape index. A group (Scene::groups) is a scene of its own,
 // built once (its shapes numbered 0, 1, ... there; hits are given the
 // scene's shape index), and each of the scene's instances places it through

@@ -5,6 +5,7 @@
 #include "core/scene_limits.h"
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -164,6 +165,33 @@ SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx) {
   sp.p_error = gamma_bound(5) * glm::abs(shape.radius * dir) + gamma_bound(2) * glm::abs(sp.p);
   sp.n = shape.flip_normals ? -dir : dir;
   return sp;
+}
+
+float sphere_crossing(const vec3& origin, const vec3& dir, float tnear, float tfar, const vec3& center, float radius) {
+  constexpr float kNone = std::numeric_limits<float>::quiet_NaN();
+  const dvec3 d(dir);
+  const dvec3 f = dvec3(origin) - dvec3(center);  // exact unless the exponents lie ~29 binades apart
+  const double r = radius;
+  const double a = glm::dot(d, d);
+  if (!(a > 0.0)) return kNone;
+  // The quadratic a t^2 + 2 b t + c with b = f.d, c = |f|^2 - r^2. Its
+  // discriminant b^2 - a c equals a (r^2 - l^2), l the distance from the
+  // centre to the ray's line (g below): no difference of two large squares.
+  const double b = glm::dot(f, d);
+  const double c = glm::dot(f, f) - r * r;
+  const dvec3 g = f - (b / a) * d;
+  const double l = std::sqrt(glm::dot(g, g));
+  const double disc = (r - l) * (r + l);
+  if (!(disc > 0.0)) return kNone;  // a miss, or a touch (no crossing), or NaN
+  const double root = std::sqrt(a * disc);
+  const double q = -(b + std::copysign(root, b));  // |q| >= root > 0
+  double t0 = q / a, t1 = c / q;
+  if (t1 < t0) std::swap(t0, t1);
+  for (const double t : {t0, t1}) {
+    const auto tf = static_cast<float>(t);
+    if (tf > tnear && tf < tfar) return tf;
+  }
+  return kNone;
 }
 
 vec3 shading_normal(const vec3& ng, const vec3& sum) {

@@ -74,6 +74,31 @@ SurfacePoint triangle_point(const Shape& shape, std::uint32_t tri, vec2 b);
 // A point near `p_approx` projected back onto the sphere.
 SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx);
 
+// The first crossing of the ray origin + t dir with the sphere (center,
+// radius) with tnear < t < tfar, or NaN if there is none. `dir` need not be
+// of unit length (an instance's space scales it); t is in its units.
+// Every ray query decides its sphere hits here: EmbreeAccel registers
+// spheres as Embree user geometry that calls this function for each ray,
+// whatever API (one ray, 16-wide packet, stream) and batch it came in, so a
+// ray's hit - whether, where, and which of the two crossings - is a function
+// of the ray alone. (Embree's own sphere kernels are not: its one-ray and
+// 16-wide kernels round t differently, by a few ulps, which moves hits across
+// a shadow ray's tmax; docs/ARCHITECTURE.md, Ray offsets, Sphere hits.)
+// Computed in double from the float inputs, which are exact there: the
+// discriminant from the ray's perpendicular offset from the centre, as
+// (r - l)(r + l) (PBR 4th ed. 6.8.4; Haines et al., Ray Tracing Gems ch. 7),
+// and the two roots as q / a and c / q, so neither root is a difference of
+// near-equal numbers. Each root is then rounded to float once, and tested
+// against tnear and tfar as a float, as Embree stores t: a crossing at or
+// beyond tfar never counts (rounding is monotonic), nor one within half a
+// float below it (it rounds to tfar), so the sphere a shadow ray ends just
+// before does not stop it. Its error before that rounding is a
+// few double ulps of the distances involved, below the float offsets of
+// core/ray.h by ~2^29, so the crossing a ray just left (its origin offset off
+// the sphere) is never found again. A ray that touches the sphere (one
+// double root) crosses it nowhere and finds nothing.
+float sphere_crossing(const vec3& origin, const vec3& dir, float tnear, float tfar, const vec3& center, float radius);
+
 // The shading normal at a point with geometric normal `ng` from the
 // interpolated vertex normals `sum` (not normalised): unit length, turned to
 // ng's side of the surface (so flip_normals and the file's winding decide the

@@ -108,18 +108,44 @@ class SampleStream {
   // False under zsobol: get() is then no function of key() alone.
   constexpr bool independent() const { return index_bits_ == kHash; }
 
+  // The two numbers of a 2D pair: {get(bounce, x), get(bounce, x + 1)} bit
+  // for bit, for x = FilmX, LensX, LightX or DirectionX. Under zsobol the
+  // pair's index permutation, the sampler's main cost, is done once.
+  struct Pair {
+    float x, y;
+  };
+  constexpr Pair get2(std::uint32_t bounce, Dim x) const {
+    const Dim y = static_cast<Dim>(static_cast<std::uint32_t>(x) + 1);
+    if (index_bits_ != kHash) {
+      const SobolSlot s = sobol_slot(x);
+      if (s.entity < kSobolSlotsPerVertex && s.axis == 0 && sobol_slot(y).entity == s.entity) {
+        const Point p = zsobol_point(bounce * kSobolSlotsPerVertex + s.entity);
+        return {p.value(0), p.value(1)};
+      }
+    }
+    return {get(bounce, x), get(bounce, y)};
+  }
+
   // Point `slot` of the zsobol sequence in Sobol' dimension `axis`, as get()
   // draws it (public for the tests of its parts).
-  constexpr float zsobol(std::uint32_t slot, int axis) const {
-    const std::uint64_t h = mix64(sobol_key_ ^ (static_cast<std::uint64_t>(slot) * 0xd1b54a32d192ed03ull));
-    const std::uint64_t index = sobol::permute_digits(index_, index_bits_, h);
-    const std::uint32_t v = sobol::scramble(sobol::sample(index, axis), mix64(h + 1 + static_cast<std::uint64_t>(axis)));
-    return sobol::to_float(v);
-  }
+  constexpr float zsobol(std::uint32_t slot, int axis) const { return zsobol_point(slot).value(axis); }
 
  private:
   friend class SamplerSetup;
   static constexpr std::uint32_t kHash = 0xffffffffu;
+  // One slot's permuted Sobol' index and its scrambling key: both axes of
+  // the slot's 2D point come from it.
+  struct Point {
+    std::uint64_t index, h;
+    constexpr float value(int axis) const {
+      return sobol::to_float(
+          sobol::scramble(sobol::sample(index, axis), mix64(h + 1 + static_cast<std::uint64_t>(axis))));
+    }
+  };
+  constexpr Point zsobol_point(std::uint32_t slot) const {
+    const std::uint64_t h = mix64(sobol_key_ ^ (static_cast<std::uint64_t>(slot) * 0xd1b54a32d192ed03ull));
+    return {sobol::permute_digits(index_, index_bits_, h), h};
+  }
   std::uint64_t key_;
   std::uint64_t index_ = 0;       // zsobol: morton(x, y) << log2_spp | sample mod 2^log2_spp
   std::uint64_t sobol_key_ = 0;   // zsobol: a hash of the seed and the sample's replicate

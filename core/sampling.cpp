@@ -1,32 +1,32 @@
 #include "core/sampling.h"
 
+#include "core/simd/sampling-inl.h"
+
+#include <hwy/highway.h>
+
 #include <algorithm>
 #include <cmath>
 
 namespace pathlab {
 
+// The warps written once for every SIMD width (core/simd/sampling-inl.h),
+// here at width 1 with the build's own instruction set.
+namespace {
+namespace hn = hwy::HWY_NAMESPACE;
+constexpr hn::CappedTag<float, 1> kOne;
+float lane(hn::Vec<decltype(kOne)> v) { return hn::GetLane(v); }
+}  // namespace
+
 SinCos sin_cos_quarter(float x) {
-  // Written out operation by operation: wavefront/vector_stages_avx512.cpp
-  // evaluates the same products and sums in the same order.
-  const float z = x * x;
-  const float s = ((((-1.9515295891e-4f * z) + 8.3321608736e-3f) * z) - 1.6666654611e-1f) * z * x + x;
-  const float c = ((((2.443315711809948e-5f * z) - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) * z * z -
-                   0.5f * z) + 1.0f;
-  return {s, c};
+  hn::Vec<decltype(kOne)> s, c;
+  HWY_NAMESPACE::sin_cos_quarter(kOne, hn::Set(kOne, x), s, c);
+  return {lane(s), lane(c)};
 }
 
 vec2 square_to_concentric_disk(vec2 u) {
-  const vec2 o = 2.0f * u - vec2(1.0f);
-  if (o.x == 0.0f && o.y == 0.0f) return vec2(0.0f);
-  // theta = (pi/4) (y/x) in the left and right wedges; in the top and
-  // bottom ones theta = pi/2 - phi with phi = (pi/4) (x/y), so that
-  // (cos theta, sin theta) = (sin phi, cos phi).
-  if (std::abs(o.x) > std::abs(o.y)) {
-    const SinCos t = sin_cos_quarter((kPi / 4.0f) * (o.y / o.x));
-    return o.x * vec2(t.cos, t.sin);
-  }
-  const SinCos t = sin_cos_quarter((kPi / 4.0f) * (o.x / o.y));
-  return o.y * vec2(t.sin, t.cos);
+  hn::Vec<decltype(kOne)> x, y;
+  HWY_NAMESPACE::concentric_disk(kOne, hn::Set(kOne, u.x), hn::Set(kOne, u.y), x, y);
+  return vec2(lane(x), lane(y));
 }
 
 vec2 concentric_disk_to_square(vec2 p) {
@@ -53,9 +53,9 @@ vec2 concentric_disk_to_square(vec2 p) {
 }
 
 vec3 square_to_cosine_hemisphere(vec2 u) {
-  const vec2 d = square_to_concentric_disk(u);
-  const float z = std::sqrt(std::max(0.0f, 1.0f - d.x * d.x - d.y * d.y));
-  return vec3(d.x, d.y, z);
+  hn::Vec<decltype(kOne)> x, y, z;
+  HWY_NAMESPACE::cosine_hemisphere(kOne, hn::Set(kOne, u.x), hn::Set(kOne, u.y), x, y, z);
+  return vec3(lane(x), lane(y), lane(z));
 }
 
 float cosine_hemisphere_pdf(const vec3& w) { return w.z > 0.0f ? w.z * kInvPi : 0.0f; }

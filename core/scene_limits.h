@@ -39,7 +39,8 @@ std::uint64_t embree_rejected_rays();
 // +-kMaxSceneCoordinate in each coordinate, 100x inside Embree's bound, so
 // that a ray leaving any point of the scene (a unit direction, an offset of
 // a few floats) stays acceptable. Sphere radii are at least kMinSphereRadius,
-// so that radius^2 (Embree's sphere test) is a normal float, not a denormal or
+// so that radius^2 (a sphere light's area; once Embree's float sphere test,
+// now sphere_crossing's, in double) is a normal float, not a denormal or
 // zero. docs/scene-format.md ("Limits") states the same rule.
 inline constexpr float kMaxSceneCoordinate = 1e16f;
 inline constexpr float kMinSphereRadius = 1e-18f;

@@ -5,6 +5,7 @@
 #include "core/bsdf/lambert.h"
 #include "core/bsdf/mirror.h"
 #include "core/faults.h"
+#include "core/geometry.h"
 
 namespace pathlab {
 namespace {
@@ -233,7 +234,15 @@ Ray Surfel::spawn(const vec3& dir) const {
 Ray Surfel::spawn_to(const vec3& target, const vec3& target_error, const vec3& target_n) const {
   const vec3 d0 = target - p;
   const vec3 origin = offset_ray_origin(p, p_error, glm::dot(d0, n) >= 0.0f ? n : -n);
-  const vec3 end = offset_ray_origin(target, target_error,
+  // The ray below reaches t = dist within gamma(2) |end - origin| of `end`,
+  // per axis: the difference and the division round once each, and the
+  // rounded length cancels (it is both tmax and the divisor). So the end
+  // moves off the target's surface by that reach (with a float to spare)
+  // beyond the target's own error: however long the ray, the point it
+  // stops at stays off the surface it aims at, for an intersector exact on
+  // the float ray (sphere_crossing; docs/ARCHITECTURE.md, Sphere hits).
+  const vec3 reach = gamma_bound(3) * glm::abs(target - origin);
+  const vec3 end = offset_ray_origin(target, target_error + reach,
                                      glm::dot(origin - target, target_n) >= 0.0f ? target_n : -target_n);
   const vec3 d = end - origin;
   const float dist = glm::length(d);

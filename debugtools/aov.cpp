@@ -73,8 +73,9 @@ void AovAccumulator::add_batch(std::uint32_t first, std::uint32_t count, std::sp
           ++px.samples;
           // The camera ray of this sample, as both tracers draw it.
           const SampleStream u = sampler.stream(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), first + j);
-          const vec2 film(static_cast<float>(x) + u.get(0, Dim::FilmX), static_cast<float>(y) + u.get(0, Dim::FilmY));
-          Ray ray = camera.generate_ray(film, vec2(u.get(0, Dim::LensX), u.get(0, Dim::LensY)));
+          const SampleStream::Pair f = u.get2(0, Dim::FilmX), l = u.get2(0, Dim::LensX);
+          const vec2 film(static_cast<float>(x) + f.x, static_cast<float>(y) + f.y);
+          Ray ray = camera.generate_ray(film, vec2(l.x, l.y));
           ray.alpha_key = scene_.alpha_key(u, 0);  // sees through what the render saw through
           Surfel s;
           const bool hit = scene_.intersect(ray, &s, cone, &params);

@@ -14,6 +14,8 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <memory>
 #include <sstream>
 
 namespace pathlab {
@@ -62,6 +64,8 @@ std::string config_label(const ConvergeConfig& c, const ConvergeOptions& o) {
   }
   if (!o.max_depths.empty()) label += " depth " + std::to_string(c.max_depth);
   if (o.samplers.size() > 1 || c.sampler != SamplerKind::Independent) label += std::string(" ") + sampler_name(c.sampler);
+  if (o.light_samplings.size() > 1 || c.light_sampling != LightSampling::Area)
+    label += std::string(" ") + light_sampling_name(c.light_sampling);
   return label;
 }
 
@@ -169,7 +173,8 @@ ConvergeRow summarise(std::size_t config, bool time_budget, double budget, const
   // With two or more seeds the standard error comes from their spread; with
   // one, from the film's per-pixel variances.
   r.bias_se = seeds.size() >= 2 ? seed_spread(bias).se : seeds.front().bias_se_pixels;
-  r.efficiency = 1.0 / std::max(r.rel_mse * r.seconds, 1e-300);
+  // An exact estimator (relMSE 0) is infinitely efficient, and says so.
+  r.efficiency = r.rel_mse * r.seconds > 0.0 ? 1.0 / (r.rel_mse * r.seconds) : std::numeric_limits<double>::infinity();
   return r;
 }
 
@@ -302,15 +307,32 @@ ConvergeResult run_converge(const Scene& scene, const ConvergeOptions& options, 
   const std::vector<int> depths = options.max_depths.empty() ? std::vector<int>{scene.render.max_depth} : options.max_depths;
   const std::vector<SamplerKind> samplers =
       options.samplers.empty() ? std::vector<SamplerKind>{scene.render.sampler} : options.samplers;
+  const std::vector<LightSampling> light_samplings = options.light_samplings.empty()
+                                                         ? std::vector<LightSampling>{scene.render.light_sampling}
+                                                         : options.light_samplings;
   for (const std::string& t : options.tracers)
     for (Strategy s : strategies)
       for (float c : options.clamps)
         for (int d : depths)
-          for (SamplerKind k : samplers) {
-            ConvergeConfig cfg{t, s, c, d, {}, k};
-            cfg.label = config_label(cfg, options);
-            result.configs.push_back(cfg);
-          }
+          for (SamplerKind k : samplers)
+            for (LightSampling ls : light_samplings) {
+              ConvergeConfig cfg{t, s, c, d, {}, k, ls};
+              cfg.label = config_label(cfg, options);
+              result.configs.push_back(cfg);
+            }
+  // The light sampler is part of the compiled scene: one per light-sampling
+  // value, the scene's own already made above.
+  std::map<LightSampling, std::unique_ptr<const CompiledScene>> recompiled;
+  auto compiled_for = [&](LightSampling ls) -> const CompiledScene& {
+    if (ls == scene.render.light_sampling) return compiled;
+    auto& c = recompiled[ls];
+    if (!c) {
+      Scene copy = scene;
+      copy.render.light_sampling = ls;
+      c = std::make_unique<const CompiledScene>(std::move(copy));
+    }
+    return *c;
+  };
 
   const std::size_t rungs = options.spp.size(), budgets = options.time_budgets.size();
   for (std::size_t ci = 0; ci < result.configs.size(); ++ci) {
@@ -323,11 +345,12 @@ ConvergeResult run_converge(const Scene& scene, const ConvergeOptions& options, 
       settings.clamp = cfg.clamp;
       settings.max_depth = cfg.max_depth;
       settings.sampler = cfg.sampler;
+      settings.light_sampling = cfg.light_sampling;
       // zsobol lays each pixel's samples out for spp rounded up to a power of
       // two: the ladder's last rung makes the whole ladder one run.
       if (cfg.sampler != SamplerKind::Independent && !options.spp.empty()) settings.spp = options.spp.back();
       settings.seed = scene.render.seed + static_cast<std::uint64_t>(r);
-      const auto tracer = make_tracer(cfg.tracer, compiled, settings);
+      const auto tracer = make_tracer(cfg.tracer, compiled_for(cfg.light_sampling), settings);
       // The ladder: each rung extends the film of the last.
       Film film(result.width, result.height, scene.film.filter);
       double seconds = 0.0, samples = 0.0;
@@ -376,14 +399,14 @@ std::string budget_text(const ConvergeRow& r) { return r.time_budget ? fmt(r.bud
 std::string converge_csv(const ConvergeResult& result) {
   std::ostringstream out;
   out << "tracer,strategy,clamp,max_depth,budget_kind,budget,seeds,spp,seconds,samples_per_second,rmse,rmse_sd,rel_mse,"
-         "bias,bias_se,efficiency,sampler\n";
+         "bias,bias_se,efficiency,sampler,light_sampling\n";
   for (const ConvergeRow& r : result.rows) {
     const ConvergeConfig& c = result.configs[r.config];
     out << c.tracer << "," << strategy_name(c.strategy) << "," << fmt(c.clamp) << "," << c.max_depth << ","
         << (r.time_budget ? "time" : "spp") << "," << fmt(r.budget) << "," << r.rmse_per_seed.size() << ","
         << fmt(r.spp) << "," << fmt(r.seconds) << "," << fmt(r.samples_per_second) << "," << fmt(r.rmse) << ","
         << fmt(r.rmse_sd) << "," << fmt(r.rel_mse) << "," << fmt(r.bias) << "," << fmt(r.bias_se) << ","
-        << fmt(r.efficiency) << "," << sampler_name(c.sampler) << "\n";
+        << fmt(r.efficiency) << "," << sampler_name(c.sampler) << "," << light_sampling_name(c.light_sampling) << "\n";
   }
   return out.str();
 }

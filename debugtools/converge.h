@@ -29,10 +29,14 @@ using TracerFactory =
 class Film;
 
 struct ConvergeOptions {
-  // By default both tracers and all five strategies: the choices a user has.
+  // By default both tracers, all five strategies and both samplers: the
+  // choices a user has. An empty strategies or samplers list: the scene's.
   std::vector<std::string> tracers{"reference", "wavefront"};
   std::vector<Strategy> strategies{std::begin(kAllStrategies), std::end(kAllStrategies)};
-  std::vector<SamplerKind> samplers;  // empty: the scene's sampler
+  std::vector<SamplerKind> samplers{SamplerKind::Independent, SamplerKind::ZSobol};
+  // How a point on a picked area light is sampled (render.light_sampling);
+  // empty: the scene's. Each value compiles the scene once more.
+  std::vector<LightSampling> light_samplings;
   std::vector<int> spp{1, 4, 16, 64, 256, 1024};  // the ladder (progressive: each rung extends the last)
   std::vector<double> time_budgets;     // seconds, each rendered from scratch with render_until()
   int seeds = 4;                        // R: seeds scene.render.seed, +1, ..., +R-1
@@ -50,6 +54,7 @@ struct ConvergeConfig {
   int max_depth = 0;
   std::string label;  // "reference mis", "+ clamp 4", "+ depth 2", "+ zsobol" when the sweep varies them
   SamplerKind sampler = SamplerKind::Independent;
+  LightSampling light_sampling = LightSampling::Area;
 };
 
 // One budget of one configuration, averaged over the seeds.

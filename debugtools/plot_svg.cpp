@@ -1,7 +1,5 @@
 #include "debugtools/plot_svg.h"
 
-#include "core/error.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -38,6 +36,9 @@ std::string decade_label(int k) {
 
 }  // namespace
 
+const char* const kNothingToPlot =
+    "No point to draw on logarithmic axes: every value is 0 or not finite (an exact estimator has RMSE 0).";
+
 std::string loglog_svg(const LogLogPlot& plot) {
   double xmin = std::numeric_limits<double>::infinity(), xmax = 0, ymin = xmin, ymax = 0;
   for (const PlotSeries& s : plot.series)
@@ -46,7 +47,16 @@ std::string loglog_svg(const LogLogPlot& plot) {
         xmin = std::min(xmin, s.x[i]), xmax = std::max(xmax, s.x[i]);
         ymin = std::min(ymin, s.y[i]), ymax = std::max(ymax, s.y[i]);
       }
-  if (!(xmax > 0)) throw InputError("plot '" + plot.title + "': no point with positive x and y to plot");
+  if (!(xmax > 0)) {
+    // Nothing has a logarithm (an exact estimator's RMSE is 0): say so
+    // rather than draw empty axes or fail the report.
+    std::ostringstream o;
+    o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"640\" height=\"120\" viewBox=\"0 0 640 120\" "
+      << "font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+      << "<text x=\"20\" y=\"30\" font-size=\"14\">" << escape(plot.title) << "</text>\n"
+      << "<text x=\"20\" y=\"70\">" << kNothingToPlot << "</text>\n</svg>\n";
+    return o.str();
+  }
   const int x0 = static_cast<int>(std::floor(std::log10(xmin))), x1 = std::max(x0 + 1, static_cast<int>(std::ceil(std::log10(xmax))));
   const int y0 = static_cast<int>(std::floor(std::log10(ymin))), y1 = std::max(y0 + 1, static_cast<int>(std::ceil(std::log10(ymax))));
 

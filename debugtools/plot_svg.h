@@ -27,7 +27,9 @@ struct LogLogPlot {
   std::string guide_label;
 };
 
-// The SVG document. Throws InputError if no series has a positive point.
+// The SVG document. With no point of positive x and y in any series (every
+// RMSE 0: an exact estimator) it is the title and kNothingToPlot, not axes.
 std::string loglog_svg(const LogLogPlot& plot);
+extern const char* const kNothingToPlot;
 
 }  // namespace pathlab

@@ -21,6 +21,11 @@ struct ReferenceTracer::Path {
   RayCone cone{};
   SurfaceParams* params = nullptr;
   float u(int vertex, Dim dim) const { return rng.get(static_cast<std::uint32_t>(vertex), dim); }
+  // A 2D pair: u(vertex, x), u(vertex, x + 1) (SampleStream::get2).
+  vec2 u2(int vertex, Dim x) const {
+    const SampleStream::Pair p = rng.get2(static_cast<std::uint32_t>(vertex), x);
+    return vec2(p.x, p.y);
+  }
   // The key of the rays leaving `vertex` (core/alpha.h).
   std::uint32_t alpha_key(const CompiledScene& scene, int vertex) const {
     return PATHLAB_FAULT(AlphaKeysNotSet) ? 0u : scene.alpha_key(rng, vertex);
@@ -74,7 +79,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
   if (samples_area_lights(strategy, u_technique)) L += direct_area(s, wo, vertex, beta, path);
 
   // Continue the path.
-  const vec2 u_dir(path.u(vertex, Dim::DirectionX), path.u(vertex, Dim::DirectionY));
+  const vec2 u_dir = path.u2(vertex, Dim::DirectionX);
   const bool cosine = strategy == Strategy::Cosine && !s.material->is_pure_impulse();
   const std::optional<BsdfSample> bs =
       cosine ? s.scatter_cosine(wo, u_dir) : s.scatter(wo, path.u(vertex, Dim::LobeChoice), u_dir);
@@ -139,7 +144,7 @@ Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vert
 Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int vertex, const Spectrum& beta,
                                       Path& path) const {
   const std::optional<LightSample> ls = scene_.lights().sample(
-      light_query(s, wo), path.u(vertex, Dim::LightChoice), vec2(path.u(vertex, Dim::LightX), path.u(vertex, Dim::LightY)));
+      light_query(s, wo), path.u(vertex, Dim::LightChoice), path.u2(vertex, Dim::LightX));
   if (!ls) {
     if (path.observer && scene_.lights().has_area_lights())
       path.observer->on_light(rejected_light_event(vertex, false, nullptr, LightRejection::NoSample));
@@ -173,8 +178,8 @@ FilmSample ReferenceTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::
     path.cone = scene_.camera_cone(settings_.texture_filter);
   }
   FilmSample fs;
-  fs.film = vec2(static_cast<float>(x) + path.u(0, Dim::FilmX), static_cast<float>(y) + path.u(0, Dim::FilmY));
-  Ray ray = scene_.camera().generate_ray(fs.film, vec2(path.u(0, Dim::LensX), path.u(0, Dim::LensY)));
+  fs.film = vec2(static_cast<float>(x), static_cast<float>(y)) + path.u2(0, Dim::FilmX);
+  Ray ray = scene_.camera().generate_ray(fs.film, path.u2(0, Dim::LensX));
   ray.alpha_key = path.alpha_key(scene_, 0);
   if (observer) observer->on_camera({x, y, sample, fs.film, ray.origin, ray.dir});
   fs.L = Li(ray, 1, PreviousVertex{}, Spectrum(1.0f), path);

@@ -47,6 +47,7 @@ class ConvergeSweep : public ::testing::Test {
     ConvergeOptions o;
     o.tracers = {"reference", "wavefront"};
     o.strategies = {Strategy::Mis, Strategy::Cosine};
+    o.samplers = {SamplerKind::Independent};  // the n^-1/2 rate below is independent sampling's
     o.spp = {4, 16, 64, 256};
     for (int& s : o.spp) s *= test::stat_scale();
     o.seeds = kSeeds;
@@ -123,6 +124,7 @@ TEST(ConvergeDepthCaps, ShowTheirTruncationBias) {
   ConvergeOptions o;
   o.tracers = {"reference"};
   o.strategies = {};  // the scene's
+  o.samplers = {};    // the scene's
   o.spp = {16 * test::stat_scale()};
   o.seeds = kSeeds;
   o.max_depths = {1, 2, -1};
@@ -155,6 +157,7 @@ TEST(ConvergeBiasSe, OneSeedIsNotBelowTheSpreadOverSeedsOnTheWhiteSphere) {
   ConvergeOptions o;
   o.tracers = {"reference"};
   o.strategies = {};
+  o.samplers = {};
   o.spp = {16 * test::stat_scale()};
   o.seeds = 40;
   const ConvergeResult r = run_converge(scene, o, make);

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -53,7 +54,7 @@ class ConvergeCli : public test::TempDirTest {};
 TEST_F(ConvergeCli, WritesTheTableAndPlotsWithOneRowPerConfigurationAndBudget) {
   const fs::path out = dir_ / "report";
   const auto r = run_cli({"converge", kScenes + "penumbra-box.json", "--tracers", "reference,wavefront", "--strategies",
-                          "mis,light", "--clamps", "0,2", "--spp", "1,4", "--time-budgets", "0.02", "--seeds", "2",
+                          "mis,light", "--sampler", "independent", "--clamps", "0,2", "--spp", "1,4", "--time-budgets", "0.02", "--seeds", "2",
                           "--resolution", "8x6", "--out", out.string()});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto csv = lines(read_text(out / "converge.csv"));
@@ -72,22 +73,90 @@ TEST_F(ConvergeCli, WritesTheTableAndPlotsWithOneRowPerConfigurationAndBudget) {
 }
 
 // A scene with no analytic model is measured against a reference EXR.
-// Without axes: both tracers x all five strategies, one curve each.
-TEST_F(ConvergeCli, ComparesBothTracersAndAllStrategiesByDefault) {
+// Without axes: both tracers x all five strategies x both samplers, one
+// curve each.
+TEST_F(ConvergeCli, ComparesBothTracersAllStrategiesAndBothSamplersByDefault) {
   const fs::path out = dir_ / "default";
   const auto r = run_cli({"converge", kScenes + "penumbra-box.json", "--spp", "1,4", "--seeds", "2", "--resolution",
                           "8x6", "--out", out.string()});
   ASSERT_EQ(r.code, 0) << r.err;
-  const std::string csv = read_text(out / "converge.csv");
-  ASSERT_EQ(lines(csv).size(), 1u + 2 * 5 * 2) << csv;
+  const auto csv = lines(read_text(out / "converge.csv"));
+  ASSERT_EQ(csv.size(), 1u + 2 * 5 * 2 * 2) << read_text(out / "converge.csv");
+  // Each configuration's rows, by the tracer, strategy and sampler columns.
+  const auto columns = [](const std::string& line) {
+    std::vector<std::string> f;
+    std::stringstream in(line);
+    for (std::string x; std::getline(in, x, ',');) f.push_back(x);
+    return f;
+  };
+  const std::vector<std::string> header = columns(csv[0]);
+  const auto sampler_col = static_cast<std::size_t>(std::find(header.begin(), header.end(), "sampler") - header.begin());
+  ASSERT_LT(sampler_col, header.size()) << csv[0];
   for (const char* t : {"reference", "wavefront"})
     for (const char* s : {"cosine", "bsdf", "light", "light+bsdf", "mis"})
-      EXPECT_EQ(count(csv, std::string("\n") + t + "," + s + ","), 2u) << t << " " << s;
-  // Giving an axis replaces its default.
+      for (const char* k : {"independent", "zsobol"}) {
+        const auto n = std::count_if(csv.begin() + 1, csv.end(), [&](const std::string& line) {
+          const std::vector<std::string> f = columns(line);
+          return f.size() == header.size() && f[0] == t && f[1] == s && f[sampler_col] == k;
+        });
+        EXPECT_EQ(n, 2) << t << " " << s << " " << k;
+      }
+  EXPECT_NE(read_text(out / "converge.md").find("| reference mis zsobol |"), std::string::npos);
+  // Giving an axis replaces its default; --sampler K is a one-value axis.
   const auto one = run_cli({"converge", kScenes + "penumbra-box.json", "--tracers", "wavefront", "--strategies", "light",
-                            "--spp", "1", "--seeds", "1", "--resolution", "8x6", "--out", (dir_ / "one").string()});
+                            "--sampler", "zsobol", "--spp", "1", "--seeds", "1", "--resolution", "8x6", "--out",
+                            (dir_ / "one").string()});
   ASSERT_EQ(one.code, 0) << one.err;
-  EXPECT_EQ(lines(read_text(dir_ / "one" / "converge.csv")).size(), 2u);
+  const auto one_csv = lines(read_text(dir_ / "one" / "converge.csv"));
+  ASSERT_EQ(one_csv.size(), 2u);
+  EXPECT_NE(one_csv[1].find(",zsobol,"), std::string::npos) << one_csv[1];
+}
+
+// --light-samplings makes light sampling an axis: each value renders with
+// its own compiled light sampler (the same seeds then give other images),
+// named in the label and in the last column.
+TEST_F(ConvergeCli, LightSamplingsAreAnAxisEachRenderedWithItsOwnSampler) {
+  const fs::path out = dir_ / "ls";
+  const auto r = run_cli({"converge", kScenes + "penumbra-box.json", "--tracers", "reference", "--strategies", "light",
+                          "--sampler", "independent", "--light-samplings", "area,solid_angle", "--spp", "1,4",
+                          "--seeds", "2", "--resolution", "8x6", "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto csv = lines(read_text(out / "converge.csv"));
+  ASSERT_EQ(csv.size(), 1u + 2 * 2) << read_text(out / "converge.csv");
+  EXPECT_EQ(csv[0].substr(csv[0].rfind(',')), ",light_sampling");
+  const auto field = [](const std::string& line, int k) {  // the k-th comma-separated field
+    std::size_t b = 0;
+    for (int i = 0; i < k; ++i) b = line.find(',', b) + 1;
+    return line.substr(b, line.find(',', b) - b);
+  };
+  EXPECT_EQ(csv[1].substr(csv[1].rfind(',')), ",area");
+  EXPECT_EQ(csv[3].substr(csv[3].rfind(',')), ",solid_angle");
+  // Rung 4 spp of each: the RMSE (column 10) differs, as the images do.
+  EXPECT_NE(field(csv[2], 10), field(csv[4], 10)) << csv[2] << "\n" << csv[4];
+  const std::string md = read_text(out / "converge.md");
+  EXPECT_NE(md.find("| reference light solid_angle |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| reference light area |"), std::string::npos) << md;
+  const auto bad = run_cli({"converge", kScenes + "penumbra-box.json", "--light-samplings", "cone", "--out",
+                            (dir_ / "bad").string()});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("--light-samplings"), std::string::npos) << bad.err;
+}
+
+// furnace-box-back.json is rendered exactly by every configuration (RMSE
+// 0 at every rung): the report is still written, its plots say why they
+// have no lines.
+TEST_F(ConvergeCli, AnExactEstimatorStillGetsItsReport) {
+  const fs::path out = dir_ / "exact";
+  const auto r = run_cli({"converge", kScenes + "furnace-box-back.json", "--tracers", "reference", "--strategies", "mis",
+                          "--sampler", "independent", "--spp", "1,4", "--seeds", "2", "--resolution", "8x6", "--out",
+                          out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto csv = lines(read_text(out / "converge.csv"));
+  ASSERT_EQ(csv.size(), 3u);
+  EXPECT_NE(csv[2].find(",4,2,4,"), std::string::npos) << csv[2];
+  EXPECT_NE(csv[2].find(",0,0,0,0,0,inf,"), std::string::npos) << "RMSE, sd, relMSE, bias, se 0; efficiency inf: " << csv[2];
+  for (const char* svg : {"rmse-vs-time.svg", "rmse-vs-spp.svg"})
+    EXPECT_NE(read_text(out / svg).find(kNothingToPlot), std::string::npos) << svg;
 }
 
 TEST_F(ConvergeCli, UsesAReferenceExrAsTheTruth) {
@@ -96,7 +165,7 @@ TEST_F(ConvergeCli, UsesAReferenceExrAsTheTruth) {
   ASSERT_EQ(run_cli({"render", scene, "-o", ref.string(), "--spp", "256", "--resolution", "8x6", "--seed", "99",
                      "--quiet"}).code, 0);
   const auto r = run_cli({"converge", scene, "--reference", ref.string(), "--tracers", "reference", "--strategies",
-                          "mis", "--spp", "1,16", "--seeds", "2", "--resolution", "8x6", "--out",
+                          "mis", "--sampler", "independent", "--spp", "1,16", "--seeds", "2", "--resolution", "8x6", "--out",
                           (dir_ / "report").string()});
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string md = read_text(dir_ / "report" / "converge.md");
@@ -237,7 +306,10 @@ TEST(ConvergeReport, SvgHasDecadeTicksLabelsLegendAndOneLinePerSeries) {
   EXPECT_NE(svg.find("RMSE (log scale)"), std::string::npos);
   EXPECT_NE(svg.find(">slope -1/2<"), std::string::npos);
   EXPECT_EQ(count(svg, "stroke-dasharray=\"7,4\""), 2u) << "the second series is dashed, line and legend";
-  EXPECT_THROW(loglog_svg({"t", "x", "y", {{"a", {0, 1}, {1, -1}}}, 0.0, ""}), InputError);
+  // Nothing with a logarithm (an exact estimator's RMSE is 0): a note, not axes.
+  const std::string none = loglog_svg({"t", "x", "y", {{"a", {0, 1}, {1, -1}}}, 0.0, ""});
+  EXPECT_NE(none.find(kNothingToPlot), std::string::npos) << none;
+  EXPECT_EQ(count(none, "<polyline"), 0u);
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -312,6 +313,28 @@ TEST(ZSobolStream, IsAPureFunctionAndIndependentIsUnchanged) {
   }
   EXPECT_TRUE(ind.stream(1, 2, 3).independent());
   EXPECT_FALSE(z.stream(1, 2, 3).independent());
+}
+
+// get2(bounce, x) is {get(bounce, x), get(bounce, x + 1)} bit for bit under
+// both samplers: for the four pairs (one permutation for both axes under
+// zsobol) and for any other dimension (two plain draws).
+TEST(ZSobolStream, PairsAreTheTwoSingleDrawsBitForBit) {
+  for (const SamplerKind kind : {SamplerKind::ZSobol, SamplerKind::Independent})
+    for (std::uint32_t spp : {1u, 5u, 64u}) {
+      const SamplerSetup setup(kind, 7, 33, 17, spp);
+      for (std::uint32_t i = 0; i < 3000; ++i) {
+        const SampleStream st = setup.stream(i % 33, i / 33 % 17, i % 97);
+        const std::uint32_t bounce = i % 7;
+        for (std::uint32_t d = 0; d + 1 < static_cast<std::uint32_t>(Dim::Count); ++d) {
+          const auto x = static_cast<Dim>(d), y = static_cast<Dim>(d + 1);
+          const SampleStream::Pair p = st.get2(bounce, x);
+          ASSERT_EQ(std::bit_cast<std::uint32_t>(p.x), std::bit_cast<std::uint32_t>(st.get(bounce, x)))
+              << sampler_name(kind) << " dim " << d;
+          ASSERT_EQ(std::bit_cast<std::uint32_t>(p.y), std::bit_cast<std::uint32_t>(st.get(bounce, y)))
+              << sampler_name(kind) << " dim " << d;
+        }
+      }
+    }
 }
 
 TEST(ZSobolStream, SeedsRandomiseEveryPoint) {

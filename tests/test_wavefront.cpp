@@ -26,7 +26,7 @@ namespace {
 
 struct SameSeedCase {
   // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" / "alpha" / "textured" (test_scenes.h),
-  // "envmap" (below), else a file in analytic-scenes/
+  // "envmap" / "bulb" (below), else a file in analytic-scenes/
   std::string scene;
   Strategy strategy;
   LightSampling light_sampling = LightSampling::Area;
@@ -54,8 +54,8 @@ Scene envmap_scene() {
 }
 
 // The Cornell box with a small sphere light in the air, seen from outside
-// by every surface (cone sampling under light_sampling solid_angle). Not in
-// the SameSeed list (see same_seed_cases); used by the thread test below.
+// by every surface (cone sampling under light_sampling solid_angle): its
+// shadow rays end just before the sphere, some of them grazing it.
 Scene cornell_with_bulb() {
   Scene scene = builtin_cornell_box();
   Shape bulb;
@@ -78,6 +78,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "alpha"     ? test::cornell_with_alpha()
             : c.scene == "textured"  ? test::cornell_with_textures()
             : c.scene == "many"      ? test::cornell_with_many_lights()
+            : c.scene == "bulb"      ? cornell_with_bulb()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -151,18 +152,17 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("envmap");     // an environment image over a diffuse sphere and a metal ground (above)
   scenes.push_back("alpha");      // the instanced Cornell box with partial coverage (test_scenes.h)
   scenes.push_back("textured");   // the Cornell box reading textures everywhere (test_scenes.h)
+  scenes.push_back("bulb");       // the Cornell box with a sphere light seen from outside (above)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
   // Solid-angle light sampling (the wavefront's scalar stages, the same
   // LightSampler): triangle lights, a sphere light seen from inside
-  // (white-sphere-emissive-room's room), textured and delta lights. Not a
-  // sphere light seen from outside ("bulb"): there the light strategies
-  // part in 0.5-2.5 % of samples, under area sampling as well, all by
-  // rounding (Embree's one-ray and stream SPHERE_POINT kernels disagree on
-  // shadow rays that end on the sphere), above this test's 0.1 %.
+  // (white-sphere-emissive-room's room) and from outside ("bulb": cone
+  // sampling), textured and delta lights.
   for (const std::string& s : {std::string(""), std::string("penumbra-box.json"), std::string("white-sphere-emissive-room.json"),
-                               std::string("penumbra-emissive-polygon.json"), std::string("textured"), std::string("delta")})
+                               std::string("penumbra-emissive-polygon.json"), std::string("textured"), std::string("delta"),
+                               std::string("bulb")})
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st, LightSampling::SolidAngle});
   // The light BVH (scalar stages, the same LightSampler): many small lights
   // of every orientation in the Cornell box, twelve lighting each other
@@ -259,33 +259,83 @@ TEST(Wavefront, LightBvhSameBitsForOneAndTwoThreads) {
   expect_same_bits_for_one_and_two_threads(std::move(scene));
 }
 
-// With a sphere light too (cone sampling), for one thread and two at one
-// wave size. Not across wave sizes: Embree's SPHERE_POINT hits differ in
-// their last bits between a full stream packet and a short one, under area
-// sampling as well (found here, left as it was: not a light-sampling matter).
-TEST(Wavefront, SolidAngleSphereLightSameBitsForOneAndTwoThreads) {
-  Scene scene = cornell_with_bulb();
-  scene.film.width = scene.film.height = 16;
-  scene.render.spp = 4;
-  scene.render.light_sampling = LightSampling::SolidAngle;
+// The wavefront's image is the same bits for 1 and 2 threads and wave sizes
+// 17, 97 and 4096 (short stream batches, odd packets, full ones), on scenes
+// with true spheres: a sphere light seen from outside (its shadow rays end on
+// the sphere, some grazing it) under area and cone sampling, and a diffuse
+// sphere as ordinary geometry (the vectorised stages where the processor has
+// them, and the scalar ones). Each image is compared with the first, and the
+// count of differing pixels printed.
+// `vectorised_stages`: the scene is one the vectorised stages take (asserted
+// where the processor has AVX-512).
+void expect_same_bits_for_any_wave_size(const Scene& scene_in, WavefrontStages stages, bool vectorised_stages = false) {
+  Scene scene = scene_in;
+  const int width = scene.film.width, height = scene.film.height;
   const RenderSettings settings = scene.render;
   const CompiledScene compiled(std::move(scene));
-  auto render_image = [&](bool wavefront, int threads) {
+  auto render_image = [&](int threads, std::size_t wave) {
     const ThreadLimit limit(threads);
-    Film film(16, 16, FilterKind::Box);
-    if (wavefront) {
-      const WavefrontTracer tracer(compiled, settings, 97);
-      EXPECT_FALSE(tracer.vectorised());
-      render(tracer, film);
-    } else {
-      render(ReferenceTracer(compiled, settings), film);
+    Film film(width, height, FilterKind::Box);
+    const WavefrontTracer tracer(compiled, settings, wave, {}, stages);
+    if (stages == WavefrontStages::Auto && vectorised_stages) {
+      EXPECT_EQ(tracer.vectorised(), vector_stages::cpu_supported()) << tracer.scalar_reason();
     }
+    render(tracer, film);
     return film.image();
   };
-  for (const bool wavefront : {false, true}) {
-    const Image a = render_image(wavefront, 1), b = render_image(wavefront, 2);
-    EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0) << wavefront;
-  }
+  const Image first = render_image(1, WavefrontTracer::kDefaultWaveSize);
+  for (const std::size_t wave : {std::size_t{17}, std::size_t{97}, WavefrontTracer::kDefaultWaveSize})
+    for (const int threads : {1, 2}) {
+      if (wave == WavefrontTracer::kDefaultWaveSize && threads == 1) continue;
+      const Image other = render_image(threads, wave);
+      std::size_t differing = 0;
+      for (std::size_t i = 0; i < first.pixels.size(); ++i)
+        differing += std::memcmp(&first.pixels[i], &other.pixels[i], sizeof(vec3)) != 0 ? 1 : 0;
+      EXPECT_EQ(differing, 0u) << (stages == WavefrontStages::Scalar ? "scalar stages" : "stages as the scene allows")
+                               << ", wave size " << wave << ", " << threads << " thread(s): " << differing << " of "
+                               << first.pixels.size() << " pixels differ from 1 thread at wave size 4096";
+    }
+}
+
+Scene small_bulb(LightSampling sampling) {
+  Scene scene = cornell_with_bulb();
+  scene.film.width = scene.film.height = 32;
+  scene.render.spp = 4;
+  scene.render.light_sampling = sampling;
+  return scene;
+}
+
+TEST(Wavefront, SphereLightSameBitsForAnyWaveSizeAndThreads) {
+  expect_same_bits_for_any_wave_size(small_bulb(LightSampling::Area), WavefrontStages::Auto);
+}
+
+TEST(Wavefront, SolidAngleSphereLightSameBitsForAnyWaveSizeAndThreads) {
+  expect_same_bits_for_any_wave_size(small_bulb(LightSampling::SolidAngle), WavefrontStages::Auto);
+}
+
+// The Cornell box with a diffuse true sphere on its floor (not a light).
+Scene cornell_with_ball() {
+  Scene scene = builtin_cornell_box();
+  Shape ball;
+  ball.description = "ball";
+  ball.kind = Shape::Kind::Sphere;
+  ball.center = vec3(-0.35f, -0.6f, 0.15f);
+  ball.radius = 0.4f;
+  ball.material = scene.shapes.front().material;
+  scene.shapes.push_back(ball);
+  scene.film.width = scene.film.height = 32;
+  scene.render.spp = 8;
+  return scene;
+}
+
+TEST(Wavefront, DiffuseSphereSameBitsForAnyWaveSizeAndThreads) {
+  expect_same_bits_for_any_wave_size(cornell_with_ball(), WavefrontStages::Auto, true);
+  expect_same_bits_for_any_wave_size(cornell_with_ball(), WavefrontStages::Scalar);
+}
+
+// And the reference tracer for one thread and two on the bulb.
+TEST(Wavefront, SolidAngleSphereLightSameBitsForOneAndTwoThreads) {
+  expect_same_bits_for_one_and_two_threads(small_bulb(LightSampling::SolidAngle));
 }
 
 // A textured scene (texture lookups, cones, normal maps, textured emission).
@@ -372,7 +422,19 @@ struct VectorCase {
   bool thin_lens = false;
   bool tilted = false;  // the whole scene turned off the axes, so that no normal is axis-aligned
   bool crowded = false;  // more than 16 shapes and lights (tables gathered, not permuted)
+  bool one_sided = false;  // every diffuse material one-sided, and every other mesh turned inside out
+                           // (its triangles' winding reversed), so that paths meet backs too
 };
+
+// Every diffuse material one-sided (black behind its geometric normal), and
+// every other mesh's triangles wound the other way round.
+void make_one_sided(Scene& scene) {
+  for (Material& m : scene.materials)
+    if (m.type == MaterialType::Diffuse) m.one_sided = true;
+  for (std::size_t i = 0; i < scene.shapes.size(); i += 2)
+    if (scene.shapes[i].kind == Shape::Kind::Triangles && !scene.materials[scene.shapes[i].material].emits())
+      for (glm::uvec3& t : scene.shapes[i].mesh.triangles) std::swap(t.y, t.z);
+}
 
 // The scene and its camera turned by 37 degrees about (1, 2, 3).
 void tilt(Scene& scene) {
@@ -436,6 +498,7 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   if (c.rr_depth >= 0) scene.render.rr_depth = c.rr_depth;
   if (c.tilted) tilt(scene);
   if (c.crowded) crowd(scene);
+  if (c.one_sided) make_one_sided(scene);
   if (c.thin_lens) {
     scene.camera.aperture_radius = 0.1f;
     scene.camera.focus_distance = 3.0f;
@@ -487,6 +550,9 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"", st, 0.0f, -1, false, false, true});
   cases.push_back({"white-sphere-emissive-room.json", Strategy::Mis, 0.0f, -1, false, false, true});
+  for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"", st, 0.0f, 0, false, false, false, true});
+  cases.push_back({"white-sphere-emissive-room.json", Strategy::Mis, 0.0f, 0, false, false, false, true});
   return cases;
 }
 
@@ -496,7 +562,7 @@ INSTANTIATE_TEST_SUITE_P(LambertScenes, VectorStages, testing::ValuesIn(vector_c
                                            strategy_name(p.param.strategy) + (p.param.min_pdf > 0 ? "_min_pdf" : "") +
                                            (p.param.rr_depth >= 0 ? "_rr" + std::to_string(p.param.rr_depth) : "") +
                                            (p.param.tilted ? "_tilted" : "") + (p.param.thin_lens ? "_thin_lens" : "") +
-                                           (p.param.crowded ? "_crowded" : "");
+                                           (p.param.crowded ? "_crowded" : "") + (p.param.one_sided ? "_one_sided" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;

@@ -10,6 +10,7 @@ packages=(
   libopenexr-dev          # OpenEXR 3.1
   libtbb-dev              # oneTBB: the parallel-for
   libglm-dev              # vector math
+  libhwy-dev              # Google Highway 1.0: SIMD code written once, dispatched at run time (core/simd/)
   nlohmann-json3-dev      # scene files, JSON output
   libtinyobjloader-dev    # OBJ meshes
   libtinygltf-dev         # glTF 2.0 files (header only: core/gltf_loader.cpp)

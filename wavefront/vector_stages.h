@@ -1,6 +1,6 @@
 // The wavefront's stages run 16 paths at a time in AVX-512 registers, over
 // paths kept as one array per scalar (structure of arrays), for scenes that
-// need nothing more than Lambert surfaces and triangle area lights (the
+// need nothing more than Lambert surfaces, one- or two-sided, and triangle area lights (the
 // dragon benchmark, the Cornell box; meshes and spheres, any camera). Other
 // scenes, and machines without AVX-512, run the scalar stages of
 // wavefront_tracer.cpp.
@@ -80,6 +80,7 @@ enum ShapeField : int {
   kCenter = 12,        // 3 floats (a sphere)
   kRadius = 15,        // a sphere's radius
   kFlipped = 16,       // 1 if a sphere's normals point inwards
+  kOneSided = 17,      // 1 if its material is one-sided (black from behind the geometric normal)
   kShapeFields = 32,
 };
 

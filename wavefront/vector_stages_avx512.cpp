@@ -24,6 +24,7 @@ using I = __m512i;
 using M = __mmask16;
 
 constexpr float kInvPi = 1.0f / 3.14159265358979323846f;  // core/math.h
+constexpr float kGamma3 = (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);  // gamma_bound(3), core/geometry.h
 constexpr float kGamma7 = (7.0f * 0x1p-24f) / (1.0f - 7.0f * 0x1p-24f);  // gamma_bound(7), core/geometry.h
 
 F k(float v) { return _mm512_set1_ps(v); }
@@ -472,6 +473,9 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     const V3 wo = neg(load3(w, kDx, i0, ok));
     const V3 n = load3(w, kNx, i0, ok);  // the frame's normal is the surface's
     const F wo_z = dot(wo, n);
+    // A one-sided material is black unless wo and wi both leave its front
+    // (Surfel::eval); with wo in front, upper below is wi in front.
+    ok &= ~shape_flag(ok, sc, load(w, kShape, i0, ok), kOneSided) | gt(wo_z, k(0.0f));
     F wi_z = dot(wi, n);
     wi_z = select(lt(wo_z, k(0.0f)), neg(wi_z), wi_z);
     const M upper = gt(wi_z, k(0.0f));
@@ -491,7 +495,8 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     // path order (add_light() finds them again by kHasQuery).
     const V3 err = load3(w, kErrX, i0, ok);
     const V3 origin = offset_ray_origin(sp, err, select(ge(dot(d, n), k(0.0f)), n, neg(n)));
-    const V3 end = offset_ray_origin(lp, lerr, select(ge(dot(sub(origin, lp), ln), k(0.0f)), ln, neg(ln)));
+    const V3 reach = mul(k(kGamma3), abs(sub(lp, origin)));  // the float ray's own reach error
+    const V3 end = offset_ray_origin(lp, add(lerr, reach), select(ge(dot(sub(origin, lp), ln), k(0.0f)), ln, neg(ln)));
     const V3 dd = sub(end, origin);
     const F len = _mm512_sqrt_ps(dot(dd, dd));
     const V3 dir = div(dd, len);
@@ -544,6 +549,8 @@ void scatter(const Scene& sc, const Wave& w) {
     ok &= _mm512_cmp_ps_mask(pdf, k(0.0f), _CMP_NLE_UQ) & _mm512_cmp_ps_mask(pdf, k(sc.min_pdf), _CMP_NLT_UQ);
     const V3 wo = neg(load3(w, kDx, i0, ok));
     const V3 n = load3(w, kNx, i0, ok);
+    // Surfel::scatter: nothing from behind a one-sided material.
+    ok &= ~shape_flag(ok, sc, load(w, kShape, i0, ok), kOneSided) | gt(dot(wo, n), k(0.0f));
     V3 fs, ft;
     frame(n, &fs, &ft);
     const F side = select(lt(dot(wo, n), k(0.0f)), k(-1.0f), k(1.0f));

@@ -106,6 +106,11 @@ struct WavefrontTracer::Wave {
     if (cone.size() < size) cone.resize(size), params.resize(size);
   }
   float u(std::size_t i, Dim dim) const { return rng[i].get(static_cast<std::uint32_t>(vertex[i]), dim); }
+  // A 2D pair: u(i, x), u(i, x + 1) (SampleStream::get2).
+  vec2 u2(std::size_t i, Dim first) const {
+    const SampleStream::Pair p = rng[i].get2(static_cast<std::uint32_t>(vertex[i]), first);
+    return vec2(p.x, p.y);
+  }
 };
 
 namespace {
@@ -174,7 +179,6 @@ struct WavefrontTracer::VectorStages {
       if (m.type == MaterialType::Emissive) continue;  // never scatters
       if (m.type != MaterialType::Diffuse)
         return no("material '" + m.name + "' is " + material_type_name(m.type) + ", not diffuse");
-      if (m.one_sided) return no("material '" + m.name + "' is one-sided");
       if (m.shading.path != ShadingPath::LambertOnly)
         return no(std::string("shading path ") + shading_path_name(m.shading.path));
       if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return no("materials with different min_pdf");
@@ -243,6 +247,7 @@ struct WavefrontTracer::VectorStages {
       f[vs::kIsSphere] = sh.kind == Shape::Kind::Sphere ? 1.0f : 0.0f;
       f[vs::kRadius] = sh.radius;
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
+      f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
     }
     sc.shape = v->shape.data();
@@ -437,7 +442,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
       }
     }
     if (samples_area_lights(strategy, w.u(i, Dim::Technique))) {
-      const auto ls = lights.sample(light_query(s, wo), w.u(i, Dim::LightChoice), vec2(w.u(i, Dim::LightX), w.u(i, Dim::LightY)));
+      const auto ls = lights.sample(light_query(s, wo), w.u(i, Dim::LightChoice), w.u2(i, Dim::LightX));
       if (!ls) {
         if (obs && lights.has_area_lights()) w.shadow_state[2 * i + 1] = rejected_state(LightRejection::NoSample);
         continue;
@@ -512,7 +517,7 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
     const Surfel& s = w.surfel[i];
     const vec3 wo = -w.ray[i].dir;
     const int v = w.vertex[i];
-    const vec2 u_dir(w.u(i, Dim::DirectionX), w.u(i, Dim::DirectionY));
+    const vec2 u_dir = w.u2(i, Dim::DirectionX);
     const bool cosine = strategy == Strategy::Cosine && !s.material->is_pure_impulse();
     const std::optional<BsdfSample> bs = cosine ? s.scatter_cosine(wo, u_dir) : s.scatter(wo, w.u(i, Dim::LobeChoice), u_dir);
     if (!bs || is_black(bs->weight)) {
@@ -577,8 +582,8 @@ void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
   }
   for (std::size_t i = 0; i < w.n; ++i) {
     w.vertex[i] = 0;  // the camera's random numbers are those of vertex 0
-    w.film[i] = vec2(static_cast<float>(w.x[i]) + w.u(i, Dim::FilmX), static_cast<float>(w.y[i]) + w.u(i, Dim::FilmY));
-    w.ray[i] = camera.generate_ray(w.film[i], vec2(w.u(i, Dim::LensX), w.u(i, Dim::LensY)));
+    w.film[i] = vec2(static_cast<float>(w.x[i]), static_cast<float>(w.y[i])) + w.u2(i, Dim::FilmX);
+    w.ray[i] = camera.generate_ray(w.film[i], w.u2(i, Dim::LensX));
     w.ray[i].alpha_key = scene_.alpha_key(w.rng[i], 0);
     w.beta[i] = Spectrum(1.0f);
     w.L[i] = Spectrum(0.0f);

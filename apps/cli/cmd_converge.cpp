@@ -1,6 +1,7 @@
 // pathlab converge SCENE [--reference ref.exr] [--tracers T,...] [--strategies S,...]
 //                  [--spp 1,4,16,...] [--time-budgets SEC,...] [--seeds R] [--clamps C,...]
-//                  [--max-depths D,...] [--exclude-emitters] [--target-rmse X] [--threads N] --out DIR
+//                  [--max-depths D,...] [--sampler K | --samplers A,B] [--light-samplings A,B]
+//                  [--exclude-emitters] [--target-rmse X] [--threads N] --out DIR
 #include "apps/cli/commands.h"
 #include "apps/cli/validators.h"
 
@@ -23,12 +24,16 @@ void ConvergeCommand::add_to(CLI::App& app) {
   cmd->add_option("--tracers", options.tracers, "Tracers, comma-separated: reference, wavefront (default: both)")->delimiter(',');
   cmd->add_option("--strategies", strategies, "Strategies, comma-separated (default: all five)")->delimiter(',');
   CLI::Option* one_sampler =
-      cmd->add_option("--sampler", sampler, "Sampler of every render: independent or zsobol")
+      cmd->add_option("--sampler", sampler, "Sampler of every render: independent or zsobol (default: both, compared)")
           ->check(CLI::IsMember({"independent", "zsobol"}));
-  cmd->add_option("--samplers", samplers, "Samplers to compare, comma-separated: independent, zsobol (default: the scene's)")
+  cmd->add_option("--samplers", samplers, "Samplers to compare, comma-separated: independent, zsobol (default: both)")
       ->delimiter(',')
       ->check(CLI::IsMember({"independent", "zsobol"}))
       ->excludes(one_sampler);
+  cmd->add_option("--light-samplings", light_samplings,
+                  "How to sample a point on an area light, comma-separated: area, solid_angle (default: the scene's)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"area", "solid_angle"}));
   cmd->add_option("--spp", options.spp, "The samples-per-pixel ladder, increasing, comma-separated")
       ->delimiter(',')
       ->check(CLI::Range(1, 1 << 24));
@@ -59,7 +64,10 @@ int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
     if (!st) throw InputError("--strategies: unknown strategy '" + s + "' (expected cosine, bsdf, light, light+bsdf or mis)");
     o.strategies.push_back(*st);
   }
+  if (!samplers.empty()) o.samplers.clear();
   for (const std::string& s : samplers) o.samplers.push_back(*parse_sampler(s));  // checked by CLI11
+  if (sampler) o.samplers = {*parse_sampler(*sampler)};
+  for (const std::string& s : light_samplings) o.light_samplings.push_back(*parse_light_sampling(s));  // checked by CLI11
   // Fail on an unwritable folder now, not after the sweep; on any failure
   // remove the folder again if this run made it and it is still empty.
   const std::filesystem::path dir(out_dir);

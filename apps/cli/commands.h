@@ -118,6 +118,7 @@ struct ConvergeCommand {
   std::vector<std::string> strategies;  // -> options.strategies
   std::vector<std::string> samplers;    // --samplers A,B -> options.samplers
   std::optional<std::string> sampler;   // --sampler K: the scene's sampler
+  std::vector<std::string> light_samplings;  // --light-samplings A,B -> options.light_samplings
   std::optional<double> target_rmse;
   std::optional<std::string> resolution;  // "WxH"
   int threads = 0;

@@ -11,6 +11,7 @@ goes on. Python's standard library only.
 
   tools/mutate/run.py                          # every mutation, the whole suite
   tools/mutate/run.py --subset fast            # the fast closed-form tests only
+  tools/mutate/run.py --subset fast,unit,full  # a cascade: each mutant meets the cheaper tests first
   tools/mutate/run.py --only 'bsdf-*' --only film-variance-no-bessel
   tools/mutate/run.py --test pathlab_unit_tests:'Film*:Bsdf*' --test pathlab_value_tests
 
@@ -80,7 +81,10 @@ class Scratch:
         else:
             run(["git", "-C", str(self.path), "checkout", "--quiet", "--detach", head])
         self.reset()
-        self.log = open(self.path / "mutate.log", "w")  # untracked, beside build-mutate/
+        # Inside the (ignored) build folder: an untracked log in the tree would
+        # name this machine's paths and fail pathlab_portable.
+        self.build.mkdir(parents=True, exist_ok=True)
+        self.log = open(self.build / "mutate.log", "w")
         if not (self.build / "build.ninja").exists():
             rc, out = run(["cmake", "-S", str(self.path), "-B", str(self.build), "-G", "Ninja",
                            "-DPATHLAB_WERROR=ON"] + self.cmake_args)
@@ -158,8 +162,11 @@ def main():
     ap.add_argument("--mutations", type=Path, default=here / "mutations", help="directory of *.patch files")
     ap.add_argument("--only", action="append", default=[], metavar="GLOB",
                     help="run only the mutations whose name matches (repeatable)")
-    ap.add_argument("--subset", choices=sorted(SUBSETS), default="full",
-                    help="test selection: full (default: the whole suite), unit, fast (pathlab_value_tests)")
+    ap.add_argument("--subset", default="full",
+                    help="test selection: full (default: the whole suite), unit, fast (pathlab_value_tests), or a "
+                         "cascade of them, comma-separated (fast,unit,full): a mutant goes on to the next selection "
+                         "only if it survived the last, so the verdict is the last selection's at a fraction of its "
+                         "cost when each selection contains the one before")
     ap.add_argument("--test", action="append", default=[], metavar="BINARY[:GTEST_FILTER]",
                     help="run these test binaries instead of --subset (repeatable)")
     ap.add_argument("--all-tests", action="store_true",
@@ -169,7 +176,11 @@ def main():
     ap.add_argument("--data-dir", default=os.environ.get("PATHLAB_DATA_DIR", ""),
                     help="-DPATHLAB_DATA_DIR for the scratch build (default: $PATHLAB_DATA_DIR)")
     ap.add_argument("--cmake-arg", action="append", default=[], help="extra cmake configure argument")
-    ap.add_argument("--results", type=Path, default=None, help="write the results as JSON here")
+    ap.add_argument("--results", type=Path, default=None,
+                    help="write the results as JSON here (rewritten after every mutant)")
+    ap.add_argument("--resume", action="store_true",
+                    help="with --results: keep the verdicts already in that file for the same HEAD and test "
+                         "selection, and run only the other mutations")
     ap.add_argument("--list", action="store_true", help="list the mutations and exit")
     args = ap.parse_args()
 
@@ -183,55 +194,93 @@ def main():
             print(f"{p.stem:40s} {','.join(patched_files(p)):45s} {describe(p)}")
         return 0
 
-    selection = {"tests": args.test} if args.test else SUBSETS[args.subset]
+    if args.test:
+        stages = [("tests", {"tests": args.test})]
+    else:
+        names = [n.strip() for n in args.subset.split(",") if n.strip()]
+        unknown = [n for n in names if n not in SUBSETS]
+        if not names or unknown:
+            sys.exit(f"mutate: --subset {args.subset!r}: expected one or more of {', '.join(sorted(SUBSETS))}")
+        stages = [(n, SUBSETS[n]) for n in names]
+    tests_label = args.test or args.subset
     cmake_args = list(args.cmake_arg) + ([f"-DPATHLAB_DATA_DIR={args.data_dir}"] if args.data_dir else [])
     scratch_path = args.scratch.resolve()
     scratch_path.parent.mkdir(parents=True, exist_ok=True)
     scratch = Scratch(args.repo.resolve(), scratch_path, scratch_path / "build-mutate", cmake_args, args.jobs)
     head = scratch.prepare()
-    log_path = scratch_path / "mutate.log"
+    log_path = scratch_path / "build-mutate" / "mutate.log"
+    done = {}
+    if args.resume and args.results and args.results.exists():
+        previous = json.loads(args.results.read_text())
+        if previous.get("head") == head and previous.get("tests") == tests_label:
+            done = {r["mutation"]: r for r in previous["results"]}
+        else:
+            print(f"mutate: {args.results} is of another HEAD or test selection: starting afresh", flush=True)
+
+    def save(results):
+        if args.results:
+            counts = {k: sum(r["status"] == v for r in results)
+                      for k, v in (("killed", "KILLED"), ("survived", "SURVIVED"), ("build_failed", "BUILD-FAILED"))}
+            tmp = args.results.with_name(args.results.name + ".tmp")
+            tmp.write_text(json.dumps({"head": head, "tests": tests_label, "results": results, **counts}, indent=1))
+            tmp.replace(args.results)
+
     with scratch.log as log:
-        targets = build_targets_of(selection)
         print(f"mutate: {len(patches)} mutation(s) of {head[:12]} in {scratch_path}, tests: "
-              f"{args.test or args.subset}; log {log_path}", flush=True)
+              f"{tests_label}; log {log_path}", flush=True)
 
         # The unmutated tree must build and pass, or every mutant looks killed.
         t0 = time.time()
-        rc, out = scratch.build_targets(targets, args.timeout)
-        log.write(out)
-        if rc != 0:
-            sys.exit(f"mutate: the unmutated tree does not build (see {log_path})")
-        killer, out = run_selection(scratch, selection, args.timeout, True)
-        log.write(out)
-        if killer:
-            sys.exit(f"mutate: the unmutated tree fails its tests ({killer}); fix that first")
+        for name, selection in stages:
+            rc, out = scratch.build_targets(build_targets_of(selection), args.timeout)
+            log.write(out)
+            if rc != 0:
+                sys.exit(f"mutate: the unmutated tree does not build (see {log_path})")
+            killer, out = run_selection(scratch, selection, args.timeout, True)
+            log.write(out)
+            if killer:
+                sys.exit(f"mutate: the unmutated tree fails its tests ({name}: {killer}); fix that first")
         print(f"mutate: baseline builds and passes ({time.time() - t0:.0f} s)", flush=True)
 
         results = []
         for patch in patches:
+            if patch.stem in done:
+                results.append(done[patch.stem])
+                print(f"  {patch.stem:40s} {done[patch.stem]['status']:12s} (kept from {args.results})", flush=True)
+                continue
             t0 = time.time()
             scratch.reset()
             log.write(f"\n===== {patch.stem} =====\n")
             ok, out = scratch.apply(patch)
+            stage = ""
             if not ok:
                 first = out.strip().splitlines()[0] if out.strip() else ""
                 status, killer = "BUILD-FAILED", "patch does not apply: " + first
             else:
-                rc, out = scratch.build_targets(targets, args.timeout)
-                log.write(out)
-                if rc != 0:
-                    status, killer = "BUILD-FAILED", "compile error" if rc != 124 else "build timed out"
-                else:
+                status, killer = "SURVIVED", None
+                for name, selection in stages:
+                    stage = name
+                    rc, out = scratch.build_targets(build_targets_of(selection), args.timeout)
+                    log.write(out)
+                    if rc != 0:
+                        status, killer = "BUILD-FAILED", "compile error" if rc != 124 else "build timed out"
+                        break
                     killer, out = run_selection(scratch, selection, args.timeout, args.all_tests)
                     log.write(out)
-                    status = "KILLED" if killer else "SURVIVED"
+                    if killer:
+                        status = "KILLED"
+                        break
             scratch.reset()
             r = {"mutation": patch.stem, "files": patched_files(patch), "what": describe(patch), "status": status,
-                 "killed_by": killer or "", "seconds": round(time.time() - t0, 1)}
+                 "killed_by": killer or "", "stage": stage if len(stages) > 1 else "",
+                 "seconds": round(time.time() - t0, 1)}
             results.append(r)
-            print(f"  {r['mutation']:40s} {status:12s} {r['killed_by']}", flush=True)
+            save(results)
+            print(f"  {r['mutation']:40s} {status:12s} {(r['stage'] + ': ') if r['stage'] else ''}{r['killed_by']}",
+                  flush=True)
         # Leave the scratch tree clean and its build matching it.
-        scratch.build_targets(targets, args.timeout)
+        for _, selection in stages:
+            scratch.build_targets(build_targets_of(selection), args.timeout)
 
     killed = sum(r["status"] == "KILLED" for r in results)
     survived = sum(r["status"] == "SURVIVED" for r in results)
@@ -239,13 +288,12 @@ def main():
     print()
     print(f"{'mutation':40s} {'file':42s} {'status':12s} killed by")
     for r in results:
-        print(f"{r['mutation']:40s} {','.join(r['files'])[:42]:42s} {r['status']:12s} {r['killed_by']}")
+        by = (r.get("stage") + ": " if r.get("stage") else "") + r["killed_by"]
+        print(f"{r['mutation']:40s} {','.join(r['files'])[:42]:42s} {r['status']:12s} {by}")
     rate = 100.0 * killed / (killed + survived) if killed + survived else 0.0
     print(f"\nkilled {killed}, survived {survived}, build-failed {failed}: kill rate {rate:.1f} % "
           f"({killed}/{killed + survived} of the mutants that built)")
-    if args.results:
-        args.results.write_text(json.dumps({"head": head, "tests": args.test or args.subset, "results": results,
-                                            "killed": killed, "survived": survived, "build_failed": failed}, indent=1))
+    save(results)
     return 0
 
 

@@ -1,0 +1,70 @@
+// Sample warps of core/sampling.h written once over Highway's vectors:
+// core/sampling.cpp calls them at width 1 for both tracers' scalar code,
+// and vectorised code calls them at the width of its SIMD target. Every
+// lane computes the bits the width-1 call computes (core/simd/simd.h says
+// why; tests/test_simd.cpp checks it on every target this machine runs).
+//
+// Highway's "-inl.h" convention: no include guard but the toggle below, so
+// that foreach_target.h can include this file once per target, each time
+// inside that target's namespace and with its instruction set enabled.
+#if defined(PATHLAB_CORE_SIMD_SAMPLING_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef PATHLAB_CORE_SIMD_SAMPLING_INL_H_
+#undef PATHLAB_CORE_SIMD_SAMPLING_INL_H_
+#else
+#define PATHLAB_CORE_SIMD_SAMPLING_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace pathlab::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+// sin and cos of x for |x| <= pi/4: Cephes' single-precision minimax
+// polynomials (sinf, cosf), |error| < 2 ulp there, evaluated term by term
+// in this order (no FMA), so that every target and width rounds alike.
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE void sin_cos_quarter(D d, V x, V& sin, V& cos) {
+  const V z = x * x;
+  sin = ((((hn::Set(d, -1.9515295891e-4f) * z) + hn::Set(d, 8.3321608736e-3f)) * z) - hn::Set(d, 1.6666654611e-1f)) *
+            z * x +
+        x;
+  cos = ((((hn::Set(d, 2.443315711809948e-5f) * z) - hn::Set(d, 1.388731625493765e-3f)) * z +
+          hn::Set(d, 4.166664568298827e-2f)) *
+             z * z -
+         hn::Set(d, 0.5f) * z) +
+        hn::Set(d, 1.0f);
+}
+
+// Shirley and Chiu's concentric map, square [0,1)^2 -> unit disk, area
+// preserving. With o = 2u - 1: in the left and right wedges (|o.x| > |o.y|)
+// the point is o.x (cos t, sin t) with t = (pi/4)(o.y / o.x); in the top and
+// bottom ones o.y (sin p, cos p) with p = (pi/4)(o.x / o.y). The centre maps
+// to 0 (where both ratios are 0/0).
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE void concentric_disk(D d, V ux, V uy, V& x, V& y) {
+  const V ox = hn::Set(d, 2.0f) * ux - hn::Set(d, 1.0f);
+  const V oy = hn::Set(d, 2.0f) * uy - hn::Set(d, 1.0f);
+  const auto wide = hn::Abs(ox) > hn::Abs(oy);
+  const V r = hn::IfThenElse(wide, ox, oy);
+  V s, c;
+  sin_cos_quarter(d, hn::Set(d, 3.14159265358979323846f / 4.0f) * (hn::IfThenElse(wide, oy, ox) / r), s, c);
+  const auto centre = hn::And(ox == hn::Zero(d), oy == hn::Zero(d));
+  x = hn::IfThenZeroElse(centre, r * hn::IfThenElse(wide, c, s));
+  y = hn::IfThenZeroElse(centre, r * hn::IfThenElse(wide, s, c));
+}
+
+// Cosine-weighted direction about +z (Malley's method): the disk point
+// lifted to the hemisphere, z = sqrt(max(0, (1 - x x) - y y)). Max(v, 0)
+// in that order: x86's max returns its second operand for a NaN or for
+// -0 against +0, so this is std::max(0.0f, v) exactly, NaN included.
+template <class D, class V = hn::Vec<D>>
+HWY_INLINE void cosine_hemisphere(D d, V ux, V uy, V& x, V& y, V& z) {
+  concentric_disk(d, ux, uy, x, y);
+  z = hn::Sqrt(hn::Max(hn::Set(d, 1.0f) - x * x - y * y, hn::Zero(d)));
+}
+
+}  // namespace pathlab::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // PATHLAB_CORE_SIMD_SAMPLING_INL_H_ toggle
