@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <utility>
 
 namespace pathlab {
 
@@ -66,6 +67,8 @@ std::string config_label(const ConvergeConfig& c, const ConvergeOptions& o) {
   if (o.samplers.size() > 1 || c.sampler != SamplerKind::Independent) label += std::string(" ") + sampler_name(c.sampler);
   if (o.light_samplings.size() > 1 || c.light_sampling != LightSampling::Area)
     label += std::string(" ") + light_sampling_name(c.light_sampling);
+  if (o.light_samplers.size() > 1 || c.light_sampler != LightSamplerKind::Power)
+    label += std::string(" ") + light_sampler_name(c.light_sampler);
   return label;
 }
 
@@ -310,25 +313,31 @@ ConvergeResult run_converge(const Scene& scene, const ConvergeOptions& options, 
   const std::vector<LightSampling> light_samplings = options.light_samplings.empty()
                                                          ? std::vector<LightSampling>{scene.render.light_sampling}
                                                          : options.light_samplings;
+  const std::vector<LightSamplerKind> light_samplers = options.light_samplers.empty()
+                                                           ? std::vector<LightSamplerKind>{scene.render.light_sampler}
+                                                           : options.light_samplers;
   for (const std::string& t : options.tracers)
     for (Strategy s : strategies)
       for (float c : options.clamps)
         for (int d : depths)
           for (SamplerKind k : samplers)
-            for (LightSampling ls : light_samplings) {
-              ConvergeConfig cfg{t, s, c, d, {}, k, ls};
-              cfg.label = config_label(cfg, options);
-              result.configs.push_back(cfg);
-            }
-  // The light sampler is part of the compiled scene: one per light-sampling
-  // value, the scene's own already made above.
-  std::map<LightSampling, std::unique_ptr<const CompiledScene>> recompiled;
-  auto compiled_for = [&](LightSampling ls) -> const CompiledScene& {
-    if (ls == scene.render.light_sampling) return compiled;
-    auto& c = recompiled[ls];
+            for (LightSampling ls : light_samplings)
+              for (LightSamplerKind lk : light_samplers) {
+                ConvergeConfig cfg{t, s, c, d, {}, k, ls, lk};
+                cfg.label = config_label(cfg, options);
+                result.configs.push_back(cfg);
+              }
+  // The light sampler is part of the compiled scene: one per (light
+  // sampling, light sampler) pair, the scene's own already made above.
+  std::map<std::pair<LightSampling, LightSamplerKind>, std::unique_ptr<const CompiledScene>> recompiled;
+  auto compiled_for = [&](const ConvergeConfig& cfg) -> const CompiledScene& {
+    if (cfg.light_sampling == scene.render.light_sampling && cfg.light_sampler == scene.render.light_sampler)
+      return compiled;
+    auto& c = recompiled[{cfg.light_sampling, cfg.light_sampler}];
     if (!c) {
       Scene copy = scene;
-      copy.render.light_sampling = ls;
+      copy.render.light_sampling = cfg.light_sampling;
+      copy.render.light_sampler = cfg.light_sampler;
       c = std::make_unique<const CompiledScene>(std::move(copy));
     }
     return *c;
@@ -346,11 +355,12 @@ ConvergeResult run_converge(const Scene& scene, const ConvergeOptions& options, 
       settings.max_depth = cfg.max_depth;
       settings.sampler = cfg.sampler;
       settings.light_sampling = cfg.light_sampling;
+      settings.light_sampler = cfg.light_sampler;
       // zsobol lays each pixel's samples out for spp rounded up to a power of
       // two: the ladder's last rung makes the whole ladder one run.
       if (cfg.sampler != SamplerKind::Independent && !options.spp.empty()) settings.spp = options.spp.back();
       settings.seed = scene.render.seed + static_cast<std::uint64_t>(r);
-      const auto tracer = make_tracer(cfg.tracer, compiled_for(cfg.light_sampling), settings);
+      const auto tracer = make_tracer(cfg.tracer, compiled_for(cfg), settings);
       // The ladder: each rung extends the film of the last.
       Film film(result.width, result.height, scene.film.filter);
       double seconds = 0.0, samples = 0.0;
@@ -399,14 +409,15 @@ std::string budget_text(const ConvergeRow& r) { return r.time_budget ? fmt(r.bud
 std::string converge_csv(const ConvergeResult& result) {
   std::ostringstream out;
   out << "tracer,strategy,clamp,max_depth,budget_kind,budget,seeds,spp,seconds,samples_per_second,rmse,rmse_sd,rel_mse,"
-         "bias,bias_se,efficiency,sampler,light_sampling\n";
+         "bias,bias_se,efficiency,sampler,light_sampling,light_sampler\n";
   for (const ConvergeRow& r : result.rows) {
     const ConvergeConfig& c = result.configs[r.config];
     out << c.tracer << "," << strategy_name(c.strategy) << "," << fmt(c.clamp) << "," << c.max_depth << ","
         << (r.time_budget ? "time" : "spp") << "," << fmt(r.budget) << "," << r.rmse_per_seed.size() << ","
         << fmt(r.spp) << "," << fmt(r.seconds) << "," << fmt(r.samples_per_second) << "," << fmt(r.rmse) << ","
         << fmt(r.rmse_sd) << "," << fmt(r.rel_mse) << "," << fmt(r.bias) << "," << fmt(r.bias_se) << ","
-        << fmt(r.efficiency) << "," << sampler_name(c.sampler) << "," << light_sampling_name(c.light_sampling) << "\n";
+        << fmt(r.efficiency) << "," << sampler_name(c.sampler) << "," << light_sampling_name(c.light_sampling) << ","
+        << light_sampler_name(c.light_sampler) << "\n";
   }
   return out.str();
 }

@@ -37,6 +37,9 @@ struct ConvergeOptions {
   // How a point on a picked area light is sampled (render.light_sampling);
   // empty: the scene's. Each value compiles the scene once more.
   std::vector<LightSampling> light_samplings;
+  // How an area light is picked (render.light_sampler: power, bvh); empty:
+  // the scene's. Each value compiles the scene once more too.
+  std::vector<LightSamplerKind> light_samplers;
   std::vector<int> spp{1, 4, 16, 64, 256, 1024};  // the ladder (progressive: each rung extends the last)
   std::vector<double> time_budgets;     // seconds, each rendered from scratch with render_until()
   int seeds = 4;                        // R: seeds scene.render.seed, +1, ..., +R-1
@@ -55,6 +58,7 @@ struct ConvergeConfig {
   std::string label;  // "reference mis", "+ clamp 4", "+ depth 2", "+ zsobol" when the sweep varies them
   SamplerKind sampler = SamplerKind::Independent;
   LightSampling light_sampling = LightSampling::Area;
+  LightSamplerKind light_sampler = LightSamplerKind::Power;
 };
 
 // One budget of one configuration, averaged over the seeds.

@@ -1,6 +1,6 @@
 // pathlab converge SCENE [--reference ref.exr] [--tracers T,...] [--strategies S,...]
 //                  [--spp 1,4,16,...] [--time-budgets SEC,...] [--seeds R] [--clamps C,...]
-//                  [--max-depths D,...] [--sampler K | --samplers A,B] [--light-samplings A,B]
+//                  [--max-depths D,...] [--sampler K | --samplers A,B] [--light-samplings A,B] [--light-samplers A,B]
 //                  [--exclude-emitters] [--target-rmse X] [--threads N] --out DIR
 #include "apps/cli/commands.h"
 #include "apps/cli/validators.h"
@@ -34,6 +34,10 @@ void ConvergeCommand::add_to(CLI::App& app) {
                   "How to sample a point on an area light, comma-separated: area, solid_angle (default: the scene's)")
       ->delimiter(',')
       ->check(CLI::IsMember({"area", "solid_angle"}));
+  cmd->add_option("--light-samplers", light_samplers,
+                  "How to pick an area light, comma-separated: power, bvh (default: the scene's)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"power", "bvh"}));
   cmd->add_option("--spp", options.spp, "The samples-per-pixel ladder, increasing, comma-separated")
       ->delimiter(',')
       ->check(CLI::Range(1, 1 << 24));
@@ -68,6 +72,7 @@ int ConvergeCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   for (const std::string& s : samplers) o.samplers.push_back(*parse_sampler(s));  // checked by CLI11
   if (sampler) o.samplers = {*parse_sampler(*sampler)};
   for (const std::string& s : light_samplings) o.light_samplings.push_back(*parse_light_sampling(s));  // checked by CLI11
+  for (const std::string& s : light_samplers) o.light_samplers.push_back(*parse_light_sampler(s));     // checked by CLI11
   // Fail on an unwritable folder now, not after the sweep; on any failure
   // remove the folder again if this run made it and it is still empty.
   const std::filesystem::path dir(out_dir);

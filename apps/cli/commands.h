@@ -119,6 +119,7 @@ struct ConvergeCommand {
   std::vector<std::string> samplers;    // --samplers A,B -> options.samplers
   std::optional<std::string> sampler;   // --sampler K: the scene's sampler
   std::vector<std::string> light_samplings;  // --light-samplings A,B -> options.light_samplings
+  std::vector<std::string> light_samplers;   // --light-samplers A,B -> options.light_samplers
   std::optional<double> target_rmse;
   std::optional<std::string> resolution;  // "WxH"
   int threads = 0;
