@@ -9,6 +9,7 @@
 #include "core/scene_loader.h"
 #include "reference/reference_tracer.h"
 
+#include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
@@ -17,6 +18,18 @@ namespace pathlab::test {
 
 inline std::filesystem::path analytic_scene(const std::string& name) {
   return std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / name;
+}
+
+// A gtest parameter name for an analytic check: "penumbra_box_mis_wavefront",
+// "..._solid_angle" under solid-angle light sampling.
+inline std::string analytic_case_name(const std::string& scene, Strategy strategy, bool wavefront,
+                                      LightSampling light_sampling) {
+  std::string s = scene.substr(0, scene.size() - 5) + "_" + strategy_name(strategy) +
+                  (wavefront ? "_wavefront" : "_reference") +
+                  (light_sampling == LightSampling::SolidAngle ? "_solid_angle" : "");
+  for (char& c : s)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return s;
 }
 
 inline std::vector<std::string> analytic_scene_names() {

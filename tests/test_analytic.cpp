@@ -56,13 +56,8 @@ std::vector<Case> all_cases() {
 
 INSTANTIATE_TEST_SUITE_P(Reference, AnalyticScenes, testing::ValuesIn(all_cases()),
                          [](const testing::TestParamInfo<Case>& p) {
-                           std::string s = p.param.scene.substr(0, p.param.scene.size() - 5) + "_" +
-                                           strategy_name(p.param.strategy) +
-                                           (p.param.wavefront ? "_wavefront" : "_reference") +
-                                           (p.param.light_sampling == LightSampling::SolidAngle ? "_solid_angle" : "");
-                           for (char& c : s)
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           return s;
+                           return test::analytic_case_name(p.param.scene, p.param.strategy, p.param.wavefront,
+                                                           p.param.light_sampling);
                          });
 
 // Editing the parameters the models read keeps the check passing.
