@@ -48,6 +48,13 @@ std::string meta_value(const ImageMetadata& meta, const std::string& key) {
   return {};
 }
 
+// Field k (from 0) of a CSV line; converge.csv's RMSE is field 10.
+std::string csv_field(const std::string& line, int k) {
+  std::size_t b = 0;
+  for (int i = 0; i < k; ++i) b = line.find(',', b) + 1;
+  return line.substr(b, line.find(',', b) - b);
+}
+
 class ConvergeCli : public test::TempDirTest {};
 
 // Rows = tracers x strategies x clamps x budgets, one header line.
@@ -127,15 +134,10 @@ TEST_F(ConvergeCli, LightSamplingsAreAnAxisEachRenderedWithItsOwnSampler) {
     return line.size() >= end.size() && line.compare(line.size() - end.size(), end.size(), end) == 0;
   };
   EXPECT_TRUE(ends_with(csv[0], ",light_sampling,light_sampler")) << csv[0];
-  const auto field = [](const std::string& line, int k) {  // the k-th comma-separated field
-    std::size_t b = 0;
-    for (int i = 0; i < k; ++i) b = line.find(',', b) + 1;
-    return line.substr(b, line.find(',', b) - b);
-  };
   EXPECT_TRUE(ends_with(csv[1], ",area,power")) << csv[1];
   EXPECT_TRUE(ends_with(csv[3], ",solid_angle,power")) << csv[3];
   // Rung 4 spp of each: the RMSE (column 10) differs, as the images do.
-  EXPECT_NE(field(csv[2], 10), field(csv[4], 10)) << csv[2] << "\n" << csv[4];
+  EXPECT_NE(csv_field(csv[2], 10), csv_field(csv[4], 10)) << csv[2] << "\n" << csv[4];
   const std::string md = read_text(out / "converge.md");
   EXPECT_NE(md.find("| reference light solid_angle |"), std::string::npos) << md;
   EXPECT_NE(md.find("| reference light area |"), std::string::npos) << md;
@@ -159,12 +161,7 @@ TEST_F(ConvergeCli, LightSamplersAreAnAxisEachRenderedWithItsOwnSampler) {
   EXPECT_EQ(csv[0].substr(csv[0].rfind(',')), ",light_sampler");
   EXPECT_EQ(csv[1].substr(csv[1].rfind(',')), ",power");
   EXPECT_EQ(csv[2].substr(csv[2].rfind(',')), ",bvh");
-  const auto rmse = [](const std::string& line) {  // column 11 (0-based 10)
-    std::size_t b = 0;
-    for (int i = 0; i < 10; ++i) b = line.find(',', b) + 1;
-    return line.substr(b, line.find(',', b) - b);
-  };
-  EXPECT_NE(rmse(csv[1]), rmse(csv[2])) << csv[1] << "\n" << csv[2];
+  EXPECT_NE(csv_field(csv[1], 10), csv_field(csv[2], 10)) << csv[1] << "\n" << csv[2];
   EXPECT_NE(read_text(out / "converge.md").find("| reference light bvh |"), std::string::npos);
 }
 

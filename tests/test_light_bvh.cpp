@@ -170,43 +170,33 @@ TEST(LightBvh, LightsBehindTheSurfaceOrFacingAwayAreNeverPicked) {
 }
 
 // The importance formula, written here with angles (the implementation
-// subtracts cosines): one triangle's bounds at shading point q.
-double importance_by_hand(const std::array<vec3, 3>& t, double phi, const LightQuery& q) {
-  const dvec3 lo = glm::min(dvec3(t[0]), glm::min(dvec3(t[1]), dvec3(t[2])));
-  const dvec3 hi = glm::max(dvec3(t[0]), glm::max(dvec3(t[1]), dvec3(t[2])));
+// subtracts cosines): a node of bounds [lo, hi], power phi and one normal n
+// (theta_o = 0) at shading point q.
+double importance_by_hand(const dvec3& lo, const dvec3& hi, const dvec3& n, double phi, const LightQuery& q) {
   const dvec3 c = 0.5 * (lo + hi);
   const double r2 = glm::dot(hi - lo, hi - lo) / 4.0;
   const dvec3 d = dvec3(q.p) - c;
   const double d2 = glm::dot(d, d);
   const double theta_b = std::asin(std::sqrt(r2 / d2));
-  const dvec3 n = glm::normalize(glm::cross(dvec3(t[1] - t[0]), dvec3(t[2] - t[0])));
-  const double theta_w = std::acos(glm::dot(n, d / std::sqrt(d2)));
-  const double theta = std::max(0.0, theta_w - theta_b);
-  if (theta >= std::acos(-1.0) / 2.0) return 0.0;
-  const double theta_i = std::acos(glm::dot(dvec3(q.n), -d / std::sqrt(d2)));
-  const double theta_ip = std::max(0.0, theta_i - theta_b);
-  if (theta_ip >= std::acos(-1.0) / 2.0) return 0.0;
-  return phi * std::cos(theta) * std::cos(theta_ip) / std::max(d2, r2 / 4.0);
-}
-
-// The same for a node holding two triangles of one normal (their box, theta_o = 0).
-double importance_of_pair(const std::array<vec3, 3>& a, const std::array<vec3, 3>& b, double phi,
-                          const LightQuery& q) {
-  const dvec3 lo = glm::min(glm::min(dvec3(a[0]), glm::min(dvec3(a[1]), dvec3(a[2]))),
-                            glm::min(dvec3(b[0]), glm::min(dvec3(b[1]), dvec3(b[2]))));
-  const dvec3 hi = glm::max(glm::max(dvec3(a[0]), glm::max(dvec3(a[1]), dvec3(a[2]))),
-                            glm::max(dvec3(b[0]), glm::max(dvec3(b[1]), dvec3(b[2]))));
-  const dvec3 c = 0.5 * (lo + hi);
-  const double r2 = glm::dot(hi - lo, hi - lo) / 4.0;
-  const dvec3 d = dvec3(q.p) - c;
-  const double d2 = glm::dot(d, d);
-  const double theta_b = std::asin(std::sqrt(r2 / d2));
-  const dvec3 n = glm::normalize(glm::cross(dvec3(a[1] - a[0]), dvec3(a[2] - a[0])));
   const double theta = std::max(0.0, std::acos(glm::dot(n, d / std::sqrt(d2))) - theta_b);
   if (theta >= std::acos(-1.0) / 2.0) return 0.0;
   const double theta_ip = std::max(0.0, std::acos(glm::dot(dvec3(q.n), -d / std::sqrt(d2))) - theta_b);
   if (theta_ip >= std::acos(-1.0) / 2.0) return 0.0;
   return phi * std::cos(theta) * std::cos(theta_ip) / std::max(d2, r2 / 4.0);
+}
+dvec3 box_lo(const std::array<vec3, 3>& t) { return glm::min(dvec3(t[0]), glm::min(dvec3(t[1]), dvec3(t[2]))); }
+dvec3 box_hi(const std::array<vec3, 3>& t) { return glm::max(dvec3(t[0]), glm::max(dvec3(t[1]), dvec3(t[2]))); }
+dvec3 normal_of(const std::array<vec3, 3>& t) { return glm::normalize(glm::cross(dvec3(t[1] - t[0]), dvec3(t[2] - t[0]))); }
+
+// One triangle's node.
+double importance_by_hand(const std::array<vec3, 3>& t, double phi, const LightQuery& q) {
+  return importance_by_hand(box_lo(t), box_hi(t), normal_of(t), phi, q);
+}
+
+// A node holding two triangles of one normal (their box, theta_o = 0).
+double importance_of_pair(const std::array<vec3, 3>& a, const std::array<vec3, 3>& b, double phi,
+                          const LightQuery& q) {
+  return importance_by_hand(glm::min(box_lo(a), box_lo(b)), glm::max(box_hi(a), box_hi(b)), normal_of(a), phi, q);
 }
 
 double power_of(const std::array<vec3, 3>& t, float Le) {

@@ -58,6 +58,7 @@ struct Scene {
   int rr_depth = 0;
   int max_vertex = 0;  // paths end at a vertex beyond this (the depth cap)
   float min_pdf = 0.0f;
+  bool one_sided = false;  // some shape's material is one-sided (ShapeField kOneSided): else no lane looks
   Lights lights;
   // Per shape, 32 floats (ShapeField): its material's albedo, emission and
   // flags, its first light entry, and its geometry.

@@ -475,7 +475,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     const F wo_z = dot(wo, n);
     // A one-sided material is black unless wo and wi both leave its front
     // (Surfel::eval); with wo in front, upper below is wi in front.
-    ok &= ~shape_flag(ok, sc, load(w, kShape, i0, ok), kOneSided) | gt(wo_z, k(0.0f));
+    if (sc.one_sided) ok &= ~shape_flag(ok, sc, load(w, kShape, i0, ok), kOneSided) | gt(wo_z, k(0.0f));
     F wi_z = dot(wi, n);
     wi_z = select(lt(wo_z, k(0.0f)), neg(wi_z), wi_z);
     const M upper = gt(wi_z, k(0.0f));
@@ -550,7 +550,7 @@ void scatter(const Scene& sc, const Wave& w) {
     const V3 wo = neg(load3(w, kDx, i0, ok));
     const V3 n = load3(w, kNx, i0, ok);
     // Surfel::scatter: nothing from behind a one-sided material.
-    ok &= ~shape_flag(ok, sc, load(w, kShape, i0, ok), kOneSided) | gt(dot(wo, n), k(0.0f));
+    if (sc.one_sided) ok &= ~shape_flag(ok, sc, load(w, kShape, i0, ok), kOneSided) | gt(dot(wo, n), k(0.0f));
     V3 fs, ft;
     frame(n, &fs, &ft);
     const F side = select(lt(dot(wo, n), k(0.0f)), k(-1.0f), k(1.0f));

@@ -248,6 +248,7 @@ struct WavefrontTracer::VectorStages {
       f[vs::kRadius] = sh.radius;
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
       f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
+      sc.one_sided = sc.one_sided || m.one_sided;
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
     }
     sc.shape = v->shape.data();
