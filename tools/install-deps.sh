@@ -26,6 +26,7 @@ packages=(
   clang                   # clang 14: the sanitizer + libFuzzer build of CI (fuzz/, tools/run-fuzzers.sh)
   libclang-rt-14-dev      # clang 14's compiler-rt: libFuzzer, ASan, UBSan and TSan runtimes
   curl ca-certificates    # tools/fetch-data.sh: test data from the npm registry
+  git python3             # tools/mutate/run.py (and its ctest mutations_apply)
 )
 
 as_root=()

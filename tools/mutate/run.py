@@ -14,6 +14,7 @@ goes on. Python's standard library only.
   tools/mutate/run.py --subset fast,unit,full  # a cascade: each mutant meets the cheaper tests first
   tools/mutate/run.py --only 'bsdf-*' --only film-variance-no-bessel
   tools/mutate/run.py --test pathlab_unit_tests:'Film*:Bsdf*' --test pathlab_value_tests
+  tools/mutate/run.py --check                  # does every mutation still apply to the tree? (ctest mutations_apply)
 
 The scratch worktree (default $TMPDIR/pathlab-mutate) is a detached
 `git worktree` of the repository's HEAD: commit what you want mutated. Its
@@ -153,6 +154,26 @@ def build_targets_of(selection):
     return sorted({spec.partition(":")[0] for spec in selection["tests"]})
 
 
+def check_patches(repo, patches):
+    rc, _ = run(["git", "-C", str(repo), "rev-parse", "--is-inside-work-tree"])
+    if rc != 0:
+        print(f"mutate: {repo} is not a git checkout: nothing to check against")
+        return 77
+    stale = []
+    for p in patches:
+        rc, out = run(["git", "-C", str(repo), "apply", "--check", "--whitespace=nowarn", str(p)])
+        if rc != 0:
+            stale.append(p)
+            first = out.strip().splitlines()[0] if out.strip() else f"git apply rc {rc}"
+            print(f"mutate: {p.name} no longer applies: {first}")
+    if stale:
+        print(f"mutate: {len(stale)} of {len(patches)} mutation(s) do not apply: move their context to where the "
+              "code is now (the bug they plant must stay the same)")
+        return 1
+    print(f"mutate: all {len(patches)} mutation(s) apply")
+    return 0
+
+
 def main():
     here = Path(__file__).resolve().parent
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -182,6 +203,10 @@ def main():
                     help="with --results: keep the verdicts already in that file for the same HEAD and test "
                          "selection, and run only the other mutations")
     ap.add_argument("--list", action="store_true", help="list the mutations and exit")
+    ap.add_argument("--check", action="store_true",
+                    help="check that every mutation applies to the repository's working tree (git apply --check) "
+                         "and exit: 0 if all do, 1 naming those that do not, 77 if the repository is not a git "
+                         "checkout. A patch whose code has moved would otherwise only show at the next run")
     args = ap.parse_args()
 
     patches = sorted(args.mutations.glob("*.patch"))
@@ -189,6 +214,8 @@ def main():
         patches = [p for p in patches if any(fnmatch.fnmatch(p.stem, g) for g in args.only)]
     if not patches:
         sys.exit("mutate: no mutation selected")
+    if args.check:
+        return check_patches(args.repo.resolve(), patches)
     if args.list:
         for p in patches:
             print(f"{p.stem:40s} {','.join(patched_files(p)):45s} {describe(p)}")
