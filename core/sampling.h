@@ -15,8 +15,8 @@ namespace pathlab {
 // arithmetic (the coefficients of Cephes' sinf and cosf), within 2 ulp of
 // the true values. Unlike libm's, the result is the same bits in any build
 // and on any machine, and a vector lane that evaluates the same expression
-// gets it too: the warps below use it so that the wavefront's AVX-512 stages
-// (wavefront/vector_stages.h) draw the directions the reference draws.
+// gets it too: the warps below use it so that the wavefront's vectorised
+// stages (wavefront/vector_stages.h) draw the directions the reference draws.
 struct SinCos {
   float sin, cos;
 };

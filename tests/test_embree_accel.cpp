@@ -1,8 +1,8 @@
 // EmbreeAccel's batch queries: every mode (one ray at a time, 16-wide packets,
 // streams) and both layouts (Ray records, arrays) give the one-ray query's
 // answer for every batch size, including the partly filled last packet. The
-// wavefront's tests cover the modes only through the AVX-512 stages, which a
-// processor without AVX-512 skips; this runs everywhere. (A packet's unused
+// wavefront's tests cover the modes only through the vectorised stages, on
+// the Embree kernels of the processor at hand; this tests the queries alone. (A packet's unused
 // lanes once held garbage, which Embree's AVX2 kernels, tracing 16-wide
 // packets as streams, rejected with an assertion.) Hits agree bit for bit:
 // t too, on triangles and on spheres, whose hits EmbreeAccel decides in its

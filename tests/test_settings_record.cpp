@@ -6,6 +6,7 @@
 #include "apps/cli/commands.h"
 #include "core/image_io.h"
 #include "core/render.h"
+#include "core/simd/simd.h"
 #include "tests/temp_dir.h"
 
 #include <OpenImageIO/imageio.h>
@@ -176,6 +177,30 @@ TEST_F(SettingsRecord, ClampedTracePixelReportsWhatTheFilmReceived) {
     EXPECT_GT(clamped, 0) << tracer;
     EXPECT_GT(unclamped, 0) << tracer;
   }
+}
+
+// --simd chooses the vectorised code's instruction set: recorded in the EXR,
+// said by the wavefront's stage line, the same image at every target; an
+// unknown one is refused by name.
+TEST_F(SettingsRecord, RenderRecordsTheSimdTargetAndGivesTheSameImage) {
+  std::vector<Image> images;
+  for (const SimdTarget t : supported_simd_targets()) {
+    const std::string name = simd_target_name(t);
+    const fs::path exr = dir_ / ("simd-" + name + ".exr");
+    const CliResult r = run_cli({"render", "--tracer", "wavefront", "--spp", "2", "--resolution", "24x16", "--simd",
+                                 name, "-o", exr.string()});
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(exr_header(exr).at("simd"), name);
+    const std::string stages = t == SimdTarget::Scalar ? "scalar stages" : "every stage vectorised (" + name + ",";
+    EXPECT_NE(r.err.find(stages), std::string::npos) << r.err;
+    images.push_back(read_image(exr));
+  }
+  select_simd_target(SimdTarget::Auto);
+  for (std::size_t i = 1; i < images.size(); ++i)
+    EXPECT_TRUE(images[i].pixels == images[0].pixels) << "target " << simd_target_name(supported_simd_targets()[i]);
+  const CliResult bad = run_cli({"render", "--simd", "neon", "-o", (dir_ / "x.exr").string()});
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.err.find("--simd: neon not in"), std::string::npos) << bad.err;
 }
 
 }  // namespace

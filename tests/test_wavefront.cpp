@@ -5,6 +5,7 @@
 #include "core/parallel.h"
 #include "core/render.h"
 #include "core/scene_loader.h"
+#include "core/simd/simd.h"
 #include "debugtools/bounce_aov.h"
 #include "debugtools/compare.h"
 #include "debugtools/path_compare.h"
@@ -488,10 +489,17 @@ void crowd(Scene& scene) {
   scene.shapes = std::move(shapes);
 }
 
+// Dispatch runs `t` while it lives.
+struct SimdChoice {
+  explicit SimdChoice(SimdTarget t) { select_simd_target(t); }
+  ~SimdChoice() { select_simd_target(SimdTarget::Auto); }
+  SimdChoice(const SimdChoice&) = delete;
+  SimdChoice& operator=(const SimdChoice&) = delete;
+};
+
 class VectorStages : public testing::TestWithParam<VectorCase> {};
 
 TEST_P(VectorStages, GiveTheScalarStagesBits) {
-  if (!vector_stages::cpu_supported()) GTEST_SKIP() << "this processor has no AVX-512";
   const VectorCase& c = GetParam();
   Scene scene = load_case({c.scene, c.strategy});
   scene.render.min_pdf = c.min_pdf;
@@ -518,20 +526,36 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   };
   std::vector<Run> runs{{997, {}}, {4096, {}}};
   for (RayBatchMode m : kAllRayBatchModes) runs.push_back({997, {m, m, m}});
+  // The scalar stages' samples, once per run; then every vector target's.
+  std::vector<std::vector<FilmSample>> expected;
   for (const auto& [wave, modes] : runs) {
-    const WavefrontTracer vectorised(compiled, settings, wave, modes, WavefrontStages::Auto);
     const WavefrontTracer scalar(compiled, settings, wave, modes, WavefrontStages::Scalar);
-    ASSERT_TRUE(vectorised.vectorised()) << vectorised.scalar_reason();
     ASSERT_FALSE(scalar.vectorised());
-    std::vector<FilmSample> a(pixels * count), b(pixels * count);
-    vectorised.render_batch(0, count, a);
-    scalar.render_batch(0, count, b);
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < a.size(); ++i)
-      differ += std::memcmp(&a[i].L, &b[i].L, sizeof(Spectrum)) != 0 || a[i].film != b[i].film ||
-                a[i].rays != b[i].rays || a[i].hits != b[i].hits;
-    EXPECT_EQ(differ, 0u) << "of " << a.size() << " samples, wave size " << wave << ", camera rays "
-                          << ray_batch_mode_name(modes.camera);
+    expected.emplace_back(pixels * count);
+    scalar.render_batch(0, count, expected.back());
+  }
+  std::vector<SimdTarget> targets = supported_simd_targets();
+  std::erase(targets, SimdTarget::Scalar);
+  ASSERT_FALSE(targets.empty()) << "no vector SIMD target (every x86-64 CI machine has AVX2 and SSE4)";
+  for (SimdTarget target : targets) {
+    const SimdChoice choice(target);
+    // Small waves too: a wave that is not a whole number of blocks, and one smaller than a block.
+    std::vector<Run> target_runs = runs;
+    if (target == targets.front()) target_runs.push_back({3, {}});
+    for (std::size_t r = 0; r < target_runs.size(); ++r) {
+      const auto& [wave, modes] = target_runs[r];
+      const WavefrontTracer vectorised(compiled, settings, wave, modes, WavefrontStages::Auto);
+      ASSERT_TRUE(vectorised.vectorised()) << vectorised.scalar_reason();
+      std::vector<FilmSample> a(pixels * count);
+      vectorised.render_batch(0, count, a);
+      const std::vector<FilmSample>& b = expected[std::min(r, expected.size() - 1)];
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < a.size(); ++i)
+        differ += std::memcmp(&a[i].L, &b[i].L, sizeof(Spectrum)) != 0 || a[i].film != b[i].film ||
+                  a[i].rays != b[i].rays || a[i].hits != b[i].hits;
+      EXPECT_EQ(differ, 0u) << "of " << a.size() << " samples, SIMD target " << simd_target_name(target)
+                            << ", wave size " << wave << ", camera rays " << ray_batch_mode_name(modes.camera);
+    }
   }
 }
 

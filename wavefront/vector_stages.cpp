@@ -1,12 +1,659 @@
-// The parts of vector_stages.h compiled for the baseline instruction set.
+// The vectorised stages of vector_stages.h, written once over Google
+// Highway's portable vectors and compiled for every x86 SIMD target
+// (foreach_target: AVX-512, AVX2, SSE4 — 16, 8 or 4 paths at a time);
+// HWY_DYNAMIC_DISPATCH runs the one core/simd/simd.h selected. The
+// per-lane geometry, hashing and weighting steps are core's
+// (core/simd/lanes-inl.h, core/simd/sampling-inl.h: the same source core's
+// scalar code runs at width 1); what is here is the stages' own business:
+// the wave's arrays, the scene tables, gathers and compaction.
+//
+// Each step names the scalar code it computes. Every lane computes that
+// code's bits: the order of every sum and product is the scalar one, no
+// fused multiply-add (-ffp-contract=off project-wide), std::max(a, b) is
+// hn::Max(b, a). tests/test_wavefront.cpp (VectorStages) checks every
+// sample of several scenes bit for bit against the scalar stages, at every
+// target this processor runs.
+//
+// The wave's arrays are padded (WavefrontTracer::Lanes): a block of lanes
+// is loaded whole, and the lanes beyond the live paths are ignored.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "wavefront/vector_stages.cpp"
+#include <hwy/foreach_target.h>  // must come before highway.h
+
+#include <hwy/highway.h>
+
+#include "core/simd/lanes-inl.h"
+#include "core/simd/sampling-inl.h"
 #include "wavefront/vector_stages.h"
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+
+HWY_BEFORE_NAMESPACE();
+namespace pathlab::vector_stages::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+using pathlab::HWY_NAMESPACE::Vec3;
+
+#if HWY_TARGET == HWY_EMU128 || HWY_TARGET == HWY_SCALAR
+// Never called: width 1 is the scalar stages (wavefront_tracer.cpp), and
+// cpu_supported() is false there.
+[[noreturn]] void width_one() { throw std::logic_error("vector_stages: called at width 1 (run the scalar stages)"); }
+void generate_camera_rays(const Camera&, const Wave&) { width_one(); }
+void prefetch_hits(const Scene&, const Wave&) { width_one(); }
+void resolve(const Scene&, const Wave&) { width_one(); }
+void add_emission(const Scene&, const Wave&) { width_one(); }
+std::size_t sample_lights(const Scene&, const Wave&) { width_one(); }
+void scatter(const Scene&, const Wave&) { width_one(); }
+void hash_keys(std::uint64_t*, std::size_t, std::uint64_t) { width_one(); }
+std::size_t compact(const Wave&, void*, std::uint32_t) { width_one(); }
+std::size_t lanes() { return 1; }
+#else
+
+using pathlab::HWY_NAMESPACE::abs;
+using pathlab::HWY_NAMESPACE::area_to_solid_angle;
+using pathlab::HWY_NAMESPACE::concentric_disk;
+using pathlab::HWY_NAMESPACE::dot;
+using pathlab::HWY_NAMESPACE::frame;
+using pathlab::HWY_NAMESPACE::is_black;
+using pathlab::HWY_NAMESPACE::mix64;
+using pathlab::HWY_NAMESPACE::normalize;
+using pathlab::HWY_NAMESPACE::offset_ray_origin;
+using pathlab::HWY_NAMESPACE::power_heuristic;
+using pathlab::HWY_NAMESPACE::select;
+using pathlab::HWY_NAMESPACE::splat3;
+using pathlab::HWY_NAMESPACE::to_world;
+using pathlab::HWY_NAMESPACE::triangle_point;
+using pathlab::HWY_NAMESPACE::uniform_triangle;
+using pathlab::HWY_NAMESPACE::zero_unless;
+
+using DF = hn::ScalableTag<float>;
+using DI = hn::RebindToSigned<DF>;
+using DU = hn::RebindToUnsigned<DF>;
+using D8 = hn::Rebind<std::uint8_t, DF>;
+using D64 = hn::Repartition<std::uint64_t, DF>;  // half as many lanes
+using DH = hn::Half<DU>;
+using VF = hn::Vec<DF>;
+using VI = hn::Vec<DI>;
+using VU = hn::Vec<DU>;
+using V64 = hn::Vec<D64>;
+using M = hn::Mask<DF>;
+using V3 = Vec3<VF>;
+
+constexpr float kInvPi = 1.0f / 3.14159265358979323846f;  // core/math.h
+constexpr float kGamma2 = (2.0f * 0x1p-24f) / (1.0f - 2.0f * 0x1p-24f);  // gamma_bound(2), core/geometry.h
+constexpr float kGamma3 = (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);
+constexpr float kGamma5 = (5.0f * 0x1p-24f) / (1.0f - 5.0f * 0x1p-24f);
+
+std::size_t lanes() { return hn::Lanes(DF()); }
+
+VF k(float v) { return hn::Set(DF(), v); }
+V3 zero3() { return splat3(DF(), 0.0f, 0.0f, 0.0f); }
+// Masks of float lanes from integer comparisons, and back.
+template <class MI>
+M fmask(MI m) {
+  return hn::RebindMask(DF(), m);
+}
+
+// The lanes of slots [i0, i0 + lanes) that hold live paths.
+M live(std::size_t n, std::size_t i0) { return hn::FirstN(DF(), n - i0); }
+
+// Slots [i0, i0 + lanes) of the wave's arrays: 0 outside m; nothing stored outside m.
+VF load(const Wave& w, FloatArray a, std::size_t i0, M m) { return hn::IfThenElseZero(m, hn::LoadU(DF(), w.f[a] + i0)); }
+V3 load3(const Wave& w, FloatArray x, std::size_t i0, M m) {
+  return {load(w, x, i0, m), load(w, static_cast<FloatArray>(x + 1), i0, m),
+          load(w, static_cast<FloatArray>(x + 2), i0, m)};
+}
+void store(const Wave& w, FloatArray a, std::size_t i0, M m, VF v) { hn::BlendedStore(v, m, DF(), w.f[a] + i0); }
+void store3(const Wave& w, FloatArray x, std::size_t i0, M m, const V3& v) {
+  store(w, x, i0, m, v.x);
+  store(w, static_cast<FloatArray>(x + 1), i0, m, v.y);
+  store(w, static_cast<FloatArray>(x + 2), i0, m, v.z);
+}
+VI load(const Wave& w, UintArray a, std::size_t i0, M m) {
+  return hn::IfThenElseZero(hn::RebindMask(DI(), m), hn::BitCast(DI(), hn::LoadU(DU(), w.u[a] + i0)));
+}
+void store(const Wave& w, UintArray a, std::size_t i0, M m, VI v) {
+  hn::BlendedStore(hn::BitCast(DU(), v), hn::RebindMask(DU(), m), DU(), w.u[a] + i0);
+}
+// A byte array as a mask of the lanes whose byte is not 0, and back.
+M load_mask(const Wave& w, ByteArray a, std::size_t i0, M m) {
+  const VU v = hn::PromoteTo(DU(), hn::LoadU(D8(), w.b[a] + i0));
+  return hn::And(m, fmask(v != hn::Zero(DU())));
+}
+// Bytes p[0, lanes) become v's lanes where m is set (0 to 255 each) and
+// stay elsewhere: a whole block is read and written (the arrays are padded).
+void store_bytes(std::uint8_t* p, M m, VI v) {
+  const VI old = hn::PromoteTo(DI(), hn::LoadU(D8(), p));
+  hn::StoreU(hn::DemoteTo(D8(), hn::IfThenElse(hn::RebindMask(DI(), m), v, old)), D8(), p);
+}
+void store_mask(const Wave& w, ByteArray a, std::size_t i0, M m, M value) {
+  store_bytes(w.b[a] + i0, m, hn::IfThenElseZero(hn::RebindMask(DI(), value), hn::Set(DI(), 1)));
+}
+
+// Float `index` of entry `entry` of a table with `stride` floats per entry (0 outside m).
+VF gather(M m, const float* base, VI entry, int stride, int index) {
+  if (hn::AllFalse(DF(), m)) return hn::Zero(DF());
+  const VI at = entry * hn::Set(DI(), stride) + hn::Set(DI(), index);
+  return hn::IfThenElseZero(m, hn::GatherIndex(DF(), base, hn::IfThenElseZero(hn::RebindMask(DI(), m), at)));
+}
+V3 gather3(M m, const float* base, VI entry, int stride, int index) {
+  return {gather(m, base, entry, stride, index), gather(m, base, entry, stride, index + 1),
+          gather(m, base, entry, stride, index + 2)};
+}
+// Entry `entry` of a table of at most lanes() entries kept by column (`row`
+// holds one field of every entry): a permute of a register, not a gather.
+VF permute(M m, const float* row, VI entry) {
+  const VI at = hn::IfThenElseZero(hn::RebindMask(DI(), m), entry);
+  return hn::IfThenElseZero(m, hn::TableLookupLanes(hn::LoadU(DF(), row), hn::IndicesFromVec(DF(), at)));
+}
+
+// Field `field` of each lane's shape (Scene::shape). 0 outside m.
+VF shape_value(M m, const Scene& sc, VI shape, ShapeField field) {
+  if (sc.shape_columns && sc.shape_count <= lanes()) return permute(m, sc.shape_columns + 16 * field, shape);
+  return gather(m, sc.shape, shape, kShapeFields, field);
+}
+V3 shape_value3(M m, const Scene& sc, VI shape, ShapeField field) {
+  return {shape_value(m, sc, shape, field), shape_value(m, sc, shape, static_cast<ShapeField>(field + 1)),
+          shape_value(m, sc, shape, static_cast<ShapeField>(field + 2))};
+}
+VI shape_int(M m, const Scene& sc, VI shape, ShapeField field) {
+  return hn::BitCast(DI(), shape_value(m, sc, shape, field));
+}
+M shape_flag(M m, const Scene& sc, VI shape, ShapeField field) {
+  return hn::AndNot(shape_value(m, sc, shape, field) == k(0.0f), m);
+}
+// Field `field` of each lane's light entry (Lights). 0 outside m.
+VF light_value(M m, const Lights& lights, VI entry, LightField field) {
+  if (lights.columns && lights.count <= lanes()) return permute(m, lights.columns + 16 * field, entry);
+  switch (field) {
+    case kLightCdf: return gather(m, lights.cdf, entry, 1, 0);
+    case kLightPmf: return gather(m, lights.pmf, entry, 1, 0);
+    case kLightInvArea: return gather(m, lights.inv_area, entry, 1, 0);
+    default: return gather(m, lights.triangle, entry, 16, field);
+  }
+}
+V3 light_value3(M m, const Lights& lights, VI entry, LightField field) {
+  return {light_value(m, lights, entry, field), light_value(m, lights, entry, static_cast<LightField>(field + 1)),
+          light_value(m, lights, entry, static_cast<LightField>(field + 2))};
+}
+
+// The lanes of m packed to the front of `to` (to[0, count of m)); returns the count.
+std::size_t compress_store(float* to, M m, VF v) { return hn::CompressBlendedStore(v, m, DF(), to); }
+void compress_store(std::uint32_t* to, M m, VU v) { hn::CompressBlendedStore(v, hn::RebindMask(DU(), m), DU(), to); }
+
+// SampleStream::get for the block's paths at their current vertex: each
+// path's key with the vertex already xored into its high half, in two
+// halves of 64-bit lanes.
+struct Streams {
+  V64 lo, hi;
+  VF u(Dim dim) const {
+    const D64 d64;
+    const V64 d = hn::Set(d64, static_cast<std::uint64_t>(dim));
+    // to_unit_float: the top 24 bits, exactly a float, times 2^-24.
+    const V64 a = hn::ShiftRight<40>(mix64(d64, hn::Xor(lo, d)));
+    const V64 b = hn::ShiftRight<40>(mix64(d64, hn::Xor(hi, d)));
+    const VU bits = hn::ConcatEven(DU(), hn::BitCast(DU(), b), hn::BitCast(DU(), a));  // the low words, in order
+    return hn::ConvertTo(DF(), hn::BitCast(DI(), bits)) * k(0x1p-24f);
+  }
+};
+Streams streams(const Wave& w, std::size_t i0, VI vertex) {
+  const D64 d64;
+  const DH dh;
+  const std::size_t half = hn::Lanes(d64);
+  const VU v = hn::BitCast(DU(), vertex);
+  const V64 v_lo = hn::ShiftLeft<32>(hn::PromoteTo(d64, hn::LowerHalf(dh, v)));
+  const V64 v_hi = hn::ShiftLeft<32>(hn::PromoteTo(d64, hn::UpperHalf(dh, v)));
+  return {hn::Xor(hn::LoadU(d64, w.rng + i0), v_lo), hn::Xor(hn::LoadU(d64, w.rng + i0 + half), v_hi)};
+}
+
+// LightSampler::pick: the first entry whose cdf exceeds u (the last entry
+// if none does), as a branch-free binary search.
+VI pick(M m, const Lights& lights, VF u) {
+  const auto count = static_cast<std::int32_t>(lights.count);
+  std::int32_t step = 1;
+  while (step * 2 <= count) step *= 2;
+  VI idx = hn::Zero(DI());
+  for (; step > 0; step /= 2) {
+    const VI cand = idx + hn::Set(DI(), step);
+    const M valid = hn::And(m, fmask(hn::Not(cand > hn::Set(DI(), count))));
+    const VF c = light_value(valid, lights, cand - hn::Set(DI(), 1), kLightCdf);
+    idx = hn::IfThenElse(hn::RebindMask(DI(), hn::And(valid, c <= u)), cand, idx);
+  }
+  return hn::Min(idx, hn::Set(DI(), count - 1));
+}
+
+void generate_camera_rays(const Camera& c, const Wave& w) {
+  const DF df;
+  const V3 position = splat3(df, c.position[0], c.position[1], c.position[2]);
+  const V3 forward = splat3(df, c.forward[0], c.forward[1], c.forward[2]);
+  const V3 right = splat3(df, c.right[0], c.right[1], c.right[2]);
+  const V3 up = splat3(df, c.up[0], c.up[1], c.up[2]);
+  const V3 zero = zero3(), one = splat3(df, 1.0f, 1.0f, 1.0f);
+  for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
+    const M in = live(w.n, i0);
+    const Streams rng = streams(w, i0, hn::Zero(DI()));  // the camera's numbers are vertex 0's
+    // The film position: pixel + FilmX/Y (wavefront_tracer.cpp).
+    const VF fx = hn::ConvertTo(df, load(w, kPixelX, i0, in)) + rng.u(Dim::FilmX);
+    const VF fy = hn::ConvertTo(df, load(w, kPixelY, i0, in)) + rng.u(Dim::FilmY);
+    store(w, kFilmX, i0, in, fx);
+    store(w, kFilmY, i0, in, fy);
+    // Camera::generate_ray.
+    const VF sx = (k(2.0f) * fx * k(c.inv_width) - k(1.0f)) * k(c.tan_half_fov) * k(c.aspect);
+    const VF sy = (k(1.0f) - k(2.0f) * fy * k(c.inv_height)) * k(c.tan_half_fov);
+    const V3 d = normalize(df, (forward + sx * right) + sy * up);
+    if (c.aperture_radius <= 0.0f) {
+      store3(w, kOx, i0, in, position);
+      store3(w, kDx, i0, in, d);
+    } else {
+      // Thin lens: through the point of the plane in focus.
+      const V3 focus = position + (k(c.focus_distance) / dot(d, forward)) * d;
+      VF lx, ly;
+      concentric_disk(df, rng.u(Dim::LensX), rng.u(Dim::LensY), lx, ly);
+      lx = k(c.aperture_radius) * lx;
+      ly = k(c.aperture_radius) * ly;
+      const V3 origin = (position + lx * right) + ly * up;
+      store3(w, kOx, i0, in, origin);
+      store3(w, kDx, i0, in, normalize(df, focus - origin));
+    }
+    store(w, kTmax, i0, in, k(std::numeric_limits<float>::infinity()));
+    // A fresh path: beta 1, L 0, PreviousVertex{} (at 0, pdf 0, an impulse,
+    // the BSDF technique), no rays yet, alive, about to reach vertex 1.
+    store3(w, kBetaR, i0, in, one);
+    store3(w, kLR, i0, in, zero);
+    store3(w, kPrevX, i0, in, zero);
+    store(w, kPrevPdf, i0, in, k(0.0f));
+    store_mask(w, kPrevImpulse, i0, in, in);
+    store_mask(w, kPrevBsdfTechnique, i0, in, in);
+    store(w, kRays, i0, in, hn::Zero(DI()));
+    store(w, kVertex, i0, in, hn::Set(DI(), 1));
+    store_mask(w, kAlive, i0, in, in);
+  }
+}
+
+void prefetch_hits(const Scene& sc, const Wave& w) {
+  HWY_ALIGN std::int32_t tri[hn::MaxLanes(DI())];
+  for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
+    const M found = load_mask(w, kFound, i0, live(w.n, i0));
+    if (hn::AllFalse(DF(), found)) continue;
+    const VI shape = load(w, kShape, i0, found);
+    const M mesh = hn::AndNot(shape_flag(found, sc, shape, kIsSphere), found);
+    if (hn::AllFalse(DF(), mesh)) continue;
+    const VI t = shape_int(mesh, sc, shape, kFirstTriangle) + load(w, kPrim, i0, mesh);
+    hn::Store(hn::IfThenElse(hn::RebindMask(DI(), mesh), t, hn::Set(DI(), -1)), DI(), tri);
+    for (std::size_t j = 0; j < lanes(); ++j) {
+      if (tri[j] < 0) continue;
+      const float* p = sc.triangles + 12 * static_cast<std::size_t>(tri[j]);
+      __builtin_prefetch(p);       // p0 ...
+      __builtin_prefetch(p + 11);  // ... n: a triangle may straddle two lines
+    }
+  }
+}
+
+void resolve(const Scene& sc, const Wave& w) {
+  const DF df;
+  for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
+    const M in = live(w.n, i0);
+    store(w, kRays, i0, in, load(w, kRays, i0, in) + hn::Set(DI(), 1));
+    const M found = load_mask(w, kFound, i0, in);
+    if (hn::AllFalse(df, found)) continue;
+    const VI shape = load(w, kShape, i0, found);
+    const M sphere = shape_flag(found, sc, shape, kIsSphere), mesh = hn::AndNot(sphere, found);
+    V3 p = zero3(), error = zero3(), n = zero3();
+    if (!hn::AllFalse(df, mesh)) {
+      // triangle_point (core/geometry.cpp) of the shape's triangle prim.
+      const VI tri = shape_int(mesh, sc, shape, kFirstTriangle) + load(w, kPrim, i0, mesh);
+      const V3 p0 = gather3(mesh, sc.triangles, tri, 12, 0), p1 = gather3(mesh, sc.triangles, tri, 12, 3),
+               p2 = gather3(mesh, sc.triangles, tri, 12, 6);
+      n = gather3(mesh, sc.triangles, tri, 12, 9);
+      triangle_point(df, load(w, kHitU, i0, mesh), load(w, kHitV, i0, mesh), p0, p1, p2, p, error);
+    }
+    if (!hn::AllFalse(df, sphere)) {
+      // sphere_point (core/geometry.cpp) of origin + t dir.
+      const VF t = load(w, kHitT, i0, sphere);
+      const V3 o = load3(w, kOx, i0, sphere), d = load3(w, kDx, i0, sphere);
+      const V3 center = shape_value3(sphere, sc, shape, kCenter);
+      const VF radius = shape_value(sphere, sc, shape, kRadius);
+      const V3 dir = normalize(df, (o + t * d) - center);
+      const V3 rdir = radius * dir;
+      const V3 sp = center + rdir;
+      const V3 serr = k(kGamma5) * abs(rdir) + k(kGamma2) * abs(sp);
+      const V3 sn = select(shape_flag(sphere, sc, shape, kFlipped), -dir, dir);
+      p = select(sphere, sp, p);
+      error = select(sphere, serr, error);
+      n = select(sphere, sn, n);
+    }
+    store3(w, kPx, i0, found, p);
+    store3(w, kErrX, i0, found, error);
+    store3(w, kNx, i0, found, n);
+  }
+}
+
+void add_emission(const Scene& sc, const Wave& w) {
+  const DF df;
+  const V3 zero = zero3();
+  for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
+    const M in = live(w.n, i0);
+    const M found = load_mask(w, kFound, i0, in);
+    const V3 beta = load3(w, kBetaR, i0, in);
+    const V3 L = load3(w, kLR, i0, in);
+    // Escaped: no environment, so Le = 0 and its weight 0; L += beta * (0 * 0).
+    // A ray the accel refused (t = NaN) makes the sample bad (NaN).
+    V3 L_new = L + beta * (k(0.0f) * zero);
+    const M escaped = hn::AndNot(found, in);
+    const M refused = hn::And(escaped, hn::IsNaN(load(w, kHitT, i0, escaped)));
+    if (!hn::AllFalse(df, refused)) {
+      const V3 nan = splat3(df, NAN, NAN, NAN);
+      L_new = select(refused, nan, L_new);
+    }
+    M alive = hn::FirstN(df, 0);
+    if (!hn::AllFalse(df, found)) {
+      // Surfel::emitted.
+      const VI shape = load(w, kShape, i0, found);
+      const V3 wo = -load3(w, kDx, i0, found);
+      const V3 n = load3(w, kNx, i0, found);
+      const M facing = hn::Or(shape_flag(found, sc, shape, kTwoSided), dot(n, wo) > k(0.0f));
+      const V3 Le = zero_unless(hn::And(shape_flag(found, sc, shape, kEmits), facing),
+                                shape_value3(found, sc, shape, kEmission));
+      const M lit = hn::AndNot(is_black(df, Le), found);
+      // LightSampler::pdf(prev.p, s).
+      const M impulse = load_mask(w, kPrevImpulse, i0, lit);
+      const M bsdf_technique = load_mask(w, kPrevBsdfTechnique, i0, lit);
+      const VF prev_pdf = load(w, kPrevPdf, i0, lit);
+      const VI first = shape_int(lit, sc, shape, kFirstLight);
+      const M light = hn::And(lit, fmask(hn::Not(first < hn::Zero(DI()))));
+      const VI entry = first + load(w, kPrim, i0, light);
+      const V3 d = load3(w, kPx, i0, light) - load3(w, kPrevX, i0, light);
+      const VF dist = hn::Sqrt(dot(d, d));
+      const VF inv_area = light_value(light, sc.lights, entry, kLightInvArea);
+      const VF pmf = light_value(light, sc.lights, entry, kLightPmf);
+      const VF light_pdf = hn::IfThenElseZero(light, pmf * area_to_solid_angle(df, inv_area, dist, dot(n, d) / dist));
+      // emission_weight (core/strategy_weights.h).
+      VF weight = k(1.0f);
+      if (sc.strategy == Strategy::Light) weight = hn::IfThenElse(light_pdf > k(0.0f), k(0.0f), k(1.0f));
+      if (sc.strategy == Strategy::Mis) weight = power_heuristic(df, prev_pdf, light_pdf);
+      if (sc.strategy == Strategy::LightBsdf)
+        weight = hn::IfThenElseZero(bsdf_technique, k(2.0f) * prev_pdf / (prev_pdf + light_pdf));
+      weight = hn::IfThenElseZero(lit, hn::IfThenElse(impulse, k(1.0f), weight));
+      L_new = select(found, L + beta * (weight * Le), L_new);
+      // The path goes on if it may take another vertex and the surface scatters.
+      alive = hn::And(fmask(hn::Not(load(w, kVertex, i0, found) > hn::Set(DI(), sc.max_vertex))),
+                      shape_flag(found, sc, shape, kScatters));
+    }
+    store3(w, kLR, i0, in, L_new);
+    store_mask(w, kAlive, i0, in, alive);
+  }
+}
+
+std::size_t sample_lights(const Scene& sc, const Wave& w) {
+  const DF df;
+  std::size_t queries = 0;
+  for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
+    const M in = live(w.n, i0);
+    const VI vertex = load(w, kVertex, i0, in);
+    const Streams rng = streams(w, i0, vertex);
+    // samples_area_lights (core/strategy_weights.h).
+    M ok = load_mask(w, kAlive, i0, in);
+    if (sc.strategy == Strategy::Bsdf || sc.lights.count == 0) ok = hn::FirstN(df, 0);
+    if (sc.strategy == Strategy::LightBsdf) ok = hn::And(ok, rng.u(Dim::Technique) < k(0.5f));
+    if (hn::AllFalse(df, ok)) {
+      store_mask(w, kHasQuery, i0, in, ok);
+      continue;
+    }
+
+    // LightSampler::sample: pick a triangle, then a point uniformly on it
+    // (square_to_uniform_triangle, triangle_point).
+    const VI light = pick(ok, sc.lights, rng.u(Dim::LightChoice));
+    VF b1, b2;
+    uniform_triangle(df, rng.u(Dim::LightX), rng.u(Dim::LightY), b1, b2);
+    const V3 p0 = light_value3(ok, sc.lights, light, kLightP0), p1 = light_value3(ok, sc.lights, light, kLightP1),
+             p2 = light_value3(ok, sc.lights, light, kLightP2), ln = light_value3(ok, sc.lights, light, kLightNormal),
+             Le = light_value3(ok, sc.lights, light, kLightLe);
+    const VF two_sided = light_value(ok, sc.lights, light, kLightTwoSided);
+    V3 lp, lerr;
+    triangle_point(df, b1, b2, p0, p1, p2, lp, lerr);
+
+    const V3 sp = load3(w, kPx, i0, ok);
+    const V3 d = lp - sp;
+    const VF dist = hn::Sqrt(dot(d, d));
+    ok = hn::And(ok, dist > k(0.0f));
+    const V3 wi = d / dist;
+    const VF cos_light = dot(ln, -wi);
+    // The back of a one-sided emitter: cos_light <= 0 (NaN passes, as in the scalar code).
+    ok = hn::And(ok, hn::Or(two_sided != k(0.0f), hn::Not(cos_light <= k(0.0f))));
+    // pmf * area_to_solid_angle(1 / area, dist, cos_light) (core/sampling.h).
+    const VF inv_area = light_value(ok, sc.lights, light, kLightInvArea);
+    const VF pmf = light_value(ok, sc.lights, light, kLightPmf);
+    const VF pdf_light = pmf * area_to_solid_angle(df, inv_area, dist, cos_light);
+    ok = hn::And(ok, hn::AndNot(hn::IsInf(pdf_light), pdf_light > k(0.0f)));  // seen edge-on
+
+    // Surfel::eval and Surfel::pdf of the Lambert lobe (core/surfel.cpp,
+    // bsdf/lambert.h): only the local z of wo and wi matters.
+    const V3 wo = -load3(w, kDx, i0, ok);
+    const V3 n = load3(w, kNx, i0, ok);  // the frame's normal is the surface's
+    const VF wo_z = dot(wo, n);
+    const VI shape = load(w, kShape, i0, ok);
+    // A one-sided material is black unless wo and wi both leave its front
+    // (Surfel::eval); with wo in front, upper below is wi in front.
+    if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), wo_z > k(0.0f)));
+    VF wi_z = dot(wi, n);
+    wi_z = hn::IfThenElse(wo_z < k(0.0f), hn::Neg(wi_z), wi_z);
+    const M upper = wi_z > k(0.0f);
+    const VF cos_pi = wi_z * k(kInvPi);
+    const V3 rho = shape_value3(ok, sc, shape, kAlbedo);
+    const V3 f = zero_unless(upper, cos_pi * rho);
+    ok = hn::AndNot(is_black(df, f), ok);
+    const VF pdf_bsdf = hn::IfThenElseZero(upper, cos_pi);
+
+    // light_sample_weight (core/strategy_weights.h).
+    VF weight = k(1.0f);
+    if (sc.strategy == Strategy::Mis) weight = power_heuristic(df, pdf_light, pdf_bsdf);
+    if (sc.strategy == Strategy::LightBsdf) weight = k(2.0f) * pdf_light / (pdf_light + pdf_bsdf);
+    store3(w, kUnR, i0, ok, (weight / pdf_light) * (f * Le));
+
+    // Surfel::spawn_to(lp, lerr, ln), packed behind the previous ones in
+    // path order, with the slot of the path each belongs to (add_light).
+    const V3 err = load3(w, kErrX, i0, ok);
+    const V3 origin = offset_ray_origin(df, sp, err, select(dot(d, n) >= k(0.0f), n, -n));
+    const V3 reach = k(kGamma3) * abs(lp - origin);  // the float ray's own reach error
+    const V3 end = offset_ray_origin(df, lp, lerr + reach, select(dot(origin - lp, ln) >= k(0.0f), ln, -ln));
+    const V3 dd = end - origin;
+    const VF len = hn::Sqrt(dot(dd, dd));
+    const V3 dir = dd / len;
+    const VF q[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
+    std::size_t count = 0;
+    for (int a = 0; a < 7; ++a) count = compress_store(w.f[kQOx + a] + queries, ok, q[a]);
+    const VU slot = hn::Iota(DU(), static_cast<std::uint32_t>(i0));
+    compress_store(w.u[kQPath] + queries, ok, slot);
+    store_mask(w, kHasQuery, i0, in, ok);
+    // The shadow ray counts as one of the path's rays.
+    store(w, kRays, i0, ok, load(w, kRays, i0, ok) + hn::Set(DI(), 1));
+    queries += count;
+  }
+  return queries;
+}
+
+void scatter(const Scene& sc, const Wave& w) {
+  const DF df;
+  for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
+    const M in = live(w.n, i0);
+    M ok = load_mask(w, kAlive, i0, in);
+    if (hn::AllFalse(df, ok)) continue;
+    VI vertex = load(w, kVertex, i0, in);
+    const Streams rng = streams(w, i0, vertex);
+
+    // square_to_cosine_hemisphere (core/sampling.cpp).
+    VF x, y, z;
+    pathlab::HWY_NAMESPACE::cosine_hemisphere(df, rng.u(Dim::DirectionX), rng.u(Dim::DirectionY), x, y, z);
+
+    // Surfel::scatter, Lambert: no sample on the disk's rim, or below min_pdf
+    // (pdf > 0 and !(pdf < min_pdf), a NaN pdf passing as in the scalar code).
+    const VF pdf = hn::IfThenElseZero(z > k(0.0f), z * k(kInvPi));
+    ok = hn::And(ok, hn::And(hn::Not(pdf <= k(0.0f)), hn::Not(pdf < k(sc.min_pdf))));
+    const V3 wo = -load3(w, kDx, i0, ok);
+    const V3 n = load3(w, kNx, i0, ok);
+    const VI shape = load(w, kShape, i0, ok);
+    // Surfel::scatter: nothing from behind a one-sided material.
+    if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), dot(wo, n) > k(0.0f)));
+    V3 fs, ft;
+    frame(df, n, fs, ft);
+    const VF side = hn::IfThenElse(dot(wo, n) < k(0.0f), k(-1.0f), k(1.0f));
+    const V3 wi = to_world(fs, ft, n, x, y, z * side);
+    V3 weight = shape_value3(ok, sc, shape, kAlbedo);
+    ok = hn::AndNot(is_black(df, weight), ok);
+
+    // Russian roulette (the scatter stage).
+    const V3 beta = load3(w, kBetaR, i0, ok);
+    const M rr = hn::And(ok, fmask(vertex > hn::Set(DI(), sc.rr_depth)));
+    if (!hn::AllFalse(df, rr)) {
+      const V3 bw = beta * weight;
+      // std::min(std::max(std::max(bw.x, bw.y), bw.z), 1) in Max/Min's operand order.
+      const VF survival = hn::Min(hn::Max(hn::Max(bw.z, bw.y), bw.x), k(1.0f));
+      ok = hn::AndNot(hn::AndNot(rng.u(Dim::Roulette) < survival, rr), ok);
+      weight = select(rr, weight / survival, weight);
+    }
+    store3(w, kBetaR, i0, ok, beta * weight);
+
+    // PreviousVertex{s.p, pdf, impulse = false, bsdf_technique}.
+    const V3 sp = load3(w, kPx, i0, ok);
+    store3(w, kPrevX, i0, ok, sp);
+    store(w, kPrevPdf, i0, ok, pdf);
+    store_mask(w, kPrevImpulse, i0, ok, hn::FirstN(df, 0));
+    M bsdf_technique = hn::FirstN(df, lanes());
+    if (sc.strategy == Strategy::LightBsdf) bsdf_technique = hn::Not(rng.u(Dim::Technique) < k(0.5f));
+    store_mask(w, kPrevBsdfTechnique, i0, ok, bsdf_technique);
+
+    // Surfel::spawn(wi).
+    const V3 err = load3(w, kErrX, i0, ok);
+    store3(w, kOx, i0, ok, offset_ray_origin(df, sp, err, select(dot(wi, n) >= k(0.0f), n, -n)));
+    store3(w, kDx, i0, ok, wi);
+    store(w, kTmax, i0, ok, k(std::numeric_limits<float>::infinity()));
+    vertex = vertex + hn::Set(DI(), 1);
+    store(w, kVertex, i0, ok, vertex);
+    store_mask(w, kAlive, i0, in, ok);
+  }
+}
+
+void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
+  const D64 d64;
+  const V64 seed = hn::Set(d64, seed_key);
+  for (std::size_t i0 = 0; i0 < n; i0 += hn::Lanes(d64))
+    hn::StoreU(mix64(d64, hn::Xor(seed, hn::LoadU(d64, keys + i0))), d64, keys + i0);
+}
+
+std::size_t compact(const Wave& w, void* samples, std::uint32_t first_slot) {
+  static constexpr FloatArray kMovedFloats[] = {kOx,   kOy,   kOz,   kDx,   kDy,    kDz,    kTmax,  kBetaR,   kBetaG, kBetaB,
+                                                kLR,   kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX, kFilmY};
+  static constexpr UintArray kMovedUints[] = {kOutIndex, kRays, kVertex};
+  static constexpr ByteArray kMovedBytes[] = {kPrevImpulse, kPrevBsdfTechnique};
+  const DF df;
+  const D64 d64;
+  const DH dh;
+  HWY_ALIGN std::int32_t dead[hn::MaxLanes(DI())];
+  std::size_t m = 0;
+  for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
+    const M in = live(w.n, i0);
+    const M alive = load_mask(w, kAlive, i0, in);
+    // The paths that ended: FilmSample{film, L, rays, hits}, field by field
+    // (a Sample built on the stack and copied whole would be read back
+    // before its parts' stores retire: a store-forwarding stall per path).
+    const M ended = hn::AndNot(alive, in);
+    if (!hn::AllFalse(df, ended)) {
+      hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), ended)), DI(), dead);
+      for (std::size_t j = 0; j < lanes(); ++j) {
+        if (dead[j] == 0) continue;
+        const std::size_t i = i0 + j;
+        char* out = static_cast<char*>(samples) + sizeof(Sample) * (w.u[kOutIndex][i] - first_slot);
+        const std::uint32_t hits = w.u[kVertex][i] - (w.b[kFound][i] ? 0u : 1u);
+        std::memcpy(out + offsetof(Sample, film_x), &w.f[kFilmX][i], sizeof(float));
+        std::memcpy(out + offsetof(Sample, film_y), &w.f[kFilmY][i], sizeof(float));
+        std::memcpy(out + offsetof(Sample, L) + 0 * sizeof(float), &w.f[kLR][i], sizeof(float));
+        std::memcpy(out + offsetof(Sample, L) + 1 * sizeof(float), &w.f[kLG][i], sizeof(float));
+        std::memcpy(out + offsetof(Sample, L) + 2 * sizeof(float), &w.f[kLB][i], sizeof(float));
+        std::memcpy(out + offsetof(Sample, rays), &w.u[kRays][i], sizeof(std::uint32_t));
+        std::memcpy(out + offsetof(Sample, hits), &hits, sizeof(std::uint32_t));
+      }
+    }
+    // The survivors, packed behind the previous ones (m <= i0: a block is
+    // read before anything is written over it).
+    const std::size_t count = hn::CountTrue(df, alive);
+    if (hn::AllFalse(df, ended) && m == i0) {
+      m += count;
+      continue;
+    }
+    for (FloatArray a : kMovedFloats) compress_store(w.f[a] + m, alive, hn::LoadU(df, w.f[a] + i0));
+    for (UintArray a : kMovedUints) compress_store(w.u[a] + m, alive, hn::LoadU(DU(), w.u[a] + i0));
+    for (ByteArray a : kMovedBytes) {
+      const VI v = hn::Compress(hn::PromoteTo(DI(), hn::LoadU(D8(), w.b[a] + i0)), hn::RebindMask(DI(), alive));
+      store_bytes(w.b[a] + m, hn::FirstN(df, count), v);
+    }
+    // The keys: each half of the block's lanes as 64-bit lanes.
+    const VU alive_bits = hn::VecFromMask(DU(), hn::RebindMask(DU(), alive));
+    const auto alive_lo = hn::PromoteTo(d64, hn::LowerHalf(dh, alive_bits)) != hn::Zero(d64);
+    const auto alive_hi = hn::PromoteTo(d64, hn::UpperHalf(dh, alive_bits)) != hn::Zero(d64);
+    const std::size_t half = hn::Lanes(d64);
+    const std::size_t lo = hn::CompressBlendedStore(hn::LoadU(d64, w.rng + i0), alive_lo, d64, w.rng + m);
+    hn::CompressBlendedStore(hn::LoadU(d64, w.rng + i0 + half), alive_hi, d64, w.rng + m + lo);
+    store_bytes(w.b[kAlive] + m, hn::FirstN(df, count), hn::Set(DI(), 1));
+    m += count;
+  }
+  return m;
+}
+
+#endif  // HWY_TARGET
+}  // namespace pathlab::vector_stages::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+
+#include "core/simd/simd.h"
 
 namespace pathlab::vector_stages {
 
-bool cpu_supported() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-         __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
+HWY_EXPORT(generate_camera_rays);
+HWY_EXPORT(prefetch_hits);
+HWY_EXPORT(resolve);
+HWY_EXPORT(add_emission);
+HWY_EXPORT(sample_lights);
+HWY_EXPORT(scatter);
+HWY_EXPORT(hash_keys);
+HWY_EXPORT(compact);
+HWY_EXPORT(lanes);
+
+bool cpu_supported() { return active_simd_target() != SimdTarget::Scalar; }
+std::size_t lanes() { return HWY_DYNAMIC_DISPATCH(lanes)(); }
+
+void generate_camera_rays(const Camera& camera, const Wave& wave) {
+  HWY_DYNAMIC_DISPATCH(generate_camera_rays)(camera, wave);
+}
+void prefetch_hits(const Scene& scene, const Wave& wave) { HWY_DYNAMIC_DISPATCH(prefetch_hits)(scene, wave); }
+void resolve(const Scene& scene, const Wave& wave) { HWY_DYNAMIC_DISPATCH(resolve)(scene, wave); }
+void add_emission(const Scene& scene, const Wave& wave) { HWY_DYNAMIC_DISPATCH(add_emission)(scene, wave); }
+std::size_t sample_lights(const Scene& scene, const Wave& wave) {
+  return HWY_DYNAMIC_DISPATCH(sample_lights)(scene, wave);
+}
+void scatter(const Scene& scene, const Wave& wave) { HWY_DYNAMIC_DISPATCH(scatter)(scene, wave); }
+void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
+  HWY_DYNAMIC_DISPATCH(hash_keys)(keys, n, seed_key);
+}
+std::size_t compact(const Wave& wave, void* samples, std::uint32_t first_slot) {
+  return HWY_DYNAMIC_DISPATCH(compact)(wave, samples, first_slot);
+}
+
+// The light of every visible sample, once Embree has filled kQOccluded: L
+// += beta * unoccluded, and + 0 behind an occluder, as the scalar add_light
+// adds. One path per shadow ray: a plain loop over the packed rays.
+void add_light(const Wave& w, std::size_t queries) {
+  for (std::size_t r = 0; r < queries; ++r) {
+    const std::size_t i = w.u[kQPath][r];
+    const bool visible = w.b[kQOccluded][r] == 0;
+    for (int c = 0; c < 3; ++c)
+      w.f[kLR + c][i] += visible ? w.f[kBetaR + c][i] * w.f[kUnR + c][i] : 0.0f;
+  }
 }
 
 }  // namespace pathlab::vector_stages
+
+#endif  // HWY_ONCE

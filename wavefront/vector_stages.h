@@ -1,23 +1,20 @@
-// The wavefront's stages run 16 paths at a time in AVX-512 registers, over
-// paths kept as one array per scalar (structure of arrays), for scenes that
-// need nothing more than Lambert surfaces, one- or two-sided, and triangle area lights (the
-// dragon benchmark, the Cornell box; meshes and spheres, any camera). Other
-// scenes, and machines without AVX-512, run the scalar stages of
-// wavefront_tracer.cpp.
+// The wavefront's vectorised stages: paths kept as one array per scalar
+// (structure of arrays), a block of them per SIMD register — 16 with
+// AVX-512, 8 with AVX2, 4 with SSE4, whichever core/simd/simd.h's dispatch
+// selected — for scenes that need nothing more than Lambert surfaces, one-
+// or two-sided, and triangle area lights (the dragon benchmark, the Cornell
+// box; meshes and spheres, any camera). Other scenes, and `--simd scalar`,
+// run the scalar stages of wavefront_tracer.cpp.
 //
-// Same paths: every lane computes what the scalar code computes, operation
-// for operation and in the same order (IEEE add, multiply, divide and square
-// root round the same in a vector lane as in a scalar register), nothing is
-// contracted into FMAs (-ffp-contract=off, project-wide), and the one
-// transcendental step, the concentric disk's sine and cosine, is
-// core/sampling.h's sin_cos_quarter polynomial rather than libm's. Embree
+// Written once (vector_stages.cpp, over Google Highway, compiled for every
+// target) on core's per-lane code (core/simd/*-inl.h, which core's scalar
+// code runs at width 1). Same paths: every lane computes what the scalar
+// code computes, operation for operation and in the same order, and Embree
 // sees the same batches in the same order. tests/test_wavefront.cpp checks
-// every sample of several scenes bit for bit against the scalar stages.
+// every sample of several scenes bit for bit against the scalar stages at
+// every target the processor runs.
 //
-// This header is plain data on purpose: vector_stages_avx512.cpp is compiled
-// for AVX-512 and must not instantiate any inline function (GLM, the standard
-// library) that another translation unit also instantiates - the linker would
-// keep one copy, possibly the AVX-512 one, for everybody.
+// This header is plain data: the per-target code lives in vector_stages.cpp.
 #pragma once
 
 #include "core/sample_dims.h"
@@ -58,6 +55,7 @@ struct Scene {
   int rr_depth = 0;
   int max_vertex = 0;  // paths end at a vertex beyond this (the depth cap)
   float min_pdf = 0.0f;
+  std::size_t shape_count = 0;
   bool one_sided = false;  // some shape's material is one-sided (ShapeField kOneSided): else no lane looks
   Lights lights;
   // Per shape, 32 floats (ShapeField): its material's albedo, emission and
@@ -112,6 +110,7 @@ enum FloatArray : int {
 enum UintArray : int {
   kOutIndex, kRays, kVertex, kPixelX, kPixelY,
   kShape, kPrim,  // the hit's
+  kQPath,         // per packed shadow ray: the slot of its path
   kUintArrays
 };
 enum ByteArray : int {
@@ -135,8 +134,14 @@ struct Sample {
   std::uint32_t rays, hits;
 };
 
-// Whether this processor runs the vectorised stages.
+// Whether the vectorised stages run: the selected SIMD target is not
+// `scalar` (core/simd/simd.h).
 bool cpu_supported();
+// Paths per block (lanes of the selected target): 16, 8 or 4.
+std::size_t lanes();
+// The arrays of a Wave need this many slots beyond its capacity, rounded up
+// to a whole block of the widest target: a block is loaded whole.
+constexpr std::size_t kPadding = 32;
 
 // SampleStream keys for a wave: each of keys[0, n) holds pixel << 32 |
 // sample and becomes mix64(seed_key ^ that), SampleStream::key().
@@ -158,9 +163,10 @@ void resolve(const Scene& scene, const Wave& wave);
 void add_emission(const Scene& scene, const Wave& wave);
 // Next-event estimation towards one area light for every live path (the
 // scene has no point lights); packs the shadow rays to trace into the kQ
-// arrays and returns how many.
+// arrays, in path order, and returns how many.
 std::size_t sample_lights(const Scene& scene, const Wave& wave);
-// The light of every visible sample, once Embree has filled kQOccluded.
+// The light of every visible sample, once Embree has filled kQOccluded
+// (kQPath says whose each packed shadow ray is).
 void add_light(const Wave& wave, std::size_t queries);
 // A cosine-weighted continuation, Russian roulette and the next ray.
 void scatter(const Scene& scene, const Wave& wave);

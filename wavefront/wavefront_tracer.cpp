@@ -5,6 +5,7 @@
 #include "core/rng.h"
 #include "core/scene_limits.h"
 #include "core/strategy_weights.h"
+#include "core/simd/simd.h"
 #include "wavefront/vector_stages.h"
 
 #include <algorithm>
@@ -145,9 +146,9 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns;
 
-  // Null, with *why_not saying what stops it, unless the processor has
-  // AVX-512 and the scene needs nothing more than Lambert surfaces and
-  // triangle area lights.
+  // Null, with *why_not saying what stops it, unless the selected SIMD
+  // target is a vector one and the scene needs nothing more than Lambert
+  // surfaces and triangle area lights.
   static std::unique_ptr<const VectorStages> make(const CompiledScene& compiled, const RenderSettings& settings,
                                                   std::string* why_not) {
     namespace vs = vector_stages;
@@ -155,7 +156,8 @@ struct WavefrontTracer::VectorStages {
       *why_not = std::move(why);
       return nullptr;
     };
-    if (!vs::cpu_supported()) return no("the processor has no AVX-512");
+    if (!vs::cpu_supported())
+      return no("the SIMD target is scalar (--simd scalar, PATHLAB_SIMD=scalar, or a processor without SSE4.1)");
     // The vector stages draw the independent sampler's hashes in bulk from
     // SampleStream::key(); any other sampler's numbers are the scalar stages'.
     if (settings.sampler != SamplerKind::Independent)
@@ -252,6 +254,7 @@ struct WavefrontTracer::VectorStages {
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
     }
     sc.shape = v->shape.data();
+    sc.shape_count = scene.shapes.size();
     if (scene.shapes.size() <= 16) {
       v->shape_columns.assign(16 * vs::kShapeFields, 0.0f);
       for (std::size_t i = 0; i < scene.shapes.size(); ++i)
@@ -296,17 +299,19 @@ struct WavefrontTracer::Lanes {
   vector_stages::Wave view;  // pointers into the arrays; view.n live paths
 
   void resize(std::size_t size) {
-    for (auto& a : f) a.resize(size);
-    for (auto& a : u) a.resize(size);
-    for (auto& a : b) a.resize(size);
-    rng.resize(size);
+    // A block of lanes is loaded whole, past the last path (vector_stages.h).
+    const std::size_t padded = size + vector_stages::kPadding;
+    for (auto& a : f) a.resize(padded);
+    for (auto& a : u) a.resize(padded);
+    for (auto& a : b) a.resize(padded);
+    rng.resize(padded);
     samples.resize(size);
     for (int a = 0; a < vector_stages::kFloatArrays; ++a) view.f[a] = f[a].data();
     for (int a = 0; a < vector_stages::kUintArrays; ++a) view.u[a] = u[a].data();
     for (int a = 0; a < vector_stages::kByteArrays; ++a) view.b[a] = b[a].data();
     view.rng = rng.data();
   }
-  std::size_t capacity() const { return rng.size(); }
+  std::size_t capacity() const { return samples.size(); }
   static constexpr std::size_t bytes_per_path() {
     return vector_stages::kFloatArrays * sizeof(float) + vector_stages::kUintArrays * sizeof(std::uint32_t) +
            vector_stages::kByteArrays + sizeof(std::uint64_t) + sizeof(FilmSample);
@@ -327,8 +332,9 @@ WavefrontTracer::~WavefrontTracer() = default;
 bool WavefrontTracer::vectorised() const { return vector_ != nullptr; }
 
 std::string WavefrontTracer::stages_description() const {
-  return vector_ ? "every stage vectorised (AVX-512, 16 paths at a time, paths as structure of arrays)"
-                 : "scalar stages (" + scalar_reason_ + ")";
+  if (!vector_) return "scalar stages (" + scalar_reason_ + ")";
+  return std::string("every stage vectorised (") + simd_target_name(active_simd_target()) + ", " +
+         std::to_string(vector_stages::lanes()) + " paths at a time, paths as structure of arrays)";
 }
 
 std::size_t WavefrontTracer::bytes_per_path() const {

@@ -7,7 +7,8 @@
 // and sample count. Two implementations of the stages: scalar ones over
 // arrays of records (Ray, Surfel, ...), which run every scene, and
 // vectorised ones over one array per scalar (vector_stages.h), which run the
-// scenes they model on processors with AVX-512.
+// scenes they model at the SIMD target core/simd/simd.h selected (AVX-512,
+// AVX2 or SSE4).
 //
 // Same sample contract as the reference (rng.h, sample_dims.h) and the same
 // strategy weights (strategy_weights.h): the same seed gives the same path,
@@ -100,10 +101,10 @@ class WavefrontTracer final : public Tracer {
   std::size_t bytes_per_path() const;
   std::size_t wave_size() const { return wave_size_; }
   const RayModes& ray_modes() const { return modes_; }
-  // Whether the stages run vectorised (vector_stages.h: 16 paths per
-  // AVX-512 register, paths as one array per scalar): the scene needs only
+  // Whether the stages run vectorised (vector_stages.h: 16, 8 or 4 paths
+  // per register, paths as one array per scalar): the scene needs only
   // Lambert surfaces and triangle area lights, the strategy is not
-  // "cosine", and the processor has AVX-512. Tracing one sample with an
+  // "cosine", and the SIMD target is not scalar. Tracing one sample with an
   // observer always runs the scalar stages (they report every event); the
   // paths are the same bits either way.
   bool vectorised() const;

@@ -17,6 +17,7 @@
 #include "core/parallel.h"
 #include "core/render.h"
 #include "core/scene_limits.h"
+#include "core/simd/simd.h"
 #include "debugtools/aov.h"
 #include "debugtools/bounce_aov.h"
 #include "debugtools/stage_buffers.h"
@@ -362,6 +363,7 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
         {"clamped_samples", std::to_string(stats.clamped_samples)},
         {"clamped_energy_fraction", clamped_fraction},
         {"render_time_seconds", seconds},
+        {"simd", simd_target_name(active_simd_target())},
         {"bad_samples", std::to_string(stats.bad_samples)},
         {"version", PATHLAB_VERSION},
         {"git_revision", git_revision()},

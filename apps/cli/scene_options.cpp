@@ -1,10 +1,12 @@
 #include "apps/cli/scene_options.h"
 
+
 #include "apps/cli/validators.h"
 
 #include "core/compiled_scene.h"
 #include "core/error.h"
 #include "core/scene_loader.h"
+#include "core/simd/simd.h"
 
 #include <charconv>
 #include <sstream>
@@ -54,12 +56,26 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
       ->check(CLI::IsMember({"cone", "point"}));
   cmd.add_option("--texture-cache-mb", texture_cache_mb, "OpenImageIO's texture tile cache, in MB")
       ->check(number_range(1.0, 1.0e6));
+  cmd.add_option("--simd", simd,
+                 "SIMD instruction set of the vectorised code: auto (the best this processor runs), avx512, avx2, "
+                 "sse4, or scalar (the same source at width 1: the wavefront's scalar stages); the same image at "
+                 "every one (default: $PATHLAB_SIMD, else auto)")
+      ->check(CLI::IsMember({"auto", "avx512", "avx2", "sse4", "scalar"}));
   cmd.add_flag("--general-shading", general_shading,
                "Shade every material through the general Disney-capable code instead of code specialised to the "
                "scene's lobes (same image, slower)");
 }
 
 Scene SceneOptions::load() const {
+  if (simd) {
+    try {
+      select_simd_target(*parse_simd_target(*simd));
+    } catch (const InputError& e) {
+      throw InputError(std::string("--simd ") + *simd + ": " + e.what());
+    }
+  } else {
+    select_simd_target_from_environment();
+  }
   Scene scene = scene_file.empty() ? builtin_cornell_box() : load_scene(scene_file);
   RenderSettings& r = scene.render;
   if (strategy) r.strategy = *parse_strategy(*strategy);

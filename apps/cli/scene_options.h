@@ -34,11 +34,14 @@ struct SceneOptions {
   std::optional<std::string> texture_filter;  // cone | point
   std::optional<std::string> sampler;         // independent | zsobol
   std::optional<float> texture_cache_mb;
+  std::optional<std::string> simd;  // auto | avx512 | avx2 | sse4 | scalar (not a scene setting: same bits)
 
   // Registers the options on `cmd`; `with_spp` for commands that render,
   // `allow_both` for trace-pixel's --tracer both.
   void add_to(CLI::App& cmd, bool with_spp, bool allow_both = false);
-  // Loads the scene and applies the overrides. Throws InputError.
+  // Loads the scene and applies the overrides; selects the SIMD target
+  // (--simd, else $PATHLAB_SIMD, else the best this processor runs). Throws
+  // InputError.
   Scene load() const;
   // "pathlab trace-pixel <scene> --pixel x,y --sample s ..." for one sample
   // of a render with `scene`'s final settings.
