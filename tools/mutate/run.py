@@ -69,12 +69,16 @@ def patched_files(patch):
 
 
 class Scratch:
-    def __init__(self, repo, path, build_dir, cmake_args, jobs):
+    def __init__(self, repo, path, build_dir, cmake_args, jobs, rev="HEAD"):
         self.repo, self.path, self.build, self.cmake_args, self.jobs = repo, path, build_dir, cmake_args, jobs
+        self.rev = rev
         self.log = None
 
     def prepare(self):
-        head = run(["git", "-C", str(self.repo), "rev-parse", "HEAD"])[1].strip()
+        rc, out = run(["git", "-C", str(self.repo), "rev-parse", "--verify", self.rev + "^{commit}"])
+        if rc != 0:
+            sys.exit(f"mutate: --rev {self.rev}: not a commit of {self.repo}")
+        head = out.strip()
         if not (self.path / ".git").exists():
             rc, out = run(["git", "-C", str(self.repo), "worktree", "add", "--detach", str(self.path), head])
             if rc != 0:
@@ -202,6 +206,8 @@ def main():
     ap.add_argument("--resume", action="store_true",
                     help="with --results: keep the verdicts already in that file for the same HEAD and test "
                          "selection, and run only the other mutations")
+    ap.add_argument("--rev", default="HEAD",
+                    help="the commit to mutate (default HEAD): a fixed one lets --resume go on across your own commits")
     ap.add_argument("--list", action="store_true", help="list the mutations and exit")
     ap.add_argument("--check", action="store_true",
                     help="check that every mutation applies to the repository's working tree (git apply --check) "
@@ -233,7 +239,7 @@ def main():
     cmake_args = list(args.cmake_arg) + ([f"-DPATHLAB_DATA_DIR={args.data_dir}"] if args.data_dir else [])
     scratch_path = args.scratch.resolve()
     scratch_path.parent.mkdir(parents=True, exist_ok=True)
-    scratch = Scratch(args.repo.resolve(), scratch_path, scratch_path / "build-mutate", cmake_args, args.jobs)
+    scratch = Scratch(args.repo.resolve(), scratch_path, scratch_path / "build-mutate", cmake_args, args.jobs, args.rev)
     head = scratch.prepare()
     log_path = scratch_path / "build-mutate" / "mutate.log"
     done = {}
