@@ -1,7 +1,10 @@
-// Geometry, hashing and weighting steps of the estimator written once over
-// Highway's vectors: core's scalar code calls them at width 1 (core/ray.cpp's
-// offset_ray_origin) and the wavefront's vectorised stages at the width of
-// their SIMD target (wavefront/vector_stages.cpp). Every lane computes the
+// Geometry, hashing and weighting steps of the estimator over Highway's
+// vectors, for the wavefront's vectorised stages at the width of their SIMD
+// target (wavefront/vector_stages.cpp). Each mirrors a scalar function of
+// core, named at its definition; VectorStages.* holds them to its bits.
+// core's scalar code does not run these at width 1 yet: at the build's
+// baseline target (HWY_SCALAR) the branch-free forms cost several times the
+// scalar ones (docs/one-estimator.md). Every lane computes the
 // bits the scalar code computes; the rules that make it so are in
 // core/simd/simd.h and docs/one-estimator.md. In short: the order of every
 // sum and product is the scalar code's (GLM's dot is (x + y) + z, a vec3
