@@ -184,15 +184,25 @@ class SamplerSetup {
   constexpr SampleStream stream(std::uint32_t x, std::uint32_t y, std::uint32_t sample) const {
     SampleStream s(seed_, y * width_ + x, sample);
     if (kind_ == SamplerKind::ZSobol) {
-      const std::uint64_t low = (1ull << log2_spp_) - 1;
-      s.index_ = (sobol::morton(x, y) << log2_spp_) | (sample & low);
-      s.index_bits_ = morton_bits_ + log2_spp_;
-      s.sobol_key_ = mix64(SampleStream::seed_key(seed_) ^ mix64((sample >> log2_spp_) + 0x5851f42d4c957f2dull));
+      s.index_ = zsobol_index(x, y, sample);
+      s.index_bits_ = zsobol_bits();
+      s.sobol_key_ = zsobol_key(sample);
     }
     return s;
   }
   constexpr SamplerKind kind() const { return kind_; }
   constexpr std::uint32_t log2_spp() const { return log2_spp_; }
+  // What stream() gives a zsobol stream, for code that draws many streams'
+  // numbers at once (the wavefront's vectorised stages, core/simd/sobol-inl.h):
+  // its Sobol' index, the bits of it that are permuted, its scrambling key.
+  constexpr std::uint64_t zsobol_index(std::uint32_t x, std::uint32_t y, std::uint32_t sample) const {
+    const std::uint64_t low = (1ull << log2_spp_) - 1;
+    return (sobol::morton(x, y) << log2_spp_) | (sample & low);
+  }
+  constexpr std::uint32_t zsobol_bits() const { return morton_bits_ + log2_spp_; }
+  constexpr std::uint64_t zsobol_key(std::uint32_t sample) const {
+    return mix64(SampleStream::seed_key(seed_) ^ mix64((sample >> log2_spp_) + 0x5851f42d4c957f2dull));
+  }
 
  private:
   SamplerKind kind_ = SamplerKind::Independent;

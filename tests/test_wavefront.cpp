@@ -425,6 +425,8 @@ struct VectorCase {
   bool crowded = false;  // more than 16 shapes and lights (tables gathered, not permuted)
   bool one_sided = false;  // every diffuse material one-sided, and every other mesh turned inside out
                            // (its triangles' winding reversed), so that paths meet backs too
+  bool zsobol = false;     // the zsobol sampler (Sobol' points, core/simd/sobol-inl.h in the lanes)
+  int spp = 0;             // 0: the scene's (an odd log2 of it gives zsobol's index a lone lowest bit)
 };
 
 // Every diffuse material one-sided (black behind its geometric normal), and
@@ -507,6 +509,8 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   if (c.tilted) tilt(scene);
   if (c.crowded) crowd(scene);
   if (c.one_sided) make_one_sided(scene);
+  if (c.zsobol) scene.render.sampler = SamplerKind::ZSobol;
+  if (c.spp > 0) scene.render.spp = c.spp;
   if (c.thin_lens) {
     scene.camera.aperture_radius = 0.1f;
     scene.camera.focus_distance = 3.0f;
@@ -577,6 +581,14 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"", st, 0.0f, 0, false, false, false, true});
   cases.push_back({"white-sphere-emissive-room.json", Strategy::Mis, 0.0f, 0, false, false, false, true});
+  // zsobol: every slot of a vertex (film, lens, light choice and point, technique, direction, roulette); with
+  // 2 or 8 spp the permuted index has an odd number of bits (its lone lowest bit).
+  for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"", st, 0.0f, 0, false, false, false, false, true});
+  cases.push_back({"", Strategy::Mis, 0.0f, -1, true, false, false, false, true});  // thin lens
+  cases.push_back({"", Strategy::LightBsdf, 0.0f, 0, true, false, false, false, true, 2});
+  cases.push_back({"", Strategy::Mis, 0.0f, 0, false, false, false, false, true, 8});
+  cases.push_back({"white-sphere-emissive-room.json", Strategy::LightBsdf, 0.0f, 0, false, true, true, false, true});
   return cases;
 }
 
@@ -586,7 +598,9 @@ INSTANTIATE_TEST_SUITE_P(LambertScenes, VectorStages, testing::ValuesIn(vector_c
                                            strategy_name(p.param.strategy) + (p.param.min_pdf > 0 ? "_min_pdf" : "") +
                                            (p.param.rr_depth >= 0 ? "_rr" + std::to_string(p.param.rr_depth) : "") +
                                            (p.param.tilted ? "_tilted" : "") + (p.param.thin_lens ? "_thin_lens" : "") +
-                                           (p.param.crowded ? "_crowded" : "") + (p.param.one_sided ? "_one_sided" : "");
+                                           (p.param.crowded ? "_crowded" : "") + (p.param.one_sided ? "_one_sided" : "") +
+                                           (p.param.zsobol ? "_zsobol" : "") +
+                                           (p.param.spp > 0 ? "_spp" + std::to_string(p.param.spp) : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;
@@ -603,6 +617,10 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
   };
   const Scene cornell = builtin_cornell_box();
   EXPECT_EQ(vectorised(cornell, Strategy::Mis), vector_stages::cpu_supported());
+
+  Scene zsobol = cornell;  // its Sobol' points are drawn in the lanes too
+  zsobol.render.sampler = SamplerKind::ZSobol;
+  EXPECT_EQ(vectorised(zsobol, Strategy::Mis), vector_stages::cpu_supported());
 
   EXPECT_FALSE(vectorised(cornell, Strategy::Cosine));
   EXPECT_FALSE(vectorised(cornell, Strategy::Mis, true));  // --general-shading

@@ -24,6 +24,8 @@
 
 #include "core/simd/lanes-inl.h"
 #include "core/simd/sampling-inl.h"
+#include "core/simd/sobol-inl.h"
+#include "core/rng.h"
 #include "wavefront/vector_stages.h"
 
 #include <cmath>
@@ -41,14 +43,14 @@ using pathlab::HWY_NAMESPACE::Vec3;
 // Never called: width 1 is the scalar stages (wavefront_tracer.cpp), and
 // cpu_supported() is false there.
 [[noreturn]] void width_one() { throw std::logic_error("vector_stages: called at width 1 (run the scalar stages)"); }
-void generate_camera_rays(const Camera&, const Wave&) { width_one(); }
+void generate_camera_rays(const Scene&, const Camera&, const Wave&) { width_one(); }
 void prefetch_hits(const Scene&, const Wave&) { width_one(); }
 void resolve(const Scene&, const Wave&) { width_one(); }
 void add_emission(const Scene&, const Wave&) { width_one(); }
 std::size_t sample_lights(const Scene&, const Wave&) { width_one(); }
 void scatter(const Scene&, const Wave&) { width_one(); }
 void hash_keys(std::uint64_t*, std::size_t, std::uint64_t) { width_one(); }
-std::size_t compact(const Wave&, void*, std::uint32_t) { width_one(); }
+std::size_t compact(const Wave&, bool, void*, std::uint32_t) { width_one(); }
 std::size_t lanes() { return 1; }
 #else
 
@@ -59,6 +61,8 @@ using pathlab::HWY_NAMESPACE::dot;
 using pathlab::HWY_NAMESPACE::frame;
 using pathlab::HWY_NAMESPACE::is_black;
 using pathlab::HWY_NAMESPACE::mix64;
+using pathlab::HWY_NAMESPACE::mul64;
+using pathlab::HWY_NAMESPACE::zsobol_top24;
 using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::offset_ray_origin;
 using pathlab::HWY_NAMESPACE::power_heuristic;
@@ -184,29 +188,76 @@ V3 light_value3(M m, const Lights& lights, VI entry, LightField field) {
 std::size_t compress_store(float* to, M m, VF v) { return hn::CompressBlendedStore(v, m, DF(), to); }
 void compress_store(std::uint32_t* to, M m, VU v) { hn::CompressBlendedStore(v, hn::RebindMask(DU(), m), DU(), to); }
 
-// SampleStream::get for the block's paths at their current vertex: each
-// path's key with the vertex already xored into its high half, in two
-// halves of 64-bit lanes.
+// SampleStream::get for the block's paths at their current vertex, each
+// half of the block in 64-bit lanes: under the independent sampler the
+// hash of each path's key with the vertex xored into its high half, under
+// zsobol the point of the dimension's slot (core/simd/sobol-inl.h).
 struct Streams {
-  V64 lo, hi;
+  V64 lo, hi;  // key ^ vertex << 32
+  const Scene* scene;
+  V64 zindex_lo, zindex_hi, zkey_lo, zkey_hi, slot_lo, slot_hi;  // zsobol; slot: vertex * slots per vertex
+
   VF u(Dim dim) const {
+    if (scene->zsobol) {
+      const SobolSlot s = sobol_slot(dim);
+      if (s.entity < kSobolSlotsPerVertex) return zsobol(s, nullptr);
+    }
     const D64 d64;
     const V64 d = hn::Set(d64, static_cast<std::uint64_t>(dim));
     // to_unit_float: the top 24 bits, exactly a float, times 2^-24.
-    const V64 a = hn::ShiftRight<40>(mix64(d64, hn::Xor(lo, d)));
-    const V64 b = hn::ShiftRight<40>(mix64(d64, hn::Xor(hi, d)));
+    return unit(hn::ShiftRight<40>(mix64(d64, hn::Xor(lo, d))), hn::ShiftRight<40>(mix64(d64, hn::Xor(hi, d))));
+  }
+  // SampleStream::get2: {u(x), u(x + 1)}, the pair's point made once under zsobol.
+  void u2(Dim x, VF& a, VF& b) const {
+    const Dim y = static_cast<Dim>(static_cast<std::uint32_t>(x) + 1);
+    if (scene->zsobol) {
+      const SobolSlot s = sobol_slot(x);
+      if (s.entity < kSobolSlotsPerVertex && s.axis == 0 && sobol_slot(y).entity == s.entity) {
+        a = zsobol(s, &b);
+        return;
+      }
+    }
+    a = u(x);
+    b = u(y);
+  }
+
+ private:
+  // Two halves of 24-bit integers as the floats of the block, times 2^-24.
+  static VF unit(V64 a, V64 b) {
     const VU bits = hn::ConcatEven(DU(), hn::BitCast(DU(), b), hn::BitCast(DU(), a));  // the low words, in order
-    return hn::ConvertTo(DF(), hn::BitCast(DI(), bits)) * k(0x1p-24f);
+    return hn::ConvertTo(DF(), hn::BitCast(DI(), bits)) * hn::Set(DF(), 0x1p-24f);
+  }
+  // The slot's axis (and axis 1 into *second when not null).
+  VF zsobol(SobolSlot s, VF* second) const {
+    const D64 d64;
+    const V64 entity = hn::Set(d64, s.entity);
+    const unsigned bits = scene->zsobol_bits;
+    V64 lo2, hi2;
+    const V64 a = zsobol_top24(d64, zindex_lo, zkey_lo, bits, slot_lo + entity, s.axis, second ? &lo2 : nullptr);
+    const V64 b = zsobol_top24(d64, zindex_hi, zkey_hi, bits, slot_hi + entity, s.axis, second ? &hi2 : nullptr);
+    if (second) *second = unit(lo2, hi2);
+    return unit(a, b);
   }
 };
-Streams streams(const Wave& w, std::size_t i0, VI vertex) {
+Streams streams(const Scene& sc, const Wave& w, std::size_t i0, VI vertex) {
   const D64 d64;
   const DH dh;
   const std::size_t half = hn::Lanes(d64);
   const VU v = hn::BitCast(DU(), vertex);
-  const V64 v_lo = hn::ShiftLeft<32>(hn::PromoteTo(d64, hn::LowerHalf(dh, v)));
-  const V64 v_hi = hn::ShiftLeft<32>(hn::PromoteTo(d64, hn::UpperHalf(dh, v)));
-  return {hn::Xor(hn::LoadU(d64, w.rng + i0), v_lo), hn::Xor(hn::LoadU(d64, w.rng + i0 + half), v_hi)};
+  const V64 vertex_lo = hn::PromoteTo(d64, hn::LowerHalf(dh, v)), vertex_hi = hn::PromoteTo(d64, hn::UpperHalf(dh, v));
+  Streams s{hn::Xor(hn::LoadU(d64, w.rng + i0), hn::ShiftLeft<32>(vertex_lo)),
+            hn::Xor(hn::LoadU(d64, w.rng + i0 + half), hn::ShiftLeft<32>(vertex_hi)),
+            &sc,
+            hn::Zero(d64), hn::Zero(d64), hn::Zero(d64), hn::Zero(d64), hn::Zero(d64), hn::Zero(d64)};
+  if (sc.zsobol) {
+    s.zindex_lo = hn::LoadU(d64, w.zindex + i0);
+    s.zindex_hi = hn::LoadU(d64, w.zindex + i0 + half);
+    s.zkey_lo = hn::LoadU(d64, w.zkey + i0);
+    s.zkey_hi = hn::LoadU(d64, w.zkey + i0 + half);
+    s.slot_lo = mul64(d64, vertex_lo, kSobolSlotsPerVertex);
+    s.slot_hi = mul64(d64, vertex_hi, kSobolSlotsPerVertex);
+  }
+  return s;
 }
 
 // LightSampler::pick: the first entry whose cdf exceeds u (the last entry
@@ -225,7 +276,7 @@ VI pick(M m, const Lights& lights, VF u) {
   return hn::Min(idx, hn::Set(DI(), count - 1));
 }
 
-void generate_camera_rays(const Camera& c, const Wave& w) {
+void generate_camera_rays(const Scene& sc, const Camera& c, const Wave& w) {
   const DF df;
   const V3 position = splat3(df, c.position[0], c.position[1], c.position[2]);
   const V3 forward = splat3(df, c.forward[0], c.forward[1], c.forward[2]);
@@ -234,10 +285,12 @@ void generate_camera_rays(const Camera& c, const Wave& w) {
   const V3 zero = zero3(), one = splat3(df, 1.0f, 1.0f, 1.0f);
   for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
     const M in = live(w.n, i0);
-    const Streams rng = streams(w, i0, hn::Zero(DI()));  // the camera's numbers are vertex 0's
+    const Streams rng = streams(sc, w, i0, hn::Zero(DI()));  // the camera's numbers are vertex 0's
     // The film position: pixel + FilmX/Y (wavefront_tracer.cpp).
-    const VF fx = hn::ConvertTo(df, load(w, kPixelX, i0, in)) + rng.u(Dim::FilmX);
-    const VF fy = hn::ConvertTo(df, load(w, kPixelY, i0, in)) + rng.u(Dim::FilmY);
+    VF ux, uy;
+    rng.u2(Dim::FilmX, ux, uy);
+    const VF fx = hn::ConvertTo(df, load(w, kPixelX, i0, in)) + ux;
+    const VF fy = hn::ConvertTo(df, load(w, kPixelY, i0, in)) + uy;
     store(w, kFilmX, i0, in, fx);
     store(w, kFilmY, i0, in, fy);
     // Camera::generate_ray.
@@ -251,7 +304,9 @@ void generate_camera_rays(const Camera& c, const Wave& w) {
       // Thin lens: through the point of the plane in focus.
       const V3 focus = position + (k(c.focus_distance) / dot(d, forward)) * d;
       VF lx, ly;
-      concentric_disk(df, rng.u(Dim::LensX), rng.u(Dim::LensY), lx, ly);
+      VF lu, lv;
+      rng.u2(Dim::LensX, lu, lv);
+      concentric_disk(df, lu, lv, lx, ly);
       lx = k(c.aperture_radius) * lx;
       ly = k(c.aperture_radius) * ly;
       const V3 origin = (position + lx * right) + ly * up;
@@ -393,7 +448,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
   for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
     const M in = live(w.n, i0);
     const VI vertex = load(w, kVertex, i0, in);
-    const Streams rng = streams(w, i0, vertex);
+    const Streams rng = streams(sc, w, i0, vertex);
     // samples_area_lights (core/strategy_weights.h).
     M ok = load_mask(w, kAlive, i0, in);
     if (sc.strategy == Strategy::Bsdf || sc.lights.count == 0) ok = hn::FirstN(df, 0);
@@ -407,7 +462,9 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     // (square_to_uniform_triangle, triangle_point).
     const VI light = pick(ok, sc.lights, rng.u(Dim::LightChoice));
     VF b1, b2;
-    uniform_triangle(df, rng.u(Dim::LightX), rng.u(Dim::LightY), b1, b2);
+    VF lu, lv;
+    rng.u2(Dim::LightX, lu, lv);
+    uniform_triangle(df, lu, lv, b1, b2);
     const V3 p0 = light_value3(ok, sc.lights, light, kLightP0), p1 = light_value3(ok, sc.lights, light, kLightP1),
              p2 = light_value3(ok, sc.lights, light, kLightP2), ln = light_value3(ok, sc.lights, light, kLightNormal),
              Le = light_value3(ok, sc.lights, light, kLightLe);
@@ -482,11 +539,13 @@ void scatter(const Scene& sc, const Wave& w) {
     M ok = load_mask(w, kAlive, i0, in);
     if (hn::AllFalse(df, ok)) continue;
     VI vertex = load(w, kVertex, i0, in);
-    const Streams rng = streams(w, i0, vertex);
+    const Streams rng = streams(sc, w, i0, vertex);
 
     // square_to_cosine_hemisphere (core/sampling.cpp).
     VF x, y, z;
-    pathlab::HWY_NAMESPACE::cosine_hemisphere(df, rng.u(Dim::DirectionX), rng.u(Dim::DirectionY), x, y, z);
+    VF du, dv;
+    rng.u2(Dim::DirectionX, du, dv);
+    pathlab::HWY_NAMESPACE::cosine_hemisphere(df, du, dv, x, y, z);
 
     // Surfel::scatter, Lambert: no sample on the disk's rim, or below min_pdf
     // (pdf > 0 and !(pdf < min_pdf), a NaN pdf passing as in the scalar code).
@@ -543,7 +602,7 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
     hn::StoreU(mix64(d64, hn::Xor(seed, hn::LoadU(d64, keys + i0))), d64, keys + i0);
 }
 
-std::size_t compact(const Wave& w, void* samples, std::uint32_t first_slot) {
+std::size_t compact(const Wave& w, bool zsobol, void* samples, std::uint32_t first_slot) {
   static constexpr FloatArray kMovedFloats[] = {kOx,   kOy,   kOz,   kDx,   kDy,    kDz,    kTmax,  kBetaR,   kBetaG, kBetaB,
                                                 kLR,   kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX, kFilmY};
   static constexpr UintArray kMovedUints[] = {kOutIndex, kRays, kVertex};
@@ -594,8 +653,15 @@ std::size_t compact(const Wave& w, void* samples, std::uint32_t first_slot) {
     const auto alive_lo = hn::PromoteTo(d64, hn::LowerHalf(dh, alive_bits)) != hn::Zero(d64);
     const auto alive_hi = hn::PromoteTo(d64, hn::UpperHalf(dh, alive_bits)) != hn::Zero(d64);
     const std::size_t half = hn::Lanes(d64);
-    const std::size_t lo = hn::CompressBlendedStore(hn::LoadU(d64, w.rng + i0), alive_lo, d64, w.rng + m);
-    hn::CompressBlendedStore(hn::LoadU(d64, w.rng + i0 + half), alive_hi, d64, w.rng + m + lo);
+    auto move64 = [&](std::uint64_t* a) {
+      const std::size_t lo = hn::CompressBlendedStore(hn::LoadU(d64, a + i0), alive_lo, d64, a + m);
+      hn::CompressBlendedStore(hn::LoadU(d64, a + i0 + half), alive_hi, d64, a + m + lo);
+    };
+    move64(w.rng);
+    if (zsobol) {
+      move64(w.zindex);
+      move64(w.zkey);
+    }
     store_bytes(w.b[kAlive] + m, hn::FirstN(df, count), hn::Set(DI(), 1));
     m += count;
   }
@@ -625,8 +691,8 @@ HWY_EXPORT(lanes);
 bool cpu_supported() { return active_simd_target() != SimdTarget::Scalar; }
 std::size_t lanes() { return HWY_DYNAMIC_DISPATCH(lanes)(); }
 
-void generate_camera_rays(const Camera& camera, const Wave& wave) {
-  HWY_DYNAMIC_DISPATCH(generate_camera_rays)(camera, wave);
+void generate_camera_rays(const Scene& scene, const Camera& camera, const Wave& wave) {
+  HWY_DYNAMIC_DISPATCH(generate_camera_rays)(scene, camera, wave);
 }
 void prefetch_hits(const Scene& scene, const Wave& wave) { HWY_DYNAMIC_DISPATCH(prefetch_hits)(scene, wave); }
 void resolve(const Scene& scene, const Wave& wave) { HWY_DYNAMIC_DISPATCH(resolve)(scene, wave); }
@@ -638,8 +704,8 @@ void scatter(const Scene& scene, const Wave& wave) { HWY_DYNAMIC_DISPATCH(scatte
 void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
   HWY_DYNAMIC_DISPATCH(hash_keys)(keys, n, seed_key);
 }
-std::size_t compact(const Wave& wave, void* samples, std::uint32_t first_slot) {
-  return HWY_DYNAMIC_DISPATCH(compact)(wave, samples, first_slot);
+std::size_t compact(const Scene& scene, const Wave& wave, void* samples, std::uint32_t first_slot) {
+  return HWY_DYNAMIC_DISPATCH(compact)(wave, scene.zsobol, samples, first_slot);
 }
 
 // The light of every visible sample, once Embree has filled kQOccluded: L

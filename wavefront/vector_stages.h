@@ -56,7 +56,10 @@ struct Scene {
   int max_vertex = 0;  // paths end at a vertex beyond this (the depth cap)
   float min_pdf = 0.0f;
   std::size_t shape_count = 0;
-  bool one_sided = false;  // some shape's material is one-sided (ShapeField kOneSided): else no lane looks
+  bool one_sided = false;
+  // The zsobol sampler (else the independent one): SamplerSetup::zsobol_bits().
+  bool zsobol = false;
+  unsigned zsobol_bits = 0;  // some shape's material is one-sided (ShapeField kOneSided): else no lane looks
   Lights lights;
   // Per shape, 32 floats (ShapeField): its material's albedo, emission and
   // flags, its first light entry, and its geometry.
@@ -125,6 +128,9 @@ struct Wave {
   std::uint32_t* u[kUintArrays] = {};
   std::uint8_t* b[kByteArrays] = {};
   std::uint64_t* rng = nullptr;  // SampleStream::key() per path
+  // Under zsobol (Scene::zsobol): SamplerSetup::zsobol_index and zsobol_key per path.
+  std::uint64_t* zindex = nullptr;
+  std::uint64_t* zkey = nullptr;
 };
 
 // What compact() writes for each path that ended: FilmSample's fields, in
@@ -151,7 +157,7 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key);
 // scalar twin of each). Tracing the rays themselves is Embree's.
 // Each path's random stream, pixel and sample are set; make its camera ray
 // and reset its state.
-void generate_camera_rays(const Camera& camera, const Wave& wave);
+void generate_camera_rays(const Scene& scene, const Camera& camera, const Wave& wave);
 // Prefetches the triangle each mesh hit landed on, for resolve(): one pass
 // first lets the hits' cache misses overlap.
 void prefetch_hits(const Scene& scene, const Wave& wave);
@@ -173,6 +179,6 @@ void scatter(const Scene& scene, const Wave& wave);
 // Packs the survivors into slots [0, m) in order and returns m; each path
 // that ended is written to samples[its kOutIndex - first_slot] (an array of
 // Sample's layout, copied in bytes).
-std::size_t compact(const Wave& wave, void* samples, std::uint32_t first_slot);
+std::size_t compact(const Scene& scene, const Wave& wave, void* samples, std::uint32_t first_slot);
 
 }  // namespace pathlab::vector_stages

@@ -150,7 +150,7 @@ struct WavefrontTracer::VectorStages {
   // target is a vector one and the scene needs nothing more than Lambert
   // surfaces and triangle area lights.
   static std::unique_ptr<const VectorStages> make(const CompiledScene& compiled, const RenderSettings& settings,
-                                                  std::string* why_not) {
+                                                  const SamplerSetup& sampler, std::string* why_not) {
     namespace vs = vector_stages;
     auto no = [&](std::string why) {
       *why_not = std::move(why);
@@ -158,10 +158,6 @@ struct WavefrontTracer::VectorStages {
     };
     if (!vs::cpu_supported())
       return no("the SIMD target is scalar (--simd scalar, PATHLAB_SIMD=scalar, or a processor without SSE4.1)");
-    // The vector stages draw the independent sampler's hashes in bulk from
-    // SampleStream::key(); any other sampler's numbers are the scalar stages'.
-    if (settings.sampler != SamplerKind::Independent)
-      return no(std::string("the ") + sampler_name(settings.sampler) + " sampler (the vector stages draw only independent's hashes)");
     auto v = std::make_unique<VectorStages>();
     vs::Scene& sc = v->scene;
     switch (settings.strategy) {
@@ -255,6 +251,8 @@ struct WavefrontTracer::VectorStages {
     }
     sc.shape = v->shape.data();
     sc.shape_count = scene.shapes.size();
+    sc.zsobol = settings.sampler == SamplerKind::ZSobol;
+    sc.zsobol_bits = sampler.zsobol_bits();
     if (scene.shapes.size() <= 16) {
       v->shape_columns.assign(16 * vs::kShapeFields, 0.0f);
       for (std::size_t i = 0; i < scene.shapes.size(); ++i)
@@ -290,7 +288,7 @@ struct WavefrontTracer::Lanes {
   std::vector<float> f[vector_stages::kFloatArrays];
   std::vector<std::uint32_t> u[vector_stages::kUintArrays];
   std::vector<std::uint8_t> b[vector_stages::kByteArrays];
-  std::vector<std::uint64_t> rng;
+  std::vector<std::uint64_t> rng, zindex, zkey;
   // The wave's finished samples, in its own order: compact() writes them
   // here (a region the caches hold) and the wave copies them out at its end
   // in one sequential pass, instead of scattering them over the render's
@@ -305,16 +303,20 @@ struct WavefrontTracer::Lanes {
     for (auto& a : u) a.resize(padded);
     for (auto& a : b) a.resize(padded);
     rng.resize(padded);
+    zindex.resize(padded);
+    zkey.resize(padded);
     samples.resize(size);
     for (int a = 0; a < vector_stages::kFloatArrays; ++a) view.f[a] = f[a].data();
     for (int a = 0; a < vector_stages::kUintArrays; ++a) view.u[a] = u[a].data();
     for (int a = 0; a < vector_stages::kByteArrays; ++a) view.b[a] = b[a].data();
     view.rng = rng.data();
+    view.zindex = zindex.data();
+    view.zkey = zkey.data();
   }
   std::size_t capacity() const { return samples.size(); }
   static constexpr std::size_t bytes_per_path() {
     return vector_stages::kFloatArrays * sizeof(float) + vector_stages::kUintArrays * sizeof(std::uint32_t) +
-           vector_stages::kByteArrays + sizeof(std::uint64_t) + sizeof(FilmSample);
+           vector_stages::kByteArrays + 3 * sizeof(std::uint64_t) + sizeof(FilmSample);
   }
 };
 
@@ -323,7 +325,7 @@ WavefrontTracer::WavefrontTracer(const CompiledScene& scene, const RenderSetting
     : Tracer(scene, settings),
       wave_size_(std::max<std::size_t>(wave_size, 1)),
       modes_(modes),
-      vector_(stages == WavefrontStages::Auto ? VectorStages::make(scene, settings, &scalar_reason_) : nullptr) {
+      vector_(stages == WavefrontStages::Auto ? VectorStages::make(scene, settings, sampler(), &scalar_reason_) : nullptr) {
   if (stages == WavefrontStages::Scalar) scalar_reason_ = "asked for";
 }
 
@@ -647,7 +649,7 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
   Clock clock;
   const std::uint64_t t0 = clock_ns();
   const std::size_t paths = w.n;
-  vs::generate_camera_rays(vector_->camera, w);
+  vs::generate_camera_rays(sc, vector_->camera, w);
   for (bool camera_rays = true; lanes.view.n > 0; camera_rays = false) {
     const std::size_t n = w.n;
     const RayArrays rays{w.f[vs::kOx], w.f[vs::kOy], w.f[vs::kOz], w.f[vs::kDx], w.f[vs::kDy], w.f[vs::kDz], w.f[vs::kTmax]};
@@ -668,7 +670,7 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
       vs::add_light(w, q);
     }
     vs::scatter(sc, w);
-    lanes.view.n = vs::compact(w, lanes.samples.data(), first_slot);
+    lanes.view.n = vs::compact(sc, w, lanes.samples.data(), first_slot);
   }
   std::copy_n(lanes.samples.begin(), paths, out.begin());
   clock.nanoseconds[kWave] = clock_ns() - t0;
@@ -724,6 +726,7 @@ void WavefrontTracer::render_waves(std::uint32_t first, std::uint32_t count, std
   const std::size_t n_max = std::min(wave_size, out.size());
   if (vector_ && records.empty()) {  // the records are the scalar stages' arrays
     parallel_for(0, waves, 1, [&](std::size_t k0, std::size_t k1) {
+      const bool zsobol = vector_->scene.zsobol;
       thread_local Lanes lanes;
       if (lanes.capacity() < n_max) lanes.resize(n_max);
       namespace vs = vector_stages;
@@ -737,6 +740,10 @@ void WavefrontTracer::render_waves(std::uint32_t first, std::uint32_t count, std
                lanes.u[vs::kPixelX][i] = x;
                lanes.u[vs::kPixelY][i] = y;
                lanes.rng[i] = (std::uint64_t{pixel} << 32) | sample;  // hashed into the key below
+               if (zsobol) {
+                 lanes.zindex[i] = sampler().zsobol_index(x, y, sample);
+                 lanes.zkey[i] = sampler().zsobol_key(sample);
+               }
              });
         vs::hash_keys(lanes.rng.data(), lanes.view.n, SampleStream::seed_key(settings_.seed));
         run_wave_vector(lanes, out.subspan(begin, lanes.view.n), static_cast<std::uint32_t>(begin));
