@@ -29,6 +29,7 @@
 #include "core/parallel.h"
 #include "core/render.h"
 #include "core/scene_loader.h"
+#include "core/simd/simd.h"
 #include "reference/reference_tracer.h"
 #include "wavefront/wavefront_tracer.h"
 
@@ -531,6 +532,7 @@ int main(int argc, char** argv) {
   Setup& s = setup();
   // Our own flags first; the rest go to Google Benchmark.
   std::vector<char*> rest{argv[0]};
+  std::optional<SimdTarget> simd;  // --simd=NAME, else $PATHLAB_SIMD, else the best the processor runs
   for (int i = 1; i < argc; ++i) {
     if (std::strncmp(argv[i], "--scene=", 8) == 0)
       s.scene_file = argv[i] + 8;
@@ -540,6 +542,14 @@ int main(int argc, char** argv) {
       std::sscanf(argv[i] + 13, "%dx%d", &s.width, &s.height);
     else if (std::strcmp(argv[i], "--cpu-time") == 0)
       s.cpu_time = true;
+    else if (std::strncmp(argv[i], "--simd=", 7) == 0) {
+      const std::optional<SimdTarget> t = parse_simd_target(argv[i] + 7);
+      if (!t) {
+        std::fprintf(stderr, "pathlab bench: --simd: expected auto, avx512, avx2, sse4 or scalar, got '%s'\n", argv[i] + 7);
+        return 1;
+      }
+      simd = t;
+    }
     else if (std::strncmp(argv[i], "--spp=", 6) == 0)
       s.spp = std::max(1, std::atoi(argv[i] + 6));
     else if (std::strncmp(argv[i], "--waves=", 8) == 0) {
@@ -575,6 +585,10 @@ int main(int argc, char** argv) {
   int rest_argc = static_cast<int>(rest.size());
   benchmark::Initialize(&rest_argc, rest.data());
   try {
+    if (simd)
+      select_simd_target(*simd);
+    else
+      select_simd_target_from_environment();
     Scene scene = load_scene(s.scene_file);
     scene.render.spp = s.spp;
     if (s.width > 0 && s.height > 0) scene.film.width = s.width, scene.film.height = s.height;
@@ -591,6 +605,9 @@ int main(int argc, char** argv) {
   const std::string cpu = processor();
   benchmark::AddCustomContext("processor", cpu);
   std::fprintf(stderr, "pathlab bench: processor %s\n", cpu.c_str());
+  benchmark::AddCustomContext("simd", simd_target_name(active_simd_target()));
+  std::fprintf(stderr, "pathlab bench: SIMD target %s (--simd=NAME or PATHLAB_SIMD to choose)\n",
+               simd_target_name(active_simd_target()));
   register_benchmarks();
   RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
