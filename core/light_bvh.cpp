@@ -284,4 +284,26 @@ std::uint32_t LightBvh::share(const LightQuery& q, std::uint32_t light, std::uin
   return count;
 }
 
+std::vector<double> LightBvh::node_table() const {
+  std::vector<double> table;
+  table.reserve(nodes_.size() * kBvhFields);
+  for (const Node& node : nodes_) {
+    const LightBounds& b = node.bounds;
+    double f[kBvhFields] = {};
+    for (int c = 0; c < 3; ++c) {
+      f[kBvhLo + c] = b.lo[c];
+      f[kBvhHi + c] = b.hi[c];
+      f[kBvhAxis + c] = b.axis[c];
+    }
+    f[kBvhCosO] = b.cos_o;
+    f[kBvhCosE] = b.cos_e;
+    f[kBvhPhi] = b.phi;
+    f[kBvhTwoSided] = b.two_sided ? 1.0 : 0.0;
+    f[kBvhIndex] = node.index;
+    f[kBvhLeaf] = node.leaf ? 1.0 : 0.0;
+    table.insert(table.end(), std::begin(f), std::end(f));
+  }
+  return table;
+}
+
 }  // namespace pathlab

@@ -73,6 +73,13 @@ LightBounds merge(const LightBounds& a, const LightBounds& b);
 // Computed in double, with cosines and sines of differences (no acos).
 double importance(const LightBounds& b, const LightQuery& q);
 
+// The layout of LightBvh::node_table(): per node, its bounds, its index and
+// whether it is a leaf, as doubles (core/simd/light_bvh-inl.h reads it).
+enum BvhField : int {
+  kBvhLo = 0, kBvhHi = 3, kBvhAxis = 6, kBvhCosO = 9, kBvhCosE = 10, kBvhPhi = 11, kBvhTwoSided = 12,
+  kBvhIndex = 13, kBvhLeaf = 14, kBvhFields = 16,
+};
+
 class LightBvh {
  public:
   // Lights 0 .. n-1 with their bounds (each phi > 0). Empty: no tree.
@@ -96,6 +103,13 @@ class LightBvh {
   // How a range of `count` points is cut between children of importance
   // i0 and i1: the first child's part, or nothing when both are 0.
   static std::optional<std::uint32_t> split(double i0, double i1, std::uint32_t count);
+
+  // The tree as pick() and share() walk it, for code that walks it in bulk
+  // (the wavefront's vectorised stages, core/simd/light_bvh-inl.h): the
+  // nodes as a table of kBvhFields doubles each (BvhField), in order, and
+  // per light the trail share() follows.
+  std::vector<double> node_table() const;
+  const std::vector<std::uint64_t>& trails() const { return trail_; }
 
  private:
   struct Node {

@@ -188,6 +188,10 @@ class LightSampler {
   // The light BVH (null under `power`); its light i is entry bvh_entry(i).
   const LightBvh* bvh() const { return bvh_.get(); }
   std::size_t bvh_entry(std::uint32_t light) const { return tree_entry_[light]; }
+  // Entry i's light in the BVH, or -1 (not in the tree); and the grid points
+  // of LightChoice ([0, bvh_grid()) of 2^24) that walk the tree.
+  std::int64_t bvh_light(std::size_t entry) const { return entry_tree_[entry]; }
+  std::uint32_t bvh_grid() const { return sky_start_.empty() ? 0 : sky_start_[0]; }
 
   // The area-light distribution itself, for code that samples lights in
   // bulk (the wavefront's vectorised stages) and must pick exactly as

@@ -206,8 +206,9 @@ TEST(Wavefront, SameBitsForOneAndTwoThreadsAndAnyWaveSize) {
 }
 
 // Both tracers give the same bits for one thread and two, and the wavefront
-// for any wave size, on a scene the vectorised stages leave to the scalar ones.
-void expect_same_bits_for_one_and_two_threads(Scene scene) {
+// for any wave size, on a scene the vectorised stages leave to the scalar ones
+// (or, with `vectorised_stages`, one they take where the processor runs them).
+void expect_same_bits_for_one_and_two_threads(Scene scene, bool vectorised_stages = false) {
   const int width = scene.film.width, height = scene.film.height;
   const RenderSettings settings = scene.render;
   const CompiledScene compiled(std::move(scene));
@@ -216,7 +217,7 @@ void expect_same_bits_for_one_and_two_threads(Scene scene) {
     Film film(width, height, FilterKind::Box);
     if (wavefront) {
       const WavefrontTracer tracer(compiled, settings, wave);
-      EXPECT_FALSE(tracer.vectorised());
+      EXPECT_EQ(tracer.vectorised(), vectorised_stages && vector_stages::cpu_supported()) << tracer.scalar_reason();
       render(tracer, film);
     } else {
       const ReferenceTracer tracer(compiled, settings);
@@ -249,15 +250,15 @@ TEST(Wavefront, SolidAngleLightSamplingSameBitsForOneAndTwoThreads) {
   expect_same_bits_for_one_and_two_threads(std::move(scene));
 }
 
-// The light BVH: the wavefront runs its scalar stages (asserted inside) and
-// both tracers give the same bits for one thread and two, and the wavefront
-// for any wave size, on the Cornell box with many lights.
+// The light BVH: the wavefront runs its vectorised stages (asserted inside)
+// and both tracers give the same bits for one thread and two, and the
+// wavefront for any wave size, on the Cornell box with many lights.
 TEST(Wavefront, LightBvhSameBitsForOneAndTwoThreads) {
   Scene scene = test::cornell_with_many_lights();
   scene.film.width = scene.film.height = 16;
   scene.render.spp = 4;
   scene.render.light_sampler = LightSamplerKind::Bvh;
-  expect_same_bits_for_one_and_two_threads(std::move(scene));
+  expect_same_bits_for_one_and_two_threads(std::move(scene), true);
 }
 
 // The wavefront's image is the same bits for 1 and 2 threads and wave sizes
@@ -427,6 +428,7 @@ struct VectorCase {
                            // (its triangles' winding reversed), so that paths meet backs too
   bool zsobol = false;     // the zsobol sampler (Sobol' points, core/simd/sobol-inl.h in the lanes)
   int spp = 0;             // 0: the scene's (an odd log2 of it gives zsobol's index a lone lowest bit)
+  bool bvh = false;        // light_sampler bvh (the tree walked in double lanes, core/simd/light_bvh-inl.h)
 };
 
 // Every diffuse material one-sided (black behind its geometric normal), and
@@ -511,6 +513,7 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   if (c.one_sided) make_one_sided(scene);
   if (c.zsobol) scene.render.sampler = SamplerKind::ZSobol;
   if (c.spp > 0) scene.render.spp = c.spp;
+  if (c.bvh) scene.render.light_sampler = LightSamplerKind::Bvh;
   if (c.thin_lens) {
     scene.camera.aperture_radius = 0.1f;
     scene.camera.focus_distance = 3.0f;
@@ -589,6 +592,13 @@ std::vector<VectorCase> vector_cases() {
   cases.push_back({"", Strategy::LightBsdf, 0.0f, 0, true, false, false, false, true, 2});
   cases.push_back({"", Strategy::Mis, 0.0f, 0, false, false, false, false, true, 8});
   cases.push_back({"white-sphere-emissive-room.json", Strategy::LightBsdf, 0.0f, 0, false, true, true, false, true});
+  // The light BVH: its pick in sample_lights, its share for the MIS weight of emission found by a ray; more than
+  // 16 lights (a deeper tree), off-axis, one-sided, under zsobol.
+  for (Strategy st : {Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"", st, 0.0f, 0, false, false, false, false, false, 0, true});
+  cases.push_back({"white-sphere-emissive-room.json", Strategy::Mis, 0.0f, 0, false, true, true, false, false, 0, true});
+  cases.push_back({"white-sphere-emissive-room.json", Strategy::LightBsdf, 0.0f, -1, false, false, true, true, false, 0, true});
+  cases.push_back({"", Strategy::LightBsdf, 0.0f, 0, false, true, true, false, true, 0, true});
   return cases;
 }
 
@@ -600,7 +610,8 @@ INSTANTIATE_TEST_SUITE_P(LambertScenes, VectorStages, testing::ValuesIn(vector_c
                                            (p.param.tilted ? "_tilted" : "") + (p.param.thin_lens ? "_thin_lens" : "") +
                                            (p.param.crowded ? "_crowded" : "") + (p.param.one_sided ? "_one_sided" : "") +
                                            (p.param.zsobol ? "_zsobol" : "") +
-                                           (p.param.spp > 0 ? "_spp" + std::to_string(p.param.spp) : "");
+                                           (p.param.spp > 0 ? "_spp" + std::to_string(p.param.spp) : "") +
+                                           (p.param.bvh ? "_bvh" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;

@@ -23,6 +23,7 @@
 #include <hwy/highway.h>
 
 #include "core/simd/lanes-inl.h"
+#include "core/simd/light_bvh-inl.h"
 #include "core/simd/sampling-inl.h"
 #include "core/simd/sobol-inl.h"
 #include "core/rng.h"
@@ -56,6 +57,9 @@ std::size_t lanes() { return 1; }
 
 using pathlab::HWY_NAMESPACE::abs;
 using pathlab::HWY_NAMESPACE::area_to_solid_angle;
+using pathlab::HWY_NAMESPACE::bvh_field;
+using pathlab::HWY_NAMESPACE::bvh_importance;
+using pathlab::HWY_NAMESPACE::bvh_split;
 using pathlab::HWY_NAMESPACE::concentric_disk;
 using pathlab::HWY_NAMESPACE::dot;
 using pathlab::HWY_NAMESPACE::frame;
@@ -85,6 +89,12 @@ using VU = hn::Vec<DU>;
 using V64 = hn::Vec<D64>;
 using M = hn::Mask<DF>;
 using V3 = Vec3<VF>;
+using DD = hn::Repartition<double, DF>;  // half as many lanes
+using VD = hn::Vec<DD>;
+using MD = hn::Mask<DD>;
+using DDI = hn::RebindToSigned<DD>;
+using VDI = hn::Vec<DDI>;
+using V3D = Vec3<VD>;
 
 constexpr float kInvPi = 1.0f / 3.14159265358979323846f;  // core/math.h
 constexpr float kGamma2 = (2.0f * 0x1p-24f) / (1.0f - 2.0f * 0x1p-24f);  // gamma_bound(2), core/geometry.h
@@ -196,7 +206,9 @@ struct Packer {
   M first;  // the lanes [0, count)
   explicit Packer(M m)
       : count(hn::CountTrue(DF(), m)),
-        order(hn::IndicesFromVec(DF(), hn::Compress(hn::Iota(DI(), 0), hn::RebindMask(DI(), m)))),
+        // The lanes past count are unspecified after Compress: 0, so that every index is valid.
+        order(hn::IndicesFromVec(DF(), hn::IfThenElseZero(hn::FirstN(DI(), hn::CountTrue(DF(), m)),
+                                                          hn::Compress(hn::Iota(DI(), 0), hn::RebindMask(DI(), m))))),
         first(hn::FirstN(DF(), count)) {}
   // The kept lanes of v written to to[0, count).
   void store(float* to, VF v) const { hn::BlendedStore(hn::TableLookupLanes(v, order), first, DF(), to); }
@@ -252,8 +264,11 @@ struct Streams {
     const V64 entity = hn::Set(d64, s.entity);
     const unsigned bits = scene->zsobol_bits;
     V64 lo2, hi2;
-    const V64 a = zsobol_top24(d64, zindex_lo, zkey_lo, bits, slot_lo + entity, s.axis, second ? &lo2 : nullptr);
-    const V64 b = zsobol_top24(d64, zindex_hi, zkey_hi, bits, slot_hi + entity, s.axis, second ? &hi2 : nullptr);
+    const V64 low32 = hn::Set(d64, 0xffffffffull);
+    const V64 a = zsobol_top24(d64, zindex_lo, zkey_lo, bits, hn::And(slot_lo + entity, low32), s.axis,
+                               second ? &lo2 : nullptr);
+    const V64 b = zsobol_top24(d64, zindex_hi, zkey_hi, bits, hn::And(slot_hi + entity, low32), s.axis,
+                               second ? &hi2 : nullptr);
     if (second) *second = unit(lo2, hi2);
     return unit(a, b);
   }
@@ -273,6 +288,7 @@ Streams streams(const Scene& sc, const Wave& w, std::size_t i0, VI vertex) {
     s.zindex_hi = hn::LoadU(d64, w.zindex + i0 + half);
     s.zkey_lo = hn::LoadU(d64, w.zkey + i0);
     s.zkey_hi = hn::LoadU(d64, w.zkey + i0 + half);
+    // vertex * slots per vertex (+ entity, in zsobol()) wraps at 2^32 as SampleStream's uint32 does.
     s.slot_lo = mul64(d64, vertex_lo, kSobolSlotsPerVertex);
     s.slot_hi = mul64(d64, vertex_hi, kSobolSlotsPerVertex);
   }
@@ -293,6 +309,78 @@ VI pick(M m, const Lights& lights, VF u) {
     idx = hn::IfThenElse(hn::RebindMask(DI(), hn::And(valid, c <= u)), cand, idx);
   }
   return hn::Min(idx, hn::Set(DI(), count - 1));
+}
+
+// The light BVH (core/light_bvh.cpp), each half of a block in double lanes.
+// Float lanes to the halves' doubles and back (exact both ways for the
+// values here: floats, and whole numbers below 2^24).
+VD half_d(VF v, bool upper) {
+  const hn::Half<DF> dh;
+  return hn::PromoteTo(DD(), upper ? hn::UpperHalf(dh, v) : hn::LowerHalf(dh, v));
+}
+V3D half_d(const V3& v, bool upper) { return {half_d(v.x, upper), half_d(v.y, upper), half_d(v.z, upper)}; }
+MD half_mask(M m, bool upper) { return half_d(hn::IfThenElseZero(m, k(1.0f)), upper) != hn::Zero(DD()); }
+VF join_f(VD lo, VD hi) {
+  const hn::Rebind<float, DD> dfh;
+  return hn::Combine(DF(), hn::DemoteTo(dfh, hi), hn::DemoteTo(dfh, lo));
+}
+
+// LightBvh::pick for the lanes of `active`: the light grid point k (of
+// `count`) leads to, and its share (0 where the walk ends on two children
+// of importance 0, or the root has none).
+void bvh_pick(const Lights& lights, const V3D& p, const V3D& n, VD k, VD count, MD active, VD& light, VD& share) {
+  const DD dd;
+  const double* t = lights.bvh_nodes;
+  VDI node = hn::Zero(DDI());
+  MD ok = hn::And(active, bvh_importance(dd, t, node, p, n) > hn::Zero(dd));
+  for (;;) {
+    const MD walking = hn::AndNot(bvh_field(dd, t, node, kBvhLeaf) != hn::Zero(dd), ok);
+    if (hn::AllFalse(dd, walking)) break;
+    const VDI c0 = node + hn::Set(DDI(), 1);
+    const VDI c1 = hn::IfThenElse(hn::RebindMask(DDI(), walking), hn::ConvertTo(DDI(), bvh_field(dd, t, node, kBvhIndex)), c0);
+    MD valid;
+    const VD first = bvh_split(dd, bvh_importance(dd, t, c0, p, n), bvh_importance(dd, t, c1, p, n), count, valid);
+    ok = hn::AndNot(hn::AndNot(valid, walking), ok);
+    const MD to_first = hn::And(walking, k < first), to_second = hn::AndNot(k < first, walking);
+    node = hn::IfThenElse(hn::RebindMask(DDI(), to_first), c0, hn::IfThenElse(hn::RebindMask(DDI(), to_second), c1, node));
+    k = hn::IfThenElse(to_second, k - first, k);
+    count = hn::IfThenElse(to_first, first, hn::IfThenElse(to_second, count - first, count));
+  }
+  light = bvh_field(dd, t, node, kBvhIndex);
+  share = hn::IfThenElseZero(ok, count);
+}
+
+// LightBvh::share: the grid points (of `count`) that lead to `light`.
+VD bvh_share(const Lights& lights, const V3D& p, const V3D& n, VD light, VD count, MD active) {
+  const DD dd;
+  const hn::RebindToUnsigned<DD> du64;
+  const double* t = lights.bvh_nodes;
+  const VDI light_index = hn::IfThenElseZero(hn::RebindMask(DDI(), active), hn::ConvertTo(DDI(), light));
+  auto trail = hn::GatherIndex(du64, lights.bvh_trail, light_index);
+  VDI node = hn::Zero(DDI());
+  MD ok = hn::And(active, bvh_importance(dd, t, node, p, n) > hn::Zero(dd));
+  for (;;) {
+    const MD walking = hn::AndNot(bvh_field(dd, t, node, kBvhLeaf) != hn::Zero(dd), ok);
+    if (hn::AllFalse(dd, walking)) break;
+    const VDI c0 = node + hn::Set(DDI(), 1);
+    const VDI c1 = hn::IfThenElse(hn::RebindMask(DDI(), walking), hn::ConvertTo(DDI(), bvh_field(dd, t, node, kBvhIndex)), c0);
+    MD valid;
+    const VD first = bvh_split(dd, bvh_importance(dd, t, c0, p, n), bvh_importance(dd, t, c1, p, n), count, valid);
+    ok = hn::AndNot(hn::AndNot(valid, walking), ok);
+    const MD second = hn::RebindMask(dd, hn::And(trail, hn::Set(du64, 1)) != hn::Zero(du64));
+    const MD to_first = hn::AndNot(second, walking), to_second = hn::And(walking, second);
+    node = hn::IfThenElse(hn::RebindMask(DDI(), to_first), c0, hn::IfThenElse(hn::RebindMask(DDI(), to_second), c1, node));
+    count = hn::IfThenElse(to_first, first, hn::IfThenElse(to_second, count - first, count));
+    ok = hn::AndNot(hn::And(walking, count == hn::Zero(dd)), ok);
+    trail = hn::IfThenElse(hn::RebindMask(du64, walking), hn::ShiftRight<1>(trail), trail);
+  }
+  return hn::IfThenElseZero(ok, count);
+}
+
+// light_query's normal (core/light_sampler.h): n turned to wo's side, 0 edge-on.
+V3 query_normal(const V3& n, const V3& wo) {
+  const VF c = dot(n, wo);
+  return select(c > k(0.0f), n, select(c < k(0.0f), -n, zero3()));
 }
 
 void generate_camera_rays(const Scene& sc, const Camera& c, const Wave& w) {
@@ -338,6 +426,7 @@ void generate_camera_rays(const Scene& sc, const Camera& c, const Wave& w) {
     store3(w, kBetaR, i0, in, one);
     store3(w, kLR, i0, in, zero);
     store3(w, kPrevX, i0, in, zero);
+    store3(w, kPrevNx, i0, in, zero);
     store(w, kPrevPdf, i0, in, k(0.0f));
     store_mask(w, kPrevImpulse, i0, in, in);
     store_mask(w, kPrevBsdfTechnique, i0, in, in);
@@ -442,8 +531,27 @@ void add_emission(const Scene& sc, const Wave& w) {
       const V3 d = load3(w, kPx, i0, light) - load3(w, kPrevX, i0, light);
       const VF dist = hn::Sqrt(dot(d, d));
       const VF inv_area = light_value(light, sc.lights, entry, kLightInvArea);
-      const VF pmf = light_value(light, sc.lights, entry, kLightPmf);
-      const VF light_pdf = hn::IfThenElseZero(light, pmf * area_to_solid_angle(df, inv_area, dist, dot(n, d) / dist));
+      VF pmf = light_value(light, sc.lights, entry, kLightPmf);
+      M pdf_zero = hn::FirstN(df, 0);
+      if (sc.lights.bvh_nodes && !hn::AllFalse(df, light)) {
+        // LightSampler::pick_pmf from the previous vertex's query: the
+        // tree's share for the tree's lights (their power pmf is 0).
+        const VI safe_entry = hn::IfThenElseZero(hn::RebindMask(DI(), light), entry);
+        const VI tree_light = hn::GatherIndex(DI(), sc.lights.bvh_light, safe_entry);
+        const M in_tree = hn::And(light, fmask(hn::Not(tree_light < hn::Zero(DI()))));
+        if (!hn::AllFalse(df, in_tree)) {
+          const V3 qp = load3(w, kPrevX, i0, in_tree), qn = load3(w, kPrevNx, i0, in_tree);
+          const VF tl = hn::ConvertTo(df, hn::IfThenElseZero(hn::RebindMask(DI(), in_tree), tree_light));
+          const VD grid = hn::Set(DD(), static_cast<double>(sc.lights.bvh_grid));
+          VD share[2];
+          for (int h = 0; h < 2; ++h)
+            share[h] = bvh_share(sc.lights, half_d(qp, h), half_d(qn, h), half_d(tl, h), grid, half_mask(in_tree, h));
+          pmf = hn::IfThenElse(in_tree, join_f(share[0], share[1]) * k(0x1p-24f), pmf);
+        }
+        pdf_zero = pmf == k(0.0f);  // a light the tree gives nothing from here: density 0
+      }
+      const VF light_pdf =
+          hn::IfThenZeroElse(pdf_zero, hn::IfThenElseZero(light, pmf * area_to_solid_angle(df, inv_area, dist, dot(n, d) / dist)));
       // emission_weight (core/strategy_weights.h).
       VF weight = k(1.0f);
       if (sc.strategy == Strategy::Light) weight = hn::IfThenElse(light_pdf > k(0.0f), k(0.0f), k(1.0f));
@@ -473,13 +581,37 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     if (sc.strategy == Strategy::Bsdf || sc.lights.count == 0) ok = hn::FirstN(df, 0);
     if (sc.strategy == Strategy::LightBsdf) ok = hn::And(ok, rng.u(Dim::Technique) < k(0.5f));
     if (hn::AllFalse(df, ok)) {
-      store_mask(w, kHasQuery, i0, in, ok);
       continue;
     }
 
     // LightSampler::sample: pick a triangle, then a point uniformly on it
     // (square_to_uniform_triangle, triangle_point).
-    const VI light = pick(ok, sc.lights, rng.u(Dim::LightChoice));
+    const VF u_choice = rng.u(Dim::LightChoice);
+    const V3 sp = load3(w, kPx, i0, ok);
+    const V3 wo = -load3(w, kDx, i0, ok);
+    const V3 n = load3(w, kNx, i0, ok);  // the frame's normal is the surface's
+    VI light;
+    VF bvh_pmf = hn::Zero(df);
+    if (sc.lights.bvh_nodes) {
+      // LightSampler::pick under bvh: the grid point k of u_choice walks the
+      // tree from light_query(s, wo) (no sky: every point is the tree's).
+      const V3 qn = query_normal(n, wo);
+      VD share[2], tree_light[2];
+      for (int h = 0; h < 2; ++h) {
+        const VD scaled = hn::Floor(half_d(u_choice, h) * hn::Set(DD(), 0x1p24));
+        const VD grid_k = hn::IfThenElse(scaled < hn::Zero(DD()), hn::Zero(DD()),
+                                         hn::IfThenElse(hn::Set(DD(), 0x1p24 - 1) < scaled, hn::Set(DD(), 0x1p24 - 1), scaled));
+        bvh_pick(sc.lights, half_d(sp, h), half_d(qn, h), grid_k, hn::Set(DD(), static_cast<double>(sc.lights.bvh_grid)),
+                 half_mask(ok, h), tree_light[h], share[h]);
+      }
+      const VF shares = join_f(share[0], share[1]);
+      ok = hn::And(ok, shares > k(0.0f));
+      bvh_pmf = shares * k(0x1p-24f);
+      const VI tl = hn::IfThenElseZero(hn::RebindMask(DI(), ok), hn::ConvertTo(DI(), join_f(tree_light[0], tree_light[1])));
+      light = hn::IfThenElseZero(hn::RebindMask(DI(), ok), hn::GatherIndex(DI(), sc.lights.bvh_entry, tl));
+    } else {
+      light = pick(ok, sc.lights, u_choice);
+    }
     VF b1, b2;
     VF lu, lv;
     rng.u2(Dim::LightX, lu, lv);
@@ -491,7 +623,6 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     V3 lp, lerr;
     triangle_point(df, b1, b2, p0, p1, p2, lp, lerr);
 
-    const V3 sp = load3(w, kPx, i0, ok);
     const V3 d = lp - sp;
     const VF dist = hn::Sqrt(dot(d, d));
     ok = hn::And(ok, dist > k(0.0f));
@@ -501,14 +632,12 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     ok = hn::And(ok, hn::Or(two_sided != k(0.0f), hn::Not(cos_light <= k(0.0f))));
     // pmf * area_to_solid_angle(1 / area, dist, cos_light) (core/sampling.h).
     const VF inv_area = light_value(ok, sc.lights, light, kLightInvArea);
-    const VF pmf = light_value(ok, sc.lights, light, kLightPmf);
+    const VF pmf = sc.lights.bvh_nodes ? bvh_pmf : light_value(ok, sc.lights, light, kLightPmf);
     const VF pdf_light = pmf * area_to_solid_angle(df, inv_area, dist, cos_light);
     ok = hn::And(ok, hn::AndNot(hn::IsInf(pdf_light), pdf_light > k(0.0f)));  // seen edge-on
 
     // Surfel::eval and Surfel::pdf of the Lambert lobe (core/surfel.cpp,
     // bsdf/lambert.h): only the local z of wo and wi matters.
-    const V3 wo = -load3(w, kDx, i0, ok);
-    const V3 n = load3(w, kNx, i0, ok);  // the frame's normal is the surface's
     const VF wo_z = dot(wo, n);
     const VI shape = load(w, kShape, i0, ok);
     // A one-sided material is black unless wo and wi both leave its front
@@ -543,7 +672,6 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     for (int a = 0; a < 7; ++a) pack.store(w.f[kQOx + a] + queries, q[a]);
     pack.store(w.u[kQPath] + queries, hn::Iota(DU(), static_cast<std::uint32_t>(i0)));
     const std::size_t count = pack.count;
-    store_mask(w, kHasQuery, i0, in, ok);
     // The shadow ray counts as one of the path's rays.
     store(w, kRays, i0, ok, load(w, kRays, i0, ok) + hn::Set(DI(), 1));
     queries += count;
@@ -587,7 +715,7 @@ void scatter(const Scene& sc, const Wave& w) {
     const M rr = hn::And(ok, fmask(vertex > hn::Set(DI(), sc.rr_depth)));
     if (!hn::AllFalse(df, rr)) {
       const V3 bw = beta * weight;
-      // std::min(std::max(std::max(bw.x, bw.y), bw.z), 1) in Max/Min's operand order.
+      // std::min(1.0f, std::max(bw.x, std::max(bw.y, bw.z))) (max_component), in Max/Min's operand order.
       const VF survival = hn::Min(hn::Max(hn::Max(bw.z, bw.y), bw.x), k(1.0f));
       ok = hn::AndNot(hn::AndNot(rng.u(Dim::Roulette) < survival, rr), ok);
       weight = select(rr, weight / survival, weight);
@@ -597,6 +725,7 @@ void scatter(const Scene& sc, const Wave& w) {
     // PreviousVertex{s.p, pdf, impulse = false, bsdf_technique}.
     const V3 sp = load3(w, kPx, i0, ok);
     store3(w, kPrevX, i0, ok, sp);
+    store3(w, kPrevNx, i0, ok, query_normal(n, wo));
     store(w, kPrevPdf, i0, ok, pdf);
     store_mask(w, kPrevImpulse, i0, ok, hn::FirstN(df, 0));
     M bsdf_technique = hn::FirstN(df, lanes());
@@ -623,7 +752,8 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
 
 std::size_t compact(const Wave& w, bool zsobol, void* samples, std::uint32_t first_slot) {
   static constexpr FloatArray kMovedFloats[] = {kOx,   kOy,   kOz,   kDx,   kDy,    kDz,    kTmax,  kBetaR,   kBetaG, kBetaB,
-                                                kLR,   kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX, kFilmY};
+                                                kLR,   kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX, kFilmY,
+                                                kPrevNx, kPrevNy, kPrevNz};
   static constexpr UintArray kMovedUints[] = {kOutIndex, kRays, kVertex};
   static constexpr ByteArray kMovedBytes[] = {kPrevImpulse, kPrevBsdfTechnique};
   const DF df;

@@ -7,8 +7,8 @@
 // run the scalar stages of wavefront_tracer.cpp.
 //
 // Written once (vector_stages.cpp, over Google Highway, compiled for every
-// target) on core's per-lane code (core/simd/*-inl.h, which core's scalar
-// code runs at width 1). Same paths: every lane computes what the scalar
+// target) on core's per-lane code (core/simd/*-inl.h; core's scalar code
+// runs sampling-inl.h at width 1, and has a scalar twin of the rest). Same paths: every lane computes what the scalar
 // code computes, operation for operation and in the same order, and Embree
 // sees the same batches in the same order. tests/test_wavefront.cpp checks
 // every sample of several scenes bit for bit against the scalar stages at
@@ -42,6 +42,15 @@ struct Lights {
   // rows (kLightCdf...). A lookup is then one permute of a register
   // instead of a gather from memory.
   const float* columns = nullptr;
+  // Under `light_sampler: bvh` (else bvh_nodes is null): the tree, kBvhFields
+  // doubles per node (core/simd/light_bvh-inl.h, BvhField); per tree light its
+  // trail (LightBvh::trails) and entry; per entry its tree light or -1; the
+  // grid points of LightChoice that walk the tree (LightSampler::bvh_grid).
+  const double* bvh_nodes = nullptr;
+  const std::uint64_t* bvh_trail = nullptr;
+  const std::int32_t* bvh_entry = nullptr;
+  const std::int32_t* bvh_light = nullptr;
+  std::uint32_t bvh_grid = 0;
 };
 enum LightField : int {
   kLightP0 = 0, kLightP1 = 3, kLightP2 = 6, kLightNormal = 9, kLightLe = 12, kLightTwoSided = 15,
@@ -56,10 +65,10 @@ struct Scene {
   int max_vertex = 0;  // paths end at a vertex beyond this (the depth cap)
   float min_pdf = 0.0f;
   std::size_t shape_count = 0;
-  bool one_sided = false;
+  bool one_sided = false;  // some shape's material is one-sided (ShapeField kOneSided): else no lane looks
   // The zsobol sampler (else the independent one): SamplerSetup::zsobol_bits().
   bool zsobol = false;
-  unsigned zsobol_bits = 0;  // some shape's material is one-sided (ShapeField kOneSided): else no lane looks
+  unsigned zsobol_bits = 0;
   Lights lights;
   // Per shape, 32 floats (ShapeField): its material's albedo, emission and
   // flags, its first light entry, and its geometry.
@@ -100,6 +109,7 @@ enum FloatArray : int {
   kBetaR, kBetaG, kBetaB,               // throughput
   kLR, kLG, kLB,                        // radiance so far
   kPrevX, kPrevY, kPrevZ, kPrevPdf,     // PreviousVertex
+  kPrevNx, kPrevNy, kPrevNz,            // PreviousVertex::ref.n (the light BVH's query)
   kFilmX, kFilmY,
   // This bounce only: the hit and the Surfel made of it.
   kHitT, kHitU, kHitV,
@@ -118,7 +128,6 @@ enum UintArray : int {
 };
 enum ByteArray : int {
   kAlive, kFound, kPrevImpulse, kPrevBsdfTechnique,
-  kHasQuery,   // whether the path has a shadow ray among the packed ones
   kQOccluded,  // per packed shadow ray
   kByteArrays
 };

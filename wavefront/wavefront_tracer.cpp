@@ -145,6 +145,8 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns;
+  std::vector<double> bvh_nodes;
+  std::vector<std::int32_t> bvh_entry, bvh_light;
 
   // Null, with *why_not saying what stops it, unless the selected SIMD
   // target is a vector one and the scene needs nothing more than Lambert
@@ -189,8 +191,10 @@ struct WavefrontTracer::VectorStages {
       if (m.has_alpha()) return no("material '" + m.name + "' has alpha (partial coverage)");
     if (compiled.has_textures()) return no("textures");
     // Flat triangles only: the stages shade with the geometric normal.
-    for (const Shape& shape : scene.shapes)
+    for (const Shape& shape : scene.shapes) {
       if (shape.mesh.has_normals()) return no(shape.description + " has vertex normals (smooth shading)");
+      if (!shape.mesh.tangents.empty()) return no(shape.description + " has tangents (a rotated shading frame)");
+    }
     // Only triangle area lights: no delta light, sphere light or environment.
     const LightSampler& lights = compiled.lights();
     if (lights.has_delta_lights()) return no("delta lights (point, spot, directional)");
@@ -199,9 +203,6 @@ struct WavefrontTracer::VectorStages {
     // in LightSampler::sample() alone, which the scalar stages call.
     if (lights.light_sampling() != LightSampling::Area)
       return no(std::string("light_sampling ") + light_sampling_name(lights.light_sampling()));
-    // Likewise the light BVH's pick: LightSampler::sample() alone.
-    if (lights.light_sampler() != LightSamplerKind::Power)
-      return no(std::string("light_sampler ") + light_sampler_name(lights.light_sampler()));
     for (const LightSampler::Entry& e : lights.entries()) {
       const Shape& shape = scene.shapes[e.shape];
       if (shape.kind != Shape::Kind::Triangles) return no("a sphere light (" + shape.description + ")");
@@ -217,13 +218,25 @@ struct WavefrontTracer::VectorStages {
       v->light_columns.assign(16 * vs::kLightColumns, 0.0f);
       for (std::size_t l = 0; l < n_lights; ++l) {
         for (int f = 0; f < vs::kLightCdf; ++f) v->light_columns[16 * f + l] = v->light_triangle[16 * l + f];
-        v->light_columns[16 * vs::kLightCdf + l] = lights.cdf()[l];
+        if (!lights.cdf().empty()) v->light_columns[16 * vs::kLightCdf + l] = lights.cdf()[l];  // none under bvh
         v->light_columns[16 * vs::kLightPmf + l] = lights.pmf()[l];
         v->light_columns[16 * vs::kLightInvArea + l] = v->inv_area[l];
       }
     }
     sc.lights = {n_lights, lights.cdf().data(), lights.pmf().data(), v->inv_area.data(), v->light_triangle.data(),
                  v->light_columns.empty() ? nullptr : v->light_columns.data()};
+    if (const LightBvh* bvh = lights.bvh(); bvh && !bvh->empty()) {
+      // The light BVH as the stages walk it (core/simd/light_bvh-inl.h).
+      v->bvh_nodes = bvh->node_table();
+      for (std::uint32_t l = 0; l < bvh->trails().size(); ++l)
+        v->bvh_entry.push_back(static_cast<std::int32_t>(lights.bvh_entry(l)));
+      for (std::size_t e = 0; e < n_lights; ++e) v->bvh_light.push_back(static_cast<std::int32_t>(lights.bvh_light(e)));
+      sc.lights.bvh_nodes = v->bvh_nodes.data();
+      sc.lights.bvh_trail = bvh->trails().data();
+      sc.lights.bvh_entry = v->bvh_entry.data();
+      sc.lights.bvh_light = v->bvh_light.data();
+      sc.lights.bvh_grid = lights.bvh_grid();
+    }
     // Per shape: its material's parameters and its geometry.
     // Gathers index these tables with 32-bit float indices: 32 per shape, 12 per triangle, 16 per light.
     if (compiled.triangles().size() >= (std::size_t{1} << 27)) return no("more than 2^27 triangles");
