@@ -635,6 +635,13 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
 
   EXPECT_FALSE(vectorised(cornell, Strategy::Cosine));
   EXPECT_FALSE(vectorised(cornell, Strategy::Mis, true));  // --general-shading
+  Scene tangents = cornell;  // a tangent frame rotates the sampled directions (glTF TANGENT without NORMAL)
+  for (Shape& shape : tangents.shapes)
+    if (shape.kind == Shape::Kind::Triangles && !tangents.materials[shape.material].emits()) {
+      shape.mesh.tangents.assign(shape.mesh.positions.size(), glm::vec4(1, 0, 0, 1));
+      break;
+    }
+  EXPECT_FALSE(vectorised(tangents, Strategy::Mis));
   Scene solid_angle = cornell;  // the stages sample lights by area only
   solid_angle.render.light_sampling = LightSampling::SolidAngle;
   EXPECT_FALSE(vectorised(solid_angle, Strategy::Mis));
