@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
 
 namespace pathlab {
@@ -119,6 +120,32 @@ TEST(AnalyticPenumbra, EmissivePolygonMatchesTheLightsExpectedImage) {
     EXPECT_TRUE(check_against_expected(film, expected_image(*model, compiled.camera(), compiled.scene().film)).pass)
         << strategy_name(strategy);
   }
+}
+
+// The sun disk model's own radiance against its closed form: a disk of
+// angular radius alpha giving irradiance E at normal incidence has radiance
+// E / (pi sin^2 alpha), the cosine-weighted solid angle of the cap being
+// pi sin^2 alpha; nothing outside the cap. (The plane's pixels do not depend
+// on it: only a camera that sees the sun would, so it is tested here.)
+TEST(AnalyticSun, DiskRadianceIsIrradianceOverPiSinSquaredAlpha) {
+  const Scene s = load_scene(test::analytic_scene("sun-disk-plane.json"));
+  const auto model = make_analytic_model(s);
+  const DeltaLight& sun = s.delta_lights[0];
+  const glm::dvec3 to_sun = -glm::normalize(glm::dvec3(sun.direction));
+  const double alpha = sun.angular_radius, sin_alpha = std::sin(alpha);
+  const vec3 above(0.0f, 2.0f, 0.0f);
+  const Spectrum L = model->radiance(Ray{above, vec3(to_sun)});
+  for (int c = 0; c < 3; ++c) {
+    const double expected = double(sun.intensity[c]) / (M_PI * sin_alpha * sin_alpha);
+    EXPECT_NEAR(L[c], expected, 1e-6 * expected) << "channel " << c;
+  }
+  // Just inside and just outside the cap's rim (rotated about the z axis, perpendicular to to_sun).
+  auto tilted = [&](double angle) {
+    const double c = std::cos(angle), sn = std::sin(angle);
+    return vec3(glm::normalize(glm::dvec3(c * to_sun.x - sn * to_sun.y, sn * to_sun.x + c * to_sun.y, to_sun.z)));
+  };
+  EXPECT_GT(model->radiance(Ray{above, tilted(0.99 * alpha)}).x, 0.0f);
+  EXPECT_EQ(model->radiance(Ray{above, tilted(1.01 * alpha)}), Spectrum(0.0f));
 }
 
 void expect_refused(const std::string& scene_name, const std::function<void(Scene&)>& edit, const std::string& words) {
