@@ -325,54 +325,62 @@ VF join_f(VD lo, VD hi) {
   return hn::Combine(DF(), hn::DemoteTo(dfh, hi), hn::DemoteTo(dfh, lo));
 }
 
+// One level of a walk down the light BVH (LightBvh::pick and share): for the
+// lanes of ok still above a leaf (`walking`), their children c0 and c1 and
+// the first child's part of `count` (LightBvh::split); a walking lane whose
+// children both have importance 0 leaves ok. False when no lane walks.
+struct BvhLevel {
+  MD walking;
+  VDI c0, c1;
+  VD first;
+};
+bool bvh_level(const Lights& lights, const V3D& p, const V3D& n, VDI node, VD count, MD& ok, BvhLevel& level) {
+  const DD dd;
+  const double* t = lights.bvh_nodes;
+  level.walking = hn::AndNot(bvh_field(dd, t, node, kBvhLeaf) != hn::Zero(dd), ok);
+  if (hn::AllFalse(dd, level.walking)) return false;
+  level.c0 = node + hn::Set(DDI(), 1);
+  level.c1 = hn::IfThenElse(hn::RebindMask(DDI(), level.walking), hn::ConvertTo(DDI(), bvh_field(dd, t, node, kBvhIndex)),
+                            level.c0);
+  MD valid;
+  level.first = bvh_split(dd, bvh_importance(dd, t, level.c0, p, n), bvh_importance(dd, t, level.c1, p, n), count, valid);
+  ok = hn::AndNot(hn::AndNot(valid, level.walking), ok);
+  return true;
+}
+
 // LightBvh::pick for the lanes of `active`: the light grid point k (of
 // `count`) leads to, and its share (0 where the walk ends on two children
 // of importance 0, or the root has none).
 void bvh_pick(const Lights& lights, const V3D& p, const V3D& n, VD k, VD count, MD active, VD& light, VD& share) {
   const DD dd;
-  const double* t = lights.bvh_nodes;
   VDI node = hn::Zero(DDI());
-  MD ok = hn::And(active, bvh_importance(dd, t, node, p, n) > hn::Zero(dd));
-  for (;;) {
-    const MD walking = hn::AndNot(bvh_field(dd, t, node, kBvhLeaf) != hn::Zero(dd), ok);
-    if (hn::AllFalse(dd, walking)) break;
-    const VDI c0 = node + hn::Set(DDI(), 1);
-    const VDI c1 = hn::IfThenElse(hn::RebindMask(DDI(), walking), hn::ConvertTo(DDI(), bvh_field(dd, t, node, kBvhIndex)), c0);
-    MD valid;
-    const VD first = bvh_split(dd, bvh_importance(dd, t, c0, p, n), bvh_importance(dd, t, c1, p, n), count, valid);
-    ok = hn::AndNot(hn::AndNot(valid, walking), ok);
-    const MD to_first = hn::And(walking, k < first), to_second = hn::AndNot(k < first, walking);
-    node = hn::IfThenElse(hn::RebindMask(DDI(), to_first), c0, hn::IfThenElse(hn::RebindMask(DDI(), to_second), c1, node));
-    k = hn::IfThenElse(to_second, k - first, k);
-    count = hn::IfThenElse(to_first, first, hn::IfThenElse(to_second, count - first, count));
+  MD ok = hn::And(active, bvh_importance(dd, lights.bvh_nodes, node, p, n) > hn::Zero(dd));
+  for (BvhLevel l; bvh_level(lights, p, n, node, count, ok, l);) {
+    const MD to_first = hn::And(l.walking, k < l.first), to_second = hn::AndNot(k < l.first, l.walking);
+    node = hn::IfThenElse(hn::RebindMask(DDI(), to_first), l.c0, hn::IfThenElse(hn::RebindMask(DDI(), to_second), l.c1, node));
+    k = hn::IfThenElse(to_second, k - l.first, k);  // re-based to the second child's part
+    count = hn::IfThenElse(to_first, l.first, hn::IfThenElse(to_second, count - l.first, count));
   }
-  light = bvh_field(dd, t, node, kBvhIndex);
+  light = bvh_field(dd, lights.bvh_nodes, node, kBvhIndex);
   share = hn::IfThenElseZero(ok, count);
 }
 
-// LightBvh::share: the grid points (of `count`) that lead to `light`.
+// LightBvh::share: the grid points (of `count`) that lead to `light`, down
+// the light's trail (bit d set: the second child at depth d).
 VD bvh_share(const Lights& lights, const V3D& p, const V3D& n, VD light, VD count, MD active) {
   const DD dd;
   const hn::RebindToUnsigned<DD> du64;
-  const double* t = lights.bvh_nodes;
   const VDI light_index = hn::IfThenElseZero(hn::RebindMask(DDI(), active), hn::ConvertTo(DDI(), light));
   auto trail = hn::GatherIndex(du64, lights.bvh_trail, light_index);
   VDI node = hn::Zero(DDI());
-  MD ok = hn::And(active, bvh_importance(dd, t, node, p, n) > hn::Zero(dd));
-  for (;;) {
-    const MD walking = hn::AndNot(bvh_field(dd, t, node, kBvhLeaf) != hn::Zero(dd), ok);
-    if (hn::AllFalse(dd, walking)) break;
-    const VDI c0 = node + hn::Set(DDI(), 1);
-    const VDI c1 = hn::IfThenElse(hn::RebindMask(DDI(), walking), hn::ConvertTo(DDI(), bvh_field(dd, t, node, kBvhIndex)), c0);
-    MD valid;
-    const VD first = bvh_split(dd, bvh_importance(dd, t, c0, p, n), bvh_importance(dd, t, c1, p, n), count, valid);
-    ok = hn::AndNot(hn::AndNot(valid, walking), ok);
+  MD ok = hn::And(active, bvh_importance(dd, lights.bvh_nodes, node, p, n) > hn::Zero(dd));
+  for (BvhLevel l; bvh_level(lights, p, n, node, count, ok, l);) {
     const MD second = hn::RebindMask(dd, hn::And(trail, hn::Set(du64, 1)) != hn::Zero(du64));
-    const MD to_first = hn::AndNot(second, walking), to_second = hn::And(walking, second);
-    node = hn::IfThenElse(hn::RebindMask(DDI(), to_first), c0, hn::IfThenElse(hn::RebindMask(DDI(), to_second), c1, node));
-    count = hn::IfThenElse(to_first, first, hn::IfThenElse(to_second, count - first, count));
-    ok = hn::AndNot(hn::And(walking, count == hn::Zero(dd)), ok);
-    trail = hn::IfThenElse(hn::RebindMask(du64, walking), hn::ShiftRight<1>(trail), trail);
+    const MD to_first = hn::AndNot(second, l.walking), to_second = hn::And(l.walking, second);
+    node = hn::IfThenElse(hn::RebindMask(DDI(), to_first), l.c0, hn::IfThenElse(hn::RebindMask(DDI(), to_second), l.c1, node));
+    count = hn::IfThenElse(to_first, l.first, hn::IfThenElse(to_second, count - l.first, count));
+    ok = hn::AndNot(hn::And(l.walking, count == hn::Zero(dd)), ok);
+    trail = hn::IfThenElse(hn::RebindMask(du64, l.walking), hn::ShiftRight<1>(trail), trail);
   }
   return hn::IfThenElseZero(ok, count);
 }
