@@ -254,6 +254,10 @@ def main():
 
     def save(results):
         if args.results:
+            # Verdicts of mutations outside this run's selection (--only) stay in the file.
+            merged = dict(done)
+            merged.update({r["mutation"]: r for r in results})
+            results = [merged[k] for k in sorted(merged)]
             counts = {k: sum(r["status"] == v for r in results)
                       for k, v in (("killed", "KILLED"), ("survived", "SURVIVED"), ("build_failed", "BUILD-FAILED"))}
             tmp = args.results.with_name(args.results.name + ".tmp")
