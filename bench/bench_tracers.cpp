@@ -585,10 +585,7 @@ int main(int argc, char** argv) {
   int rest_argc = static_cast<int>(rest.size());
   benchmark::Initialize(&rest_argc, rest.data());
   try {
-    if (simd)
-      select_simd_target(*simd);
-    else
-      select_simd_target_from_environment();
+    select_simd_target(simd, "--simd");
     Scene scene = load_scene(s.scene_file);
     scene.render.spp = s.spp;
     if (s.width > 0 && s.height > 0) scene.film.width = s.width, scene.film.height = s.height;

@@ -16,8 +16,8 @@ namespace pathlab {
 // A strong 64-bit bijective mixer (the splitmix64 finaliser, Steele et al.
 // 2014). Every output bit depends on every input bit.
 constexpr std::uint64_t mix64(std::uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  z = (z ^ (z >> 30)) * sobol::kMixMul0;
+  z = (z ^ (z >> 27)) * sobol::kMixMul1;
   return z ^ (z >> 31);
 }
 
@@ -143,7 +143,7 @@ class SampleStream {
     }
   };
   constexpr Point zsobol_point(std::uint32_t slot) const {
-    const std::uint64_t h = mix64(sobol_key_ ^ (static_cast<std::uint64_t>(slot) * 0xd1b54a32d192ed03ull));
+    const std::uint64_t h = mix64(sobol_key_ ^ (static_cast<std::uint64_t>(slot) * sobol::kSlotStep));
     return {sobol::permute_digits(index_, index_bits_, h), h};
   }
   std::uint64_t key_;

@@ -16,11 +16,23 @@
 
 namespace pathlab::sobol {
 
+// The constants of the zsobol sampler's hashes, named once for the scalar
+// code here and in core/rng.h and for its lanes (core/simd/sobol-inl.h,
+// core/simd/lanes-inl.h), which must compute the same bits.
+inline constexpr std::uint64_t kMixMul0 = 0xbf58476d1ce4e5b9ull;  // splitmix64's finaliser
+inline constexpr std::uint64_t kMixMul1 = 0x94d049bb133111ebull;
+inline constexpr std::uint64_t kDigitStep = 0x9e3779b97f4a7c15ull;  // permute_digits: per digit place
+inline constexpr std::uint64_t kLoneBitSalt = 0x3c6ef372fe94f82bull;  // permute_digits: the lone lowest bit
+inline constexpr std::uint64_t kScrambleSalt = 0xa0761d6478bd642full;  // scramble: the second pair of keys
+inline constexpr std::uint32_t kScrambleEven0 = 0x6b43a9b6u;  // scramble: the xor-multiplies (even)
+inline constexpr std::uint32_t kScrambleEven1 = 0x9e3779b8u;
+inline constexpr std::uint64_t kSlotStep = 0xd1b54a32d192ed03ull;  // SampleStream: a slot's point hash
+
 // splitmix64's finaliser (as mix64 in core/rng.h, kept here so this header
 // stands alone).
 constexpr std::uint64_t mix(std::uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  z = (z ^ (z >> 30)) * kMixMul0;
+  z = (z ^ (z >> 27)) * kMixMul1;
   return z ^ (z >> 31);
 }
 
@@ -72,16 +84,16 @@ constexpr std::uint32_t sample(std::uint64_t index, int dim) {
 // with four 32-bit keys drawn from the seed). The first add's key is
 // independent of the rest, so each value is scrambled to a uniform one.
 constexpr std::uint32_t scramble(std::uint32_t v, std::uint64_t seed) {
-  const std::uint64_t more = mix(seed ^ 0xa0761d6478bd642full);
+  const std::uint64_t more = mix(seed ^ kScrambleSalt);
   const auto k0 = static_cast<std::uint32_t>(seed), k1 = static_cast<std::uint32_t>(seed >> 32);
   const auto k2 = static_cast<std::uint32_t>(more), k3 = static_cast<std::uint32_t>(more >> 32);
   v = reverse_bits(v);
   v += k0;
   v *= k1 | 1u;
-  v ^= v * 0x6b43a9b6u;  // even
+  v ^= v * kScrambleEven0;
   v += k2;
   v *= k3 | 1u;
-  v ^= v * 0x9e3779b8u;  // even
+  v ^= v * kScrambleEven1;
   return reverse_bits(v);
 }
 
@@ -133,13 +145,13 @@ constexpr std::uint64_t permute_digits(std::uint64_t index, unsigned bits, std::
   for (unsigned p = bits - 2; p + 2 > lone && p < 64; p -= 2) {  // digit in bits [p, p + 1]
     const std::uint64_t higher = index >> (p + 2);
     const auto digit = static_cast<unsigned>((index >> p) & 3u);
-    const std::uint64_t h = mix((seed + (static_cast<std::uint64_t>(p) + 1) * 0x9e3779b97f4a7c15ull) ^ higher);
+    const std::uint64_t h = mix((seed + (static_cast<std::uint64_t>(p) + 1) * kDigitStep) ^ higher);
     const unsigned perm = kPermutations4[static_cast<std::size_t>((h >> 32) % 24)];
     out |= static_cast<std::uint64_t>((perm >> (2 * digit)) & 3u) << p;
     if (p < 2) break;
   }
   if (lone) {
-    const std::uint64_t h = mix(seed ^ 0x3c6ef372fe94f82bull ^ (index >> 1));
+    const std::uint64_t h = mix(seed ^ kLoneBitSalt ^ (index >> 1));
     out |= (index ^ (h >> 63)) & 1u;
   }
   return out;

@@ -1,6 +1,5 @@
 #include "apps/cli/scene_options.h"
 
-
 #include "apps/cli/validators.h"
 
 #include "core/compiled_scene.h"
@@ -67,15 +66,7 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
 }
 
 Scene SceneOptions::load() const {
-  if (simd) {
-    try {
-      select_simd_target(*parse_simd_target(*simd));
-    } catch (const InputError& e) {
-      throw InputError(std::string("--simd ") + *simd + ": " + e.what());
-    }
-  } else {
-    select_simd_target_from_environment();
-  }
+  select_simd_target(simd ? parse_simd_target(*simd) : std::nullopt, "--simd");
   Scene scene = scene_file.empty() ? builtin_cornell_box() : load_scene(scene_file);
   RenderSettings& r = scene.render;
   if (strategy) r.strategy = *parse_strategy(*strategy);

@@ -22,6 +22,8 @@
 
 #include <hwy/highway.h>
 
+#include "core/sobol.h"
+
 #include <cmath>
 #include <cstdint>
 
@@ -204,8 +206,8 @@ HWY_INLINE V64 mul64(D64 d64, V64 z, std::uint64_t c) {
 // mix64 (core/rng.h): the splitmix64 finaliser.
 template <class D64, class V64 = hn::Vec<D64>>
 HWY_INLINE V64 mix64(D64 d64, V64 z) {
-  z = mul64(d64, hn::Xor(z, hn::ShiftRight<30>(z)), 0xbf58476d1ce4e5b9ull);
-  z = mul64(d64, hn::Xor(z, hn::ShiftRight<27>(z)), 0x94d049bb133111ebull);
+  z = mul64(d64, hn::Xor(z, hn::ShiftRight<30>(z)), sobol::kMixMul0);
+  z = mul64(d64, hn::Xor(z, hn::ShiftRight<27>(z)), sobol::kMixMul1);
   return hn::Xor(z, hn::ShiftRight<31>(z));
 }
 

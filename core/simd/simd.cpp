@@ -123,6 +123,18 @@ void select_simd_target_from_environment() {
   }
 }
 
+void select_simd_target(std::optional<SimdTarget> asked, std::string_view option) {
+  if (!asked) {
+    select_simd_target_from_environment();
+    return;
+  }
+  try {
+    select_simd_target(*asked);
+  } catch (const InputError& e) {
+    throw InputError(std::string(option) + " " + simd_target_name(*asked) + ": " + e.what());
+  }
+}
+
 SimdTarget active_simd_target() { return from_hwy(HWY_DYNAMIC_DISPATCH(compiled_target)()); }
 
 }  // namespace pathlab

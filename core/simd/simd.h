@@ -40,6 +40,10 @@ void select_simd_target(SimdTarget t);
 // and not empty; an unknown name or an unsupported target throws InputError
 // naming the variable.
 void select_simd_target_from_environment();
+// What a command line does: the target it asked for (--simd), else
+// $PATHLAB_SIMD's, else the best this processor runs. InputError as above,
+// an asked-for target's naming `option`.
+void select_simd_target(std::optional<SimdTarget> asked, std::string_view option);
 
 // The target dispatch calls now (never Auto).
 SimdTarget active_simd_target();

@@ -44,7 +44,7 @@ HWY_INLINE V64 permute_digits(D64 d64, V64 index, unsigned bits, V64 seed) {
   for (unsigned p = bits - 2; p + 2 > lone && p < 64; p -= 2) {  // digit in bits [p, p + 1]
     const V64 higher = hn::ShiftRightSame(index, static_cast<int>(p + 2));
     const V64 digit = hn::And(hn::ShiftRightSame(index, static_cast<int>(p)), hn::Set(d64, 3));
-    const V64 h = mix64(d64, hn::Xor(seed + hn::Set(d64, (static_cast<std::uint64_t>(p) + 1) * 0x9e3779b97f4a7c15ull),
+    const V64 h = mix64(d64, hn::Xor(seed + hn::Set(d64, (static_cast<std::uint64_t>(p) + 1) * sobol::kDigitStep),
                                      higher));
     // (h >> 32) % 24, exactly: for x < 2^32, x / 24 = (x * 0xaaaaaaab) >> 36.
     const V64 x = hn::ShiftRight<32>(h);
@@ -56,7 +56,7 @@ HWY_INLINE V64 permute_digits(D64 d64, V64 index, unsigned bits, V64 seed) {
     if (p < 2) break;
   }
   if (lone) {
-    const V64 h = mix64(d64, hn::Xor(hn::Xor(seed, hn::Set(d64, 0x3c6ef372fe94f82bull)), hn::ShiftRight<1>(index)));
+    const V64 h = mix64(d64, hn::Xor(hn::Xor(seed, hn::Set(d64, sobol::kLoneBitSalt)), hn::ShiftRight<1>(index)));
     out = hn::Or(out, hn::And(hn::Xor(index, hn::ShiftRight<63>(h)), hn::Set(d64, 1)));
   }
   return out;
@@ -102,16 +102,16 @@ HWY_INLINE V64 sobol_sample(D64 d64, V64 index, int axis) {
 template <class D64, class V64 = hn::Vec<D64>>
 HWY_INLINE V64 scramble(D64 d64, V64 v, V64 seed) {
   const V64 mask = hn::Set(d64, 0xffffffffu), odd = hn::Set(d64, 1);
-  const V64 more = mix64(d64, hn::Xor(seed, hn::Set(d64, 0xa0761d6478bd642full)));
+  const V64 more = mix64(d64, hn::Xor(seed, hn::Set(d64, sobol::kScrambleSalt)));
   const V64 k0 = hn::And(seed, mask), k1 = hn::ShiftRight<32>(seed);
   const V64 k2 = hn::And(more, mask), k3 = hn::ShiftRight<32>(more);
   v = reverse_bits32(d64, v);
   v = hn::And(v + k0, mask);
   v = mul32(d64, v, hn::Or(k1, odd));
-  v = hn::Xor(v, mul32(d64, v, hn::Set(d64, 0x6b43a9b6u)));
+  v = hn::Xor(v, mul32(d64, v, hn::Set(d64, sobol::kScrambleEven0)));
   v = hn::And(v + k2, mask);
   v = mul32(d64, v, hn::Or(k3, odd));
-  v = hn::Xor(v, mul32(d64, v, hn::Set(d64, 0x9e3779b8u)));
+  v = hn::Xor(v, mul32(d64, v, hn::Set(d64, sobol::kScrambleEven1)));
   return reverse_bits32(d64, v);
 }
 
@@ -121,7 +121,7 @@ HWY_INLINE V64 scramble(D64 d64, V64 v, V64 seed) {
 // SamplerSetup::zsobol_key, `index` zsobol_index, `bits` zsobol_bits.
 template <class D64, class V64 = hn::Vec<D64>>
 HWY_INLINE V64 zsobol_top24(D64 d64, V64 index, V64 key, unsigned bits, V64 slot, int axis0, V64* second) {
-  const V64 h = mix64(d64, hn::Xor(key, mul64(d64, slot, 0xd1b54a32d192ed03ull)));
+  const V64 h = mix64(d64, hn::Xor(key, mul64(d64, slot, sobol::kSlotStep)));
   const V64 permuted = permute_digits(d64, index, bits, h);
   auto value = [&](int axis) {
     const V64 seed = h + hn::Set(d64, 1 + static_cast<std::uint64_t>(axis));
