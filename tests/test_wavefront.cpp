@@ -70,8 +70,39 @@ Scene cornell_with_bulb() {
   return scene;
 }
 
+// The Cornell box with every kind of material the vectorised stages hand to
+// core's Surfel: the short box gold (Disney, metallic), the tall one glass,
+// the back wall a clear-coated velvet (Disney sheen and clearcoat) and the
+// red wall a mirror.
+Scene cornell_with_materials() {
+  Scene s = builtin_cornell_box();
+  auto add = [&s](Material m, const char* name) {
+    m.name = name;
+    s.materials.push_back(std::move(m));
+    return static_cast<std::uint32_t>(s.materials.size() - 1);
+  };
+  DisneyParams gold;
+  gold.base_color = Spectrum(1.0f, 0.77f, 0.34f);
+  gold.metallic = 1.0f;
+  gold.roughness = 0.25f;
+  DisneyParams velvet;
+  velvet.base_color = Spectrum(0.25f, 0.1f, 0.45f);
+  velvet.roughness = 0.9f;
+  velvet.sheen = 1.0f;
+  velvet.clearcoat = 1.0f;
+  velvet.clearcoat_gloss = 0.9f;
+  Material mirror = diffuse_material(Spectrum(0.9f, 0.85f, 0.8f));
+  mirror.type = MaterialType::Mirror;
+  s.shapes.at(2).material = add(disney_material(velvet), "velvet");
+  s.shapes.at(3).material = add(std::move(mirror), "mirror");
+  s.shapes.at(5).material = add(disney_material(gold), "gold");
+  s.shapes.at(6).material = add(dielectric_material({}), "glass");
+  return s;
+}
+
 Scene load_case(const SameSeedCase& c) {
   Scene s = c.scene.empty()          ? builtin_cornell_box()
+            : c.scene == "materials" ? cornell_with_materials()
             : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
             : c.scene == "instanced" ? test::cornell_with_instances()
             : c.scene == "delta"     ? test::cornell_with_delta_lights()
@@ -429,6 +460,7 @@ struct VectorCase {
   bool zsobol = false;     // the zsobol sampler (Sobol' points, core/simd/sobol-inl.h in the lanes)
   int spp = 0;             // 0: the scene's (an odd log2 of it gives zsobol's index a lone lowest bit)
   bool bvh = false;        // light_sampler bvh (the tree walked in double lanes, core/simd/light_bvh-inl.h)
+  bool general_shading = false;  // every material through the Disney closure (--general-shading)
 };
 
 // Every diffuse material one-sided (black behind its geometric normal), and
@@ -514,6 +546,7 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   if (c.zsobol) scene.render.sampler = SamplerKind::ZSobol;
   if (c.spp > 0) scene.render.spp = c.spp;
   if (c.bvh) scene.render.light_sampler = LightSamplerKind::Bvh;
+  scene.render.force_general_shading = c.general_shading;
   if (c.thin_lens) {
     scene.camera.aperture_radius = 0.1f;
     scene.camera.focus_distance = 3.0f;
@@ -599,10 +632,20 @@ std::vector<VectorCase> vector_cases() {
   cases.push_back({"white-sphere-emissive-room.json", Strategy::Mis, 0.0f, 0, false, true, true, false, false, 0, true});
   cases.push_back({"white-sphere-emissive-room.json", Strategy::LightBsdf, 0.0f, -1, false, false, true, true, false, 0, true});
   cases.push_back({"", Strategy::LightBsdf, 0.0f, 0, false, true, true, false, true, 0, true});
+  // Materials shaded by core's Surfel between the lanes' steps: Disney (metallic; sheen and clearcoat), glass and
+  // a mirror, and Lambert through the closure (--general-shading).
+  for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"materials", st, 0.0f, 0});
+  cases.push_back({"materials", Strategy::Mis, 0.2f, 0});
+  cases.push_back({"materials", Strategy::Mis, 0.0f, 0, false, true, false, true});
+  cases.push_back({"materials", Strategy::LightBsdf, 0.0f, 0, false, false, true, false, true, 0, true});
+  cases.push_back({"", Strategy::Mis, 0.0f, 0, false, false, false, false, false, 0, false, true});
+  cases.push_back({"white-sphere-emissive-room.json", Strategy::LightBsdf, 0.0f, 0, false, true, false, true, false, 0,
+                   false, true});
   return cases;
 }
 
-INSTANTIATE_TEST_SUITE_P(LambertScenes, VectorStages, testing::ValuesIn(vector_cases()),
+INSTANTIATE_TEST_SUITE_P(Scenes, VectorStages, testing::ValuesIn(vector_cases()),
                          [](const testing::TestParamInfo<VectorCase>& p) {
                            std::string s = (p.param.scene.empty() ? std::string("cornell") : p.param.scene) + "_" +
                                            strategy_name(p.param.strategy) + (p.param.min_pdf > 0 ? "_min_pdf" : "") +
@@ -611,7 +654,8 @@ INSTANTIATE_TEST_SUITE_P(LambertScenes, VectorStages, testing::ValuesIn(vector_c
                                            (p.param.crowded ? "_crowded" : "") + (p.param.one_sided ? "_one_sided" : "") +
                                            (p.param.zsobol ? "_zsobol" : "") +
                                            (p.param.spp > 0 ? "_spp" + std::to_string(p.param.spp) : "") +
-                                           (p.param.bvh ? "_bvh" : "");
+                                           (p.param.bvh ? "_bvh" : "") +
+                                           (p.param.general_shading ? "_general_shading" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;
@@ -634,7 +678,9 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
   EXPECT_EQ(vectorised(zsobol, Strategy::Mis), vector_stages::cpu_supported());
 
   EXPECT_FALSE(vectorised(cornell, Strategy::Cosine));
-  EXPECT_FALSE(vectorised(cornell, Strategy::Mis, true));  // --general-shading
+  // Materials the lanes do not shade are shaded by core's Surfel between them.
+  EXPECT_EQ(vectorised(cornell, Strategy::Mis, true), vector_stages::cpu_supported());  // --general-shading
+  EXPECT_EQ(vectorised(cornell_with_materials(), Strategy::Mis), vector_stages::cpu_supported());
   Scene tangents = cornell;  // a tangent frame rotates the sampled directions (glTF TANGENT without NORMAL)
   for (Shape& shape : tangents.shapes)
     if (shape.kind == Shape::Kind::Triangles && !tangents.materials[shape.material].emits()) {
@@ -668,9 +714,9 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
   Scene envmap = cornell;  // Lambert-only and triangle lights, but an environment image
   envmap.environment_map = load_scene(analytic / "envmap-direct.json").environment_map;
   EXPECT_FALSE(vectorised(envmap, Strategy::Mis));
-  EXPECT_FALSE(vectorised(load_scene(analytic / "mirror-sphere-gray-room.json"), Strategy::Mis));    // mirror
+  EXPECT_FALSE(vectorised(load_scene(analytic / "mirror-sphere-gray-room.json"), Strategy::Mis));  // a sphere light
   EXPECT_FALSE(vectorised(load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "scenes" / "materials.json"),
-                          Strategy::Mis));  // Disney, glass
+                          Strategy::Mis));  // an environment
 }
 
 // times() counts every ray the render counts, by kind, and the time inside

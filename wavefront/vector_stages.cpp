@@ -35,6 +35,25 @@
 #include <limits>
 #include <stdexcept>
 
+#ifndef PATHLAB_VECTOR_STAGES_GENERAL
+#define PATHLAB_VECTOR_STAGES_GENERAL
+namespace pathlab::vector_stages {
+// A general material's BSDF (Scene::general) for the path in slot i, by
+// core's Surfel: what the scalar stages compute for it, one path at a time.
+// Compiled once, for the baseline target (at the end of this file); each
+// target's stages call them for the lanes of such materials.
+struct GeneralSample {
+  float wi[3], weight[3], pdf;
+  bool impulse;
+};
+// Surfel::eval and Surfel::pdf towards wi.
+void general_eval(const Scene& scene, const Wave& wave, std::size_t i, const float wi[3], float f[3], float* pdf);
+// Surfel::scatter; false where it samples nothing.
+bool general_scatter(const Scene& scene, const Wave& wave, std::size_t i, float u_lobe, float u0, float u1,
+                     GeneralSample* out);
+}  // namespace pathlab::vector_stages
+#endif
+
 HWY_BEFORE_NAMESPACE();
 namespace pathlab::vector_stages::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
@@ -385,6 +404,16 @@ VD bvh_share(const Lights& lights, const V3D& p, const V3D& n, VD light, VD coun
   return hn::IfThenElseZero(ok, count);
 }
 
+// fn(slot, lane) for each lane of m, in lane order (the general materials'
+// paths, shaded one at a time).
+template <class Fn>
+void for_each_lane(M m, std::size_t i0, Fn&& fn) {
+  HWY_ALIGN std::int32_t set[hn::MaxLanes(DI())];
+  hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), m)), DI(), set);
+  for (std::size_t j = 0; j < lanes(); ++j)
+    if (set[j] != 0) fn(i0 + j, j);
+}
+
 // light_query's normal (core/light_sampler.h): n turned to wo's side, 0 edge-on.
 V3 query_normal(const V3& n, const V3& wo) {
   const VF c = dot(n, wo);
@@ -656,9 +685,28 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     const M upper = wi_z > k(0.0f);
     const VF cos_pi = wi_z * k(kInvPi);
     const V3 rho = shape_value3(ok, sc, shape, kAlbedo);
-    const V3 f = zero_unless(upper, cos_pi * rho);
+    V3 f = zero_unless(upper, cos_pi * rho);
+    VF pdf_bsdf = hn::IfThenElseZero(upper, cos_pi);
+    if (sc.general) {
+      // Any other material: Surfel::eval and Surfel::pdf, path by path.
+      const M general = shape_flag(ok, sc, shape, kGeneral);
+      if (!hn::AllFalse(df, general)) {
+        constexpr std::size_t kMax = hn::MaxLanes(DF());
+        HWY_ALIGN float to[3][kMax], value[3][kMax] = {}, density[kMax] = {};
+        hn::Store(wi.x, df, to[0]);
+        hn::Store(wi.y, df, to[1]);
+        hn::Store(wi.z, df, to[2]);
+        for_each_lane(general, i0, [&](std::size_t i, std::size_t j) {
+          const float d[3] = {to[0][j], to[1][j], to[2][j]};
+          float fj[3];
+          general_eval(sc, w, i, d, fj, &density[j]);
+          for (int c = 0; c < 3; ++c) value[c][j] = fj[c];
+        });
+        f = select(general, V3{hn::Load(df, value[0]), hn::Load(df, value[1]), hn::Load(df, value[2])}, f);
+        pdf_bsdf = hn::IfThenElse(general, hn::Load(df, density), pdf_bsdf);
+      }
+    }
     ok = hn::AndNot(is_black(df, f), ok);
-    const VF pdf_bsdf = hn::IfThenElseZero(upper, cos_pi);
 
     // light_sample_weight (core/strategy_weights.h).
     VF weight = k(1.0f);
@@ -704,18 +752,48 @@ void scatter(const Scene& sc, const Wave& w) {
 
     // Surfel::scatter, Lambert: no sample on the disk's rim, or below min_pdf
     // (pdf > 0 and !(pdf < min_pdf), a NaN pdf passing as in the scalar code).
-    const VF pdf = hn::IfThenElseZero(z > k(0.0f), z * k(kInvPi));
-    ok = hn::And(ok, hn::And(hn::Not(pdf <= k(0.0f)), hn::Not(pdf < k(sc.min_pdf))));
+    VF pdf = hn::IfThenElseZero(z > k(0.0f), z * k(kInvPi));
+    const VI shape = load(w, kShape, i0, ok);
+    const M general = sc.general ? shape_flag(ok, sc, shape, kGeneral) : hn::FirstN(df, 0);
+    ok = hn::Or(general, hn::And(ok, hn::And(hn::Not(pdf <= k(0.0f)), hn::Not(pdf < k(sc.min_pdf)))));
     const V3 wo = -load3(w, kDx, i0, ok);
     const V3 n = load3(w, kNx, i0, ok);
-    const VI shape = load(w, kShape, i0, ok);
     // Surfel::scatter: nothing from behind a one-sided material.
     if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), dot(wo, n) > k(0.0f)));
     V3 fs, ft;
     frame(df, n, fs, ft);
     const VF side = hn::IfThenElse(dot(wo, n) < k(0.0f), k(-1.0f), k(1.0f));
-    const V3 wi = to_world(fs, ft, n, x, y, z * side);
+    V3 wi = to_world(fs, ft, n, x, y, z * side);
     V3 weight = shape_value3(ok, sc, shape, kAlbedo);
+    M impulse = hn::FirstN(df, 0);
+    if (const M g = hn::And(general, ok); !hn::AllFalse(df, g)) {
+      // Any other material: Surfel::scatter, path by path.
+      constexpr std::size_t kMax = hn::MaxLanes(DF());
+      HWY_ALIGN float u[3][kMax], dir[3][kMax] = {}, wt[3][kMax] = {}, density[kMax] = {};
+      HWY_ALIGN std::int32_t scattered[kMax] = {}, impulses[kMax] = {};
+      hn::Store(rng.u(Dim::LobeChoice), df, u[0]);
+      hn::Store(du, df, u[1]);
+      hn::Store(dv, df, u[2]);
+      for_each_lane(g, i0, [&](std::size_t i, std::size_t j) {
+        GeneralSample bs;
+        if (!general_scatter(sc, w, i, u[0][j], u[1][j], u[2][j], &bs)) return;
+        scattered[j] = 1;
+        impulses[j] = bs.impulse ? 1 : 0;
+        density[j] = bs.pdf;
+        for (int c = 0; c < 3; ++c) {
+          dir[c][j] = bs.wi[c];
+          wt[c][j] = bs.weight[c];
+        }
+      });
+      const auto loaded = [&](float (&a)[3][kMax]) {
+        return V3{hn::Load(df, a[0]), hn::Load(df, a[1]), hn::Load(df, a[2])};
+      };
+      wi = select(g, loaded(dir), wi);
+      weight = select(g, loaded(wt), weight);
+      pdf = hn::IfThenElse(g, hn::Load(df, density), pdf);
+      impulse = hn::And(g, fmask(hn::Load(DI(), impulses) != hn::Zero(DI())));
+      ok = hn::AndNot(hn::AndNot(fmask(hn::Load(DI(), scattered) != hn::Zero(DI())), g), ok);
+    }
     ok = hn::AndNot(is_black(df, weight), ok);
 
     // Russian roulette (the scatter stage).
@@ -730,12 +808,12 @@ void scatter(const Scene& sc, const Wave& w) {
     }
     store3(w, kBetaR, i0, ok, beta * weight);
 
-    // PreviousVertex{s.p, pdf, impulse = false, bsdf_technique}.
+    // PreviousVertex{s.p, pdf, impulse, bsdf_technique}.
     const V3 sp = load3(w, kPx, i0, ok);
     store3(w, kPrevX, i0, ok, sp);
     store3(w, kPrevNx, i0, ok, query_normal(n, wo));
     store(w, kPrevPdf, i0, ok, pdf);
-    store_mask(w, kPrevImpulse, i0, ok, hn::FirstN(df, 0));
+    store_mask(w, kPrevImpulse, i0, ok, impulse);
     M bsdf_technique = hn::FirstN(df, lanes());
     if (sc.strategy == Strategy::LightBsdf) bsdf_technique = hn::Not(rng.u(Dim::Technique) < k(0.5f));
     store_mask(w, kPrevBsdfTechnique, i0, ok, bsdf_technique);
@@ -831,6 +909,7 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 
 #include "core/simd/simd.h"
+#include "core/surfel.h"
 
 namespace pathlab::vector_stages {
 
@@ -862,6 +941,44 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
 }
 std::size_t compact(const Scene& scene, const Wave& wave, void* samples, std::uint32_t first_slot) {
   return HWY_DYNAMIC_DISPATCH(compact)(wave, scene.zsobol, samples, first_slot);
+}
+
+// The Surfel resolve() makes of the hit in slot i (CompiledScene::resolve of
+// a flat mesh or a sphere, untextured, not instanced: the stages take no
+// other scene), from the point, error and normal the stages resolved.
+static Surfel general_surfel(const Scene& sc, const Wave& w, std::size_t i) {
+  Surfel s;
+  s.p = vec3(w.f[kPx][i], w.f[kPy][i], w.f[kPz][i]);
+  s.p_error = vec3(w.f[kErrX][i], w.f[kErrY][i], w.f[kErrZ][i]);
+  s.n = vec3(w.f[kNx][i], w.f[kNy][i], w.f[kNz][i]);
+  s.frame = Frame(s.n);
+  s.uv = vec2(w.f[kHitU][i], w.f[kHitV][i]);
+  s.shape = w.u[kShape][i];
+  s.prim = w.u[kPrim][i];
+  s.material = sc.shape_material[s.shape];
+  return s;
+}
+
+void general_eval(const Scene& sc, const Wave& w, std::size_t i, const float wi[3], float f[3], float* pdf) {
+  const Surfel s = general_surfel(sc, w, i);
+  const vec3 to(wi[0], wi[1], wi[2]), wo = -vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]);
+  const Spectrum value = s.eval(to, wo);
+  for (int c = 0; c < 3; ++c) f[c] = value[c];
+  *pdf = is_black(value) ? 0.0f : s.pdf(to, wo);  // read only where f is not black
+}
+
+bool general_scatter(const Scene& sc, const Wave& w, std::size_t i, float u_lobe, float u0, float u1,
+                     GeneralSample* out) {
+  const Surfel s = general_surfel(sc, w, i);
+  const std::optional<BsdfSample> bs = s.scatter(-vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]), u_lobe, vec2(u0, u1));
+  if (!bs) return false;
+  for (int c = 0; c < 3; ++c) {
+    out->wi[c] = bs->wi[c];
+    out->weight[c] = bs->weight[c];
+  }
+  out->pdf = bs->pdf;
+  out->impulse = bs->impulse;
+  return true;
 }
 
 // The light of every visible sample, once Embree has filled kQOccluded: L

@@ -145,12 +145,14 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns;
+  std::vector<const Material*> shape_material;
+  std::vector<std::string> general;  // the materials core's Surfel shades, path by path
   std::vector<double> bvh_nodes;
   std::vector<std::int32_t> bvh_entry, bvh_light;
 
   // Null, with *why_not saying what stops it, unless the selected SIMD
-  // target is a vector one and the scene needs nothing more than Lambert
-  // surfaces and triangle area lights.
+  // target is a vector one and the scene has flat, untextured surfaces lit by
+  // triangle area lights alone.
   static std::unique_ptr<const VectorStages> make(const CompiledScene& compiled, const RenderSettings& settings,
                                                   const SamplerSetup& sampler, std::string* why_not) {
     namespace vs = vector_stages;
@@ -171,16 +173,17 @@ struct WavefrontTracer::VectorStages {
     }
     sc.rr_depth = settings.rr_depth;
     sc.max_vertex = settings.max_depth >= 0 ? settings.max_depth : kMaxVerticesUncapped;
-    // Every material Lambert (shaded by the Lambert-only code) or an
-    // emitter that does not scatter, with one min_pdf.
+    // Lambert surfaces (shaded by lambert.h, not through the Disney closure)
+    // are shaded in the lanes, with one min_pdf; any other material that
+    // scatters by core's Surfel, path by path (vector_stages.h).
     const Scene& scene = compiled.scene();
     const Material* diffuse = nullptr;
     for (const Material& m : scene.materials) {
       if (m.type == MaterialType::Emissive) continue;  // never scatters
-      if (m.type != MaterialType::Diffuse)
-        return no("material '" + m.name + "' is " + material_type_name(m.type) + ", not diffuse");
-      if (m.shading.path != ShadingPath::LambertOnly)
-        return no(std::string("shading path ") + shading_path_name(m.shading.path));
+      if (!in_lanes(m)) {
+        v->general.push_back(m.name);
+        continue;
+      }
       if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return no("materials with different min_pdf");
       diffuse = &m;
     }
@@ -260,9 +263,14 @@ struct WavefrontTracer::VectorStages {
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
       f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
       sc.one_sided = sc.one_sided || m.one_sided;
+      const bool general = m.scatters() && !in_lanes(m);
+      f[vs::kGeneral] = general ? 1.0f : 0.0f;
+      sc.general = sc.general || general;
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
+      v->shape_material.push_back(&m);
     }
     sc.shape = v->shape.data();
+    sc.shape_material = v->shape_material.data();
     sc.shape_count = scene.shapes.size();
     sc.zsobol = settings.sampler == SamplerKind::ZSobol;
     sc.zsobol_bits = sampler.zsobol_bits();
@@ -284,6 +292,12 @@ struct WavefrontTracer::VectorStages {
                            {p.up.x, p.up.y, p.up.z},
                            p.tan_half_fov, p.aspect, p.inv_width, p.inv_height, d.aperture_radius, d.focus_distance};
     return v;
+  }
+
+  // Whether the lanes shade m: Lambert, by lambert.h (every shading path but
+  // General, which shades it through the Disney closure; core/surfel.cpp).
+  static bool in_lanes(const Material& m) {
+    return m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General;
   }
 };
 
@@ -348,8 +362,16 @@ bool WavefrontTracer::vectorised() const { return vector_ != nullptr; }
 
 std::string WavefrontTracer::stages_description() const {
   if (!vector_) return "scalar stages (" + scalar_reason_ + ")";
-  return std::string("every stage vectorised (") + simd_target_name(active_simd_target()) + ", " +
-         std::to_string(vector_stages::lanes()) + " paths at a time, paths as structure of arrays)";
+  std::string d = std::string("every stage vectorised (") + simd_target_name(active_simd_target()) + ", " +
+                  std::to_string(vector_stages::lanes()) + " paths at a time, paths as structure of arrays)";
+  if (!vector_->general.empty()) {
+    d += "; the BSDF of material";
+    d += vector_->general.size() > 1 ? "s " : " ";
+    for (std::size_t i = 0; i < vector_->general.size(); ++i)
+      d += (i == 0 ? "'" : i + 1 == vector_->general.size() ? " and '" : ", '") + vector_->general[i] + "'";
+    d += " one path at a time (core's Surfel)";
+  }
+  return d;
 }
 
 std::size_t WavefrontTracer::bytes_per_path() const {
