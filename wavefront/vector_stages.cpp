@@ -908,6 +908,7 @@ HWY_AFTER_NAMESPACE();
 
 #if HWY_ONCE
 
+#include "core/compiled_scene.h"
 #include "core/simd/simd.h"
 #include "core/surfel.h"
 
@@ -943,19 +944,20 @@ std::size_t compact(const Scene& scene, const Wave& wave, void* samples, std::ui
   return HWY_DYNAMIC_DISPATCH(compact)(wave, scene.zsobol, samples, first_slot);
 }
 
-// The Surfel resolve() makes of the hit in slot i (CompiledScene::resolve of
-// a flat mesh or a sphere, untextured, not instanced: the stages take no
-// other scene), from the point, error and normal the stages resolved.
+// The Surfel of the hit in slot i, as the scalar stages make it: resolve()
+// of the path's ray (still in kOx... until scatter() spawns the next one) and
+// hit (the stages take no instance and no texture). Its point, error and
+// geometric normal are those the lanes resolved, bit for bit; its shading
+// frame is the vertex normals' or the tangents' where the mesh has them.
 static Surfel general_surfel(const Scene& sc, const Wave& w, std::size_t i) {
+  const Ray ray{vec3(w.f[kOx][i], w.f[kOy][i], w.f[kOz][i]), vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]), w.f[kTmax][i]};
+  RayHit hit;
+  hit.t = w.f[kHitT][i];
+  hit.shape = w.u[kShape][i];
+  hit.prim = w.u[kPrim][i];
+  hit.uv = vec2(w.f[kHitU][i], w.f[kHitV][i]);
   Surfel s;
-  s.p = vec3(w.f[kPx][i], w.f[kPy][i], w.f[kPz][i]);
-  s.p_error = vec3(w.f[kErrX][i], w.f[kErrY][i], w.f[kErrZ][i]);
-  s.n = vec3(w.f[kNx][i], w.f[kNy][i], w.f[kNz][i]);
-  s.frame = Frame(s.n);
-  s.uv = vec2(w.f[kHitU][i], w.f[kHitV][i]);
-  s.shape = w.u[kShape][i];
-  s.prim = w.u[kPrim][i];
-  s.material = sc.shape_material[s.shape];
+  sc.compiled->resolve(ray, hit, &s);
   return s;
 }
 

@@ -1,12 +1,13 @@
 // The wavefront's vectorised stages: paths kept as one array per scalar
 // (structure of arrays), a block of them per SIMD register — 16 with
 // AVX-512, 8 with AVX2, 4 with SSE4, whichever core/simd/simd.h's dispatch
-// selected — for scenes of flat meshes and spheres lit by triangle area
-// lights (the dragon benchmarks, the Cornell box; any camera). Lambert
-// surfaces, one- or two-sided, are shaded in the lanes; every other material
-// (Disney, mirror, glass, Lambert under --general-shading) by core's Surfel,
-// one path at a time, between the lanes' steps (Scene::general). Other
-// scenes, and `--simd scalar`, run the scalar stages of wavefront_tracer.cpp.
+// selected — for scenes of meshes and spheres lit by triangle area lights
+// (the dragon benchmarks, the Cornell box; any camera). Flat Lambert
+// surfaces, one- or two-sided, are shaded in the lanes; every other surface
+// (Disney, mirror, glass, Lambert under --general-shading, vertex normals)
+// by core's Surfel, one path at a time, between the lanes' steps
+// (Scene::general). Other scenes, and `--simd scalar`, run the scalar stages
+// of wavefront_tracer.cpp.
 //
 // Written once (vector_stages.cpp, over Google Highway, compiled for every
 // target) on core's per-lane code (core/simd/*-inl.h; core's scalar code
@@ -25,7 +26,7 @@
 #include <cstdint>
 
 namespace pathlab {
-struct Material;
+class CompiledScene;
 }
 
 namespace pathlab::vector_stages {
@@ -72,11 +73,11 @@ struct Scene {
   float min_pdf = 0.0f;
   std::size_t shape_count = 0;
   bool one_sided = false;  // some shape's material is one-sided (ShapeField kOneSided): else no lane looks
-  // Some shape's material is not shaded in the lanes (ShapeField kGeneral):
-  // its paths' BSDF is evaluated and sampled by core's Surfel, one path at a
-  // time, with the material of shape_material[shape].
+  // Some shape is not shaded in the lanes (ShapeField kGeneral): its paths'
+  // BSDF is evaluated and sampled by core's Surfel, one path at a time, made
+  // by compiled->resolve() of the path's ray and hit.
   bool general = false;
-  const Material* const* shape_material = nullptr;
+  const CompiledScene* compiled = nullptr;
   // The zsobol sampler (else the independent one): SamplerSetup::zsobol_bits().
   bool zsobol = false;
   unsigned zsobol_bits = 0;
@@ -103,7 +104,7 @@ enum ShapeField : int {
   kRadius = 15,        // a sphere's radius
   kFlipped = 16,       // 1 if a sphere's normals point inwards
   kOneSided = 17,      // 1 if its material is one-sided (black from behind the geometric normal)
-  kGeneral = 18,       // 1 if its material is shaded by core's Surfel (not Lambert in the lanes)
+  kGeneral = 18,       // 1 if it is shaded by core's Surfel (not Lambert, or with vertex normals or tangents)
   kShapeFields = 32,
 };
 

@@ -145,8 +145,7 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns;
-  std::vector<const Material*> shape_material;
-  std::vector<std::string> general;  // the materials core's Surfel shades, path by path
+  std::vector<std::string> general;  // what core's Surfel shades, path by path (stages_description)
   std::vector<double> bvh_nodes;
   std::vector<std::int32_t> bvh_entry, bvh_light;
 
@@ -173,15 +172,15 @@ struct WavefrontTracer::VectorStages {
     }
     sc.rr_depth = settings.rr_depth;
     sc.max_vertex = settings.max_depth >= 0 ? settings.max_depth : kMaxVerticesUncapped;
-    // Lambert surfaces (shaded by lambert.h, not through the Disney closure)
-    // are shaded in the lanes, with one min_pdf; any other material that
-    // scatters by core's Surfel, path by path (vector_stages.h).
+    // Flat Lambert surfaces (shaded by lambert.h, not through the Disney
+    // closure) are shaded in the lanes, with one min_pdf; any other surface
+    // that scatters by core's Surfel, path by path (vector_stages.h).
     const Scene& scene = compiled.scene();
     const Material* diffuse = nullptr;
     for (const Material& m : scene.materials) {
       if (m.type == MaterialType::Emissive) continue;  // never scatters
       if (!in_lanes(m)) {
-        v->general.push_back(m.name);
+        v->general.push_back("material '" + m.name + "'");
         continue;
       }
       if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return no("materials with different min_pdf");
@@ -193,11 +192,10 @@ struct WavefrontTracer::VectorStages {
     for (const Material& m : scene.materials)
       if (m.has_alpha()) return no("material '" + m.name + "' has alpha (partial coverage)");
     if (compiled.has_textures()) return no("textures");
-    // Flat triangles only: the stages shade with the geometric normal.
-    for (const Shape& shape : scene.shapes) {
-      if (shape.mesh.has_normals()) return no(shape.description + " has vertex normals (smooth shading)");
-      if (!shape.mesh.tangents.empty()) return no(shape.description + " has tangents (a rotated shading frame)");
-    }
+    // A mesh with vertex normals or tangents has its own shading frame: core's Surfel shades it.
+    for (const Shape& shape : scene.shapes)
+      if (shading_frame(shape) && scene.materials[shape.material].scatters() && in_lanes(scene.materials[shape.material]))
+        v->general.push_back("the shading frame of " + shape.description);
     // Only triangle area lights: no delta light, sphere light or environment.
     const LightSampler& lights = compiled.lights();
     if (lights.has_delta_lights()) return no("delta lights (point, spot, directional)");
@@ -263,14 +261,13 @@ struct WavefrontTracer::VectorStages {
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
       f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
       sc.one_sided = sc.one_sided || m.one_sided;
-      const bool general = m.scatters() && !in_lanes(m);
+      const bool general = m.scatters() && (!in_lanes(m) || shading_frame(sh));
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
       sc.general = sc.general || general;
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
-      v->shape_material.push_back(&m);
     }
     sc.shape = v->shape.data();
-    sc.shape_material = v->shape_material.data();
+    sc.compiled = &compiled;
     sc.shape_count = scene.shapes.size();
     sc.zsobol = settings.sampler == SamplerKind::ZSobol;
     sc.zsobol_bits = sampler.zsobol_bits();
@@ -299,6 +296,8 @@ struct WavefrontTracer::VectorStages {
   static bool in_lanes(const Material& m) {
     return m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General;
   }
+  // Whether a shape shades in a frame of its own (not the geometric normal's).
+  static bool shading_frame(const Shape& shape) { return shape.mesh.has_normals() || !shape.mesh.tangents.empty(); }
 };
 
 // vector_stages::compact() writes finished paths as FilmSamples, byte for byte.
@@ -365,11 +364,9 @@ std::string WavefrontTracer::stages_description() const {
   std::string d = std::string("every stage vectorised (") + simd_target_name(active_simd_target()) + ", " +
                   std::to_string(vector_stages::lanes()) + " paths at a time, paths as structure of arrays)";
   if (!vector_->general.empty()) {
-    d += "; the BSDF of material";
-    d += vector_->general.size() > 1 ? "s " : " ";
+    d += "; shaded one path at a time (core's Surfel): ";
     for (std::size_t i = 0; i < vector_->general.size(); ++i)
-      d += (i == 0 ? "'" : i + 1 == vector_->general.size() ? " and '" : ", '") + vector_->general[i] + "'";
-    d += " one path at a time (core's Surfel)";
+      d += (i == 0 ? "" : i + 1 == vector_->general.size() ? " and " : ", ") + vector_->general[i];
   }
   return d;
 }
