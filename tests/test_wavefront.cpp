@@ -282,16 +282,17 @@ TEST(Wavefront, EnvironmentMapSameBitsForOneAndTwoThreads) {
   scene.film.width = 16;
   scene.film.height = 12;
   scene.render.spp = 4;
-  expect_same_bits_for_one_and_two_threads(std::move(scene));
+  expect_same_bits_for_one_and_two_threads(std::move(scene), true);
 }
 
-// Solid-angle light sampling: the wavefront runs its scalar stages (asserted
-// inside) and both tracers give the same bits for one thread and two, and the
+// Solid-angle light sampling: the wavefront runs its vectorised stages, the
+// light samples drawn by core's LightSampler path by path (asserted inside),
+// and both tracers give the same bits for one thread and two, and the
 // wavefront for any wave size, on the Cornell box (triangle lights).
 TEST(Wavefront, SolidAngleLightSamplingSameBitsForOneAndTwoThreads) {
   Scene scene = test::small_cornell(16, 4, FilterKind::Box);
   scene.render.light_sampling = LightSampling::SolidAngle;
-  expect_same_bits_for_one_and_two_threads(std::move(scene));
+  expect_same_bits_for_one_and_two_threads(std::move(scene), true);
 }
 
 // The light BVH: the wavefront runs its vectorised stages (asserted inside)
@@ -381,7 +382,7 @@ TEST(Wavefront, DiffuseSphereSameBitsForAnyWaveSizeAndThreads) {
 
 // And the reference tracer for one thread and two on the bulb.
 TEST(Wavefront, SolidAngleSphereLightSameBitsForOneAndTwoThreads) {
-  expect_same_bits_for_one_and_two_threads(small_bulb(LightSampling::SolidAngle));
+  expect_same_bits_for_one_and_two_threads(small_bulb(LightSampling::SolidAngle), true);
 }
 
 // A textured scene (texture lookups, cones, normal maps, textured emission).
@@ -474,6 +475,7 @@ struct VectorCase {
   int spp = 0;             // 0: the scene's (an odd log2 of it gives zsobol's index a lone lowest bit)
   bool bvh = false;        // light_sampler bvh (the tree walked in double lanes, core/simd/light_bvh-inl.h)
   bool general_shading = false;  // every material through the Disney closure (--general-shading)
+  bool solid_angle = false;      // light_sampling solid_angle (LightSampler::sample, path by path)
 };
 
 // Every diffuse material one-sided (black behind its geometric normal), and
@@ -560,6 +562,7 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   if (c.spp > 0) scene.render.spp = c.spp;
   if (c.bvh) scene.render.light_sampler = LightSamplerKind::Bvh;
   scene.render.force_general_shading = c.general_shading;
+  if (c.solid_angle) scene.render.light_sampling = LightSampling::SolidAngle;
   if (c.thin_lens) {
     scene.camera.aperture_radius = 0.1f;
     scene.camera.focus_distance = 3.0f;
@@ -657,6 +660,18 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf}) cases.push_back({"smooth", st, 0.0f, 0});
   cases.push_back({"smooth", Strategy::Mis, 0.0f, 0, false, true, false, true});
   cases.push_back({"tangents", Strategy::Mis, 0.0f, 0});
+  // Lights sampled by core's LightSampler between the lanes' steps: an environment image (with triangle lights),
+  // a constant environment, a sun disk, a sphere light, solid-angle sampling, with the light BVH.
+  for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"envmap", st, 0.0f, 0});
+  for (const char* s : {"sphere-in-environment.json", "sun-disk-plane.json", "glass-sphere-tinted.json",
+                        "rough-conductor-sphere.json", "mirror-sphere-gray-room.json", "furnace-sphere.json", "bulb"})
+    cases.push_back({s, Strategy::Mis, 0.0f, 0});
+  cases.push_back({"bulb", Strategy::LightBsdf, 0.0f, 0, false, true, false, true, true});
+  for (Strategy st : {Strategy::Light, Strategy::Mis})
+    cases.push_back({"", st, 0.0f, 0, false, false, false, false, false, 0, false, false, true});
+  cases.push_back({"materials", Strategy::Mis, 0.0f, 0, false, false, false, false, false, 0, true, false, true});
+  cases.push_back({"bulb", Strategy::Mis, 0.0f, 0, false, false, true, false, false, 0, true});
   cases.push_back({"white-sphere-emissive-room.json", Strategy::LightBsdf, 0.0f, 0, false, true, false, true, false, 0,
                    false, true});
   return cases;
@@ -672,7 +687,8 @@ INSTANTIATE_TEST_SUITE_P(Scenes, VectorStages, testing::ValuesIn(vector_cases())
                                            (p.param.zsobol ? "_zsobol" : "") +
                                            (p.param.spp > 0 ? "_spp" + std::to_string(p.param.spp) : "") +
                                            (p.param.bvh ? "_bvh" : "") +
-                                           (p.param.general_shading ? "_general_shading" : "");
+                                           (p.param.general_shading ? "_general_shading" : "") +
+                                           (p.param.solid_angle ? "_solid_angle" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;
@@ -701,9 +717,11 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
   // Shading frames of their own (vertex normals, tangents): core's Surfel shades those shapes too.
   EXPECT_EQ(vectorised(cornell_with_tangents(), Strategy::Mis), vector_stages::cpu_supported());
   EXPECT_EQ(vectorised(test::cornell_with_smooth_sphere(), Strategy::Mis), vector_stages::cpu_supported());
-  Scene solid_angle = cornell;  // the stages sample lights by area only
+  // Lights the lanes do not sample (solid-angle sampling, sphere lights, an environment) are sampled by core's
+  // LightSampler between them; delta lights (a second shadow ray per path) run the scalar stages.
+  Scene solid_angle = cornell;
   solid_angle.render.light_sampling = LightSampling::SolidAngle;
-  EXPECT_FALSE(vectorised(solid_angle, Strategy::Mis));
+  EXPECT_EQ(vectorised(solid_angle, Strategy::Mis), vector_stages::cpu_supported());
   const auto analytic = std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes";
   Scene sphere_light = cornell;
   Shape bulb;
@@ -714,7 +732,7 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
     if (sphere_light.materials[m].emits()) bulb.material = m;
   ASSERT_TRUE(sphere_light.materials[bulb.material].emits());
   sphere_light.shapes.push_back(bulb);
-  EXPECT_FALSE(vectorised(sphere_light, Strategy::Mis));
+  EXPECT_EQ(vectorised(sphere_light, Strategy::Mis), vector_stages::cpu_supported());
   Scene point_light = cornell;
   point_light.delta_lights.push_back({vec3(0.0f, 1.0f, 0.0f), Spectrum(1.0f)});
   EXPECT_FALSE(vectorised(point_light, Strategy::Mis));
@@ -723,13 +741,18 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
   sun.delta_lights.push_back({vec3(0.0f), Spectrum(1.0f), DeltaLight::Kind::Directional, vec3(0, -1, 0), 0.0f, 0.0f});
   EXPECT_FALSE(vectorised(spot, Strategy::Mis));
   EXPECT_FALSE(vectorised(sun, Strategy::Mis));
-  EXPECT_FALSE(vectorised(load_scene(analytic / "sphere-in-environment.json"), Strategy::Mis));      // environment
-  Scene envmap = cornell;  // Lambert-only and triangle lights, but an environment image
+  const bool any = vector_stages::cpu_supported();
+  EXPECT_EQ(vectorised(load_scene(analytic / "sphere-in-environment.json"), Strategy::Mis), any);  // environment
+  Scene envmap = cornell;  // triangle lights and an environment image
   envmap.environment_map = load_scene(analytic / "envmap-direct.json").environment_map;
-  EXPECT_FALSE(vectorised(envmap, Strategy::Mis));
-  EXPECT_FALSE(vectorised(load_scene(analytic / "mirror-sphere-gray-room.json"), Strategy::Mis));  // a sphere light
-  EXPECT_FALSE(vectorised(load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "scenes" / "materials.json"),
-                          Strategy::Mis));  // an environment
+  EXPECT_EQ(vectorised(envmap, Strategy::Mis), any);
+  EXPECT_EQ(vectorised(load_scene(analytic / "mirror-sphere-gray-room.json"), Strategy::Mis), any);  // a sphere light
+  EXPECT_EQ(vectorised(load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "scenes" / "materials.json"),
+                       Strategy::Mis),
+            any);  // an environment, Disney, glass
+  EXPECT_FALSE(vectorised(test::cornell_with_textures(), Strategy::Mis));
+  EXPECT_FALSE(vectorised(test::cornell_with_alpha(), Strategy::Mis));
+  EXPECT_FALSE(vectorised(test::cornell_with_instances(), Strategy::Mis));
 }
 
 // times() counts every ray the render counts, by kind, and the time inside

@@ -29,6 +29,7 @@
 #include "core/rng.h"
 #include "wavefront/vector_stages.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -51,6 +52,19 @@ void general_eval(const Scene& scene, const Wave& wave, std::size_t i, const flo
 // Surfel::scatter; false where it samples nothing.
 bool general_scatter(const Scene& scene, const Wave& wave, std::size_t i, float u_lobe, float u0, float u1,
                      GeneralSample* out);
+// Lights beyond triangles sampled by area (Scene::general_lights), by core's
+// LightSampler for the path in slot i: a light sample and its shadow ray
+// (origin, direction, tmax; shadow_ray), false where sample() gives none.
+struct GeneralLight {
+  float wi[3], Le[3], pdf, ray[7];
+};
+bool general_light(const Scene& scene, const Wave& wave, std::size_t i, float u_choice, float u0, float u1,
+                   GeneralLight* out);
+// The light the path's ray finds: the sky along an escaped ray (Scene::sky;
+// LightSampler::sky), or the density with which the light sampler would
+// have chosen the emitter it hit (LightSampler::pdf from the previous vertex).
+void general_sky(const Scene& scene, const Wave& wave, std::size_t i, float Le[3], float* pdf);
+float general_light_pdf(const Scene& scene, const Wave& wave, std::size_t i);
 }  // namespace pathlab::vector_stages
 #endif
 
@@ -531,9 +545,55 @@ void resolve(const Scene& sc, const Wave& w) {
   }
 }
 
+// LightSampler::pdf(prev.p, s) of triangle lights sampled by area, in the
+// lanes of lit (hits on emitters).
+VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI shape, const V3& n) {
+  const DF df;
+  const VI first = shape_int(lit, sc, shape, kFirstLight);
+  const M light = hn::And(lit, fmask(hn::Not(first < hn::Zero(DI()))));
+  const VI entry = first + load(w, kPrim, i0, light);
+  const V3 d = load3(w, kPx, i0, light) - load3(w, kPrevX, i0, light);
+  const VF dist = hn::Sqrt(dot(d, d));
+  const VF inv_area = light_value(light, sc.lights, entry, kLightInvArea);
+  VF pmf = light_value(light, sc.lights, entry, kLightPmf);
+  M pdf_zero = hn::FirstN(df, 0);
+  if (sc.lights.bvh_nodes && !hn::AllFalse(df, light)) {
+    // LightSampler::pick_pmf from the previous vertex's query: the
+    // tree's share for the tree's lights (their power pmf is 0).
+    const VI safe_entry = hn::IfThenElseZero(hn::RebindMask(DI(), light), entry);
+    const VI tree_light = hn::GatherIndex(DI(), sc.lights.bvh_light, safe_entry);
+    const M in_tree = hn::And(light, fmask(hn::Not(tree_light < hn::Zero(DI()))));
+    if (!hn::AllFalse(df, in_tree)) {
+      const V3 qp = load3(w, kPrevX, i0, in_tree), qn = load3(w, kPrevNx, i0, in_tree);
+      const VF tl = hn::ConvertTo(df, hn::IfThenElseZero(hn::RebindMask(DI(), in_tree), tree_light));
+      const VD grid = hn::Set(DD(), static_cast<double>(sc.lights.bvh_grid));
+      VD share[2];
+      for (int h = 0; h < 2; ++h)
+        share[h] = bvh_share(sc.lights, half_d(qp, h), half_d(qn, h), half_d(tl, h), grid, half_mask(in_tree, h));
+      pmf = hn::IfThenElse(in_tree, join_f(share[0], share[1]) * k(0x1p-24f), pmf);
+    }
+    pdf_zero = pmf == k(0.0f);  // a light the tree gives nothing from here: density 0
+  }
+  return hn::IfThenZeroElse(pdf_zero, hn::IfThenElseZero(light, pmf * area_to_solid_angle(df, inv_area, dist, dot(n, d) / dist)));
+}
+
+// emission_weight (core/strategy_weights.h) for the lanes of lit (0 elsewhere).
+VF emission_weight(const Scene& sc, const Wave& w, std::size_t i0, M lit, VF light_pdf) {
+  const M impulse = load_mask(w, kPrevImpulse, i0, lit);
+  const M bsdf_technique = load_mask(w, kPrevBsdfTechnique, i0, lit);
+  const VF prev_pdf = load(w, kPrevPdf, i0, lit);
+  VF weight = k(1.0f);
+  if (sc.strategy == Strategy::Light) weight = hn::IfThenElse(light_pdf > k(0.0f), k(0.0f), k(1.0f));
+  if (sc.strategy == Strategy::Mis) weight = power_heuristic(DF(), prev_pdf, light_pdf);
+  if (sc.strategy == Strategy::LightBsdf)
+    weight = hn::IfThenElseZero(bsdf_technique, k(2.0f) * prev_pdf / (prev_pdf + light_pdf));
+  return hn::IfThenElseZero(lit, hn::IfThenElse(impulse, k(1.0f), weight));
+}
+
 void add_emission(const Scene& sc, const Wave& w) {
   const DF df;
   const V3 zero = zero3();
+  constexpr std::size_t kMax = hn::MaxLanes(DF());
   for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
     const M in = live(w.n, i0);
     const M found = load_mask(w, kFound, i0, in);
@@ -548,6 +608,18 @@ void add_emission(const Scene& sc, const Wave& w) {
       const V3 nan = splat3(df, NAN, NAN, NAN);
       L_new = select(refused, nan, L_new);
     }
+    if (const M sky = hn::AndNot(refused, escaped); sc.sky && !hn::AllFalse(df, sky)) {
+      // The environment along the ray (LightSampler::sky), path by path.
+      HWY_ALIGN float radiance[3][kMax] = {}, density[kMax] = {};
+      for_each_lane(sky, i0, [&](std::size_t i, std::size_t j) {
+        float Le[3];
+        general_sky(sc, w, i, Le, &density[j]);
+        for (int c = 0; c < 3; ++c) radiance[c][j] = Le[c];
+      });
+      const V3 Le{hn::Load(df, radiance[0]), hn::Load(df, radiance[1]), hn::Load(df, radiance[2])};
+      const VF weight = emission_weight(sc, w, i0, hn::AndNot(is_black(df, Le), sky), hn::Load(df, density));
+      L_new = select(sky, L + beta * (weight * Le), L_new);
+    }
     M alive = hn::FirstN(df, 0);
     if (!hn::AllFalse(df, found)) {
       // Surfel::emitted.
@@ -559,44 +631,16 @@ void add_emission(const Scene& sc, const Wave& w) {
                                 shape_value3(found, sc, shape, kEmission));
       const M lit = hn::AndNot(is_black(df, Le), found);
       // LightSampler::pdf(prev.p, s).
-      const M impulse = load_mask(w, kPrevImpulse, i0, lit);
-      const M bsdf_technique = load_mask(w, kPrevBsdfTechnique, i0, lit);
-      const VF prev_pdf = load(w, kPrevPdf, i0, lit);
-      const VI first = shape_int(lit, sc, shape, kFirstLight);
-      const M light = hn::And(lit, fmask(hn::Not(first < hn::Zero(DI()))));
-      const VI entry = first + load(w, kPrim, i0, light);
-      const V3 d = load3(w, kPx, i0, light) - load3(w, kPrevX, i0, light);
-      const VF dist = hn::Sqrt(dot(d, d));
-      const VF inv_area = light_value(light, sc.lights, entry, kLightInvArea);
-      VF pmf = light_value(light, sc.lights, entry, kLightPmf);
-      M pdf_zero = hn::FirstN(df, 0);
-      if (sc.lights.bvh_nodes && !hn::AllFalse(df, light)) {
-        // LightSampler::pick_pmf from the previous vertex's query: the
-        // tree's share for the tree's lights (their power pmf is 0).
-        const VI safe_entry = hn::IfThenElseZero(hn::RebindMask(DI(), light), entry);
-        const VI tree_light = hn::GatherIndex(DI(), sc.lights.bvh_light, safe_entry);
-        const M in_tree = hn::And(light, fmask(hn::Not(tree_light < hn::Zero(DI()))));
-        if (!hn::AllFalse(df, in_tree)) {
-          const V3 qp = load3(w, kPrevX, i0, in_tree), qn = load3(w, kPrevNx, i0, in_tree);
-          const VF tl = hn::ConvertTo(df, hn::IfThenElseZero(hn::RebindMask(DI(), in_tree), tree_light));
-          const VD grid = hn::Set(DD(), static_cast<double>(sc.lights.bvh_grid));
-          VD share[2];
-          for (int h = 0; h < 2; ++h)
-            share[h] = bvh_share(sc.lights, half_d(qp, h), half_d(qn, h), half_d(tl, h), grid, half_mask(in_tree, h));
-          pmf = hn::IfThenElse(in_tree, join_f(share[0], share[1]) * k(0x1p-24f), pmf);
-        }
-        pdf_zero = pmf == k(0.0f);  // a light the tree gives nothing from here: density 0
+      VF light_pdf;
+      if (sc.general_lights) {
+        // By core's LightSampler, path by path.
+        HWY_ALIGN float density[kMax] = {};
+        for_each_lane(lit, i0, [&](std::size_t i, std::size_t j) { density[j] = general_light_pdf(sc, w, i); });
+        light_pdf = hn::Load(df, density);
+      } else {
+        light_pdf = triangle_light_pdf(sc, w, i0, lit, shape, n);
       }
-      const VF light_pdf =
-          hn::IfThenZeroElse(pdf_zero, hn::IfThenElseZero(light, pmf * area_to_solid_angle(df, inv_area, dist, dot(n, d) / dist)));
-      // emission_weight (core/strategy_weights.h).
-      VF weight = k(1.0f);
-      if (sc.strategy == Strategy::Light) weight = hn::IfThenElse(light_pdf > k(0.0f), k(0.0f), k(1.0f));
-      if (sc.strategy == Strategy::Mis) weight = power_heuristic(df, prev_pdf, light_pdf);
-      if (sc.strategy == Strategy::LightBsdf)
-        weight = hn::IfThenElseZero(bsdf_technique, k(2.0f) * prev_pdf / (prev_pdf + light_pdf));
-      weight = hn::IfThenElseZero(lit, hn::IfThenElse(impulse, k(1.0f), weight));
-      L_new = select(found, L + beta * (weight * Le), L_new);
+      L_new = select(found, L + beta * (emission_weight(sc, w, i0, lit, light_pdf) * Le), L_new);
       // The path goes on if it may take another vertex and the surface scatters.
       alive = hn::And(fmask(hn::Not(load(w, kVertex, i0, found) > hn::Set(DI(), sc.max_vertex))),
                       shape_flag(found, sc, shape, kScatters));
@@ -604,6 +648,114 @@ void add_emission(const Scene& sc, const Wave& w) {
     store3(w, kLR, i0, in, L_new);
     store_mask(w, kAlive, i0, in, alive);
   }
+}
+
+// What a light sample brings to sample_lights: its direction, radiance and
+// density, and the shadow ray towards it (origin, direction, tmax).
+struct LightLanes {
+  V3 wi, Le;
+  VF pdf;
+  VF ray[7];
+};
+
+// LightSampler::sample for triangle lights sampled by area, in the lanes;
+// the lanes of ok it gives no sample leave ok.
+LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, const V3& sp, const V3& wo,
+                          const V3& n, M& ok) {
+  const DF df;
+  LightLanes ls;
+  // LightSampler::sample: pick a triangle, then a point uniformly on it
+  // (square_to_uniform_triangle, triangle_point).
+  const VF u_choice = rng.u(Dim::LightChoice);
+  VI light;
+  VF bvh_pmf = hn::Zero(df);
+  if (sc.lights.bvh_nodes) {
+    // LightSampler::pick under bvh: the grid point k of u_choice walks the
+    // tree from light_query(s, wo) (no sky: every point is the tree's).
+    const V3 qn = query_normal(n, wo);
+    VD share[2], tree_light[2];
+    for (int h = 0; h < 2; ++h) {
+      const VD scaled = hn::Floor(half_d(u_choice, h) * hn::Set(DD(), 0x1p24));
+      const VD grid_k = hn::IfThenElse(scaled < hn::Zero(DD()), hn::Zero(DD()),
+                                       hn::IfThenElse(hn::Set(DD(), 0x1p24 - 1) < scaled, hn::Set(DD(), 0x1p24 - 1), scaled));
+      bvh_pick(sc.lights, half_d(sp, h), half_d(qn, h), grid_k, hn::Set(DD(), static_cast<double>(sc.lights.bvh_grid)),
+               half_mask(ok, h), tree_light[h], share[h]);
+    }
+    const VF shares = join_f(share[0], share[1]);
+    ok = hn::And(ok, shares > k(0.0f));
+    bvh_pmf = shares * k(0x1p-24f);
+    const VI tl = hn::IfThenElseZero(hn::RebindMask(DI(), ok), hn::ConvertTo(DI(), join_f(tree_light[0], tree_light[1])));
+    light = hn::IfThenElseZero(hn::RebindMask(DI(), ok), hn::GatherIndex(DI(), sc.lights.bvh_entry, tl));
+  } else {
+    light = pick(ok, sc.lights, u_choice);
+  }
+  VF b1, b2;
+  VF lu, lv;
+  rng.u2(Dim::LightX, lu, lv);
+  uniform_triangle(df, lu, lv, b1, b2);
+  const V3 p0 = light_value3(ok, sc.lights, light, kLightP0), p1 = light_value3(ok, sc.lights, light, kLightP1),
+           p2 = light_value3(ok, sc.lights, light, kLightP2), ln = light_value3(ok, sc.lights, light, kLightNormal),
+           Le = light_value3(ok, sc.lights, light, kLightLe);
+  ls.Le = Le;
+  const VF two_sided = light_value(ok, sc.lights, light, kLightTwoSided);
+  V3 lp, lerr;
+  triangle_point(df, b1, b2, p0, p1, p2, lp, lerr);
+
+  const V3 d = lp - sp;
+  const VF dist = hn::Sqrt(dot(d, d));
+  ok = hn::And(ok, dist > k(0.0f));
+  ls.wi = d / dist;
+  const V3& wi = ls.wi;
+  const VF cos_light = dot(ln, -wi);
+  // The back of a one-sided emitter: cos_light <= 0 (NaN passes, as in the scalar code).
+  ok = hn::And(ok, hn::Or(two_sided != k(0.0f), hn::Not(cos_light <= k(0.0f))));
+  // pmf * area_to_solid_angle(1 / area, dist, cos_light) (core/sampling.h).
+  const VF inv_area = light_value(ok, sc.lights, light, kLightInvArea);
+  const VF pmf = sc.lights.bvh_nodes ? bvh_pmf : light_value(ok, sc.lights, light, kLightPmf);
+  const VF pdf_light = pmf * area_to_solid_angle(df, inv_area, dist, cos_light);
+  ls.pdf = pdf_light;
+  ok = hn::And(ok, hn::AndNot(hn::IsInf(pdf_light), pdf_light > k(0.0f)));  // seen edge-on
+
+  // Surfel::spawn_to(lp, lerr, ln).
+  const V3 err = load3(w, kErrX, i0, ok);
+  const V3 origin = offset_ray_origin(df, sp, err, select(dot(d, n) >= k(0.0f), n, -n));
+  const V3 reach = k(kGamma3) * abs(lp - origin);  // the float ray's own reach error
+  const V3 end = offset_ray_origin(df, lp, lerr + reach, select(dot(origin - lp, ln) >= k(0.0f), ln, -ln));
+  const V3 dd = end - origin;
+  const VF len = hn::Sqrt(dot(dd, dd));
+  const V3 dir = dd / len;
+  const VF ray[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
+  std::copy(std::begin(ray), std::end(ray), ls.ray);
+  return ls;
+}
+
+// Any other lights (Scene::general_lights): LightSampler::sample and
+// shadow_ray by core, path by path (general_light).
+LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, M& ok) {
+  const DF df;
+  constexpr std::size_t kMax = hn::MaxLanes(DF());
+  HWY_ALIGN float u[3][kMax], out[14][kMax] = {};
+  HWY_ALIGN std::int32_t sampled[kMax] = {};
+  hn::Store(rng.u(Dim::LightChoice), df, u[0]);
+  VF lu, lv;
+  rng.u2(Dim::LightX, lu, lv);
+  hn::Store(lu, df, u[1]);
+  hn::Store(lv, df, u[2]);
+  for_each_lane(ok, i0, [&](std::size_t i, std::size_t j) {
+    GeneralLight gl;
+    if (!general_light(sc, w, i, u[0][j], u[1][j], u[2][j], &gl)) return;
+    sampled[j] = 1;
+    const float v[14] = {gl.wi[0], gl.wi[1], gl.wi[2], gl.Le[0], gl.Le[1], gl.Le[2], gl.pdf,
+                         gl.ray[0], gl.ray[1], gl.ray[2], gl.ray[3], gl.ray[4], gl.ray[5], gl.ray[6]};
+    for (int a = 0; a < 14; ++a) out[a][j] = v[a];
+  });
+  ok = hn::And(ok, fmask(hn::Load(DI(), sampled) != hn::Zero(DI())));
+  LightLanes ls;
+  ls.wi = {hn::Load(df, out[0]), hn::Load(df, out[1]), hn::Load(df, out[2])};
+  ls.Le = {hn::Load(df, out[3]), hn::Load(df, out[4]), hn::Load(df, out[5])};
+  ls.pdf = hn::Load(df, out[6]);
+  for (int a = 0; a < 7; ++a) ls.ray[a] = hn::Load(df, out[7 + a]);
+  return ls;
 }
 
 std::size_t sample_lights(const Scene& sc, const Wave& w) {
@@ -615,63 +767,19 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     const Streams rng = streams(sc, w, i0, vertex);
     // samples_area_lights (core/strategy_weights.h).
     M ok = load_mask(w, kAlive, i0, in);
-    if (sc.strategy == Strategy::Bsdf || sc.lights.count == 0) ok = hn::FirstN(df, 0);
+    if (sc.strategy == Strategy::Bsdf || (sc.lights.count == 0 && !sc.general_lights)) ok = hn::FirstN(df, 0);
     if (sc.strategy == Strategy::LightBsdf) ok = hn::And(ok, rng.u(Dim::Technique) < k(0.5f));
     if (hn::AllFalse(df, ok)) {
       continue;
     }
 
-    // LightSampler::sample: pick a triangle, then a point uniformly on it
-    // (square_to_uniform_triangle, triangle_point).
-    const VF u_choice = rng.u(Dim::LightChoice);
     const V3 sp = load3(w, kPx, i0, ok);
     const V3 wo = -load3(w, kDx, i0, ok);
     const V3 n = load3(w, kNx, i0, ok);  // the frame's normal is the surface's
-    VI light;
-    VF bvh_pmf = hn::Zero(df);
-    if (sc.lights.bvh_nodes) {
-      // LightSampler::pick under bvh: the grid point k of u_choice walks the
-      // tree from light_query(s, wo) (no sky: every point is the tree's).
-      const V3 qn = query_normal(n, wo);
-      VD share[2], tree_light[2];
-      for (int h = 0; h < 2; ++h) {
-        const VD scaled = hn::Floor(half_d(u_choice, h) * hn::Set(DD(), 0x1p24));
-        const VD grid_k = hn::IfThenElse(scaled < hn::Zero(DD()), hn::Zero(DD()),
-                                         hn::IfThenElse(hn::Set(DD(), 0x1p24 - 1) < scaled, hn::Set(DD(), 0x1p24 - 1), scaled));
-        bvh_pick(sc.lights, half_d(sp, h), half_d(qn, h), grid_k, hn::Set(DD(), static_cast<double>(sc.lights.bvh_grid)),
-                 half_mask(ok, h), tree_light[h], share[h]);
-      }
-      const VF shares = join_f(share[0], share[1]);
-      ok = hn::And(ok, shares > k(0.0f));
-      bvh_pmf = shares * k(0x1p-24f);
-      const VI tl = hn::IfThenElseZero(hn::RebindMask(DI(), ok), hn::ConvertTo(DI(), join_f(tree_light[0], tree_light[1])));
-      light = hn::IfThenElseZero(hn::RebindMask(DI(), ok), hn::GatherIndex(DI(), sc.lights.bvh_entry, tl));
-    } else {
-      light = pick(ok, sc.lights, u_choice);
-    }
-    VF b1, b2;
-    VF lu, lv;
-    rng.u2(Dim::LightX, lu, lv);
-    uniform_triangle(df, lu, lv, b1, b2);
-    const V3 p0 = light_value3(ok, sc.lights, light, kLightP0), p1 = light_value3(ok, sc.lights, light, kLightP1),
-             p2 = light_value3(ok, sc.lights, light, kLightP2), ln = light_value3(ok, sc.lights, light, kLightNormal),
-             Le = light_value3(ok, sc.lights, light, kLightLe);
-    const VF two_sided = light_value(ok, sc.lights, light, kLightTwoSided);
-    V3 lp, lerr;
-    triangle_point(df, b1, b2, p0, p1, p2, lp, lerr);
-
-    const V3 d = lp - sp;
-    const VF dist = hn::Sqrt(dot(d, d));
-    ok = hn::And(ok, dist > k(0.0f));
-    const V3 wi = d / dist;
-    const VF cos_light = dot(ln, -wi);
-    // The back of a one-sided emitter: cos_light <= 0 (NaN passes, as in the scalar code).
-    ok = hn::And(ok, hn::Or(two_sided != k(0.0f), hn::Not(cos_light <= k(0.0f))));
-    // pmf * area_to_solid_angle(1 / area, dist, cos_light) (core/sampling.h).
-    const VF inv_area = light_value(ok, sc.lights, light, kLightInvArea);
-    const VF pmf = sc.lights.bvh_nodes ? bvh_pmf : light_value(ok, sc.lights, light, kLightPmf);
-    const VF pdf_light = pmf * area_to_solid_angle(df, inv_area, dist, cos_light);
-    ok = hn::And(ok, hn::AndNot(hn::IsInf(pdf_light), pdf_light > k(0.0f)));  // seen edge-on
+    const LightLanes ls = sc.general_lights ? other_light(sc, w, i0, rng, ok) : triangle_light(sc, w, i0, rng, sp, wo, n, ok);
+    const V3& wi = ls.wi;
+    const V3& Le = ls.Le;
+    const VF& pdf_light = ls.pdf;
 
     // Surfel::eval and Surfel::pdf of the Lambert lobe (core/surfel.cpp,
     // bsdf/lambert.h): only the local z of wo and wi matters.
@@ -714,18 +822,10 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     if (sc.strategy == Strategy::LightBsdf) weight = k(2.0f) * pdf_light / (pdf_light + pdf_bsdf);
     store3(w, kUnR, i0, ok, (weight / pdf_light) * (f * Le));
 
-    // Surfel::spawn_to(lp, lerr, ln), packed behind the previous ones in
-    // path order, with the slot of the path each belongs to (add_light).
-    const V3 err = load3(w, kErrX, i0, ok);
-    const V3 origin = offset_ray_origin(df, sp, err, select(dot(d, n) >= k(0.0f), n, -n));
-    const V3 reach = k(kGamma3) * abs(lp - origin);  // the float ray's own reach error
-    const V3 end = offset_ray_origin(df, lp, lerr + reach, select(dot(origin - lp, ln) >= k(0.0f), ln, -ln));
-    const V3 dd = end - origin;
-    const VF len = hn::Sqrt(dot(dd, dd));
-    const V3 dir = dd / len;
-    const VF q[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
+    // The shadow ray, packed behind the previous ones in path order, with
+    // the slot of the path each belongs to (add_light).
     const Packer pack(ok);
-    for (int a = 0; a < 7; ++a) pack.store(w.f[kQOx + a] + queries, q[a]);
+    for (int a = 0; a < 7; ++a) pack.store(w.f[kQOx + a] + queries, ls.ray[a]);
     pack.store(w.u[kQPath] + queries, hn::Iota(DU(), static_cast<std::uint32_t>(i0)));
     const std::size_t count = pack.count;
     // The shadow ray counts as one of the path's rays.
@@ -981,6 +1081,46 @@ bool general_scatter(const Scene& sc, const Wave& w, std::size_t i, float u_lobe
   out->pdf = bs->pdf;
   out->impulse = bs->impulse;
   return true;
+}
+
+// What light_query and shadow_ray read of the Surfel in slot i: its point,
+// error bound and geometric normal.
+static Surfel shading_point(const Wave& w, std::size_t i) {
+  Surfel s;
+  s.p = vec3(w.f[kPx][i], w.f[kPy][i], w.f[kPz][i]);
+  s.p_error = vec3(w.f[kErrX][i], w.f[kErrY][i], w.f[kErrZ][i]);
+  s.n = vec3(w.f[kNx][i], w.f[kNy][i], w.f[kNz][i]);
+  return s;
+}
+
+bool general_light(const Scene& sc, const Wave& w, std::size_t i, float u_choice, float u0, float u1,
+                   GeneralLight* out) {
+  const Surfel s = shading_point(w, i);
+  const vec3 wo = -vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]);
+  const std::optional<LightSample> ls = sc.compiled->lights().sample(light_query(s, wo), u_choice, vec2(u0, u1));
+  if (!ls) return false;
+  const Ray r = shadow_ray(s, *ls);
+  for (int c = 0; c < 3; ++c) {
+    out->wi[c] = ls->wi[c];
+    out->Le[c] = ls->Le[c];
+    out->ray[c] = r.origin[c];
+    out->ray[3 + c] = r.dir[c];
+  }
+  out->pdf = ls->pdf;
+  out->ray[6] = r.tmax;
+  return true;
+}
+
+void general_sky(const Scene& sc, const Wave& w, std::size_t i, float Le[3], float* pdf) {
+  const LightSampler::Sky sky = sc.compiled->lights().sky(vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]));
+  for (int c = 0; c < 3; ++c) Le[c] = sky.Le[c];
+  *pdf = sky.pdf;
+}
+
+float general_light_pdf(const Scene& sc, const Wave& w, std::size_t i) {
+  const LightQuery ref{vec3(w.f[kPrevX][i], w.f[kPrevY][i], w.f[kPrevZ][i]),
+                       vec3(w.f[kPrevNx][i], w.f[kPrevNy][i], w.f[kPrevNz][i])};
+  return sc.compiled->lights().pdf(ref, general_surfel(sc, w, i));
 }
 
 // The light of every visible sample, once Embree has filled kQOccluded: L

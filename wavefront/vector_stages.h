@@ -78,6 +78,12 @@ struct Scene {
   // by compiled->resolve() of the path's ray and hit.
   bool general = false;
   const CompiledScene* compiled = nullptr;
+  // Lights beyond triangles sampled by area (an environment, sun disks,
+  // sphere lights, light_sampling solid_angle): compiled->lights() samples
+  // them and gives their densities, path by path; `sky`: escaped rays find
+  // an environment (LightSampler::sky).
+  bool general_lights = false;
+  bool sky = false;
   // The zsobol sampler (else the independent one): SamplerSetup::zsobol_bits().
   bool zsobol = false;
   unsigned zsobol_bits = 0;

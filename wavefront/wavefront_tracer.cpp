@@ -145,7 +145,9 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns;
-  std::vector<std::string> general;  // what core's Surfel shades, path by path (stages_description)
+  // What core shades or samples path by path (stages_description): the
+  // materials by name, then shapes' shading frames and lights.
+  std::vector<std::string> general_materials, general;
   std::vector<double> bvh_nodes;
   std::vector<std::int32_t> bvh_entry, bvh_light;
 
@@ -180,7 +182,7 @@ struct WavefrontTracer::VectorStages {
     for (const Material& m : scene.materials) {
       if (m.type == MaterialType::Emissive) continue;  // never scatters
       if (!in_lanes(m)) {
-        v->general.push_back("material '" + m.name + "'");
+        v->general_materials.push_back("'" + m.name + "'");
         continue;
       }
       if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return no("materials with different min_pdf");
@@ -198,15 +200,29 @@ struct WavefrontTracer::VectorStages {
         v->general.push_back("the shading frame of " + shape.description);
     // Only triangle area lights: no delta light, sphere light or environment.
     const LightSampler& lights = compiled.lights();
+    // A delta light adds a second shadow ray per path, which the stages do not pack.
     if (lights.has_delta_lights()) return no("delta lights (point, spot, directional)");
-    if (lights.samples_environment()) return no("an environment or sun disk light");
-    // The stages sample triangle lights by area; solid-angle sampling lives
-    // in LightSampler::sample() alone, which the scalar stages call.
+    // The lanes sample triangle lights by area; any other light (or
+    // solid-angle sampling) is sampled by LightSampler::sample(), path by path.
+    std::vector<std::string> other_lights;
+    if (lights.samples_environment()) other_lights.push_back("the environment");
+    for (std::uint32_t i = 0; i < scene.shapes.size(); ++i)
+      if (scene.shapes[i].kind == Shape::Kind::Sphere && lights.first_entry(i) >= 0) {
+        other_lights.push_back("sphere lights");
+        break;
+      }
     if (lights.light_sampling() != LightSampling::Area)
-      return no(std::string("light_sampling ") + light_sampling_name(lights.light_sampling()));
+      other_lights.push_back(std::string("light_sampling ") + light_sampling_name(lights.light_sampling()));
+    sc.sky = lights.samples_environment();
+    sc.general_lights = !other_lights.empty();
+    if (sc.general_lights) {
+      std::string what = "the light samples (";
+      for (std::size_t i = 0; i < other_lights.size(); ++i) what += (i ? ", " : "") + other_lights[i];
+      v->general.push_back(what + ")");
+    }
     for (const LightSampler::Entry& e : lights.entries()) {
+      if (sc.general_lights) break;  // the tables below are the lanes' own sampler's
       const Shape& shape = scene.shapes[e.shape];
-      if (shape.kind != Shape::Kind::Triangles) return no("a sphere light (" + shape.description + ")");
       const Material& m = scene.materials[shape.material];
       const Triangle& t = e.triangle;
       for (const vec3& c : {t.p0, t.p1, t.p2, t.n, m.emission})
@@ -215,7 +231,7 @@ struct WavefrontTracer::VectorStages {
       v->inv_area.push_back(1.0f / e.area);
     }
     const std::size_t n_lights = lights.entries().size();
-    if (n_lights >= 1 && n_lights <= 16) {  // small enough to keep by column
+    if (!sc.general_lights && n_lights >= 1 && n_lights <= 16) {  // small enough to keep by column
       v->light_columns.assign(16 * vs::kLightColumns, 0.0f);
       for (std::size_t l = 0; l < n_lights; ++l) {
         for (int f = 0; f < vs::kLightCdf; ++f) v->light_columns[16 * f + l] = v->light_triangle[16 * l + f];
@@ -226,7 +242,7 @@ struct WavefrontTracer::VectorStages {
     }
     sc.lights = {n_lights, lights.cdf().data(), lights.pmf().data(), v->inv_area.data(), v->light_triangle.data(),
                  v->light_columns.empty() ? nullptr : v->light_columns.data()};
-    if (const LightBvh* bvh = lights.bvh(); bvh && !bvh->empty()) {
+    if (const LightBvh* bvh = lights.bvh(); bvh && !bvh->empty() && !sc.general_lights) {
       // The light BVH as the stages walk it (core/simd/light_bvh-inl.h).
       v->bvh_nodes = bvh->node_table();
       for (std::uint32_t l = 0; l < bvh->trails().size(); ++l)
@@ -363,11 +379,16 @@ std::string WavefrontTracer::stages_description() const {
   if (!vector_) return "scalar stages (" + scalar_reason_ + ")";
   std::string d = std::string("every stage vectorised (") + simd_target_name(active_simd_target()) + ", " +
                   std::to_string(vector_stages::lanes()) + " paths at a time, paths as structure of arrays)";
-  if (!vector_->general.empty()) {
-    d += "; shaded one path at a time (core's Surfel): ";
-    for (std::size_t i = 0; i < vector_->general.size(); ++i)
-      d += (i == 0 ? "" : i + 1 == vector_->general.size() ? " and " : ", ") + vector_->general[i];
-  }
+  auto list = [](const std::vector<std::string>& items) {
+    std::string l;
+    for (std::size_t i = 0; i < items.size(); ++i) l += (i == 0 ? "" : i + 1 == items.size() ? " and " : ", ") + items[i];
+    return l;
+  };
+  std::vector<std::string> general = vector_->general;
+  if (!vector_->general_materials.empty())
+    general.insert(general.begin(), std::string(vector_->general_materials.size() > 1 ? "materials " : "material ") +
+                                        list(vector_->general_materials));
+  for (std::size_t i = 0; i < general.size(); ++i) d += (i == 0 ? "; by core, one path at a time: " : "; ") + general[i];
   return d;
 }
 
