@@ -65,6 +65,10 @@ bool general_light(const Scene& scene, const Wave& wave, std::size_t i, float u_
 // have chosen the emitter it hit (LightSampler::pdf from the previous vertex).
 void general_sky(const Scene& scene, const Wave& wave, std::size_t i, float Le[3], float* pdf);
 float general_light_pdf(const Scene& scene, const Wave& wave, std::size_t i);
+// CompiledScene::resolve of the hit in slot i, written to the Surfel's
+// arrays: its point, error bound and geometric normal (a hit on an instance,
+// Scene::instanced), and its shading frame (a kGeneral shape's).
+void general_resolve(const Scene& scene, const Wave& wave, std::size_t i);
 }  // namespace pathlab::vector_stages
 #endif
 
@@ -542,6 +546,13 @@ void resolve(const Scene& sc, const Wave& w) {
     store3(w, kPx, i0, found, p);
     store3(w, kErrX, i0, found, error);
     store3(w, kNx, i0, found, n);
+    // By core, path by path: a hit on an instance (found in the group's own
+    // space; kInstance is not kNoInstance, all ones), and the shading frame
+    // of a shape the lanes do not shade.
+    M by_core = hn::FirstN(df, 0);
+    if (sc.instanced) by_core = hn::And(found, fmask(load(w, kInstance, i0, found) != hn::Set(DI(), -1)));
+    if (sc.general) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kGeneral));
+    for_each_lane(by_core, i0, [&](std::size_t i, std::size_t) { general_resolve(sc, w, i); });
   }
 }
 
@@ -1046,18 +1057,50 @@ std::size_t compact(const Scene& scene, const Wave& wave, void* samples, std::ui
 
 // The Surfel of the hit in slot i, as the scalar stages make it: resolve()
 // of the path's ray (still in kOx... until scatter() spawns the next one) and
-// hit (the stages take no instance and no texture). Its point, error and
-// geometric normal are those the lanes resolved, bit for bit; its shading
-// frame is the vertex normals' or the tangents' where the mesh has them.
-static Surfel general_surfel(const Scene& sc, const Wave& w, std::size_t i) {
+// hit (the stages take no texture). Its point, error and geometric normal
+// are those the lanes resolved, bit for bit, but for an instance's.
+static Surfel resolved_surfel(const Scene& sc, const Wave& w, std::size_t i) {
   const Ray ray{vec3(w.f[kOx][i], w.f[kOy][i], w.f[kOz][i]), vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]), w.f[kTmax][i]};
   RayHit hit;
   hit.t = w.f[kHitT][i];
   hit.shape = w.u[kShape][i];
   hit.prim = w.u[kPrim][i];
   hit.uv = vec2(w.f[kHitU][i], w.f[kHitV][i]);
+  if (sc.instanced) hit.instance = w.u[kInstance][i];
   Surfel s;
   sc.compiled->resolve(ray, hit, &s);
+  return s;
+}
+
+static vec3 at(const Wave& w, FloatArray x, std::size_t i) { return vec3(w.f[x][i], w.f[x + 1][i], w.f[x + 2][i]); }
+
+void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {
+  const Surfel s = resolved_surfel(sc, w, i);
+  const vec3* fields[] = {&s.p, &s.p_error, &s.n, &s.frame.s, &s.frame.t, &s.frame.n};
+  const FloatArray arrays[] = {kPx, kErrX, kNx, kFsX, kFtX, kFnX};
+  for (int a = 0; a < 6; ++a)
+    for (int c = 0; c < 3; ++c) w.f[arrays[a] + c][i] = (*fields[a])[c];
+  w.b[kShadingNormal][i] = s.shading_normal ? 1 : 0;
+}
+
+// The Surfel of a hit on a kGeneral shape, from what general_resolve kept:
+// resolved_surfel's, field for field (the stages take no texture, so uv is
+// the hit's and params is null).
+static Surfel general_surfel(const Scene& sc, const Wave& w, std::size_t i) {
+  Surfel s;
+  s.p = at(w, kPx, i);
+  s.p_error = at(w, kErrX, i);
+  s.n = at(w, kNx, i);
+  s.frame.s = at(w, kFsX, i);
+  s.frame.t = at(w, kFtX, i);
+  s.frame.n = at(w, kFnX, i);
+  s.uv = vec2(w.f[kHitU][i], w.f[kHitV][i]);
+  s.shading_normal = w.b[kShadingNormal][i] != 0;
+  s.shape = w.u[kShape][i];
+  s.prim = w.u[kPrim][i];
+  if (sc.instanced) s.instance = w.u[kInstance][i];
+  const pathlab::Scene& scene = sc.compiled->scene();
+  s.material = &scene.materials[scene.shapes[s.shape].material];
   return s;
 }
 
@@ -1120,7 +1163,7 @@ void general_sky(const Scene& sc, const Wave& w, std::size_t i, float Le[3], flo
 float general_light_pdf(const Scene& sc, const Wave& w, std::size_t i) {
   const LightQuery ref{vec3(w.f[kPrevX][i], w.f[kPrevY][i], w.f[kPrevZ][i]),
                        vec3(w.f[kPrevNx][i], w.f[kPrevNy][i], w.f[kPrevNz][i])};
-  return sc.compiled->lights().pdf(ref, general_surfel(sc, w, i));
+  return sc.compiled->lights().pdf(ref, resolved_surfel(sc, w, i));
 }
 
 // The light of every visible sample, once Embree has filled kQOccluded: L

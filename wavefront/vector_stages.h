@@ -2,7 +2,7 @@
 // (structure of arrays), a block of them per SIMD register — 16 with
 // AVX-512, 8 with AVX2, 4 with SSE4, whichever core/simd/simd.h's dispatch
 // selected — for scenes of meshes and spheres lit by triangle area lights
-// (the dragon benchmarks, the Cornell box; any camera). Flat Lambert
+// (the dragon benchmarks, the Cornell box; any camera; instances). Flat Lambert
 // surfaces, one- or two-sided, are shaded in the lanes; every other surface
 // (Disney, mirror, glass, Lambert under --general-shading, vertex normals)
 // by core's Surfel, one path at a time, between the lanes' steps
@@ -74,8 +74,8 @@ struct Scene {
   std::size_t shape_count = 0;
   bool one_sided = false;  // some shape's material is one-sided (ShapeField kOneSided): else no lane looks
   // Some shape is not shaded in the lanes (ShapeField kGeneral): its paths'
-  // BSDF is evaluated and sampled by core's Surfel, one path at a time, made
-  // by compiled->resolve() of the path's ray and hit.
+  // BSDF is evaluated and sampled by core's Surfel, one path at a time;
+  // resolve() keeps its shading frame from compiled->resolve() (kFsX...).
   bool general = false;
   const CompiledScene* compiled = nullptr;
   // Lights beyond triangles sampled by area (an environment, sun disks,
@@ -84,6 +84,9 @@ struct Scene {
   // an environment (LightSampler::sky).
   bool general_lights = false;
   bool sky = false;
+  // The scene places shapes by instances: hits on them (kInstance set) are
+  // resolved by compiled->resolve(), path by path.
+  bool instanced = false;
   // The zsobol sampler (else the independent one): SamplerSetup::zsobol_bits().
   bool zsobol = false;
   unsigned zsobol_bits = 0;
@@ -133,6 +136,9 @@ enum FloatArray : int {
   // This bounce only: the hit and the Surfel made of it.
   kHitT, kHitU, kHitV,
   kPx, kPy, kPz, kErrX, kErrY, kErrZ, kNx, kNy, kNz,
+  // The shading frame (s, t, n) of a hit on a shape core's Surfel shades
+  // (ShapeField kGeneral), as CompiledScene::resolve made it.
+  kFsX, kFsY, kFsZ, kFtX, kFtY, kFtZ, kFnX, kFnY, kFnZ,
   // What the area-light sample brings if nothing blocks its shadow ray.
   kUnR, kUnG, kUnB,
   // The shadow rays to trace, packed in path order for Embree.
@@ -142,11 +148,13 @@ enum FloatArray : int {
 enum UintArray : int {
   kOutIndex, kRays, kVertex, kPixelX, kPixelY,
   kShape, kPrim,  // the hit's
+  kInstance,      // the hit's instance (kNoInstance for a shape in world space), when Scene::instanced
   kQPath,         // per packed shadow ray: the slot of its path
   kUintArrays
 };
 enum ByteArray : int {
   kAlive, kFound, kPrevImpulse, kPrevBsdfTechnique,
+  kShadingNormal,  // Surfel::shading_normal of a hit on a kGeneral shape
   kQOccluded,  // per packed shadow ray
   kByteArrays
 };

@@ -189,7 +189,9 @@ struct WavefrontTracer::VectorStages {
       diffuse = &m;
     }
     if (diffuse) sc.min_pdf = diffuse->shading.min_pdf;
-    if (!scene.instances.empty()) return no("instances");
+    // Hits on instances are placed by CompiledScene::resolve, path by path.
+    sc.instanced = !scene.instances.empty();
+    if (sc.instanced) v->general.push_back("the hit points on instances");
     // Alpha is decided inside Embree by the rays' keys, which Lanes do not carry.
     for (const Material& m : scene.materials)
       if (m.has_alpha()) return no("material '" + m.name + "' has alpha (partial coverage)");
@@ -213,6 +215,11 @@ struct WavefrontTracer::VectorStages {
       }
     if (lights.light_sampling() != LightSampling::Area)
       other_lights.push_back(std::string("light_sampling ") + light_sampling_name(lights.light_sampling()));
+    for (const Shape& shape : scene.shapes)
+      if (shape.in_group && scene.materials[shape.material].emits()) {
+        other_lights.push_back("emitters placed by instances");
+        break;
+      }
     sc.sky = lights.samples_environment();
     sc.general_lights = !other_lights.empty();
     if (sc.general_lights) {
@@ -706,7 +713,8 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
   for (bool camera_rays = true; lanes.view.n > 0; camera_rays = false) {
     const std::size_t n = w.n;
     const RayArrays rays{w.f[vs::kOx], w.f[vs::kOy], w.f[vs::kOz], w.f[vs::kDx], w.f[vs::kDy], w.f[vs::kDz], w.f[vs::kTmax]};
-    const HitArrays hits{w.f[vs::kHitT], w.f[vs::kHitU], w.f[vs::kHitV], w.u[vs::kShape], w.u[vs::kPrim], w.b[vs::kFound]};
+    const HitArrays hits{w.f[vs::kHitT], w.f[vs::kHitU], w.f[vs::kHitV], w.u[vs::kShape], w.u[vs::kPrim], w.b[vs::kFound],
+                         sc.instanced ? w.u[vs::kInstance] : nullptr};
     const std::uint64_t t = clock_ns();
     scene_.intersect_arrays(rays, n, hits, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
     clock.batch(camera_rays ? kCameraQueries : kBounceQueries, t, n);
