@@ -69,6 +69,11 @@ float general_light_pdf(const Scene& scene, const Wave& wave, std::size_t i);
 // arrays: its point, error bound and geometric normal (a hit on an instance,
 // Scene::instanced), and its shading frame (a kGeneral shape's).
 void general_resolve(const Scene& scene, const Wave& wave, std::size_t i);
+// Surfel::emitted towards the path's wo, for a kTexturedEmission shape's hit.
+void general_emitted(const Scene& scene, const Wave& wave, std::size_t i, float Le[3]);
+// Under Scene::textured: the cone of the path in slot i after it scattered
+// (scattered_cone of its ray's, to its hit), before the next ray replaces it.
+void general_cone(const Scene& scene, const Wave& wave, std::size_t i, bool impulse, float pdf);
 }  // namespace pathlab::vector_stages
 #endif
 
@@ -88,7 +93,7 @@ void add_emission(const Scene&, const Wave&) { width_one(); }
 std::size_t sample_lights(const Scene&, const Wave&) { width_one(); }
 void scatter(const Scene&, const Wave&) { width_one(); }
 void hash_keys(std::uint64_t*, std::size_t, std::uint64_t) { width_one(); }
-std::size_t compact(const Wave&, bool, void*, std::uint32_t) { width_one(); }
+std::size_t compact(const Wave&, bool, bool, void*, std::uint32_t) { width_one(); }
 std::size_t lanes() { return 1; }
 #else
 
@@ -476,6 +481,10 @@ void generate_camera_rays(const Scene& sc, const Camera& c, const Wave& w) {
       store3(w, kDx, i0, in, normalize(df, focus - origin));
     }
     store(w, kTmax, i0, in, k(std::numeric_limits<float>::infinity()));
+    if (sc.textured) {
+      store(w, kConeWidth, i0, in, k(sc.camera_cone_width));
+      store(w, kConeSpread, i0, in, k(sc.camera_cone_spread));
+    }
     // A fresh path: beta 1, L 0, PreviousVertex{} (at 0, pdf 0, an impulse,
     // the BSDF technique), no rays yet, alive, about to reach vertex 1.
     store3(w, kBetaR, i0, in, one);
@@ -552,6 +561,7 @@ void resolve(const Scene& sc, const Wave& w) {
     M by_core = hn::FirstN(df, 0);
     if (sc.instanced) by_core = hn::And(found, fmask(load(w, kInstance, i0, found) != hn::Set(DI(), -1)));
     if (sc.general) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kGeneral));
+    if (sc.textured) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kTexturedEmission));
     for_each_lane(by_core, i0, [&](std::size_t i, std::size_t) { general_resolve(sc, w, i); });
   }
 }
@@ -638,8 +648,20 @@ void add_emission(const Scene& sc, const Wave& w) {
       const V3 wo = -load3(w, kDx, i0, found);
       const V3 n = load3(w, kNx, i0, found);
       const M facing = hn::Or(shape_flag(found, sc, shape, kTwoSided), dot(n, wo) > k(0.0f));
-      const V3 Le = zero_unless(hn::And(shape_flag(found, sc, shape, kEmits), facing),
-                                shape_value3(found, sc, shape, kEmission));
+      V3 Le = zero_unless(hn::And(shape_flag(found, sc, shape, kEmits), facing), shape_value3(found, sc, shape, kEmission));
+      if (sc.textured) {
+        // Textured emission: Surfel::emitted, path by path.
+        const M textured = shape_flag(found, sc, shape, kTexturedEmission);
+        if (!hn::AllFalse(df, textured)) {
+          HWY_ALIGN float radiance[3][kMax] = {};
+          for_each_lane(textured, i0, [&](std::size_t i, std::size_t j) {
+            float e[3];
+            general_emitted(sc, w, i, e);
+            for (int c = 0; c < 3; ++c) radiance[c][j] = e[c];
+          });
+          Le = select(textured, V3{hn::Load(df, radiance[0]), hn::Load(df, radiance[1]), hn::Load(df, radiance[2])}, Le);
+        }
+      }
       const M lit = hn::AndNot(is_black(df, Le), found);
       // LightSampler::pdf(prev.p, s).
       VF light_pdf;
@@ -929,6 +951,16 @@ void scatter(const Scene& sc, const Wave& w) {
     if (sc.strategy == Strategy::LightBsdf) bsdf_technique = hn::Not(rng.u(Dim::Technique) < k(0.5f));
     store_mask(w, kPrevBsdfTechnique, i0, ok, bsdf_technique);
 
+    if (sc.textured && !hn::AllFalse(df, ok)) {
+      // The ray cone after the scatter, path by path (core/ray_cone.h).
+      constexpr std::size_t kMax = hn::MaxLanes(DF());
+      HWY_ALIGN float density[kMax];
+      HWY_ALIGN std::int32_t impulses[kMax];
+      hn::Store(pdf, df, density);
+      hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), impulse)), DI(), impulses);
+      for_each_lane(ok, i0, [&](std::size_t i, std::size_t j) { general_cone(sc, w, i, impulses[j] != 0, density[j]); });
+    }
+
     // Surfel::spawn(wi).
     const V3 err = load3(w, kErrX, i0, ok);
     store3(w, kOx, i0, ok, offset_ray_origin(df, sp, err, select(dot(wi, n) >= k(0.0f), n, -n)));
@@ -947,7 +979,7 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
     hn::StoreU(mix64(d64, hn::Xor(seed, hn::LoadU(d64, keys + i0))), d64, keys + i0);
 }
 
-std::size_t compact(const Wave& w, bool zsobol, void* samples, std::uint32_t first_slot) {
+std::size_t compact(const Wave& w, bool zsobol, bool textured, void* samples, std::uint32_t first_slot) {
   static constexpr FloatArray kMovedFloats[] = {kOx,   kOy,   kOz,   kDx,   kDy,    kDz,    kTmax,  kBetaR,   kBetaG, kBetaB,
                                                 kLR,   kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX, kFilmY,
                                                 kPrevNx, kPrevNy, kPrevNz};
@@ -990,6 +1022,8 @@ std::size_t compact(const Wave& w, bool zsobol, void* samples, std::uint32_t fir
     const Packer pack(alive);
     const std::size_t count = pack.count;
     for (FloatArray a : kMovedFloats) pack.store(w.f[a] + m, hn::LoadU(df, w.f[a] + i0));
+    if (textured)
+      for (FloatArray a : {kConeWidth, kConeSpread}) pack.store(w.f[a] + m, hn::LoadU(df, w.f[a] + i0));
     for (UintArray a : kMovedUints) pack.store(w.u[a] + m, hn::LoadU(DU(), w.u[a] + i0));
     for (ByteArray a : kMovedBytes)
       store_bytes(w.b[a] + m, pack.first, pack.packed(hn::PromoteTo(DI(), hn::LoadU(D8(), w.b[a] + i0))));
@@ -1052,7 +1086,7 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
   HWY_DYNAMIC_DISPATCH(hash_keys)(keys, n, seed_key);
 }
 std::size_t compact(const Scene& scene, const Wave& wave, void* samples, std::uint32_t first_slot) {
-  return HWY_DYNAMIC_DISPATCH(compact)(wave, scene.zsobol, samples, first_slot);
+  return HWY_DYNAMIC_DISPATCH(compact)(wave, scene.zsobol, scene.textured, samples, first_slot);
 }
 
 // The Surfel of the hit in slot i, as the scalar stages make it: resolve()
@@ -1068,7 +1102,10 @@ static Surfel resolved_surfel(const Scene& sc, const Wave& w, std::size_t i) {
   hit.uv = vec2(w.f[kHitU][i], w.f[kHitV][i]);
   if (sc.instanced) hit.instance = w.u[kInstance][i];
   Surfel s;
-  sc.compiled->resolve(ray, hit, &s);
+  if (sc.textured)
+    sc.compiled->resolve(ray, hit, &s, RayCone{w.f[kConeWidth][i], w.f[kConeSpread][i]}, &w.params[i]);
+  else
+    sc.compiled->resolve(ray, hit, &s);
   return s;
 }
 
@@ -1081,11 +1118,19 @@ void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {
   for (int a = 0; a < 6; ++a)
     for (int c = 0; c < 3; ++c) w.f[arrays[a] + c][i] = (*fields[a])[c];
   w.b[kShadingNormal][i] = s.shading_normal ? 1 : 0;
+  w.b[kHasParams][i] = s.params != nullptr ? 1 : 0;
+}
+
+void general_cone(const Scene& sc, const Wave& w, std::size_t i, bool impulse, float pdf) {
+  const RayCone cone = scattered_cone(RayCone{w.f[kConeWidth][i], w.f[kConeSpread][i]}, glm::length(at(w, kPx, i) - at(w, kOx, i)),
+                                      impulse, pdf, static_cast<TextureFilter>(sc.texture_filter));
+  w.f[kConeWidth][i] = cone.width;
+  w.f[kConeSpread][i] = cone.spread;
 }
 
 // The Surfel of a hit on a kGeneral shape, from what general_resolve kept:
-// resolved_surfel's, field for field (the stages take no texture, so uv is
-// the hit's and params is null).
+// resolved_surfel's, field for field (uv is read only by textures, which
+// resolve() has read into params already).
 static Surfel general_surfel(const Scene& sc, const Wave& w, std::size_t i) {
   Surfel s;
   s.p = at(w, kPx, i);
@@ -1099,9 +1144,15 @@ static Surfel general_surfel(const Scene& sc, const Wave& w, std::size_t i) {
   s.shape = w.u[kShape][i];
   s.prim = w.u[kPrim][i];
   if (sc.instanced) s.instance = w.u[kInstance][i];
+  if (w.b[kHasParams][i] != 0) s.params = &w.params[i];
   const pathlab::Scene& scene = sc.compiled->scene();
   s.material = &scene.materials[scene.shapes[s.shape].material];
   return s;
+}
+
+void general_emitted(const Scene& sc, const Wave& w, std::size_t i, float Le[3]) {
+  const Spectrum e = general_surfel(sc, w, i).emitted(-at(w, kDx, i));
+  for (int c = 0; c < 3; ++c) Le[c] = e[c];
 }
 
 void general_eval(const Scene& sc, const Wave& w, std::size_t i, const float wi[3], float f[3], float* pdf) {

@@ -27,6 +27,7 @@
 
 namespace pathlab {
 class CompiledScene;
+struct SurfaceParams;
 }
 
 namespace pathlab::vector_stages {
@@ -87,6 +88,13 @@ struct Scene {
   // The scene places shapes by instances: hits on them (kInstance set) are
   // resolved by compiled->resolve(), path by path.
   bool instanced = false;
+  // The scene has textures: each path carries its ray cone (kConeWidth,
+  // kConeSpread; CompiledScene::camera_cone, scattered_cone under
+  // texture_filter, a TextureFilter), and a textured material's hit its
+  // parameters (Wave::params), read by compiled->resolve().
+  bool textured = false;
+  float camera_cone_width = 0.0f, camera_cone_spread = 0.0f;
+  std::uint8_t texture_filter = 0;
   // The zsobol sampler (else the independent one): SamplerSetup::zsobol_bits().
   bool zsobol = false;
   unsigned zsobol_bits = 0;
@@ -114,6 +122,7 @@ enum ShapeField : int {
   kFlipped = 16,       // 1 if a sphere's normals point inwards
   kOneSided = 17,      // 1 if its material is one-sided (black from behind the geometric normal)
   kGeneral = 18,       // 1 if it is shaded by core's Surfel (not Lambert, or with vertex normals or tangents)
+  kTexturedEmission = 19,  // 1 if its emission is textured (Surfel::emitted, path by path)
   kShapeFields = 32,
 };
 
@@ -133,6 +142,7 @@ enum FloatArray : int {
   kPrevX, kPrevY, kPrevZ, kPrevPdf,     // PreviousVertex
   kPrevNx, kPrevNy, kPrevNz,            // PreviousVertex::ref.n (the light BVH's query)
   kFilmX, kFilmY,
+  kConeWidth, kConeSpread,              // the ray's cone (Scene::textured)
   // This bounce only: the hit and the Surfel made of it.
   kHitT, kHitU, kHitV,
   kPx, kPy, kPz, kErrX, kErrY, kErrZ, kNx, kNy, kNz,
@@ -155,6 +165,7 @@ enum UintArray : int {
 enum ByteArray : int {
   kAlive, kFound, kPrevImpulse, kPrevBsdfTechnique,
   kShadingNormal,  // Surfel::shading_normal of a hit on a kGeneral shape
+  kHasParams,      // its Surfel reads Wave::params (a textured material's)
   kQOccluded,  // per packed shadow ray
   kByteArrays
 };
@@ -167,6 +178,8 @@ struct Wave {
   // Under zsobol (Scene::zsobol): SamplerSetup::zsobol_index and zsobol_key per path.
   std::uint64_t* zindex = nullptr;
   std::uint64_t* zkey = nullptr;
+  // Under Scene::textured: per slot, the parameters of this bounce's hit.
+  SurfaceParams* params = nullptr;
 };
 
 // What compact() writes for each path that ended: FilmSample's fields, in

@@ -195,7 +195,16 @@ struct WavefrontTracer::VectorStages {
     // Alpha is decided inside Embree by the rays' keys, which Lanes do not carry.
     for (const Material& m : scene.materials)
       if (m.has_alpha()) return no("material '" + m.name + "' has alpha (partial coverage)");
-    if (compiled.has_textures()) return no("textures");
+    // Textured materials and normal maps are shaded by core's Surfel (their
+    // parameters read by resolve() with the path's ray cone), textured
+    // emission found by Surfel::emitted and sampled by LightSampler.
+    sc.textured = compiled.has_textures();
+    if (sc.textured) {
+      const RayCone cone = compiled.camera_cone(settings.texture_filter);
+      sc.camera_cone_width = cone.width;
+      sc.camera_cone_spread = cone.spread;
+      sc.texture_filter = static_cast<std::uint8_t>(settings.texture_filter);
+    }
     // A mesh with vertex normals or tangents has its own shading frame: core's Surfel shades it.
     for (const Shape& shape : scene.shapes)
       if (shading_frame(shape) && scene.materials[shape.material].scatters() && in_lanes(scene.materials[shape.material]))
@@ -218,6 +227,11 @@ struct WavefrontTracer::VectorStages {
     for (const Shape& shape : scene.shapes)
       if (shape.in_group && scene.materials[shape.material].emits()) {
         other_lights.push_back("emitters placed by instances");
+        break;
+      }
+    for (const Material& m : scene.materials)
+      if (m.emission_textured) {
+        other_lights.push_back("textured emitters");
         break;
       }
     sc.sky = lights.samples_environment();
@@ -286,6 +300,7 @@ struct WavefrontTracer::VectorStages {
       sc.one_sided = sc.one_sided || m.one_sided;
       const bool general = m.scatters() && (!in_lanes(m) || shading_frame(sh));
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
+      f[vs::kTexturedEmission] = m.emission_textured ? 1.0f : 0.0f;
       sc.general = sc.general || general;
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
     }
@@ -317,7 +332,8 @@ struct WavefrontTracer::VectorStages {
   // Whether the lanes shade m: Lambert, by lambert.h (every shading path but
   // General, which shades it through the Disney closure; core/surfel.cpp).
   static bool in_lanes(const Material& m) {
-    return m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General;
+    return m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General && !m.is_textured() &&
+           !m.normal_map;
   }
   // Whether a shape shades in a frame of its own (not the geometric normal's).
   static bool shading_frame(const Shape& shape) { return shape.mesh.has_normals() || !shape.mesh.tangents.empty(); }
@@ -338,6 +354,7 @@ struct WavefrontTracer::Lanes {
   std::vector<std::uint32_t> u[vector_stages::kUintArrays];
   std::vector<std::uint8_t> b[vector_stages::kByteArrays];
   std::vector<std::uint64_t> rng, zindex, zkey;
+  std::vector<SurfaceParams> params;  // a textured scene's only (textured())
   // The wave's finished samples, in its own order: compact() writes them
   // here (a region the caches hold) and the wave copies them out at its end
   // in one sequential pass, instead of scattering them over the render's
@@ -363,6 +380,11 @@ struct WavefrontTracer::Lanes {
     view.zkey = zkey.data();
   }
   std::size_t capacity() const { return samples.size(); }
+  // Room for every slot's hit parameters (Wave::params).
+  void textured() {
+    if (params.size() < rng.size()) params.resize(rng.size());
+    view.params = params.data();
+  }
   static constexpr std::size_t bytes_per_path() {
     return vector_stages::kFloatArrays * sizeof(float) + vector_stages::kUintArrays * sizeof(std::uint32_t) +
            vector_stages::kByteArrays + 3 * sizeof(std::uint64_t) + sizeof(FilmSample);
@@ -400,7 +422,7 @@ std::string WavefrontTracer::stages_description() const {
 }
 
 std::size_t WavefrontTracer::bytes_per_path() const {
-  if (vector_) return Lanes::bytes_per_path();
+  if (vector_) return Lanes::bytes_per_path() + (vector_->scene.textured ? sizeof(SurfaceParams) : 0);
   // A textured scene's paths also carry their cone and their hit's parameters.
   return scalar_bytes_per_path() + (scene_.has_textures() ? sizeof(RayCone) + sizeof(SurfaceParams) : 0);
 }
@@ -790,6 +812,7 @@ void WavefrontTracer::render_waves(std::uint32_t first, std::uint32_t count, std
       const bool zsobol = vector_->scene.zsobol;
       thread_local Lanes lanes;
       if (lanes.capacity() < n_max) lanes.resize(n_max);
+      if (vector_->scene.textured) lanes.textured();
       namespace vs = vector_stages;
       for (std::size_t k = k0; k < k1; ++k) {
         const std::size_t begin = k * wave_size;
