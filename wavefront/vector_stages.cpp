@@ -52,13 +52,14 @@ void general_eval(const Scene& scene, const Wave& wave, std::size_t i, const flo
 // Surfel::scatter; false where it samples nothing.
 bool general_scatter(const Scene& scene, const Wave& wave, std::size_t i, float u_lobe, float u0, float u1,
                      GeneralSample* out);
-// Lights beyond triangles sampled by area (Scene::general_lights), by core's
-// LightSampler for the path in slot i: a light sample and its shadow ray
-// (origin, direction, tmax; shadow_ray), false where sample() gives none.
+// Lights beyond triangles sampled by area (Scene::general_lights), or a
+// delta light (`delta`: u0, u1 unused), by core's LightSampler for the path
+// in slot i: a light sample and its shadow ray (origin, direction, tmax;
+// shadow_ray), false where sample() or sample_delta() gives none.
 struct GeneralLight {
   float wi[3], Le[3], pdf, ray[7];
 };
-bool general_light(const Scene& scene, const Wave& wave, std::size_t i, float u_choice, float u0, float u1,
+bool general_light(const Scene& scene, const Wave& wave, std::size_t i, bool delta, float u_choice, float u0, float u1,
                    GeneralLight* out);
 // The light the path's ray finds: the sky along an escaped ray (Scene::sky;
 // LightSampler::sky), or the density with which the light sampler would
@@ -762,21 +763,26 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, const 
   return ls;
 }
 
-// Any other lights (Scene::general_lights): LightSampler::sample and
-// shadow_ray by core, path by path (general_light).
-LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, M& ok) {
+// Any other lights (Scene::general_lights), or a delta light (`delta`):
+// LightSampler::sample or sample_delta and shadow_ray by core, path by path
+// (general_light).
+LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, M& ok, bool delta) {
   const DF df;
   constexpr std::size_t kMax = hn::MaxLanes(DF());
-  HWY_ALIGN float u[3][kMax], out[14][kMax] = {};
+  HWY_ALIGN float u[3][kMax] = {}, out[14][kMax] = {};
   HWY_ALIGN std::int32_t sampled[kMax] = {};
-  hn::Store(rng.u(Dim::LightChoice), df, u[0]);
-  VF lu, lv;
-  rng.u2(Dim::LightX, lu, lv);
-  hn::Store(lu, df, u[1]);
-  hn::Store(lv, df, u[2]);
+  if (delta) {
+    hn::Store(rng.u(Dim::DeltaLightChoice), df, u[0]);
+  } else {
+    hn::Store(rng.u(Dim::LightChoice), df, u[0]);
+    VF lu, lv;
+    rng.u2(Dim::LightX, lu, lv);
+    hn::Store(lu, df, u[1]);
+    hn::Store(lv, df, u[2]);
+  }
   for_each_lane(ok, i0, [&](std::size_t i, std::size_t j) {
     GeneralLight gl;
-    if (!general_light(sc, w, i, u[0][j], u[1][j], u[2][j], &gl)) return;
+    if (!general_light(sc, w, i, delta, u[0][j], u[1][j], u[2][j], &gl)) return;
     sampled[j] = 1;
     const float v[14] = {gl.wi[0], gl.wi[1], gl.wi[2], gl.Le[0], gl.Le[1], gl.Le[2], gl.pdf,
                          gl.ray[0], gl.ray[1], gl.ray[2], gl.ray[3], gl.ray[4], gl.ray[5], gl.ray[6]};
@@ -791,79 +797,147 @@ LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Str
   return ls;
 }
 
+// Surfel::eval and Surfel::pdf towards wi for the lanes of ok (which lose
+// the lanes whose f is black): the Lambert lobe in the lanes (core/surfel.cpp,
+// bsdf/lambert.h: only the local z of wo and wi matters), any other material
+// by core, path by path.
+void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V3& wo, const V3& n, const V3& wi, M& ok,
+               V3& f, VF& pdf_bsdf) {
+  const DF df;
+  const VF wo_z = dot(wo, n);
+  // A one-sided material is black unless wo and wi both leave its front
+  // (Surfel::eval); with wo in front, upper below is wi in front.
+  if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), wo_z > k(0.0f)));
+  VF wi_z = dot(wi, n);
+  wi_z = hn::IfThenElse(wo_z < k(0.0f), hn::Neg(wi_z), wi_z);
+  const M upper = wi_z > k(0.0f);
+  const VF cos_pi = wi_z * k(kInvPi);
+  const V3 rho = shape_value3(ok, sc, shape, kAlbedo);
+  f = zero_unless(upper, cos_pi * rho);
+  pdf_bsdf = hn::IfThenElseZero(upper, cos_pi);
+  if (sc.general) {
+    const M general = shape_flag(ok, sc, shape, kGeneral);
+    if (!hn::AllFalse(df, general)) {
+      constexpr std::size_t kMax = hn::MaxLanes(DF());
+      HWY_ALIGN float to[3][kMax], value[3][kMax] = {}, density[kMax] = {};
+      hn::Store(wi.x, df, to[0]);
+      hn::Store(wi.y, df, to[1]);
+      hn::Store(wi.z, df, to[2]);
+      for_each_lane(general, i0, [&](std::size_t i, std::size_t j) {
+        const float d[3] = {to[0][j], to[1][j], to[2][j]};
+        float fj[3];
+        general_eval(sc, w, i, d, fj, &density[j]);
+        for (int c = 0; c < 3; ++c) value[c][j] = fj[c];
+      });
+      f = select(general, V3{hn::Load(df, value[0]), hn::Load(df, value[1]), hn::Load(df, value[2])}, f);
+      pdf_bsdf = hn::IfThenElse(general, hn::Load(df, density), pdf_bsdf);
+    }
+  }
+  ok = hn::AndNot(is_black(df, f), ok);
+}
+
+// A shadow ray to trace for the lanes of ok, and the light it brings if
+// nothing blocks it.
+struct ShadowLanes {
+  M ok;
+  V3 unoccluded;
+  VF ray[7];
+};
+
+// The block's shadow rays written to the kQ arrays from slot `queries` on,
+// in path order, a delta light's before an area light's (the scalar stages'
+// order, and so Embree's batch); returns how many.
+std::size_t pack_shadow_rays(const Wave& w, std::size_t i0, std::size_t queries, const ShadowLanes* delta,
+                             const ShadowLanes& area) {
+  const DF df;
+  if (delta == nullptr) {
+    const Packer pack(area.ok);
+    for (int a = 0; a < 7; ++a) pack.store(w.f[kQOx + a] + queries, area.ray[a]);
+    pack.store(w.f[kQUnR] + queries, area.unoccluded.x);
+    pack.store(w.f[kQUnG] + queries, area.unoccluded.y);
+    pack.store(w.f[kQUnB] + queries, area.unoccluded.z);
+    pack.store(w.u[kQPath] + queries, hn::Iota(DU(), static_cast<std::uint32_t>(i0)));
+    return pack.count;
+  }
+  // Two rays a path: interleaved one lane at a time.
+  constexpr std::size_t kMax = hn::MaxLanes(DF());
+  HWY_ALIGN float v[2][10][kMax];
+  HWY_ALIGN std::int32_t set[2][kMax];
+  const ShadowLanes* both[2] = {delta, &area};
+  for (int k2 = 0; k2 < 2; ++k2) {
+    const ShadowLanes& s = *both[k2];
+    for (int a = 0; a < 7; ++a) hn::Store(s.ray[a], df, v[k2][a]);
+    hn::Store(s.unoccluded.x, df, v[k2][7]);
+    hn::Store(s.unoccluded.y, df, v[k2][8]);
+    hn::Store(s.unoccluded.z, df, v[k2][9]);
+    hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), s.ok)), DI(), set[k2]);
+  }
+  std::size_t q = queries;
+  for (std::size_t j = 0; j < lanes(); ++j)
+    for (int k2 = 0; k2 < 2; ++k2) {
+      if (set[k2][j] == 0) continue;
+      for (int a = 0; a < 7; ++a) w.f[kQOx + a][q] = v[k2][a][j];
+      for (int c = 0; c < 3; ++c) w.f[kQUnR + c][q] = v[k2][7 + c][j];
+      w.u[kQPath][q] = static_cast<std::uint32_t>(i0 + j);
+      ++q;
+    }
+  return q - queries;
+}
+
 std::size_t sample_lights(const Scene& sc, const Wave& w) {
   const DF df;
   std::size_t queries = 0;
   for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
     const M in = live(w.n, i0);
+    const M alive = load_mask(w, kAlive, i0, in);
+    if (hn::AllFalse(df, alive)) continue;
     const VI vertex = load(w, kVertex, i0, in);
     const Streams rng = streams(sc, w, i0, vertex);
-    // samples_area_lights (core/strategy_weights.h).
-    M ok = load_mask(w, kAlive, i0, in);
+    const V3 sp = load3(w, kPx, i0, alive);
+    const V3 wo = -load3(w, kDx, i0, alive);
+    const V3 n = load3(w, kNx, i0, alive);  // the frame's normal is the surface's
+    const VI shape = load(w, kShape, i0, alive);
+
+    // A delta light, in every strategy (LightSampler::sample_delta, path by
+    // path): f Le / pdf, weight 1.
+    ShadowLanes delta{hn::FirstN(df, 0), zero3(), {}};
+    if (sc.delta_lights) {
+      delta.ok = alive;
+      const LightLanes ls = other_light(sc, w, i0, rng, delta.ok, true);
+      V3 f;
+      VF pdf_bsdf;
+      eval_bsdf(sc, w, i0, shape, wo, n, ls.wi, delta.ok, f, pdf_bsdf);
+      delta.unoccluded = (f * ls.Le) / ls.pdf;
+      std::copy(std::begin(ls.ray), std::end(ls.ray), delta.ray);
+    }
+
+    // An area light, as samples_area_lights says (core/strategy_weights.h).
+    ShadowLanes area{alive, zero3(), {}};
+    M& ok = area.ok;
     if (sc.strategy == Strategy::Bsdf || (sc.lights.count == 0 && !sc.general_lights)) ok = hn::FirstN(df, 0);
     if (sc.strategy == Strategy::LightBsdf) ok = hn::And(ok, rng.u(Dim::Technique) < k(0.5f));
-    if (hn::AllFalse(df, ok)) {
-      continue;
+    if (!hn::AllFalse(df, ok)) {
+      const LightLanes ls =
+          sc.general_lights ? other_light(sc, w, i0, rng, ok, false) : triangle_light(sc, w, i0, rng, sp, wo, n, ok);
+      V3 f;
+      VF pdf_bsdf;
+      eval_bsdf(sc, w, i0, shape, wo, n, ls.wi, ok, f, pdf_bsdf);
+      // light_sample_weight (core/strategy_weights.h).
+      VF weight = k(1.0f);
+      if (sc.strategy == Strategy::Mis) weight = power_heuristic(df, ls.pdf, pdf_bsdf);
+      if (sc.strategy == Strategy::LightBsdf) weight = k(2.0f) * ls.pdf / (ls.pdf + pdf_bsdf);
+      area.unoccluded = (weight / ls.pdf) * (f * ls.Le);
+      std::copy(std::begin(ls.ray), std::end(ls.ray), area.ray);
     }
+    if (hn::AllFalse(df, hn::Or(delta.ok, ok))) continue;
 
-    const V3 sp = load3(w, kPx, i0, ok);
-    const V3 wo = -load3(w, kDx, i0, ok);
-    const V3 n = load3(w, kNx, i0, ok);  // the frame's normal is the surface's
-    const LightLanes ls = sc.general_lights ? other_light(sc, w, i0, rng, ok) : triangle_light(sc, w, i0, rng, sp, wo, n, ok);
-    const V3& wi = ls.wi;
-    const V3& Le = ls.Le;
-    const VF& pdf_light = ls.pdf;
-
-    // Surfel::eval and Surfel::pdf of the Lambert lobe (core/surfel.cpp,
-    // bsdf/lambert.h): only the local z of wo and wi matters.
-    const VF wo_z = dot(wo, n);
-    const VI shape = load(w, kShape, i0, ok);
-    // A one-sided material is black unless wo and wi both leave its front
-    // (Surfel::eval); with wo in front, upper below is wi in front.
-    if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), wo_z > k(0.0f)));
-    VF wi_z = dot(wi, n);
-    wi_z = hn::IfThenElse(wo_z < k(0.0f), hn::Neg(wi_z), wi_z);
-    const M upper = wi_z > k(0.0f);
-    const VF cos_pi = wi_z * k(kInvPi);
-    const V3 rho = shape_value3(ok, sc, shape, kAlbedo);
-    V3 f = zero_unless(upper, cos_pi * rho);
-    VF pdf_bsdf = hn::IfThenElseZero(upper, cos_pi);
-    if (sc.general) {
-      // Any other material: Surfel::eval and Surfel::pdf, path by path.
-      const M general = shape_flag(ok, sc, shape, kGeneral);
-      if (!hn::AllFalse(df, general)) {
-        constexpr std::size_t kMax = hn::MaxLanes(DF());
-        HWY_ALIGN float to[3][kMax], value[3][kMax] = {}, density[kMax] = {};
-        hn::Store(wi.x, df, to[0]);
-        hn::Store(wi.y, df, to[1]);
-        hn::Store(wi.z, df, to[2]);
-        for_each_lane(general, i0, [&](std::size_t i, std::size_t j) {
-          const float d[3] = {to[0][j], to[1][j], to[2][j]};
-          float fj[3];
-          general_eval(sc, w, i, d, fj, &density[j]);
-          for (int c = 0; c < 3; ++c) value[c][j] = fj[c];
-        });
-        f = select(general, V3{hn::Load(df, value[0]), hn::Load(df, value[1]), hn::Load(df, value[2])}, f);
-        pdf_bsdf = hn::IfThenElse(general, hn::Load(df, density), pdf_bsdf);
-      }
-    }
-    ok = hn::AndNot(is_black(df, f), ok);
-
-    // light_sample_weight (core/strategy_weights.h).
-    VF weight = k(1.0f);
-    if (sc.strategy == Strategy::Mis) weight = power_heuristic(df, pdf_light, pdf_bsdf);
-    if (sc.strategy == Strategy::LightBsdf) weight = k(2.0f) * pdf_light / (pdf_light + pdf_bsdf);
-    store3(w, kUnR, i0, ok, (weight / pdf_light) * (f * Le));
-
-    // The shadow ray, packed behind the previous ones in path order, with
-    // the slot of the path each belongs to (add_light).
-    const Packer pack(ok);
-    for (int a = 0; a < 7; ++a) pack.store(w.f[kQOx + a] + queries, ls.ray[a]);
-    pack.store(w.u[kQPath] + queries, hn::Iota(DU(), static_cast<std::uint32_t>(i0)));
-    const std::size_t count = pack.count;
-    // The shadow ray counts as one of the path's rays.
-    store(w, kRays, i0, ok, load(w, kRays, i0, ok) + hn::Set(DI(), 1));
-    queries += count;
+    // The shadow rays, packed behind the previous ones with the slot of the
+    // path each belongs to (add_light); each counts as one of its path's rays.
+    queries += pack_shadow_rays(w, i0, queries, sc.delta_lights ? &delta : nullptr, area);
+    const VI rays = load(w, kRays, i0, alive);
+    store(w, kRays, i0, alive,
+          rays + hn::IfThenElseZero(hn::RebindMask(DI(), delta.ok), hn::Set(DI(), 1)) +
+              hn::IfThenElseZero(hn::RebindMask(DI(), ok), hn::Set(DI(), 1)));
   }
   return queries;
 }
@@ -1187,11 +1261,13 @@ static Surfel shading_point(const Wave& w, std::size_t i) {
   return s;
 }
 
-bool general_light(const Scene& sc, const Wave& w, std::size_t i, float u_choice, float u0, float u1,
+bool general_light(const Scene& sc, const Wave& w, std::size_t i, bool delta, float u_choice, float u0, float u1,
                    GeneralLight* out) {
   const Surfel s = shading_point(w, i);
   const vec3 wo = -vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]);
-  const std::optional<LightSample> ls = sc.compiled->lights().sample(light_query(s, wo), u_choice, vec2(u0, u1));
+  const LightSampler& lights = sc.compiled->lights();
+  const std::optional<LightSample> ls =
+      delta ? lights.sample_delta(s.p, u_choice) : lights.sample(light_query(s, wo), u_choice, vec2(u0, u1));
   if (!ls) return false;
   const Ray r = shadow_ray(s, *ls);
   for (int c = 0; c < 3; ++c) {
@@ -1225,7 +1301,7 @@ void add_light(const Wave& w, std::size_t queries) {
     const std::size_t i = w.u[kQPath][r];
     const bool visible = w.b[kQOccluded][r] == 0;
     for (int c = 0; c < 3; ++c)
-      w.f[kLR + c][i] += visible ? w.f[kBetaR + c][i] * w.f[kUnR + c][i] : 0.0f;
+      w.f[kLR + c][i] += visible ? w.f[kBetaR + c][i] * w.f[kQUnR + c][r] : 0.0f;
   }
 }
 

@@ -88,6 +88,9 @@ struct Scene {
   // The scene places shapes by instances: hits on them (kInstance set) are
   // resolved by compiled->resolve(), path by path.
   bool instanced = false;
+  // The scene has delta lights (point, spot, directional): each path samples
+  // one too (LightSampler::sample_delta, path by path), a second shadow ray.
+  bool delta_lights = false;
   // The scene has textures: each path carries its ray cone (kConeWidth,
   // kConeSpread; CompiledScene::camera_cone, scattered_cone under
   // texture_filter, a TextureFilter), and a textured material's hit its
@@ -149,10 +152,9 @@ enum FloatArray : int {
   // The shading frame (s, t, n) of a hit on a shape core's Surfel shades
   // (ShapeField kGeneral), as CompiledScene::resolve made it.
   kFsX, kFsY, kFsZ, kFtX, kFtY, kFtZ, kFnX, kFnY, kFnZ,
-  // What the area-light sample brings if nothing blocks its shadow ray.
-  kUnR, kUnG, kUnB,
-  // The shadow rays to trace, packed in path order for Embree.
-  kQOx, kQOy, kQOz, kQDx, kQDy, kQDz, kQTmax,
+  // The shadow rays to trace, packed in path order for Embree (up to two a
+  // path: room for 2 n), and what each brings if nothing blocks it.
+  kQOx, kQOy, kQOz, kQDx, kQDy, kQDz, kQTmax, kQUnR, kQUnG, kQUnB,
   kFloatArrays
 };
 enum UintArray : int {

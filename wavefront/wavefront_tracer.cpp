@@ -211,8 +211,9 @@ struct WavefrontTracer::VectorStages {
         v->general.push_back("the shading frame of " + shape.description);
     // Only triangle area lights: no delta light, sphere light or environment.
     const LightSampler& lights = compiled.lights();
-    // A delta light adds a second shadow ray per path, which the stages do not pack.
-    if (lights.has_delta_lights()) return no("delta lights (point, spot, directional)");
+    // Delta lights: a second light sample and shadow ray per path, by core.
+    sc.delta_lights = lights.has_delta_lights();
+    if (sc.delta_lights) v->general.push_back("the delta lights' samples");
     // The lanes sample triangle lights by area; any other light (or
     // solid-angle sampling) is sampled by LightSampler::sample(), path by path.
     std::vector<std::string> other_lights;
@@ -365,9 +366,12 @@ struct WavefrontTracer::Lanes {
   void resize(std::size_t size) {
     // A block of lanes is loaded whole, past the last path (vector_stages.h).
     const std::size_t padded = size + vector_stages::kPadding;
-    for (auto& a : f) a.resize(padded);
-    for (auto& a : u) a.resize(padded);
-    for (auto& a : b) a.resize(padded);
+    // The shadow rays' arrays hold up to two a path (a delta light's and an area light's).
+    const std::size_t queries = 2 * size + vector_stages::kPadding;
+    namespace vs = vector_stages;
+    for (int a = 0; a < vs::kFloatArrays; ++a) f[a].resize(a >= vs::kQOx && a <= vs::kQUnB ? queries : padded);
+    for (int a = 0; a < vs::kUintArrays; ++a) u[a].resize(a == vs::kQPath ? queries : padded);
+    for (int a = 0; a < vs::kByteArrays; ++a) b[a].resize(a == vs::kQOccluded ? queries : padded);
     rng.resize(padded);
     zindex.resize(padded);
     zkey.resize(padded);
@@ -386,8 +390,10 @@ struct WavefrontTracer::Lanes {
     view.params = params.data();
   }
   static constexpr std::size_t bytes_per_path() {
-    return vector_stages::kFloatArrays * sizeof(float) + vector_stages::kUintArrays * sizeof(std::uint32_t) +
-           vector_stages::kByteArrays + 3 * sizeof(std::uint64_t) + sizeof(FilmSample);
+    namespace vs = vector_stages;
+    constexpr std::size_t query_floats = vs::kQUnB - vs::kQOx + 1;  // twice over, with kQPath and kQOccluded
+    return (vs::kFloatArrays + query_floats) * sizeof(float) + (vs::kUintArrays + 1) * sizeof(std::uint32_t) +
+           vs::kByteArrays + 1 + 3 * sizeof(std::uint64_t) + sizeof(FilmSample);
   }
 };
 
