@@ -1,13 +1,14 @@
 // The wavefront's vectorised stages: paths kept as one array per scalar
 // (structure of arrays), a block of them per SIMD register — 16 with
 // AVX-512, 8 with AVX2, 4 with SSE4, whichever core/simd/simd.h's dispatch
-// selected — for scenes of meshes and spheres lit by triangle area lights
-// (the dragon benchmarks, the Cornell box; any camera; instances). Flat Lambert
-// surfaces, one- or two-sided, are shaded in the lanes; every other surface
-// (Disney, mirror, glass, Lambert under --general-shading, vertex normals)
-// by core's Surfel, one path at a time, between the lanes' steps
-// (Scene::general). Other scenes, and `--simd scalar`, run the scalar stages
-// of wavefront_tracer.cpp.
+// selected — for every scene without alpha (any camera, material, light,
+// texture, instance). The lanes do the camera, world-space hit points,
+// emission and its weight, triangle lights sampled by area, flat untextured
+// Lambert shading, roulette and compaction; everything else (other
+// materials, vertex normals, textures, instances, other lights) is core's,
+// called one path at a time between the lanes' steps (Scene::general,
+// general_lights, delta_lights, instanced, textured). Alpha scenes, strategy
+// cosine and `--simd scalar` run the scalar stages of wavefront_tracer.cpp.
 //
 // Written once (vector_stages.cpp, over Google Highway, compiled for every
 // target) on core's per-lane code (core/simd/*-inl.h; core's scalar code
