@@ -561,7 +561,20 @@ void resolve(const Scene& sc, const Wave& w) {
     // of a shape the lanes do not shade.
     M by_core = hn::FirstN(df, 0);
     if (sc.instanced) by_core = hn::And(found, fmask(load(w, kInstance, i0, found) != hn::Set(DI(), -1)));
-    if (sc.general) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kGeneral));
+    if (sc.general) {
+      const M general = shape_flag(found, sc, shape, kGeneral);
+      by_core = hn::Or(by_core, shape_flag(general, sc, shape, kResolveByCore));
+      // The others shade in the geometric normal's Frame (resolve's Frame(n)), made here.
+      if (const M plain = hn::AndNot(by_core, general); !hn::AllFalse(df, plain)) {
+        V3 fs, ft;
+        frame(df, n, fs, ft);
+        store3(w, kFsX, i0, plain, fs);
+        store3(w, kFtX, i0, plain, ft);
+        store3(w, kFnX, i0, plain, n);
+        store_mask(w, kShadingNormal, i0, plain, hn::FirstN(df, 0));
+        store_mask(w, kHasParams, i0, plain, hn::FirstN(df, 0));
+      }
+    }
     if (sc.textured) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kTexturedEmission));
     for_each_lane(by_core, i0, [&](std::size_t i, std::size_t) { general_resolve(sc, w, i); });
   }

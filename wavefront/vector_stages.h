@@ -127,6 +127,8 @@ enum ShapeField : int {
   kOneSided = 17,      // 1 if its material is one-sided (black from behind the geometric normal)
   kGeneral = 18,       // 1 if it is shaded by core's Surfel (not Lambert, or with vertex normals or tangents)
   kTexturedEmission = 19,  // 1 if its emission is textured (Surfel::emitted, path by path)
+  kResolveByCore = 20,     // 1 if kGeneral and its Surfel needs CompiledScene::resolve (a shading frame of its
+                           // own, textures); else resolve() makes its Frame(n) in the lanes
   kShapeFields = 32,
 };
 
