@@ -681,6 +681,11 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"delta", st, 0.0f, 0});
   cases.push_back({"delta", Strategy::LightBsdf, 0.0f, -1, true, true, true, true, true, 0, true});
+  // Alpha: every ray's key made in the lanes (camera, continuation and shadow rays, compacted with the path).
+  for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf}) cases.push_back({"alpha", st, 0.0f, 0});
+  cases.push_back({"alpha", Strategy::Mis, 0.0f, -1, true, true, false, false, true, 0, true});
+  cases.push_back({"penumbra-alpha.json", Strategy::Mis, 0.0f, 0});
+  cases.push_back({"penumbra-cutout.json", Strategy::LightBsdf, 0.0f, 0});
   // Instances: hits placed by CompiledScene::resolve, path by path.
   for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf}) cases.push_back({"instanced", st, 0.0f, 0});
   cases.push_back({"instanced", Strategy::Mis, 0.0f, 0, false, true, false, true, true, 0, true});
@@ -755,7 +760,7 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
   sun.delta_lights.push_back({vec3(0.0f), Spectrum(1.0f), DeltaLight::Kind::Directional, vec3(0, -1, 0), 0.0f, 0.0f});
   EXPECT_EQ(vectorised(spot, Strategy::Mis), any);
   EXPECT_EQ(vectorised(sun, Strategy::Mis), any);
-  EXPECT_FALSE(vectorised(test::cornell_with_alpha(), Strategy::Mis));  // alpha is decided inside Embree by ray keys
+  EXPECT_EQ(vectorised(test::cornell_with_alpha(), Strategy::Mis), any);  // each ray carries its alpha key
   EXPECT_EQ(vectorised(load_scene(analytic / "sphere-in-environment.json"), Strategy::Mis), any);  // environment
   Scene envmap = cornell;  // triangle lights and an environment image
   envmap.environment_map = load_scene(analytic / "envmap-direct.json").environment_map;

@@ -94,7 +94,7 @@ void add_emission(const Scene&, const Wave&) { width_one(); }
 std::size_t sample_lights(const Scene&, const Wave&) { width_one(); }
 void scatter(const Scene&, const Wave&) { width_one(); }
 void hash_keys(std::uint64_t*, std::size_t, std::uint64_t) { width_one(); }
-std::size_t compact(const Wave&, bool, bool, void*, std::uint32_t) { width_one(); }
+std::size_t compact(const Wave&, bool, bool, bool, void*, std::uint32_t) { width_one(); }
 std::size_t lanes() { return 1; }
 #else
 
@@ -280,6 +280,14 @@ struct Streams {
     const V64 d = hn::Set(d64, static_cast<std::uint64_t>(dim));
     // to_unit_float: the top 24 bits, exactly a float, times 2^-24.
     return unit(hn::ShiftRight<40>(mix64(d64, hn::Xor(lo, d))), hn::ShiftRight<40>(mix64(d64, hn::Xor(hi, d))));
+  }
+  // SampleStream::bits(vertex, dim) >> 32 (under either sampler): a ray's
+  // alpha key (core/alpha.h) for dim Alpha.
+  VU bits_high(Dim dim) const {
+    const D64 d64;
+    const V64 d = hn::Set(d64, static_cast<std::uint64_t>(dim));
+    const V64 a = hn::ShiftRight<32>(mix64(d64, hn::Xor(lo, d))), b = hn::ShiftRight<32>(mix64(d64, hn::Xor(hi, d)));
+    return hn::ConcatEven(DU(), hn::BitCast(DU(), b), hn::BitCast(DU(), a));  // the low words, in order
   }
   // SampleStream::get2: {u(x), u(x + 1)}, the pair's point made once under zsobol.
   void u2(Dim x, VF& a, VF& b) const {
@@ -482,6 +490,7 @@ void generate_camera_rays(const Scene& sc, const Camera& c, const Wave& w) {
       store3(w, kDx, i0, in, normalize(df, focus - origin));
     }
     store(w, kTmax, i0, in, k(std::numeric_limits<float>::infinity()));
+    if (sc.alpha) store(w, kAlphaKey, i0, in, hn::BitCast(DI(), rng.bits_high(Dim::Alpha)));
     if (sc.textured) {
       store(w, kConeWidth, i0, in, k(sc.camera_cone_width));
       store(w, kConeSpread, i0, in, k(sc.camera_cone_spread));
@@ -860,8 +869,9 @@ struct ShadowLanes {
 // The block's shadow rays written to the kQ arrays from slot `queries` on,
 // in path order, a delta light's before an area light's (the scalar stages'
 // order, and so Embree's batch); returns how many.
+// `alpha_keys`: the rays' alpha keys (Scene::alpha), else null.
 std::size_t pack_shadow_rays(const Wave& w, std::size_t i0, std::size_t queries, const ShadowLanes* delta,
-                             const ShadowLanes& area) {
+                             const ShadowLanes& area, const VU* alpha_keys) {
   const DF df;
   if (delta == nullptr) {
     const Packer pack(area.ok);
@@ -870,8 +880,11 @@ std::size_t pack_shadow_rays(const Wave& w, std::size_t i0, std::size_t queries,
     pack.store(w.f[kQUnG] + queries, area.unoccluded.y);
     pack.store(w.f[kQUnB] + queries, area.unoccluded.z);
     pack.store(w.u[kQPath] + queries, hn::Iota(DU(), static_cast<std::uint32_t>(i0)));
+    if (alpha_keys) pack.store(w.u[kQAlphaKey] + queries, *alpha_keys);
     return pack.count;
   }
+  HWY_ALIGN std::uint32_t keys[hn::MaxLanes(DU())] = {};
+  if (alpha_keys) hn::Store(*alpha_keys, DU(), keys);
   // Two rays a path: interleaved one lane at a time.
   constexpr std::size_t kMax = hn::MaxLanes(DF());
   HWY_ALIGN float v[2][10][kMax];
@@ -892,6 +905,7 @@ std::size_t pack_shadow_rays(const Wave& w, std::size_t i0, std::size_t queries,
       for (int a = 0; a < 7; ++a) w.f[kQOx + a][q] = v[k2][a][j];
       for (int c = 0; c < 3; ++c) w.f[kQUnR + c][q] = v[k2][7 + c][j];
       w.u[kQPath][q] = static_cast<std::uint32_t>(i0 + j);
+      if (alpha_keys) w.u[kQAlphaKey][q] = keys[j];
       ++q;
     }
   return q - queries;
@@ -946,7 +960,9 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
 
     // The shadow rays, packed behind the previous ones with the slot of the
     // path each belongs to (add_light); each counts as one of its path's rays.
-    queries += pack_shadow_rays(w, i0, queries, sc.delta_lights ? &delta : nullptr, area);
+    // A vertex's shadow rays share its alpha key (core/alpha.h).
+    const VU alpha_keys = sc.alpha ? rng.bits_high(Dim::Alpha) : hn::Zero(DU());
+    queries += pack_shadow_rays(w, i0, queries, sc.delta_lights ? &delta : nullptr, area, sc.alpha ? &alpha_keys : nullptr);
     const VI rays = load(w, kRays, i0, alive);
     store(w, kRays, i0, alive,
           rays + hn::IfThenElseZero(hn::RebindMask(DI(), delta.ok), hn::Set(DI(), 1)) +
@@ -1053,6 +1069,7 @@ void scatter(const Scene& sc, const Wave& w) {
     store3(w, kOx, i0, ok, offset_ray_origin(df, sp, err, select(dot(wi, n) >= k(0.0f), n, -n)));
     store3(w, kDx, i0, ok, wi);
     store(w, kTmax, i0, ok, k(std::numeric_limits<float>::infinity()));
+    if (sc.alpha) store(w, kAlphaKey, i0, ok, hn::BitCast(DI(), rng.bits_high(Dim::Alpha)));
     vertex = vertex + hn::Set(DI(), 1);
     store(w, kVertex, i0, ok, vertex);
     store_mask(w, kAlive, i0, in, ok);
@@ -1066,7 +1083,7 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
     hn::StoreU(mix64(d64, hn::Xor(seed, hn::LoadU(d64, keys + i0))), d64, keys + i0);
 }
 
-std::size_t compact(const Wave& w, bool zsobol, bool textured, void* samples, std::uint32_t first_slot) {
+std::size_t compact(const Wave& w, bool zsobol, bool textured, bool alpha, void* samples, std::uint32_t first_slot) {
   static constexpr FloatArray kMovedFloats[] = {kOx,   kOy,   kOz,   kDx,   kDy,    kDz,    kTmax,  kBetaR,   kBetaG, kBetaB,
                                                 kLR,   kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX, kFilmY,
                                                 kPrevNx, kPrevNy, kPrevNz};
@@ -1111,6 +1128,7 @@ std::size_t compact(const Wave& w, bool zsobol, bool textured, void* samples, st
     for (FloatArray a : kMovedFloats) pack.store(w.f[a] + m, hn::LoadU(df, w.f[a] + i0));
     if (textured)
       for (FloatArray a : {kConeWidth, kConeSpread}) pack.store(w.f[a] + m, hn::LoadU(df, w.f[a] + i0));
+    if (alpha) pack.store(w.u[kAlphaKey] + m, hn::LoadU(DU(), w.u[kAlphaKey] + i0));
     for (UintArray a : kMovedUints) pack.store(w.u[a] + m, hn::LoadU(DU(), w.u[a] + i0));
     for (ByteArray a : kMovedBytes)
       store_bytes(w.b[a] + m, pack.first, pack.packed(hn::PromoteTo(DI(), hn::LoadU(D8(), w.b[a] + i0))));
@@ -1173,7 +1191,7 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
   HWY_DYNAMIC_DISPATCH(hash_keys)(keys, n, seed_key);
 }
 std::size_t compact(const Scene& scene, const Wave& wave, void* samples, std::uint32_t first_slot) {
-  return HWY_DYNAMIC_DISPATCH(compact)(wave, scene.zsobol, scene.textured, samples, first_slot);
+  return HWY_DYNAMIC_DISPATCH(compact)(wave, scene.zsobol, scene.textured, scene.alpha, samples, first_slot);
 }
 
 // The Surfel of the hit in slot i, as the scalar stages make it: resolve()

@@ -1,14 +1,14 @@
 // The wavefront's vectorised stages: paths kept as one array per scalar
 // (structure of arrays), a block of them per SIMD register — 16 with
 // AVX-512, 8 with AVX2, 4 with SSE4, whichever core/simd/simd.h's dispatch
-// selected — for every scene without alpha (any camera, material, light,
-// texture, instance). The lanes do the camera, world-space hit points,
+// selected — for every scene (any camera, material, light, texture,
+// instance, alpha). The lanes do the camera, world-space hit points,
 // emission and its weight, triangle lights sampled by area, flat untextured
 // Lambert shading, roulette and compaction; everything else (other
 // materials, vertex normals, textures, instances, other lights) is core's,
 // called one path at a time between the lanes' steps (Scene::general,
-// general_lights, delta_lights, instanced, textured). Alpha scenes, strategy
-// cosine and `--simd scalar` run the scalar stages of wavefront_tracer.cpp.
+// general_lights, delta_lights, instanced, textured). Strategy cosine and
+// `--simd scalar` run the scalar stages of wavefront_tracer.cpp.
 //
 // Written once (vector_stages.cpp, over Google Highway, compiled for every
 // target) on core's per-lane code (core/simd/*-inl.h; core's scalar code
@@ -89,6 +89,9 @@ struct Scene {
   // The scene places shapes by instances: hits on them (kInstance set) are
   // resolved by compiled->resolve(), path by path.
   bool instanced = false;
+  // Some material has alpha: every ray carries its alpha key (kAlphaKey,
+  // kQAlphaKey) into Embree, whose filter decides (core/alpha.h).
+  bool alpha = false;
   // The scene has delta lights (point, spot, directional): each path samples
   // one too (LightSampler::sample_delta, path by path), a second shadow ray.
   bool delta_lights = false;
@@ -164,7 +167,9 @@ enum UintArray : int {
   kOutIndex, kRays, kVertex, kPixelX, kPixelY,
   kShape, kPrim,  // the hit's
   kInstance,      // the hit's instance (kNoInstance for a shape in world space), when Scene::instanced
+  kAlphaKey,      // the next ray's alpha key (core/alpha.h), when Scene::alpha
   kQPath,         // per packed shadow ray: the slot of its path
+  kQAlphaKey,     // per packed shadow ray: its alpha key, when Scene::alpha
   kUintArrays
 };
 enum ByteArray : int {

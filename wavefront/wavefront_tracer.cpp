@@ -192,9 +192,8 @@ struct WavefrontTracer::VectorStages {
     // Hits on instances are placed by CompiledScene::resolve, path by path.
     sc.instanced = !scene.instances.empty();
     if (sc.instanced) v->general.push_back("the hit points on instances");
-    // Alpha is decided inside Embree by the rays' keys, which Lanes do not carry.
-    for (const Material& m : scene.materials)
-      if (m.has_alpha()) return no("material '" + m.name + "' has alpha (partial coverage)");
+    // Alpha is decided inside Embree by the rays' keys, which the lanes make too.
+    sc.alpha = compiled.has_alpha();
     // Textured materials and normal maps are shaded by core's Surfel (their
     // parameters read by resolve() with the path's ray cone), textured
     // emission found by Surfel::emitted and sampled by LightSampler.
@@ -371,7 +370,7 @@ struct WavefrontTracer::Lanes {
     const std::size_t queries = 2 * size + vector_stages::kPadding;
     namespace vs = vector_stages;
     for (int a = 0; a < vs::kFloatArrays; ++a) f[a].resize(a >= vs::kQOx && a <= vs::kQUnB ? queries : padded);
-    for (int a = 0; a < vs::kUintArrays; ++a) u[a].resize(a == vs::kQPath ? queries : padded);
+    for (int a = 0; a < vs::kUintArrays; ++a) u[a].resize(a == vs::kQPath || a == vs::kQAlphaKey ? queries : padded);
     for (int a = 0; a < vs::kByteArrays; ++a) b[a].resize(a == vs::kQOccluded ? queries : padded);
     rng.resize(padded);
     zindex.resize(padded);
@@ -393,7 +392,7 @@ struct WavefrontTracer::Lanes {
   static constexpr std::size_t bytes_per_path() {
     namespace vs = vector_stages;
     constexpr std::size_t query_floats = vs::kQUnB - vs::kQOx + 1;  // twice over, with kQPath and kQOccluded
-    return (vs::kFloatArrays + query_floats) * sizeof(float) + (vs::kUintArrays + 1) * sizeof(std::uint32_t) +
+    return (vs::kFloatArrays + query_floats) * sizeof(float) + (vs::kUintArrays + 2) * sizeof(std::uint32_t) +
            vs::kByteArrays + 1 + 3 * sizeof(std::uint64_t) + sizeof(FilmSample);
   }
 };
@@ -741,7 +740,8 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
   vs::generate_camera_rays(sc, vector_->camera, w);
   for (bool camera_rays = true; lanes.view.n > 0; camera_rays = false) {
     const std::size_t n = w.n;
-    const RayArrays rays{w.f[vs::kOx], w.f[vs::kOy], w.f[vs::kOz], w.f[vs::kDx], w.f[vs::kDy], w.f[vs::kDz], w.f[vs::kTmax]};
+    const RayArrays rays{w.f[vs::kOx], w.f[vs::kOy], w.f[vs::kOz], w.f[vs::kDx], w.f[vs::kDy], w.f[vs::kDz], w.f[vs::kTmax],
+                         sc.alpha ? w.u[vs::kAlphaKey] : nullptr};
     const HitArrays hits{w.f[vs::kHitT], w.f[vs::kHitU], w.f[vs::kHitV], w.u[vs::kShape], w.u[vs::kPrim], w.b[vs::kFound],
                          sc.instanced ? w.u[vs::kInstance] : nullptr};
     const std::uint64_t t = clock_ns();
@@ -753,7 +753,7 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
     const std::size_t q = vs::sample_lights(sc, w);
     if (q > 0) {
       const RayArrays shadow{w.f[vs::kQOx], w.f[vs::kQOy], w.f[vs::kQOz], w.f[vs::kQDx],
-                             w.f[vs::kQDy], w.f[vs::kQDz], w.f[vs::kQTmax]};
+                             w.f[vs::kQDy], w.f[vs::kQDz], w.f[vs::kQTmax], sc.alpha ? w.u[vs::kQAlphaKey] : nullptr};
       const std::uint64_t ts = clock_ns();
       scene_.occluded_arrays(shadow, q, w.b[vs::kQOccluded], modes_.shadow);
       clock.batch(kShadowQueries, ts, q);
