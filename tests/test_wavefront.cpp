@@ -681,6 +681,8 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"delta", st, 0.0f, 0});
   cases.push_back({"delta", Strategy::LightBsdf, 0.0f, -1, true, true, true, true, true, 0, true});
+  // Strategy cosine: every surface scattered by core's Surfel::scatter_cosine (impulses by scatter).
+  for (const char* sc : {"", "materials", "textured"}) cases.push_back({sc, Strategy::Cosine, 0.0f, 0});
   // Alpha: every ray's key made in the lanes (camera, continuation and shadow rays, compacted with the path).
   for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf}) cases.push_back({"alpha", st, 0.0f, 0});
   cases.push_back({"alpha", Strategy::Mis, 0.0f, -1, true, true, false, false, true, 0, true});
@@ -727,7 +729,7 @@ TEST(Wavefront, VectorisedOnlyWhereTheSceneAllows) {
   zsobol.render.sampler = SamplerKind::ZSobol;
   EXPECT_EQ(vectorised(zsobol, Strategy::Mis), vector_stages::cpu_supported());
 
-  EXPECT_FALSE(vectorised(cornell, Strategy::Cosine));
+  EXPECT_EQ(vectorised(cornell, Strategy::Cosine), vector_stages::cpu_supported());  // scatter_cosine by core
   // Materials the lanes do not shade are shaded by core's Surfel between them.
   EXPECT_EQ(vectorised(cornell, Strategy::Mis, true), vector_stages::cpu_supported());  // --general-shading
   EXPECT_EQ(vectorised(cornell_with_materials(), Strategy::Mis), vector_stages::cpu_supported());

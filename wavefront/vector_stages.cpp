@@ -941,7 +941,8 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     // An area light, as samples_area_lights says (core/strategy_weights.h).
     ShadowLanes area{alive, zero3(), {}};
     M& ok = area.ok;
-    if (sc.strategy == Strategy::Bsdf || (sc.lights.count == 0 && !sc.general_lights)) ok = hn::FirstN(df, 0);
+    if (sc.strategy == Strategy::Bsdf || sc.strategy == Strategy::Cosine || (sc.lights.count == 0 && !sc.general_lights))
+      ok = hn::FirstN(df, 0);
     if (sc.strategy == Strategy::LightBsdf) ok = hn::And(ok, rng.u(Dim::Technique) < k(0.5f));
     if (!hn::AllFalse(df, ok)) {
       const LightLanes ls =
@@ -1271,7 +1272,10 @@ void general_eval(const Scene& sc, const Wave& w, std::size_t i, const float wi[
 bool general_scatter(const Scene& sc, const Wave& w, std::size_t i, float u_lobe, float u0, float u1,
                      GeneralSample* out) {
   const Surfel s = general_surfel(sc, w, i);
-  const std::optional<BsdfSample> bs = s.scatter(-vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]), u_lobe, vec2(u0, u1));
+  const vec3 wo = -vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]);
+  // The cosine strategy samples every surface but a pure impulse by the cosine (WavefrontTracer::scatter).
+  const bool cosine = sc.strategy == Strategy::Cosine && !s.material->is_pure_impulse();
+  const std::optional<BsdfSample> bs = cosine ? s.scatter_cosine(wo, vec2(u0, u1)) : s.scatter(wo, u_lobe, vec2(u0, u1));
   if (!bs) return false;
   for (int c = 0; c < 3; ++c) {
     out->wi[c] = bs->wi[c];

@@ -7,8 +7,8 @@
 // Lambert shading, roulette and compaction; everything else (other
 // materials, vertex normals, textures, instances, other lights) is core's,
 // called one path at a time between the lanes' steps (Scene::general,
-// general_lights, delta_lights, instanced, textured). Strategy cosine and
-// `--simd scalar` run the scalar stages of wavefront_tracer.cpp.
+// general_lights, delta_lights, instanced, textured). `--simd scalar` runs
+// the scalar stages of wavefront_tracer.cpp.
 //
 // Written once (vector_stages.cpp, over Google Highway, compiled for every
 // target) on core's per-lane code (core/simd/*-inl.h; core's scalar code
@@ -33,9 +33,9 @@ struct SurfaceParams;
 
 namespace pathlab::vector_stages {
 
-// The sampling strategies the vectorised stages support ("cosine" scatters
-// differently and stays scalar).
-enum class Strategy : std::uint8_t { Bsdf, Light, Mis, LightBsdf };
+// The sampling strategies (core/strategy_weights.h). Under Cosine every
+// surface scatters by core's Surfel::scatter_cosine (every shape kGeneral).
+enum class Strategy : std::uint8_t { Bsdf, Light, Mis, LightBsdf, Cosine };
 
 // The area lights, as LightSampler::sample() picks and samples them.
 struct Lights {

@@ -166,7 +166,7 @@ struct WavefrontTracer::VectorStages {
     auto v = std::make_unique<VectorStages>();
     vs::Scene& sc = v->scene;
     switch (settings.strategy) {
-      case Strategy::Cosine: return no("strategy cosine");
+      case Strategy::Cosine: sc.strategy = vs::Strategy::Cosine; break;
       case Strategy::Bsdf: sc.strategy = vs::Strategy::Bsdf; break;
       case Strategy::Light: sc.strategy = vs::Strategy::Light; break;
       case Strategy::Mis: sc.strategy = vs::Strategy::Mis; break;
@@ -179,6 +179,8 @@ struct WavefrontTracer::VectorStages {
     // that scatters by core's Surfel, path by path (vector_stages.h).
     const Scene& scene = compiled.scene();
     const Material* diffuse = nullptr;
+    const bool cosine = settings.strategy == Strategy::Cosine;  // every surface by scatter_cosine
+    if (cosine) v->general.push_back("every surface's scatter (strategy cosine)");
     for (const Material& m : scene.materials) {
       if (m.type == MaterialType::Emissive) continue;  // never scatters
       if (!in_lanes(m)) {
@@ -298,7 +300,7 @@ struct WavefrontTracer::VectorStages {
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
       f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
       sc.one_sided = sc.one_sided || m.one_sided;
-      const bool general = m.scatters() && (!in_lanes(m) || shading_frame(sh));
+      const bool general = m.scatters() && (cosine || !in_lanes(m) || shading_frame(sh));
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
       f[vs::kTexturedEmission] = m.emission_textured ? 1.0f : 0.0f;
       f[vs::kResolveByCore] = general && (shading_frame(sh) || m.is_textured() || m.normal_map) ? 1.0f : 0.0f;
