@@ -112,8 +112,25 @@ Scene cornell_with_tangents() {
   return s;
 }
 
+// cornell_with_instances() whose group's true sphere glows (an emitter no
+// light sample aims at: the loader takes emitters in groups only so), lit
+// also by delta lights and the sky: every light the stages leave to core.
+Scene cornell_with_every_light() {
+  Scene s = test::cornell_with_instances();
+  for (const DeltaLight& d : test::cornell_with_delta_lights().delta_lights) s.delta_lights.push_back(d);
+  s.environment = Spectrum(0.2f, 0.3f, 0.4f);
+  Material glow = s.materials[s.shapes.back().material];
+  glow.name = "glow";
+  glow.emission = Spectrum(2.0f, 1.5f, 1.0f);
+  glow.sampled_as_light = false;
+  s.materials.push_back(glow);
+  s.shapes.back().material = static_cast<std::uint32_t>(s.materials.size() - 1);
+  return s;
+}
+
 Scene load_case(const SameSeedCase& c) {
   Scene s = c.scene.empty()          ? builtin_cornell_box()
+            : c.scene == "every-light" ? cornell_with_every_light()
             : c.scene == "materials" ? cornell_with_materials()
             : c.scene == "tangents"  ? cornell_with_tangents()
             : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
@@ -681,6 +698,11 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"delta", st, 0.0f, 0});
   cases.push_back({"delta", Strategy::LightBsdf, 0.0f, -1, true, true, true, true, true, 0, true});
+  // Every kind of light core samples at once: delta lights, the sky, an emitter in a group, solid angle.
+  for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"every-light", st, 0.0f, 0});
+  cases.push_back({"every-light", Strategy::Mis, 0.0f, 0, false, false, false, false, true, 0, false, false, true});
+  cases.push_back({"envmap-sun-plane.json", Strategy::LightBsdf, 0.0f, 0});
   // Strategy cosine: every surface scattered by core's Surfel::scatter_cosine (impulses by scatter).
   for (const char* sc : {"", "materials", "textured"}) cases.push_back({sc, Strategy::Cosine, 0.0f, 0});
   // Alpha: every ray's key made in the lanes (camera, continuation and shadow rays, compacted with the path).

@@ -570,8 +570,14 @@ void resolve(const Scene& sc, const Wave& w) {
     // of a shape the lanes do not shade.
     M by_core = hn::FirstN(df, 0);
     if (sc.instanced) by_core = hn::And(found, fmask(load(w, kInstance, i0, found) != hn::Set(DI(), -1)));
+    // A normal that is not finite (a sliver's): resolve() marks its Surfel
+    // shading_normal (NaN != NaN), and Surfel then absorbs the path. The
+    // lanes leave such hits, like every kGeneral shape's, to core's Surfel.
+    const M finite = hn::And(hn::IsFinite(n.x), hn::And(hn::IsFinite(n.y), hn::IsFinite(n.z)));
+    M general = hn::AndNot(finite, found);
+    by_core = hn::Or(by_core, general);
     if (sc.general) {
-      const M general = shape_flag(found, sc, shape, kGeneral);
+      general = hn::Or(general, shape_flag(found, sc, shape, kGeneral));
       by_core = hn::Or(by_core, shape_flag(general, sc, shape, kResolveByCore));
       // The others shade in the geometric normal's Frame (resolve's Frame(n)), made here.
       if (const M plain = hn::AndNot(by_core, general); !hn::AllFalse(df, plain)) {
@@ -584,6 +590,7 @@ void resolve(const Scene& sc, const Wave& w) {
         store_mask(w, kHasParams, i0, plain, hn::FirstN(df, 0));
       }
     }
+    store_mask(w, kShadeByCore, i0, found, general);
     if (sc.textured) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kTexturedEmission));
     for_each_lane(by_core, i0, [&](std::size_t i, std::size_t) { general_resolve(sc, w, i); });
   }
@@ -821,8 +828,8 @@ LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Str
 
 // Surfel::eval and Surfel::pdf towards wi for the lanes of ok (which lose
 // the lanes whose f is black): the Lambert lobe in the lanes (core/surfel.cpp,
-// bsdf/lambert.h: only the local z of wo and wi matters), any other material
-// by core, path by path.
+// bsdf/lambert.h: only the local z of wo and wi matters), the lanes of
+// kShadeByCore by core, path by path.
 void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V3& wo, const V3& n, const V3& wi, M& ok,
                V3& f, VF& pdf_bsdf) {
   const DF df;
@@ -837,8 +844,8 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   const V3 rho = shape_value3(ok, sc, shape, kAlbedo);
   f = zero_unless(upper, cos_pi * rho);
   pdf_bsdf = hn::IfThenElseZero(upper, cos_pi);
-  if (sc.general) {
-    const M general = shape_flag(ok, sc, shape, kGeneral);
+  {
+    const M general = load_mask(w, kShadeByCore, i0, ok);
     if (!hn::AllFalse(df, general)) {
       constexpr std::size_t kMax = hn::MaxLanes(DF());
       HWY_ALIGN float to[3][kMax], value[3][kMax] = {}, density[kMax] = {};
@@ -991,7 +998,7 @@ void scatter(const Scene& sc, const Wave& w) {
     // (pdf > 0 and !(pdf < min_pdf), a NaN pdf passing as in the scalar code).
     VF pdf = hn::IfThenElseZero(z > k(0.0f), z * k(kInvPi));
     const VI shape = load(w, kShape, i0, ok);
-    const M general = sc.general ? shape_flag(ok, sc, shape, kGeneral) : hn::FirstN(df, 0);
+    const M general = load_mask(w, kShadeByCore, i0, ok);
     ok = hn::Or(general, hn::And(ok, hn::And(hn::Not(pdf <= k(0.0f)), hn::Not(pdf < k(sc.min_pdf)))));
     const V3 wo = -load3(w, kDx, i0, ok);
     const V3 n = load3(w, kNx, i0, ok);
@@ -1197,8 +1204,9 @@ std::size_t compact(const Scene& scene, const Wave& wave, void* samples, std::ui
 
 // The Surfel of the hit in slot i, as the scalar stages make it: resolve()
 // of the path's ray (still in kOx... until scatter() spawns the next one) and
-// hit (the stages take no texture). Its point, error and geometric normal
-// are those the lanes resolved, bit for bit, but for an instance's.
+// hit, with the path's ray cone and its slot's parameters under textures. Its
+// point, error and geometric normal are those the lanes resolved, bit for
+// bit, but for an instance's (which the lanes cannot place).
 static Surfel resolved_surfel(const Scene& sc, const Wave& w, std::size_t i) {
   const Ray ray{vec3(w.f[kOx][i], w.f[kOy][i], w.f[kOz][i]), vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]), w.f[kTmax][i]};
   RayHit hit;
@@ -1325,7 +1333,11 @@ void general_sky(const Scene& sc, const Wave& w, std::size_t i, float Le[3], flo
 float general_light_pdf(const Scene& sc, const Wave& w, std::size_t i) {
   const LightQuery ref{vec3(w.f[kPrevX][i], w.f[kPrevY][i], w.f[kPrevZ][i]),
                        vec3(w.f[kPrevNx][i], w.f[kPrevNy][i], w.f[kPrevNz][i])};
-  return sc.compiled->lights().pdf(ref, resolved_surfel(sc, w, i));
+  Surfel hit = shading_point(w, i);  // what LightSampler::pdf reads: the emitter, its point and normal
+  hit.shape = w.u[kShape][i];
+  hit.prim = w.u[kPrim][i];
+  if (sc.instanced) hit.instance = w.u[kInstance][i];
+  return sc.compiled->lights().pdf(ref, hit);
 }
 
 // The light of every visible sample, once Embree has filled kQOccluded: L

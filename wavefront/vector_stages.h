@@ -176,6 +176,7 @@ enum ByteArray : int {
   kAlive, kFound, kPrevImpulse, kPrevBsdfTechnique,
   kShadingNormal,  // Surfel::shading_normal of a hit on a kGeneral shape
   kHasParams,      // its Surfel reads Wave::params (a textured material's)
+  kShadeByCore,    // this bounce's hit is shaded by core's Surfel (a kGeneral shape's, or a normal not finite)
   kQOccluded,  // per packed shadow ray
   kByteArrays
 };
@@ -226,14 +227,16 @@ void resolve(const Scene& scene, const Wave& wave);
 // paths that escaped, passed the depth cap or cannot scatter (the scene has
 // no environment light).
 void add_emission(const Scene& scene, const Wave& wave);
-// Next-event estimation towards one area light for every live path (the
-// scene has no point lights); packs the shadow rays to trace into the kQ
-// arrays, in path order, and returns how many.
+// Next-event estimation for every live path: a delta light's sample (when
+// the scene has them) and an area light's, as the strategy says; packs the
+// shadow rays to trace into the kQ arrays, in path order, and returns how
+// many.
 std::size_t sample_lights(const Scene& scene, const Wave& wave);
 // The light of every visible sample, once Embree has filled kQOccluded
 // (kQPath says whose each packed shadow ray is).
 void add_light(const Wave& wave, std::size_t queries);
-// A cosine-weighted continuation, Russian roulette and the next ray.
+// The continuation (Lambert in the lanes, any other surface by core's
+// Surfel::scatter), Russian roulette and the next ray.
 void scatter(const Scene& scene, const Wave& wave);
 // Packs the survivors into slots [0, m) in order and returns m; each path
 // that ended is written to samples[its kOutIndex - first_slot] (an array of

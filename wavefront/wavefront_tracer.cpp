@@ -152,8 +152,7 @@ struct WavefrontTracer::VectorStages {
   std::vector<std::int32_t> bvh_entry, bvh_light;
 
   // Null, with *why_not saying what stops it, unless the selected SIMD
-  // target is a vector one and the scene has flat, untextured surfaces lit by
-  // triangle area lights alone.
+  // target is a vector one (and the scene's tables fit the gathers' indices).
   static std::unique_ptr<const VectorStages> make(const CompiledScene& compiled, const RenderSettings& settings,
                                                   const SamplerSetup& sampler, std::string* why_not) {
     namespace vs = vector_stages;
@@ -210,7 +209,7 @@ struct WavefrontTracer::VectorStages {
     for (const Shape& shape : scene.shapes)
       if (shading_frame(shape) && scene.materials[shape.material].scatters() && in_lanes(scene.materials[shape.material]))
         v->general.push_back("the shading frame of " + shape.description);
-    // Only triangle area lights: no delta light, sphere light or environment.
+    // The lanes sample triangle lights by area; the rest is core's (below).
     const LightSampler& lights = compiled.lights();
     // Delta lights: a second light sample and shadow ray per path, by core.
     sc.delta_lights = lights.has_delta_lights();
