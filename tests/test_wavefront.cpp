@@ -815,5 +815,26 @@ TEST(Wavefront, TimesCountEveryQuery) {
   EXPECT_LE(t.query_seconds(), t.waves_seconds);
 }
 
+// Each stage's clock runs (both kinds of stages), and the stages and
+// Embree's batches together take no more than the waves' time.
+TEST(Wavefront, TimesEveryStage) {
+  Scene scene = test::small_cornell(16, 4, FilterKind::Box);
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  for (WavefrontStages stages : {WavefrontStages::Auto, WavefrontStages::Scalar}) {
+    const WavefrontTracer tracer(compiled, settings, WavefrontTracer::kDefaultWaveSize, {}, stages);
+    Film film(16, 16, FilterKind::Box);
+    render(tracer, film);
+    const WavefrontTimes t = tracer.times();
+    double sum = t.query_seconds();
+    for (int k = 0; k < kWavefrontStages; ++k) {
+      EXPECT_GT(t.stage_seconds[k], 0.0) << wavefront_stage_name(static_cast<WavefrontStage>(k)) << ", "
+                                         << (stages == WavefrontStages::Auto ? "auto" : "scalar");
+      sum += t.stage_seconds[k];
+    }
+    EXPECT_LE(sum, t.waves_seconds * (1.0 + 1e-9));
+  }
+}
+
 }  // namespace
 }  // namespace pathlab

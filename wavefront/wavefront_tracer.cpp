@@ -26,7 +26,22 @@ struct WavefrontTracer::Clock {
   std::uint64_t nanoseconds[kClocked] = {}, queries[kWave] = {};
   // A batch of n queries of `kind` that started at clock_ns() == t0.
   void batch(Clocked kind, std::uint64_t t0, std::size_t n);
+  // Stage `stage` ran from *t to now; *t becomes now (the next stage's start).
+  void stage(WavefrontStage stage, std::uint64_t* t);
 };
+
+const char* wavefront_stage_name(WavefrontStage stage) {
+  switch (stage) {
+    case WavefrontStage::Camera: return "camera";
+    case WavefrontStage::Resolve: return "resolve";
+    case WavefrontStage::Emission: return "emission";
+    case WavefrontStage::Lights: return "light samples";
+    case WavefrontStage::AddLight: return "add light";
+    case WavefrontStage::Scatter: return "scatter";
+    case WavefrontStage::Compact: return "compact";
+  }
+  return "?";
+}
 
 // The state of every path of a wave, one array per field. The paths still
 // being traced occupy slots [0, n), in the order they were created: after
@@ -120,6 +135,12 @@ std::uint64_t clock_ns() {
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count());
 }
 }  // namespace
+
+void WavefrontTracer::Clock::stage(WavefrontStage stage, std::uint64_t* t) {
+  const std::uint64_t now = clock_ns();
+  nanoseconds[kFirstStage + static_cast<int>(stage)] += now - *t;
+  *t = now;
+}
 
 void WavefrontTracer::Clock::batch(Clocked kind, std::uint64_t t0, std::size_t n) {
   nanoseconds[kind] += clock_ns() - t0;
@@ -449,6 +470,7 @@ void WavefrontTracer::intersect(Wave& w) const {
   const std::uint64_t t0 = clock_ns();
   scene_.intersect_batch(rays, hits, found, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
   w.clock.batch(camera_rays ? kCameraQueries : kBounceQueries, t0, n);
+  std::uint64_t t_resolve = clock_ns();
   for (std::size_t i = 0; i < n; ++i)
     if (found[i]) scene_.prefetch(hits[i]);
   const bool textured = scene_.has_textures();  // then w.cone and w.params are sized
@@ -457,6 +479,7 @@ void WavefrontTracer::intersect(Wave& w) const {
     if (found[i])
       scene_.resolve(rays[i], hits[i], &w.surfel[i], textured ? w.cone[i] : RayCone{}, textured ? &w.params[i] : nullptr);
   }
+  w.clock.stage(WavefrontStage::Resolve, &t_resolve);
 }
 
 // Stage: the emission found at each hit (as the strategy weighs it), and
@@ -696,18 +719,30 @@ void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
 void WavefrontTracer::run_wave(Wave& w, std::span<FilmSample> out, PathObserver* obs) const {
   w.clock = Clock{};
   const std::uint64_t t0 = clock_ns();
+  std::uint64_t t_stage = t0;  // the running stage's start (Clock::stage)
   generate_camera_rays(w, obs);
+  w.clock.stage(WavefrontStage::Camera, &t_stage);
   for (int vertex = 1; w.n > 0; ++vertex) {
-    intersect(w);
+    intersect(w);  // clocks its Embree batch and its resolve itself
+    t_stage = clock_ns();
     add_emission(w, obs);
+    w.clock.stage(WavefrontStage::Emission, &t_stage);
+    // The light samples, and packing their shadow rays (Embree's batch apart).
+    const std::uint64_t shadow_ns = w.clock.nanoseconds[kShadowQueries];
     sample_lights(w, obs);
     trace_shadow_rays(w);
+    w.clock.stage(WavefrontStage::Lights, &t_stage);
+    w.clock.nanoseconds[kFirstStage + static_cast<int>(WavefrontStage::Lights)] -=
+        w.clock.nanoseconds[kShadowQueries] - shadow_ns;
     add_light(w, obs);
+    w.clock.stage(WavefrontStage::AddLight, &t_stage);
     const bool recorded = w.record != nullptr && vertex == w.record_vertex;
     if (recorded) record_stage(w);
     scatter(w, obs);
     if (recorded) record_survival(w);
+    w.clock.stage(WavefrontStage::Scatter, &t_stage);
     compact(w, out);
+    w.clock.stage(WavefrontStage::Compact, &t_stage);
   }
   w.clock.nanoseconds[kWave] = clock_ns() - t0;
   publish(w.clock);
@@ -738,7 +773,9 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
   Clock clock;
   const std::uint64_t t0 = clock_ns();
   const std::size_t paths = w.n;
+  std::uint64_t t_stage = t0;  // the running stage's start (Clock::stage)
   vs::generate_camera_rays(sc, vector_->camera, w);
+  clock.stage(WavefrontStage::Camera, &t_stage);
   for (bool camera_rays = true; lanes.view.n > 0; camera_rays = false) {
     const std::size_t n = w.n;
     const RayArrays rays{w.f[vs::kOx], w.f[vs::kOy], w.f[vs::kOz], w.f[vs::kDx], w.f[vs::kDy], w.f[vs::kDz], w.f[vs::kTmax],
@@ -748,20 +785,28 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
     const std::uint64_t t = clock_ns();
     scene_.intersect_arrays(rays, n, hits, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
     clock.batch(camera_rays ? kCameraQueries : kBounceQueries, t, n);
+    t_stage = clock_ns();
     vs::prefetch_hits(sc, w);  // overlap the hits' cache misses (as intersect() does)
     vs::resolve(sc, w);
+    clock.stage(WavefrontStage::Resolve, &t_stage);
     vs::add_emission(sc, w);
+    clock.stage(WavefrontStage::Emission, &t_stage);
     const std::size_t q = vs::sample_lights(sc, w);
+    clock.stage(WavefrontStage::Lights, &t_stage);
     if (q > 0) {
       const RayArrays shadow{w.f[vs::kQOx], w.f[vs::kQOy], w.f[vs::kQOz], w.f[vs::kQDx],
                              w.f[vs::kQDy], w.f[vs::kQDz], w.f[vs::kQTmax], sc.alpha ? w.u[vs::kQAlphaKey] : nullptr};
       const std::uint64_t ts = clock_ns();
       scene_.occluded_arrays(shadow, q, w.b[vs::kQOccluded], modes_.shadow);
       clock.batch(kShadowQueries, ts, q);
+      t_stage = clock_ns();
       vs::add_light(w, q);
+      clock.stage(WavefrontStage::AddLight, &t_stage);
     }
     vs::scatter(sc, w);
+    clock.stage(WavefrontStage::Scatter, &t_stage);
     lanes.view.n = vs::compact(sc, w, lanes.samples.data(), first_slot);
+    clock.stage(WavefrontStage::Compact, &t_stage);
   }
   std::copy_n(lanes.samples.begin(), paths, out.begin());
   clock.nanoseconds[kWave] = clock_ns() - t0;
@@ -771,7 +816,9 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
 WavefrontTimes WavefrontTracer::times() const {
   auto seconds = [&](int k) { return 1e-9 * static_cast<double>(nanoseconds_[k].load(std::memory_order_relaxed)); };
   auto queries = [&](int k) { return WavefrontTimes::Queries{rays_[k].load(std::memory_order_relaxed), seconds(k)}; };
-  return WavefrontTimes{queries(kCameraQueries), queries(kBounceQueries), queries(kShadowQueries), seconds(kWave)};
+  WavefrontTimes t{queries(kCameraQueries), queries(kBounceQueries), queries(kShadowQueries), seconds(kWave)};
+  for (int k = 0; k < kWavefrontStages; ++k) t.stage_seconds[k] = seconds(kFirstStage + k);
+  return t;
 }
 
 void WavefrontTracer::render_batch(std::uint32_t first, std::uint32_t count, std::span<FilmSample> out) const {

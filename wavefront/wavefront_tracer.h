@@ -40,6 +40,19 @@ struct WavefrontRayModes {
 // Where a wavefront's time went, summed over its renders and threads: the
 // ray queries of each kind (time inside EmbreeAccel's batch calls) against
 // the whole of tracing its waves. Rays per second here are per thread.
+// The wavefront's stages, as its clock times them (Embree's batches apart).
+enum class WavefrontStage : std::uint8_t {
+  Camera,    // camera rays
+  Resolve,   // hits into surfels (the prefetch included)
+  Emission,  // emission found by rays, its MIS weight, paths that end
+  Lights,    // light samples, their BSDF values and shadow rays
+  AddLight,  // the light of the visible ones
+  Scatter,   // continuations, roulette, next rays
+  Compact,   // finished samples out, survivors packed
+};
+inline constexpr int kWavefrontStages = 7;
+const char* wavefront_stage_name(WavefrontStage stage);
+
 struct WavefrontTimes {
   struct Queries {
     std::uint64_t rays = 0;
@@ -48,6 +61,7 @@ struct WavefrontTimes {
   };
   Queries camera, bounce, shadow;
   double waves_seconds = 0.0;  // run_wave, start to end, all waves
+  double stage_seconds[kWavefrontStages] = {};  // each stage's own time (WavefrontStage), Embree's apart
   double query_seconds() const { return camera.seconds + bounce.seconds + shadow.seconds; }
 };
 
@@ -149,7 +163,9 @@ class WavefrontTracer final : public Tracer {
   std::string scalar_reason_;
   std::unique_ptr<const VectorStages> vector_;  // null: scalar stages
   // What times() reports: nanoseconds of each, and rays of each kind of query.
-  enum Clocked { kCameraQueries, kBounceQueries, kShadowQueries, kWave, kClocked };
+  // The clock's entries: the three kinds of queries, the whole wave, then
+  // each WavefrontStage.
+  enum Clocked { kCameraQueries, kBounceQueries, kShadowQueries, kWave, kFirstStage, kClocked = kFirstStage + kWavefrontStages };
   mutable std::atomic<std::uint64_t> nanoseconds_[kClocked] = {}, rays_[kWave] = {};
 };
 

@@ -438,6 +438,14 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
                       100.0 * t.query_seconds() / t.waves_seconds, t.camera.rays_per_second(),
                       t.bounce.rays_per_second(), t.shadow.rays_per_second());
         err << "pathlab: wavefront: " << line << "\n";
+        // The stages' own shares of the waves' time (Embree's batches apart).
+        std::string stages = "pathlab: wavefront: stages (of the waves' time):";
+        for (int k = 0; k < kWavefrontStages; ++k) {
+          std::snprintf(line, sizeof line, "%s %s %.1f%%", k ? "," : "", wavefront_stage_name(static_cast<WavefrontStage>(k)),
+                        100.0 * t.stage_seconds[k] / t.waves_seconds);
+          stages += line;
+        }
+        err << stages << "\n";
       }
     }
   }
