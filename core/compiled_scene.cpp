@@ -130,8 +130,13 @@ void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const v
   s->p = sp.p;
   s->p_error = sp.p_error;
   s->n = sp.n;
+  local_shading(shape, hit, to_normal, s, ns_sum);
+}
+
+void CompiledScene::local_shading(const Shape& shape, const RayHit& hit, const mat3* to_normal, Surfel* s,
+                                  vec3* ns_sum) const {
   s->uv = hit.uv;
-  *ns_sum = sp.n;
+  *ns_sum = s->n;
   if (shape.kind == Shape::Kind::Triangles && (shape.mesh.has_normals() || shape.mesh.has_uvs())) {
     const glm::uvec3 v = shape.mesh.triangles[hit.prim];
     const float b0 = 1.0f - hit.uv.x - hit.uv.y;
@@ -155,8 +160,7 @@ void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const v
 void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s, const RayCone& cone,
                             SurfaceParams* params) const {
   const Shape& shape = scene_.shapes[hit.shape];
-  const bool interpolated = shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals();
-  vec3 ns_sum;  // read only when `interpolated`
+  vec3 ns_sum;  // read only for a mesh with vertex normals
   if (hit.instance == kNoInstance) {
     resolve_local(shape, hit, ray.origin + hit.t * ray.dir, nullptr, s, &ns_sum);
   } else {
@@ -170,6 +174,19 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s, const 
     // side, so the front stays the front under a mirroring placement too.
     s->n = glm::normalize(place.to_normal * s->n);
   }
+  shading_frame(shape, hit, ns_sum, s);
+  if (textures_ && (s->material->is_textured() || s->material->normal_map)) read_textures(shape, ray, hit, cone, params, s);
+}
+
+void CompiledScene::resolve_shading(const RayHit& hit, Surfel* s) const {
+  const Shape& shape = scene_.shapes[hit.shape];
+  vec3 ns_sum;
+  local_shading(shape, hit, nullptr, s, &ns_sum);
+  shading_frame(shape, hit, ns_sum, s);
+}
+
+void CompiledScene::shading_frame(const Shape& shape, const RayHit& hit, const vec3& ns_sum, Surfel* s) const {
+  const bool interpolated = shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals();
   const vec3 ns = interpolated ? shading_normal(s->n, ns_sum) : s->n;
   s->shading_normal = ns != s->n;
   if (shape.kind == Shape::Kind::Triangles && !shape.mesh.tangents.empty()) {
@@ -187,7 +204,6 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s, const 
   s->shape = hit.shape;
   s->prim = hit.prim;
   s->instance = hit.instance;
-  if (textures_ && (s->material->is_textured() || s->material->normal_map)) read_textures(shape, ray, hit, cone, params, s);
 }
 
 void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayHit& hit, const RayCone& cone,

@@ -93,6 +93,11 @@ class CompiledScene {
   // Surfel). Without `params` the Surfel reads the material's constants.
   void resolve(const Ray& ray, const RayHit& hit, Surfel* surfel, const RayCone& cone = {},
                SurfaceParams* params = nullptr) const;
+  // resolve() of a hit on a shape placed in world space (no instance) whose
+  // point, error bound and geometric normal `surfel` already holds, as
+  // resolve() computes them (the wavefront's lanes make them): the rest - its
+  // texture coordinates, shading frame, material - but no texture read.
+  void resolve_shading(const RayHit& hit, Surfel* surfel) const;
   // Every shape's triangles as resolve() reads them, one shape after the
   // other: triangle k of shape s is triangles()[first_triangle(s) + k]
   // (a sphere has none). A shape in a group has its triangles in the
@@ -123,6 +128,12 @@ class CompiledScene {
   // inverse transpose; null for a shape placed in world space) first.
   void resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, const mat3* to_normal, Surfel* s,
                      vec3* ns_sum) const;
+  // resolve_local()'s texture coordinates and unnormalised interpolated
+  // shading normal, from s->n (the shape's own normal at the hit).
+  void local_shading(const Shape& shape, const RayHit& hit, const mat3* to_normal, Surfel* s, vec3* ns_sum) const;
+  // The shading frame, shading_normal, material and hit identity of a Surfel
+  // whose point and geometric normal are placed in world space.
+  void shading_frame(const Shape& shape, const RayHit& hit, const vec3& ns_sum, Surfel* s) const;
   // resolve()'s texture reads for a material with textures or a normal map.
   void read_textures(const Shape& shape, const Ray& ray, const RayHit& hit, const RayCone& cone,
                      SurfaceParams* params, Surfel* s) const;

@@ -1226,6 +1226,29 @@ static Surfel resolved_surfel(const Scene& sc, const Wave& w, std::size_t i) {
 static vec3 at(const Wave& w, FloatArray x, std::size_t i) { return vec3(w.f[x][i], w.f[x + 1][i], w.f[x + 2][i]); }
 
 void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {
+  const pathlab::Scene& scene = sc.compiled->scene();
+  const std::uint32_t shape = w.u[kShape][i];
+  const Material& m = scene.materials[scene.shapes[shape].material];
+  if ((!sc.instanced || w.u[kInstance][i] == kNoInstance) && !(sc.textured && (m.is_textured() || m.normal_map))) {
+    // The lanes placed the point: core adds the shading frame (resolve_shading).
+    Surfel s;
+    s.p = at(w, kPx, i);
+    s.p_error = at(w, kErrX, i);
+    s.n = at(w, kNx, i);
+    RayHit hit;
+    hit.t = w.f[kHitT][i];
+    hit.shape = shape;
+    hit.prim = w.u[kPrim][i];
+    hit.uv = vec2(w.f[kHitU][i], w.f[kHitV][i]);
+    sc.compiled->resolve_shading(hit, &s);
+    const vec3* fields[] = {&s.frame.s, &s.frame.t, &s.frame.n};
+    const FloatArray arrays[] = {kFsX, kFtX, kFnX};
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < 3; ++c) w.f[arrays[a] + c][i] = (*fields[a])[c];
+    w.b[kShadingNormal][i] = s.shading_normal ? 1 : 0;
+    w.b[kHasParams][i] = 0;
+    return;
+  }
   const Surfel s = resolved_surfel(sc, w, i);
   const vec3* fields[] = {&s.p, &s.p_error, &s.n, &s.frame.s, &s.frame.t, &s.frame.n};
   const FloatArray arrays[] = {kPx, kErrX, kNx, kFsX, kFtX, kFnX};
