@@ -267,6 +267,10 @@ void wavefront(benchmark::State& state, std::size_t wave, WavefrontRayModes mode
   state.counters["camera_in_context"] = threads * t.camera.rays_per_second();
   state.counters["bounce_in_context"] = threads * t.bounce.rays_per_second();
   state.counters["shadow_in_context"] = threads * t.shadow.rays_per_second();
+  // Each stage's share of the waves' time (WavefrontStage; Embree's batches apart).
+  for (int k = 0; k < kWavefrontStages; ++k)
+    state.counters[std::string("stage_") + wavefront_stage_name(static_cast<WavefrontStage>(k))] =
+        t.waves_seconds > 0.0 ? t.stage_seconds[k] / t.waves_seconds : 0.0;
 }
 
 // --- the summary ------------------------------------------------------------------
@@ -397,6 +401,12 @@ class RatioReporter : public benchmark::ConsoleReporter {
                   in_context("camera_in_context", RayKind::Camera, modes.camera),
                   in_context("bounce_in_context", RayKind::Bounce, modes.bounce),
                   in_context("shadow_in_context", RayKind::Shadow, modes.shadow));
+      std::printf("  stages (of the waves' time):");
+      for (int k = 0; k < kWavefrontStages; ++k) {
+        const char* name = wavefront_stage_name(static_cast<WavefrontStage>(k));
+        std::printf("%s %s %.1f%%", k ? "," : "", name, 100.0 * median(run, std::string("stage_") + name));
+      }
+      std::printf("\n");
     }
   }
   static WavefrontRayModes parse_modes(const std::string& run) {
