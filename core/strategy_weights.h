@@ -14,6 +14,9 @@
 #include "core/math.h"
 #include "core/sampling.h"
 #include "core/scene.h"
+#include "core/surfel.h"
+
+#include <optional>
 
 namespace pathlab {
 
@@ -45,6 +48,17 @@ inline float light_sample_weight(Strategy strategy, float light_pdf, float bsdf_
   if (strategy == Strategy::Mis) return power_heuristic(light_pdf, bsdf_pdf);
   if (strategy == Strategy::LightBsdf) return 2.0f * light_pdf / (light_pdf + bsdf_pdf);
   return 1.0f;
+}
+
+// The continuation `strategy` samples at s towards wo: cosine-weighted
+// (Surfel::scatter_cosine) for every surface but a pure impulse under
+// `cosine`, the BSDF's own sampling (Surfel::scatter) otherwise. *cosine,
+// when asked for, says which (the observers report it).
+inline std::optional<BsdfSample> scatter_for(Strategy strategy, const Surfel& s, const vec3& wo, float u_lobe, vec2 u_dir,
+                                             bool* cosine = nullptr) {
+  const bool by_cosine = strategy == Strategy::Cosine && !s.material->is_pure_impulse();
+  if (cosine) *cosine = by_cosine;
+  return by_cosine ? s.scatter_cosine(wo, u_dir) : s.scatter(wo, u_lobe, u_dir);
 }
 
 // Whether vertex `vertex` samples area lights (NEE) under `strategy`;

@@ -80,9 +80,8 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
 
   // Continue the path.
   const vec2 u_dir = path.u2(vertex, Dim::DirectionX);
-  const bool cosine = strategy == Strategy::Cosine && !s.material->is_pure_impulse();
-  const std::optional<BsdfSample> bs =
-      cosine ? s.scatter_cosine(wo, u_dir) : s.scatter(wo, path.u(vertex, Dim::LobeChoice), u_dir);
+  bool cosine = false;
+  const std::optional<BsdfSample> bs = scatter_for(strategy, s, wo, path.u(vertex, Dim::LobeChoice), u_dir, &cosine);
   if (!bs || is_black(bs->weight)) {
     if (path.observer) path.observer->on_end({vertex, bs ? PathEnd::NoSample : PathEnd::Absorbed});
     return L;

@@ -27,6 +27,7 @@
 #include "core/simd/sampling-inl.h"
 #include "core/simd/sobol-inl.h"
 #include "core/rng.h"
+#include "core/scene.h"
 #include "wavefront/vector_stages.h"
 
 #include <algorithm>
@@ -66,9 +67,10 @@ bool general_light(const Scene& scene, const Wave& wave, std::size_t i, bool del
 // have chosen the emitter it hit (LightSampler::pdf from the previous vertex).
 void general_sky(const Scene& scene, const Wave& wave, std::size_t i, float Le[3], float* pdf);
 float general_light_pdf(const Scene& scene, const Wave& wave, std::size_t i);
-// CompiledScene::resolve of the hit in slot i, written to the Surfel's
-// arrays: its point, error bound and geometric normal (a hit on an instance,
-// Scene::instanced), and its shading frame (a kGeneral shape's).
+// The rest of the Surfel of the hit in slot i, by core (resolve_shading
+// from the lanes' point, or the whole of CompiledScene::resolve for a hit on
+// an instance or a material that reads textures), written to its arrays:
+// point, error bound, geometric normal, shading frame and flags.
 void general_resolve(const Scene& scene, const Wave& wave, std::size_t i);
 // Surfel::emitted towards the path's wo, for a kTexturedEmission shape's hit.
 void general_emitted(const Scene& scene, const Wave& wave, std::size_t i, float Le[3]);
@@ -94,7 +96,7 @@ void add_emission(const Scene&, const Wave&) { width_one(); }
 std::size_t sample_lights(const Scene&, const Wave&) { width_one(); }
 void scatter(const Scene&, const Wave&) { width_one(); }
 void hash_keys(std::uint64_t*, std::size_t, std::uint64_t) { width_one(); }
-std::size_t compact(const Wave&, bool, bool, bool, void*, std::uint32_t) { width_one(); }
+std::size_t compact(const Scene&, const Wave&, void*, std::uint32_t) { width_one(); }
 std::size_t lanes() { return 1; }
 #else
 
@@ -148,6 +150,10 @@ std::size_t lanes() { return hn::Lanes(DF()); }
 
 VF k(float v) { return hn::Set(DF(), v); }
 V3 zero3() { return splat3(DF(), 0.0f, 0.0f, 0.0f); }
+// A block's lanes at the widest width: the arrays that carry them to and
+// from core's per-path calls.
+constexpr std::size_t kMaxLanes = hn::MaxLanes(DF());
+V3 load_lanes(const float (&a)[3][kMaxLanes]) { return {hn::Load(DF(), a[0]), hn::Load(DF(), a[1]), hn::Load(DF(), a[2])}; }
 // Masks of float lanes from integer comparisons, and back.
 template <class MI>
 M fmask(MI m) {
@@ -440,7 +446,7 @@ VD bvh_share(const Lights& lights, const V3D& p, const V3D& n, VD light, VD coun
 // paths, shaded one at a time).
 template <class Fn>
 void for_each_lane(M m, std::size_t i0, Fn&& fn) {
-  HWY_ALIGN std::int32_t set[hn::MaxLanes(DI())];
+  HWY_ALIGN std::int32_t set[kMaxLanes];
   hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), m)), DI(), set);
   for (std::size_t j = 0; j < lanes(); ++j)
     if (set[j] != 0) fn(i0 + j, j);
@@ -644,7 +650,6 @@ VF emission_weight(const Scene& sc, const Wave& w, std::size_t i0, M lit, VF lig
 void add_emission(const Scene& sc, const Wave& w) {
   const DF df;
   const V3 zero = zero3();
-  constexpr std::size_t kMax = hn::MaxLanes(DF());
   for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
     const M in = live(w.n, i0);
     const M found = load_mask(w, kFound, i0, in);
@@ -661,13 +666,13 @@ void add_emission(const Scene& sc, const Wave& w) {
     }
     if (const M sky = hn::AndNot(refused, escaped); sc.sky && !hn::AllFalse(df, sky)) {
       // The environment along the ray (LightSampler::sky), path by path.
-      HWY_ALIGN float radiance[3][kMax] = {}, density[kMax] = {};
+      HWY_ALIGN float radiance[3][kMaxLanes] = {}, density[kMaxLanes] = {};
       for_each_lane(sky, i0, [&](std::size_t i, std::size_t j) {
         float Le[3];
         general_sky(sc, w, i, Le, &density[j]);
         for (int c = 0; c < 3; ++c) radiance[c][j] = Le[c];
       });
-      const V3 Le{hn::Load(df, radiance[0]), hn::Load(df, radiance[1]), hn::Load(df, radiance[2])};
+      const V3 Le = load_lanes(radiance);
       const VF weight = emission_weight(sc, w, i0, hn::AndNot(is_black(df, Le), sky), hn::Load(df, density));
       L_new = select(sky, L + beta * (weight * Le), L_new);
     }
@@ -683,13 +688,13 @@ void add_emission(const Scene& sc, const Wave& w) {
         // Textured emission: Surfel::emitted, path by path.
         const M textured = shape_flag(found, sc, shape, kTexturedEmission);
         if (!hn::AllFalse(df, textured)) {
-          HWY_ALIGN float radiance[3][kMax] = {};
+          HWY_ALIGN float radiance[3][kMaxLanes] = {};
           for_each_lane(textured, i0, [&](std::size_t i, std::size_t j) {
             float e[3];
             general_emitted(sc, w, i, e);
             for (int c = 0; c < 3; ++c) radiance[c][j] = e[c];
           });
-          Le = select(textured, V3{hn::Load(df, radiance[0]), hn::Load(df, radiance[1]), hn::Load(df, radiance[2])}, Le);
+          Le = select(textured, load_lanes(radiance), Le);
         }
       }
       const M lit = hn::AndNot(is_black(df, Le), found);
@@ -697,7 +702,7 @@ void add_emission(const Scene& sc, const Wave& w) {
       VF light_pdf;
       if (sc.general_lights) {
         // By core's LightSampler, path by path.
-        HWY_ALIGN float density[kMax] = {};
+        HWY_ALIGN float density[kMaxLanes] = {};
         for_each_lane(lit, i0, [&](std::size_t i, std::size_t j) { density[j] = general_light_pdf(sc, w, i); });
         light_pdf = hn::Load(df, density);
       } else {
@@ -797,9 +802,9 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, const 
 // (general_light).
 LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, M& ok, bool delta) {
   const DF df;
-  constexpr std::size_t kMax = hn::MaxLanes(DF());
-  HWY_ALIGN float u[3][kMax] = {}, out[14][kMax] = {};
-  HWY_ALIGN std::int32_t sampled[kMax] = {};
+  HWY_ALIGN float u[3][kMaxLanes] = {}, wi[3][kMaxLanes] = {}, Le[3][kMaxLanes] = {}, pdf[kMaxLanes] = {},
+                ray[7][kMaxLanes] = {};
+  HWY_ALIGN std::int32_t sampled[kMaxLanes] = {};
   if (delta) {
     hn::Store(rng.u(Dim::DeltaLightChoice), df, u[0]);
   } else {
@@ -813,16 +818,16 @@ LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Str
     GeneralLight gl;
     if (!general_light(sc, w, i, delta, u[0][j], u[1][j], u[2][j], &gl)) return;
     sampled[j] = 1;
-    const float v[14] = {gl.wi[0], gl.wi[1], gl.wi[2], gl.Le[0], gl.Le[1], gl.Le[2], gl.pdf,
-                         gl.ray[0], gl.ray[1], gl.ray[2], gl.ray[3], gl.ray[4], gl.ray[5], gl.ray[6]};
-    for (int a = 0; a < 14; ++a) out[a][j] = v[a];
+    for (int c = 0; c < 3; ++c) {
+      wi[c][j] = gl.wi[c];
+      Le[c][j] = gl.Le[c];
+    }
+    pdf[j] = gl.pdf;
+    for (int a = 0; a < 7; ++a) ray[a][j] = gl.ray[a];
   });
   ok = hn::And(ok, fmask(hn::Load(DI(), sampled) != hn::Zero(DI())));
-  LightLanes ls;
-  ls.wi = {hn::Load(df, out[0]), hn::Load(df, out[1]), hn::Load(df, out[2])};
-  ls.Le = {hn::Load(df, out[3]), hn::Load(df, out[4]), hn::Load(df, out[5])};
-  ls.pdf = hn::Load(df, out[6]);
-  for (int a = 0; a < 7; ++a) ls.ray[a] = hn::Load(df, out[7 + a]);
+  LightLanes ls{load_lanes(wi), load_lanes(Le), hn::Load(df, pdf), {}};
+  for (int a = 0; a < 7; ++a) ls.ray[a] = hn::Load(df, ray[a]);
   return ls;
 }
 
@@ -844,23 +849,19 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   const V3 rho = shape_value3(ok, sc, shape, kAlbedo);
   f = zero_unless(upper, cos_pi * rho);
   pdf_bsdf = hn::IfThenElseZero(upper, cos_pi);
-  {
-    const M general = load_mask(w, kShadeByCore, i0, ok);
-    if (!hn::AllFalse(df, general)) {
-      constexpr std::size_t kMax = hn::MaxLanes(DF());
-      HWY_ALIGN float to[3][kMax], value[3][kMax] = {}, density[kMax] = {};
-      hn::Store(wi.x, df, to[0]);
-      hn::Store(wi.y, df, to[1]);
-      hn::Store(wi.z, df, to[2]);
-      for_each_lane(general, i0, [&](std::size_t i, std::size_t j) {
-        const float d[3] = {to[0][j], to[1][j], to[2][j]};
-        float fj[3];
-        general_eval(sc, w, i, d, fj, &density[j]);
-        for (int c = 0; c < 3; ++c) value[c][j] = fj[c];
-      });
-      f = select(general, V3{hn::Load(df, value[0]), hn::Load(df, value[1]), hn::Load(df, value[2])}, f);
-      pdf_bsdf = hn::IfThenElse(general, hn::Load(df, density), pdf_bsdf);
-    }
+  if (const M general = load_mask(w, kShadeByCore, i0, ok); !hn::AllFalse(df, general)) {
+    HWY_ALIGN float to[3][kMaxLanes], value[3][kMaxLanes] = {}, density[kMaxLanes] = {};
+    hn::Store(wi.x, df, to[0]);
+    hn::Store(wi.y, df, to[1]);
+    hn::Store(wi.z, df, to[2]);
+    for_each_lane(general, i0, [&](std::size_t i, std::size_t j) {
+      const float d[3] = {to[0][j], to[1][j], to[2][j]};
+      float fj[3];
+      general_eval(sc, w, i, d, fj, &density[j]);
+      for (int c = 0; c < 3; ++c) value[c][j] = fj[c];
+    });
+    f = select(general, load_lanes(value), f);
+    pdf_bsdf = hn::IfThenElse(general, hn::Load(df, density), pdf_bsdf);
   }
   ok = hn::AndNot(is_black(df, f), ok);
 }
@@ -890,12 +891,11 @@ std::size_t pack_shadow_rays(const Wave& w, std::size_t i0, std::size_t queries,
     if (alpha_keys) pack.store(w.u[kQAlphaKey] + queries, *alpha_keys);
     return pack.count;
   }
-  HWY_ALIGN std::uint32_t keys[hn::MaxLanes(DU())] = {};
+  HWY_ALIGN std::uint32_t keys[kMaxLanes] = {};
   if (alpha_keys) hn::Store(*alpha_keys, DU(), keys);
   // Two rays a path: interleaved one lane at a time.
-  constexpr std::size_t kMax = hn::MaxLanes(DF());
-  HWY_ALIGN float v[2][10][kMax];
-  HWY_ALIGN std::int32_t set[2][kMax];
+  HWY_ALIGN float v[2][10][kMaxLanes];
+  HWY_ALIGN std::int32_t set[2][kMaxLanes];
   const ShadowLanes* both[2] = {delta, &area};
   for (int k2 = 0; k2 < 2; ++k2) {
     const ShadowLanes& s = *both[k2];
@@ -1012,9 +1012,8 @@ void scatter(const Scene& sc, const Wave& w) {
     M impulse = hn::FirstN(df, 0);
     if (const M g = hn::And(general, ok); !hn::AllFalse(df, g)) {
       // Any other material: Surfel::scatter, path by path.
-      constexpr std::size_t kMax = hn::MaxLanes(DF());
-      HWY_ALIGN float u[3][kMax], dir[3][kMax] = {}, wt[3][kMax] = {}, density[kMax] = {};
-      HWY_ALIGN std::int32_t scattered[kMax] = {}, impulses[kMax] = {};
+      HWY_ALIGN float u[3][kMaxLanes], dir[3][kMaxLanes] = {}, wt[3][kMaxLanes] = {}, density[kMaxLanes] = {};
+      HWY_ALIGN std::int32_t scattered[kMaxLanes] = {}, impulses[kMaxLanes] = {};
       hn::Store(rng.u(Dim::LobeChoice), df, u[0]);
       hn::Store(du, df, u[1]);
       hn::Store(dv, df, u[2]);
@@ -1029,11 +1028,8 @@ void scatter(const Scene& sc, const Wave& w) {
           wt[c][j] = bs.weight[c];
         }
       });
-      const auto loaded = [&](float (&a)[3][kMax]) {
-        return V3{hn::Load(df, a[0]), hn::Load(df, a[1]), hn::Load(df, a[2])};
-      };
-      wi = select(g, loaded(dir), wi);
-      weight = select(g, loaded(wt), weight);
+      wi = select(g, load_lanes(dir), wi);
+      weight = select(g, load_lanes(wt), weight);
       pdf = hn::IfThenElse(g, hn::Load(df, density), pdf);
       impulse = hn::And(g, fmask(hn::Load(DI(), impulses) != hn::Zero(DI())));
       ok = hn::AndNot(hn::AndNot(fmask(hn::Load(DI(), scattered) != hn::Zero(DI())), g), ok);
@@ -1064,9 +1060,8 @@ void scatter(const Scene& sc, const Wave& w) {
 
     if (sc.textured && !hn::AllFalse(df, ok)) {
       // The ray cone after the scatter, path by path (core/ray_cone.h).
-      constexpr std::size_t kMax = hn::MaxLanes(DF());
-      HWY_ALIGN float density[kMax];
-      HWY_ALIGN std::int32_t impulses[kMax];
+      HWY_ALIGN float density[kMaxLanes];
+      HWY_ALIGN std::int32_t impulses[kMaxLanes];
       hn::Store(pdf, df, density);
       hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), impulse)), DI(), impulses);
       for_each_lane(ok, i0, [&](std::size_t i, std::size_t j) { general_cone(sc, w, i, impulses[j] != 0, density[j]); });
@@ -1091,7 +1086,7 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
     hn::StoreU(mix64(d64, hn::Xor(seed, hn::LoadU(d64, keys + i0))), d64, keys + i0);
 }
 
-std::size_t compact(const Wave& w, bool zsobol, bool textured, bool alpha, void* samples, std::uint32_t first_slot) {
+std::size_t compact(const Scene& sc, const Wave& w, void* samples, std::uint32_t first_slot) {
   static constexpr FloatArray kMovedFloats[] = {kOx,   kOy,   kOz,   kDx,   kDy,    kDz,    kTmax,  kBetaR,   kBetaG, kBetaB,
                                                 kLR,   kLG,   kLB,   kPrevX, kPrevY, kPrevZ, kPrevPdf, kFilmX, kFilmY,
                                                 kPrevNx, kPrevNy, kPrevNz};
@@ -1134,9 +1129,9 @@ std::size_t compact(const Wave& w, bool zsobol, bool textured, bool alpha, void*
     const Packer pack(alive);
     const std::size_t count = pack.count;
     for (FloatArray a : kMovedFloats) pack.store(w.f[a] + m, hn::LoadU(df, w.f[a] + i0));
-    if (textured)
+    if (sc.textured)
       for (FloatArray a : {kConeWidth, kConeSpread}) pack.store(w.f[a] + m, hn::LoadU(df, w.f[a] + i0));
-    if (alpha) pack.store(w.u[kAlphaKey] + m, hn::LoadU(DU(), w.u[kAlphaKey] + i0));
+    if (sc.alpha) pack.store(w.u[kAlphaKey] + m, hn::LoadU(DU(), w.u[kAlphaKey] + i0));
     for (UintArray a : kMovedUints) pack.store(w.u[a] + m, hn::LoadU(DU(), w.u[a] + i0));
     for (ByteArray a : kMovedBytes)
       store_bytes(w.b[a] + m, pack.first, pack.packed(hn::PromoteTo(DI(), hn::LoadU(D8(), w.b[a] + i0))));
@@ -1150,7 +1145,7 @@ std::size_t compact(const Wave& w, bool zsobol, bool textured, bool alpha, void*
       hn::CompressBlendedStore(hn::LoadU(d64, a + i0 + half), alive_hi, d64, a + m + lo);
     };
     move64(w.rng);
-    if (zsobol) {
+    if (sc.zsobol) {
       move64(w.zindex);
       move64(w.zkey);
     }
@@ -1168,6 +1163,7 @@ HWY_AFTER_NAMESPACE();
 
 #include "core/compiled_scene.h"
 #include "core/simd/simd.h"
+#include "core/strategy_weights.h"
 #include "core/surfel.h"
 
 namespace pathlab::vector_stages {
@@ -1199,57 +1195,48 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
   HWY_DYNAMIC_DISPATCH(hash_keys)(keys, n, seed_key);
 }
 std::size_t compact(const Scene& scene, const Wave& wave, void* samples, std::uint32_t first_slot) {
-  return HWY_DYNAMIC_DISPATCH(compact)(wave, scene.zsobol, scene.textured, scene.alpha, samples, first_slot);
+  return HWY_DYNAMIC_DISPATCH(compact)(scene, wave, samples, first_slot);
 }
 
-// The Surfel of the hit in slot i, as the scalar stages make it: resolve()
-// of the path's ray (still in kOx... until scatter() spawns the next one) and
-// hit, with the path's ray cone and its slot's parameters under textures. Its
-// point, error and geometric normal are those the lanes resolved, bit for
-// bit, but for an instance's (which the lanes cannot place).
-static Surfel resolved_surfel(const Scene& sc, const Wave& w, std::size_t i) {
-  const Ray ray{vec3(w.f[kOx][i], w.f[kOy][i], w.f[kOz][i]), vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]), w.f[kTmax][i]};
+// Three consecutive arrays (x, y, z) at slot i.
+static vec3 at(const Wave& w, FloatArray x, std::size_t i) { return vec3(w.f[x][i], w.f[x + 1][i], w.f[x + 2][i]); }
+
+// The Surfel in slot i as far as the lanes made it: its point, error bound
+// and geometric normal (what light_query, shadow_ray and LightSampler::pdf
+// read).
+static Surfel shading_point(const Wave& w, std::size_t i) {
+  Surfel s;
+  s.p = at(w, kPx, i);
+  s.p_error = at(w, kErrX, i);
+  s.n = at(w, kNx, i);
+  return s;
+}
+
+void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {
   RayHit hit;
   hit.t = w.f[kHitT][i];
   hit.shape = w.u[kShape][i];
   hit.prim = w.u[kPrim][i];
   hit.uv = vec2(w.f[kHitU][i], w.f[kHitV][i]);
   if (sc.instanced) hit.instance = w.u[kInstance][i];
-  Surfel s;
-  if (sc.textured)
-    sc.compiled->resolve(ray, hit, &s, RayCone{w.f[kConeWidth][i], w.f[kConeSpread][i]}, &w.params[i]);
-  else
-    sc.compiled->resolve(ray, hit, &s);
-  return s;
-}
-
-static vec3 at(const Wave& w, FloatArray x, std::size_t i) { return vec3(w.f[x][i], w.f[x + 1][i], w.f[x + 2][i]); }
-
-void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {
   const pathlab::Scene& scene = sc.compiled->scene();
-  const std::uint32_t shape = w.u[kShape][i];
-  const Material& m = scene.materials[scene.shapes[shape].material];
-  if ((!sc.instanced || w.u[kInstance][i] == kNoInstance) && !(sc.textured && (m.is_textured() || m.normal_map))) {
-    // The lanes placed the point: core adds the shading frame (resolve_shading).
-    Surfel s;
-    s.p = at(w, kPx, i);
-    s.p_error = at(w, kErrX, i);
-    s.n = at(w, kNx, i);
-    RayHit hit;
-    hit.t = w.f[kHitT][i];
-    hit.shape = shape;
-    hit.prim = w.u[kPrim][i];
-    hit.uv = vec2(w.f[kHitU][i], w.f[kHitV][i]);
+  const Material& m = scene.materials[scene.shapes[hit.shape].material];
+  const bool reads_textures = sc.textured && (m.is_textured() || m.normal_map);
+  Surfel s;
+  if (hit.instance == kNoInstance && !reads_textures) {
+    // The lanes placed the point, bit for bit as resolve() does: core adds
+    // the rest (resolve_shading).
+    s = shading_point(w, i);
     sc.compiled->resolve_shading(hit, &s);
-    const vec3* fields[] = {&s.frame.s, &s.frame.t, &s.frame.n};
-    const FloatArray arrays[] = {kFsX, kFtX, kFnX};
-    for (int a = 0; a < 3; ++a)
-      for (int c = 0; c < 3; ++c) w.f[arrays[a] + c][i] = (*fields[a])[c];
-    w.b[kShadingNormal][i] = s.shading_normal ? 1 : 0;
-    w.b[kHasParams][i] = 0;
-    return;
+  } else {
+    // resolve() of the path's ray (still in kOx... until scatter() spawns
+    // the next one), with its cone and its slot's parameters under textures.
+    const Ray ray{at(w, kOx, i), at(w, kDx, i), w.f[kTmax][i]};
+    if (sc.textured)
+      sc.compiled->resolve(ray, hit, &s, RayCone{w.f[kConeWidth][i], w.f[kConeSpread][i]}, &w.params[i]);
+    else
+      sc.compiled->resolve(ray, hit, &s);
   }
-  const Surfel s = resolved_surfel(sc, w, i);
   const vec3* fields[] = {&s.p, &s.p_error, &s.n, &s.frame.s, &s.frame.t, &s.frame.n};
   const FloatArray arrays[] = {kPx, kErrX, kNx, kFsX, kFtX, kFnX};
   for (int a = 0; a < 6; ++a)
@@ -1265,14 +1252,11 @@ void general_cone(const Scene& sc, const Wave& w, std::size_t i, bool impulse, f
   w.f[kConeSpread][i] = cone.spread;
 }
 
-// The Surfel of a hit on a kGeneral shape, from what general_resolve kept:
-// resolved_surfel's, field for field (uv is read only by textures, which
-// resolve() has read into params already).
+// The Surfel of a hit on a kGeneral shape, from what general_resolve (or,
+// for a flat shape, resolve() in the lanes) kept, field for field (uv is
+// read only by textures, which resolve() has read into params already).
 static Surfel general_surfel(const Scene& sc, const Wave& w, std::size_t i) {
-  Surfel s;
-  s.p = at(w, kPx, i);
-  s.p_error = at(w, kErrX, i);
-  s.n = at(w, kNx, i);
+  Surfel s = shading_point(w, i);
   s.frame.s = at(w, kFsX, i);
   s.frame.t = at(w, kFtX, i);
   s.frame.n = at(w, kFnX, i);
@@ -1294,7 +1278,7 @@ void general_emitted(const Scene& sc, const Wave& w, std::size_t i, float Le[3])
 
 void general_eval(const Scene& sc, const Wave& w, std::size_t i, const float wi[3], float f[3], float* pdf) {
   const Surfel s = general_surfel(sc, w, i);
-  const vec3 to(wi[0], wi[1], wi[2]), wo = -vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]);
+  const vec3 to(wi[0], wi[1], wi[2]), wo = -at(w, kDx, i);
   const Spectrum value = s.eval(to, wo);
   for (int c = 0; c < 3; ++c) f[c] = value[c];
   *pdf = is_black(value) ? 0.0f : s.pdf(to, wo);  // read only where f is not black
@@ -1302,11 +1286,7 @@ void general_eval(const Scene& sc, const Wave& w, std::size_t i, const float wi[
 
 bool general_scatter(const Scene& sc, const Wave& w, std::size_t i, float u_lobe, float u0, float u1,
                      GeneralSample* out) {
-  const Surfel s = general_surfel(sc, w, i);
-  const vec3 wo = -vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]);
-  // The cosine strategy samples every surface but a pure impulse by the cosine (WavefrontTracer::scatter).
-  const bool cosine = sc.strategy == Strategy::Cosine && !s.material->is_pure_impulse();
-  const std::optional<BsdfSample> bs = cosine ? s.scatter_cosine(wo, vec2(u0, u1)) : s.scatter(wo, u_lobe, vec2(u0, u1));
+  const std::optional<BsdfSample> bs = scatter_for(sc.strategy, general_surfel(sc, w, i), -at(w, kDx, i), u_lobe, vec2(u0, u1));
   if (!bs) return false;
   for (int c = 0; c < 3; ++c) {
     out->wi[c] = bs->wi[c];
@@ -1317,20 +1297,10 @@ bool general_scatter(const Scene& sc, const Wave& w, std::size_t i, float u_lobe
   return true;
 }
 
-// What light_query and shadow_ray read of the Surfel in slot i: its point,
-// error bound and geometric normal.
-static Surfel shading_point(const Wave& w, std::size_t i) {
-  Surfel s;
-  s.p = vec3(w.f[kPx][i], w.f[kPy][i], w.f[kPz][i]);
-  s.p_error = vec3(w.f[kErrX][i], w.f[kErrY][i], w.f[kErrZ][i]);
-  s.n = vec3(w.f[kNx][i], w.f[kNy][i], w.f[kNz][i]);
-  return s;
-}
-
 bool general_light(const Scene& sc, const Wave& w, std::size_t i, bool delta, float u_choice, float u0, float u1,
                    GeneralLight* out) {
   const Surfel s = shading_point(w, i);
-  const vec3 wo = -vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]);
+  const vec3 wo = -at(w, kDx, i);
   const LightSampler& lights = sc.compiled->lights();
   const std::optional<LightSample> ls =
       delta ? lights.sample_delta(s.p, u_choice) : lights.sample(light_query(s, wo), u_choice, vec2(u0, u1));
@@ -1348,14 +1318,13 @@ bool general_light(const Scene& sc, const Wave& w, std::size_t i, bool delta, fl
 }
 
 void general_sky(const Scene& sc, const Wave& w, std::size_t i, float Le[3], float* pdf) {
-  const LightSampler::Sky sky = sc.compiled->lights().sky(vec3(w.f[kDx][i], w.f[kDy][i], w.f[kDz][i]));
+  const LightSampler::Sky sky = sc.compiled->lights().sky(at(w, kDx, i));
   for (int c = 0; c < 3; ++c) Le[c] = sky.Le[c];
   *pdf = sky.pdf;
 }
 
 float general_light_pdf(const Scene& sc, const Wave& w, std::size_t i) {
-  const LightQuery ref{vec3(w.f[kPrevX][i], w.f[kPrevY][i], w.f[kPrevZ][i]),
-                       vec3(w.f[kPrevNx][i], w.f[kPrevNy][i], w.f[kPrevNz][i])};
+  const LightQuery ref{at(w, kPrevX, i), at(w, kPrevNx, i)};
   Surfel hit = shading_point(w, i);  // what LightSampler::pdf reads: the emitter, its point and normal
   hit.shape = w.u[kShape][i];
   hit.prim = w.u[kPrim][i];

@@ -29,13 +29,10 @@
 namespace pathlab {
 class CompiledScene;
 struct SurfaceParams;
+enum class Strategy : std::uint8_t;  // core/scene.h
 }
 
 namespace pathlab::vector_stages {
-
-// The sampling strategies (core/strategy_weights.h). Under Cosine every
-// surface scatters by core's Surfel::scatter_cosine (every shape kGeneral).
-enum class Strategy : std::uint8_t { Bsdf, Light, Mis, LightBsdf, Cosine };
 
 // The area lights, as LightSampler::sample() picks and samples them.
 struct Lights {
@@ -69,7 +66,9 @@ enum LightField : int {
 
 // What the stages read of the scene and the render settings.
 struct Scene {
-  Strategy strategy = Strategy::Mis;
+  // The sampling strategy (core/scene.h). Under cosine every surface
+  // scatters by core's Surfel::scatter_cosine (every shape kGeneral).
+  Strategy strategy{};
   int rr_depth = 0;
   int max_vertex = 0;  // paths end at a vertex beyond this (the depth cap)
   float min_pdf = 0.0f;

@@ -185,13 +185,7 @@ struct WavefrontTracer::VectorStages {
       return no("the SIMD target is scalar (--simd scalar, PATHLAB_SIMD=scalar, or a processor without SSE4.1)");
     auto v = std::make_unique<VectorStages>();
     vs::Scene& sc = v->scene;
-    switch (settings.strategy) {
-      case Strategy::Cosine: sc.strategy = vs::Strategy::Cosine; break;
-      case Strategy::Bsdf: sc.strategy = vs::Strategy::Bsdf; break;
-      case Strategy::Light: sc.strategy = vs::Strategy::Light; break;
-      case Strategy::Mis: sc.strategy = vs::Strategy::Mis; break;
-      case Strategy::LightBsdf: sc.strategy = vs::Strategy::LightBsdf; break;
-    }
+    sc.strategy = settings.strategy;
     sc.rr_depth = settings.rr_depth;
     sc.max_vertex = settings.max_depth >= 0 ? settings.max_depth : kMaxVerticesUncapped;
     // Flat Lambert surfaces (shaded by lambert.h, not through the Disney
@@ -226,10 +220,6 @@ struct WavefrontTracer::VectorStages {
       sc.camera_cone_spread = cone.spread;
       sc.texture_filter = static_cast<std::uint8_t>(settings.texture_filter);
     }
-    // A mesh with vertex normals or tangents has its own shading frame: core's Surfel shades it.
-    for (const Shape& shape : scene.shapes)
-      if (shading_frame(shape) && scene.materials[shape.material].scatters() && in_lanes(scene.materials[shape.material]))
-        v->general.push_back("the shading frame of " + shape.description);
     // The lanes sample triangle lights by area; the rest is core's (below).
     const LightSampler& lights = compiled.lights();
     // Delta lights: a second light sample and shadow ray per path, by core.
@@ -263,39 +253,41 @@ struct WavefrontTracer::VectorStages {
       for (std::size_t i = 0; i < other_lights.size(); ++i) what += (i ? ", " : "") + other_lights[i];
       v->general.push_back(what + ")");
     }
-    for (const LightSampler::Entry& e : lights.entries()) {
-      if (sc.general_lights) break;  // the tables below are the lanes' own sampler's
-      const Shape& shape = scene.shapes[e.shape];
-      const Material& m = scene.materials[shape.material];
-      const Triangle& t = e.triangle;
-      for (const vec3& c : {t.p0, t.p1, t.p2, t.n, m.emission})
-        v->light_triangle.insert(v->light_triangle.end(), {c.x, c.y, c.z});
-      v->light_triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
-      v->inv_area.push_back(1.0f / e.area);
-    }
-    const std::size_t n_lights = lights.entries().size();
-    if (!sc.general_lights && n_lights >= 1 && n_lights <= 16) {  // small enough to keep by column
-      v->light_columns.assign(16 * vs::kLightColumns, 0.0f);
-      for (std::size_t l = 0; l < n_lights; ++l) {
-        for (int f = 0; f < vs::kLightCdf; ++f) v->light_columns[16 * f + l] = v->light_triangle[16 * l + f];
-        if (!lights.cdf().empty()) v->light_columns[16 * vs::kLightCdf + l] = lights.cdf()[l];  // none under bvh
-        v->light_columns[16 * vs::kLightPmf + l] = lights.pmf()[l];
-        v->light_columns[16 * vs::kLightInvArea + l] = v->inv_area[l];
+    // The tables the lanes' own sampler reads (triangles by area).
+    if (!sc.general_lights) {
+      for (const LightSampler::Entry& e : lights.entries()) {
+        const Shape& shape = scene.shapes[e.shape];
+        const Material& m = scene.materials[shape.material];
+        const Triangle& t = e.triangle;
+        for (const vec3& c : {t.p0, t.p1, t.p2, t.n, m.emission})
+          v->light_triangle.insert(v->light_triangle.end(), {c.x, c.y, c.z});
+        v->light_triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
+        v->inv_area.push_back(1.0f / e.area);
       }
-    }
-    sc.lights = {n_lights, lights.cdf().data(), lights.pmf().data(), v->inv_area.data(), v->light_triangle.data(),
-                 v->light_columns.empty() ? nullptr : v->light_columns.data()};
-    if (const LightBvh* bvh = lights.bvh(); bvh && !bvh->empty() && !sc.general_lights) {
-      // The light BVH as the stages walk it (core/simd/light_bvh-inl.h).
-      v->bvh_nodes = bvh->node_table();
-      for (std::uint32_t l = 0; l < bvh->trails().size(); ++l)
-        v->bvh_entry.push_back(static_cast<std::int32_t>(lights.bvh_entry(l)));
-      for (std::size_t e = 0; e < n_lights; ++e) v->bvh_light.push_back(static_cast<std::int32_t>(lights.bvh_light(e)));
-      sc.lights.bvh_nodes = v->bvh_nodes.data();
-      sc.lights.bvh_trail = bvh->trails().data();
-      sc.lights.bvh_entry = v->bvh_entry.data();
-      sc.lights.bvh_light = v->bvh_light.data();
-      sc.lights.bvh_grid = lights.bvh_grid();
+      const std::size_t n_lights = lights.entries().size();
+      if (n_lights >= 1 && n_lights <= 16) {  // small enough to keep by column
+        v->light_columns.assign(16 * vs::kLightColumns, 0.0f);
+        for (std::size_t l = 0; l < n_lights; ++l) {
+          for (int f = 0; f < vs::kLightCdf; ++f) v->light_columns[16 * f + l] = v->light_triangle[16 * l + f];
+          if (!lights.cdf().empty()) v->light_columns[16 * vs::kLightCdf + l] = lights.cdf()[l];  // none under bvh
+          v->light_columns[16 * vs::kLightPmf + l] = lights.pmf()[l];
+          v->light_columns[16 * vs::kLightInvArea + l] = v->inv_area[l];
+        }
+      }
+      sc.lights = {n_lights, lights.cdf().data(), lights.pmf().data(), v->inv_area.data(), v->light_triangle.data(),
+                   v->light_columns.empty() ? nullptr : v->light_columns.data()};
+      if (const LightBvh* bvh = lights.bvh(); bvh && !bvh->empty()) {
+        // The light BVH as the stages walk it (core/simd/light_bvh-inl.h).
+        v->bvh_nodes = bvh->node_table();
+        for (std::uint32_t l = 0; l < bvh->trails().size(); ++l)
+          v->bvh_entry.push_back(static_cast<std::int32_t>(lights.bvh_entry(l)));
+        for (std::size_t e = 0; e < n_lights; ++e) v->bvh_light.push_back(static_cast<std::int32_t>(lights.bvh_light(e)));
+        sc.lights.bvh_nodes = v->bvh_nodes.data();
+        sc.lights.bvh_trail = bvh->trails().data();
+        sc.lights.bvh_entry = v->bvh_entry.data();
+        sc.lights.bvh_light = v->bvh_light.data();
+        sc.lights.bvh_grid = lights.bvh_grid();
+      }
     }
     // Per shape: its material's parameters and its geometry.
     // Gathers index these tables with 32-bit float indices: 32 per shape, 12 per triangle, 16 per light.
@@ -320,6 +312,8 @@ struct WavefrontTracer::VectorStages {
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
       f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
       sc.one_sided = sc.one_sided || m.one_sided;
+      // A Lambert mesh with vertex normals or tangents has a shading frame of its own: core's Surfel shades it.
+      if (m.scatters() && in_lanes(m) && shading_frame(sh)) v->general.push_back("the shading frame of " + sh.description);
       const bool general = m.scatters() && (cosine || !in_lanes(m) || shading_frame(sh));
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
       f[vs::kTexturedEmission] = m.emission_textured ? 1.0f : 0.0f;
@@ -639,8 +633,8 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
     const vec3 wo = -w.ray[i].dir;
     const int v = w.vertex[i];
     const vec2 u_dir = w.u2(i, Dim::DirectionX);
-    const bool cosine = strategy == Strategy::Cosine && !s.material->is_pure_impulse();
-    const std::optional<BsdfSample> bs = cosine ? s.scatter_cosine(wo, u_dir) : s.scatter(wo, w.u(i, Dim::LobeChoice), u_dir);
+    bool cosine = false;
+    const std::optional<BsdfSample> bs = scatter_for(strategy, s, wo, w.u(i, Dim::LobeChoice), u_dir, &cosine);
     if (!bs || is_black(bs->weight)) {
       if (obs) obs->on_end({v, bs ? PathEnd::NoSample : PathEnd::Absorbed});
       w.alive[i] = 0;

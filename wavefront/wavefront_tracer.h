@@ -37,9 +37,6 @@ struct WavefrontRayModes {
   RayBatchMode shadow = RayBatchMode::Stream;
 };
 
-// Where a wavefront's time went, summed over its renders and threads: the
-// ray queries of each kind (time inside EmbreeAccel's batch calls) against
-// the whole of tracing its waves. Rays per second here are per thread.
 // The wavefront's stages, as its clock times them (Embree's batches apart).
 enum class WavefrontStage : std::uint8_t {
   Camera,    // camera rays
@@ -48,11 +45,15 @@ enum class WavefrontStage : std::uint8_t {
   Lights,    // light samples, their BSDF values and shadow rays
   AddLight,  // the light of the visible ones
   Scatter,   // continuations, roulette, next rays
-  Compact,   // finished samples out, survivors packed
+  Compact,   // finished samples out, survivors packed (the last)
 };
-inline constexpr int kWavefrontStages = 7;
+inline constexpr int kWavefrontStages = static_cast<int>(WavefrontStage::Compact) + 1;
 const char* wavefront_stage_name(WavefrontStage stage);
 
+// Where a wavefront's time went, summed over its renders and threads: the
+// ray queries of each kind (time inside EmbreeAccel's batch calls) and each
+// stage's own time against the whole of tracing its waves. Rays per second
+// here are per thread.
 struct WavefrontTimes {
   struct Queries {
     std::uint64_t rays = 0;
