@@ -11,6 +11,7 @@
 // Memory is read from /proc/self/status (VmRSS, VmHWM, after malloc_trim
 // for what is kept), so it includes everything the process holds: Embree,
 // the meshes, the scene, the allocator's own overhead.
+#include "bench/processor.h"
 #include "core/compiled_scene.h"
 #include "core/scene_loader.h"
 
@@ -34,18 +35,6 @@ double status_bytes(const std::string& field) {
   while (std::getline(in, line))
     if (line.rfind(field + ":", 0) == 0) return std::strtod(line.c_str() + field.size() + 1, nullptr) * 1024.0;
   return 0.0;
-}
-
-std::string processor() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line, family, model, name;
-  while (std::getline(in, line) && (family.empty() || model.empty() || name.empty())) {
-    const auto value = [&] { return line.substr(line.find(':') + 2); };
-    if (line.rfind("cpu family", 0) == 0) family = value();
-    else if (line.rfind("model name", 0) == 0) name = value();
-    else if (line.rfind("model", 0) == 0 && model.empty()) model = value();
-  }
-  return name + " (family " + family + " model " + model + ")";
 }
 
 int measure(const char* file, const char* bvh) {
@@ -88,7 +77,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: pathlab_bench_memory [--bvh fast|compact] SCENE [SCENE...]\n");
     return 2;
   }
-  std::printf("processor: %s\n", pathlab::processor().c_str());
+  std::printf("processor: %s\n", pathlab::bench::processor().c_str());
   int status = 0;
   for (int i = first; i < argc; ++i) {
     std::fflush(stdout);

@@ -96,7 +96,8 @@ CompiledScene::CompiledScene(Scene scene)
   }
   // The images first: alpha textures are read during traversal.
   if (!scene_.textures.empty()) textures_ = std::make_unique<Textures>(scene_.textures, scene_.render.texture_cache_mb);
-  accel_ = std::make_unique<EmbreeAccel>(scene_.shapes, scene_.groups, scene_.instances, scene_.render.compact_bvh,
+  accel_ = std::make_unique<EmbreeAccel>(scene_.shapes, scene_.groups, scene_.instances,
+                                         BvhOptions{scene_.render.compact_bvh, scene_.render.intersection},
                                          scene_.materials, textures_.get());
   first_triangle_.resize(scene_.shapes.size() + 1, 0);
   for (std::size_t i = 0; i < scene_.shapes.size(); ++i) {

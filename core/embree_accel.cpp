@@ -172,7 +172,7 @@ struct EmbreeAccel::Impl {
   // geometry k in instance i's group is group_shapes[instance_group[i]][k].
   std::vector<std::vector<std::uint32_t>> group_shapes;
   std::vector<std::uint32_t> instance_group;  // per instance; empty for a scene without instances
-  bool compact = false;
+  BvhOptions options;
   std::span<const Material> materials;  // read while building only; empty: every shape opaque
   const Textures* textures = nullptr;   // for alpha textures
   // The alpha filters' user data, one per shape with alpha (a group's shape
@@ -187,8 +187,13 @@ struct EmbreeAccel::Impl {
   RTCScene new_scene() const {
     RTCScene s = rtcNewScene(device);
     // ROBUST: no arithmetic shortcuts that could let a ray slip through an
-    // edge shared by two triangles.
-    rtcSetSceneFlags(s, compact ? RTC_SCENE_FLAG_ROBUST | RTC_SCENE_FLAG_COMPACT : RTC_SCENE_FLAG_ROBUST);
+    // edge shared by two triangles (Embree's watertight triangle test and
+    // conservative box tests); without it Embree is faster and leaks a few
+    // rays in 10^7 (bench/bench_watertight.cpp).
+    int flags = RTC_SCENE_FLAG_NONE;
+    if (options.intersection == Intersection::Robust) flags |= RTC_SCENE_FLAG_ROBUST;
+    if (options.compact) flags |= RTC_SCENE_FLAG_COMPACT;
+    rtcSetSceneFlags(s, static_cast<RTCSceneFlags>(flags));
     rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
     return s;
   }
@@ -208,10 +213,10 @@ struct EmbreeAccel::Impl {
 };
 
 EmbreeAccel::EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups,
-                         std::span<const Instance> instances, bool compact, std::span<const Material> materials,
+                         std::span<const Instance> instances, BvhOptions options, std::span<const Material> materials,
                          const Textures* textures)
     : impl_(std::make_unique<Impl>()) {
-  impl_->compact = compact;
+  impl_->options = options;
   impl_->materials = materials;
   impl_->textures = textures;
   // Set before any shape is attached: the filters read it.

@@ -57,6 +57,13 @@ struct HitArrays {
   std::uint32_t* instance = nullptr;  // as RayHit::instance; may be null for a scene without instances
 };
 
+// How the BVH is built and how triangles are intersected: the scene's
+// RenderSettings::compact_bvh and RenderSettings::intersection.
+struct BvhOptions {
+  bool compact = false;
+  Intersection intersection = Intersection::Robust;
+};
+
 class EmbreeAccel {
  public:
   // Builds the BVH. Throws SystemError with Embree's message if the device
@@ -64,13 +71,13 @@ class EmbreeAccel {
   // their vertex arrays too where they have capacity for one more vertex
   // (CompiledScene reserves it): `shapes` must outlive the accel and keep
   // those arrays unchanged. Groups and instances are copied.
-  // `compact`: RenderSettings::compact_bvh. `materials`: the table
+  // `options`: compact or not, robust or fast. `materials`: the table
   // Shape::material indexes, read for alpha (empty: every shape opaque);
   // throws InputError for alpha on a sphere, whose two crossings of one
   // ray would share a decision. `textures`: the scene's images, which
   // alpha textures read (must outlive the accel; null if it has none).
   explicit EmbreeAccel(const std::vector<Shape>& shapes, std::span<const ShapeGroup> groups = {},
-                       std::span<const Instance> instances = {}, bool compact = false,
+                       std::span<const Instance> instances = {}, BvhOptions options = {},
                        std::span<const Material> materials = {}, const Textures* textures = nullptr);
   ~EmbreeAccel();
   EmbreeAccel(const EmbreeAccel&) = delete;

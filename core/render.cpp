@@ -57,6 +57,7 @@ std::vector<std::pair<std::string, std::string>> sample_settings(const RenderSet
       {"min_pdf", float_text(r.min_pdf)},
       {"general_shading", r.force_general_shading ? "on" : "off"},
       {"texture_filter", texture_filter_name(r.texture_filter)},
+      {"intersection", intersection_name(r.intersection)},
       {"bvh", r.compact_bvh ? "compact" : "fast"},
   };
   // zsobol's numbers depend on spp rounded up to a power of two (core/rng.h).

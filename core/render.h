@@ -129,7 +129,7 @@ Spectrum clamp_radiance(const Spectrum& L, float limit);
 
 // Every setting that changes a sample's bits, as (key, value) text, in a
 // fixed order: strategy, seed, sampler, max_depth, rr_depth, bsdf_sampling,
-// light_sampling, light_sampler, clamp, min_pdf, general_shading, texture_filter (and bvh,
+// light_sampling, light_sampler, clamp, min_pdf, general_shading, texture_filter, intersection (and bvh,
 // which changes no bit but names the build). Floats are written with 9
 // significant digits (they read back to the same float). Recorded in a
 // render's EXR header

@@ -41,4 +41,12 @@ std::optional<LightSamplerKind> parse_light_sampler(std::string_view name) {
   return std::nullopt;
 }
 
+const char* intersection_name(Intersection i) { return i == Intersection::Fast ? "fast" : "robust"; }
+
+std::optional<Intersection> parse_intersection(std::string_view name) {
+  for (Intersection i : {Intersection::Robust, Intersection::Fast})
+    if (name == intersection_name(i)) return i;
+  return std::nullopt;
+}
+
 }  // namespace pathlab

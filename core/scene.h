@@ -65,6 +65,16 @@ enum class LightSamplerKind : std::uint8_t {
 const char* light_sampler_name(LightSamplerKind k);
 std::optional<LightSamplerKind> parse_light_sampler(std::string_view name);
 
+// How Embree intersects triangles (RTC_SCENE_FLAG_ROBUST or not;
+// docs/scene-format.md, "Intersection"). A speed-for-accuracy trade with a
+// measured bias: bench/bench_watertight.cpp, docs/performance.md.
+enum class Intersection : std::uint8_t {
+  Robust,  // watertight: no ray slips between two triangles sharing an edge
+  Fast,    // Embree's fastest test; a few rays in 10^7 slip through shared edges
+};
+const char* intersection_name(Intersection i);
+std::optional<Intersection> parse_intersection(std::string_view name);
+
 struct RenderSettings {
   int spp = 16;
   // Maximum number of scattering events on a path: 0 shows only emission
@@ -100,6 +110,9 @@ struct RenderSettings {
   // a fifth less memory for a large mesh, about 10 % slower; the same hits,
   // so the same image). Measured in docs/performance.md.
   bool compact_bvh = false;
+  // Robust by default: the closed-form tests rely on closed meshes staying
+  // closed. Fast changes a sample's bits where a ray slips through an edge.
+  Intersection intersection = Intersection::Robust;
   // Textures: how lookups are filtered, and OIIO's tile cache (MB).
   TextureFilter texture_filter = TextureFilter::Cone;
   float texture_cache_mb = 256.0f;

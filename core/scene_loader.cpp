@@ -102,7 +102,7 @@ auto read_choice(const Node& value, const char* what, std::span<const std::strin
 }
 
 RenderSettings read_render(const Node& node) {
-  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh",
+  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh", "intersection",
                    "texture_filter", "texture_cache_mb", "light_sampling", "light_sampler", "sampler"});
   RenderSettings r;
   if (node.has("spp")) {
@@ -143,6 +143,10 @@ RenderSettings read_render(const Node& node) {
   if (node.has("light_sampler")) {
     constexpr std::array<std::string_view, 2> names{"power", "bvh"};
     r.light_sampler = read_choice(node.child("light_sampler"), "light sampler", names, parse_light_sampler);
+  }
+  if (node.has("intersection")) {
+    constexpr std::array<std::string_view, 2> names{"robust", "fast"};
+    r.intersection = read_choice(node.child("intersection"), "intersection", names, parse_intersection);
   }
   if (node.has("bvh")) {
     const std::string name = node.child("bvh").string();

@@ -171,6 +171,7 @@ json path_to_json(const TraceHeader& h, const PathRecorder& path, const Scene& s
           {"min_pdf", r.min_pdf},
           {"general_shading", r.force_general_shading},
           {"texture_filter", texture_filter_name(r.texture_filter)},
+          {"intersection", intersection_name(r.intersection)},
           {"bvh", r.compact_bvh ? "compact" : "fast"},
           {"pathlab_version", PATHLAB_VERSION},
           {"git_revision", git_revision()},

@@ -232,7 +232,7 @@ std::vector<Ray> keyed_rays(std::size_t n) {
 // through a surface, or the test proves nothing.
 TEST(Alpha, EveryRayModeAndLayoutMakesTheSameDecisions) {
   const Scene scene = test::cornell_with_alpha();
-  const EmbreeAccel accel(scene.shapes, scene.groups, scene.instances, false, scene.materials);
+  const EmbreeAccel accel(scene.shapes, scene.groups, scene.instances, BvhOptions{}, scene.materials);
   const EmbreeAccel opaque(scene.shapes, scene.groups, scene.instances);
   const std::size_t n = 600;
   const std::vector<Ray> rays = keyed_rays(n);

@@ -457,6 +457,9 @@ TEST_F(BadInput, BadTextureKeys) {
   const std::string sampler = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"sampler\": \"zsobel\"}");
   expect_rejected(render(write("sampler.json", sampler)),
                   {"sampler.json:", "/render/sampler", "unknown sampler 'zsobel' (did you mean 'zsobol'?)"});
+  const std::string hit = scene(kMaterials, kSphere + ",\n" + kLamp, "\"render\": {\"intersection\": \"robst\"}");
+  expect_rejected(render(write("hit.json", hit)),
+                  {"hit.json:", "/render/intersection", "unknown intersection 'robst' (did you mean 'robust'?)"});
 }
 
 TEST_F(BadInput, AlbedoAboveOne) {

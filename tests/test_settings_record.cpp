@@ -50,7 +50,7 @@ std::string joined(const std::vector<std::string>& args) {
 const std::vector<std::string> kSettings = {
     "--tracer",         "wavefront", "--strategy", "light", "--seed", "77", "--max-depth", "3",
     "--rr-depth",       "2",         "--bsdf-sampling", "cospow", "--light-sampling", "solid_angle", "--light-sampler", "bvh", "--clamp", "0.375", "--min-pdf", "0.03125",
-    "--general-shading", "--texture-filter", "point", "--bvh", "compact", "--resolution", "8x6"};
+    "--general-shading", "--texture-filter", "point", "--bvh", "compact", "--intersection", "fast", "--resolution", "8x6"};
 
 class SettingsRecord : public test::TempDirTest {};
 
@@ -66,7 +66,7 @@ TEST_F(SettingsRecord, RenderWritesEverySettingIntoTheExrHeader) {
       {"max_depth", "3"},          {"rr_depth", "2"},        {"bsdf_sampling", "cospow"},
       {"light_sampling", "solid_angle"}, {"light_sampler", "bvh"},
       {"clamp", "0.375"},          {"min_pdf", "0.03125"},   {"general_shading", "on"},
-      {"texture_filter", "point"}, {"bvh", "compact"},       {"spp", "3"},
+      {"texture_filter", "point"}, {"bvh", "compact"},       {"spp", "3"}, {"intersection", "fast"},
       {"resolution", "8x6"},       {"filter", "box"},        {"scene", "<built-in cornell>"},
       {"version", PATHLAB_VERSION}, {"git_revision", git_revision()}, {"clamped", "yes"},
       {"command_line", joined(args)},
@@ -95,6 +95,7 @@ TEST_F(SettingsRecord, UnclampedRenderSaysSo) {
   EXPECT_EQ(h.at("bsdf_sampling"), "vndf");
   EXPECT_EQ(h.at("light_sampling"), "area");
   EXPECT_EQ(h.at("light_sampler"), "power");
+  EXPECT_EQ(h.at("intersection"), "robust");
 }
 
 TEST_F(SettingsRecord, TracePixelRecordsEverySettingInJsonAndText) {
@@ -116,6 +117,7 @@ TEST_F(SettingsRecord, TracePixelRecordsEverySettingInJsonAndText) {
   EXPECT_EQ(j["general_shading"], true);
   EXPECT_EQ(j["texture_filter"], "point");
   EXPECT_EQ(j["bvh"], "compact");
+  EXPECT_EQ(j["intersection"], "fast");
   EXPECT_EQ(j["resolution"], json::array({8, 6}));
   EXPECT_EQ(j["pathlab_version"], PATHLAB_VERSION);
   EXPECT_EQ(j["git_revision"], git_revision());
@@ -128,7 +130,7 @@ TEST_F(SettingsRecord, TracePixelRecordsEverySettingInJsonAndText) {
   ASSERT_EQ(t.code, 0) << t.err;
   for (const char* part : {"strategy light", "seed 77", "max depth 3", "rr depth 2", "bsdf_sampling cospow",
                            "light_sampling solid_angle", "light_sampler bvh", "clamp 0.375", "min_pdf 0.03125", "general_shading on", "texture_filter point",
-                           "bvh compact", "tracer wavefront"})
+                           "intersection fast", "bvh compact", "tracer wavefront"})
     EXPECT_NE(t.err.find(part), std::string::npos) << part << "\n" << t.err;
   EXPECT_NE(t.err.find(std::string("pathlab ") + PATHLAB_VERSION + " (git " + git_revision() + ")"), std::string::npos)
       << t.err;

@@ -80,6 +80,7 @@ std::vector<std::string> scene_args(const SceneOptions& o, bool with_spp) {
   opt("--light-sampling", o.light_sampling);
   opt("--light-sampler", o.light_sampler);
   opt("--bvh", o.bvh);
+  opt("--intersection", o.intersection);
   opt("--clamp", o.clamp);
   opt("--min-pdf", o.min_pdf);
   opt("--texture-filter", o.texture_filter);

@@ -29,6 +29,7 @@ struct SceneOptions {
   std::optional<std::string> light_sampling;  // area | solid_angle
   std::optional<std::string> light_sampler;   // power | bvh
   std::optional<std::string> bvh;            // fast | compact
+  std::optional<std::string> intersection;   // robust | fast
   std::optional<float> clamp, min_pdf;       // firefly controls (biased; 0 = off)
   bool general_shading = false;              // force the general shading path
   std::optional<std::string> texture_filter;  // cone | point
