@@ -3,6 +3,7 @@
 #include "core/error.h"
 #include "core/sampling.h"
 #include "core/scene_limits.h"
+#include "core/simd/width1.h"
 
 #include <cmath>
 #include <limits>
@@ -142,14 +143,14 @@ Triangle make_triangle(const Shape& shape, std::uint32_t tri) {
                   triangle_normal(shape, tri)};
 }
 
+// The point and its error bound (PBR 4th ed. 6.8.3: interpolation error of
+// barycentric evaluation) by the generic function the wavefront's lanes run
+// (core/simd/lanes-inl.h), at width 1.
 SurfacePoint triangle_point(const Triangle& t, vec2 b) {
-  const float b0 = 1.0f - b.x - b.y;
-  SurfacePoint sp;
-  sp.p = b0 * t.p0 + b.x * t.p1 + b.y * t.p2;
-  // PBR 4th ed. 6.8.3: interpolation error of barycentric evaluation.
-  sp.p_error = gamma_bound(7) * (glm::abs(b0 * t.p0) + glm::abs(b.x * t.p1) + glm::abs(b.y * t.p2));
-  sp.n = t.n;
-  return sp;
+  using namespace width1;
+  F3 p, error;
+  generic::triangle_point(kScalar, F{b.x}, F{b.y}, lanes(t.p0), lanes(t.p1), lanes(t.p2), p, error);
+  return SurfacePoint{scalars(p), scalars(error), t.n};
 }
 
 SurfacePoint triangle_point(const Shape& shape, std::uint32_t tri, vec2 b) {

@@ -15,13 +15,6 @@ struct SurfacePoint {
   vec3 n;        // unit normal of the front side
 };
 
-// gamma(n) of Higham / PBR: a bound on the relative error of n float
-// operations, n * eps / (1 - n * eps) with eps = 2^-24.
-constexpr float gamma_bound(int n) {
-  constexpr float eps = 0x1p-24f;
-  return (static_cast<float>(n) * eps) / (1.0f - static_cast<float>(n) * eps);
-}
-
 // An axis-aligned box, empty until something is added to it.
 struct Box {
   vec3 lo{kInfinity}, hi{-kInfinity};

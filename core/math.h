@@ -42,19 +42,22 @@ inline bool is_black(const Spectrum& c) { return c.x == 0.0f && c.y == 0.0f && c
 inline bool is_finite(const vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 inline float sqr(float x) { return x * x; }
 
+// gamma(n) of Higham / PBR: a bound on the relative error of n float
+// operations, n * eps / (1 - n * eps) with eps = 2^-24.
+constexpr float gamma_bound(int n) {
+  constexpr float eps = 0x1p-24f;
+  return (static_cast<float>(n) * eps) / (1.0f - static_cast<float>(n) * eps);
+}
+
 // Orthonormal basis with `n` as its z axis (Duff et al. 2017, "Building an
 // Orthonormal Basis, Revisited": branchless and continuous except at n.z = -1).
 struct Frame {
   vec3 s, t, n;
 
   Frame() : s(1, 0, 0), t(0, 1, 0), n(0, 0, 1) {}
-  explicit Frame(const vec3& normal) : n(normal) {
-    const float sign = std::copysign(1.0f, n.z);
-    const float a = -1.0f / (sign + n.z);
-    const float b = n.x * n.y * a;
-    s = vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    t = vec3(b, sign + n.y * n.y * a, -n.y);
-  }
+  // Duff et al.'s orthonormal basis about the unit normal (core/math.cpp:
+  // the generic frame() of core/simd/lanes-inl.h at width 1).
+  explicit Frame(const vec3& normal);
   // The frame of a unit tangent `tangent` perpendicular to `normal`: s along
   // it, t = handedness * cross(n, s), so that a mesh's bitangent (handedness
   // w = +-1, glTF's convention) is the t axis. With w = -1 the frame is

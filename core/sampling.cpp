@@ -1,6 +1,7 @@
 #include "core/sampling.h"
 
 #include "core/simd/sampling-inl.h"
+#include "core/simd/width1.h"
 
 #include <hwy/highway.h>
 
@@ -75,9 +76,24 @@ vec2 uniform_sphere_to_square(const vec3& w) {
   return vec2((1.0f - w.z) * 0.5f, phi * kInv2Pi);
 }
 
+// These two are the generic functions of core/simd/lanes-inl.h at width 1:
+// the wavefront's lanes run the same source.
+float power_heuristic(float pdf_a, float pdf_b) {
+  using namespace width1;
+  return generic::power_heuristic(kScalar, F{pdf_a}, F{pdf_b}).raw;
+}
+
+float area_to_solid_angle(float pdf_area, float dist, float cos_light) {
+  using namespace width1;
+  return generic::area_to_solid_angle(kScalar, F{pdf_area}, F{dist}, F{cos_light}).raw;
+}
+
 vec2 square_to_uniform_triangle(vec2 u) {
-  const float s = std::sqrt(u.x);
-  return vec2(u.y * s, 1.0f - s);  // (b1, b2); b0 = s (1 - u.y)
+  // (b1, b2) = (u.y sqrt(u.x), 1 - sqrt(u.x)); b0 = sqrt(u.x) (1 - u.y).
+  using namespace width1;
+  F b1, b2;
+  generic::uniform_triangle(kScalar, F{u.x}, F{u.y}, b1, b2);
+  return vec2(b1.raw, b2.raw);
 }
 
 vec2 uniform_triangle_to_square(vec2 b) {

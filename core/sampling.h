@@ -42,23 +42,16 @@ vec2 uniform_sphere_to_square(const vec3& w);
 vec2 square_to_uniform_triangle(vec2 u);
 vec2 uniform_triangle_to_square(vec2 b);
 
-// Veach's power heuristic (beta = 2) for two one-sample techniques.
-inline float power_heuristic(float pdf_a, float pdf_b) {
-  if (std::isinf(pdf_a)) return 1.0f;  // a delta the other technique cannot sample
-  if (!(pdf_a > 0.0f)) return 0.0f;
-  // a^2 / (a^2 + b^2) through the ratio: squaring the pdfs themselves would
-  // overflow above ~1.8e19 and underflow below ~1e-23.
-  const float r = pdf_b / pdf_a;
-  return 1.0f / (1.0f + r * r);
-}
+// Veach's power heuristic (beta = 2) for two one-sample techniques: 1 for
+// an infinite pdf_a (a delta the other technique cannot sample), 0 unless
+// pdf_a > 0, else a^2 / (a^2 + b^2) through the ratio b / a (squaring the
+// pdfs themselves would overflow above ~1.8e19 and underflow below ~1e-23).
+float power_heuristic(float pdf_a, float pdf_b);
 
 // Solid-angle density of a point sampled on a surface with area density
 // `pdf_area`, seen from distance `dist` at cosine `cos_light` to its normal.
 // Returns 0 when the surface is seen edge-on (the sample carries no energy).
-inline float area_to_solid_angle(float pdf_area, float dist, float cos_light) {
-  const float c = std::abs(cos_light);
-  return c > 0.0f ? pdf_area * dist * dist / c : 0.0f;
-}
+float area_to_solid_angle(float pdf_area, float dist, float cos_light);
 
 // A piecewise-constant density on [0, 1) over n equal cells, proportional
 // to non-negative weights (pbrt-v4's PiecewiseConstant1D). The density of a

@@ -4,6 +4,7 @@
 
 #include <hwy/highway.h>
 
+#include "core/simd/lanes-inl.h"
 #include "core/simd/sampling-inl.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -30,6 +31,34 @@ void simd_warps(const float* ux, const float* uy, float* x, float* y, float* z, 
   for (; i < n; ++i) warp_lanes(one, ux + i, uy + i, x + i, y + i, z + i, s + i, c + i);
 }
 
+template <class D>
+void offset_lanes(D d, const float* p, const float* e, const float* n, float* out) {
+  using V = hn::Vec<D>;
+  constexpr std::size_t kMax = hn::MaxLanes(D());
+  const std::size_t lanes = hn::Lanes(d);
+  // Interleaved xyz to one array per coordinate, and back.
+  float in[9][kMax];
+  for (std::size_t i = 0; i < lanes; ++i)
+    for (int k = 0; k < 3; ++k) in[k][i] = p[3 * i + k], in[3 + k][i] = e[3 * i + k], in[6 + k][i] = n[3 * i + k];
+  const auto load = [&](int k) {
+    return warps::Vec3<V>{hn::LoadU(d, in[k]), hn::LoadU(d, in[k + 1]), hn::LoadU(d, in[k + 2])};
+  };
+  const warps::Vec3<V> r = warps::offset_ray_origin(d, load(0), load(3), load(6));
+  float o[3][kMax];
+  hn::StoreU(r.x, d, o[0]), hn::StoreU(r.y, d, o[1]), hn::StoreU(r.z, d, o[2]);
+  for (std::size_t i = 0; i < lanes; ++i)
+    for (int k = 0; k < 3; ++k) out[3 * i + k] = o[k][i];
+}
+
+void simd_offset_ray_origin(const float* p, const float* error, const float* normal, float* out, std::size_t n) {
+  const hn::ScalableTag<float> d;
+  const std::size_t lanes = hn::Lanes(d);
+  std::size_t i = 0;
+  for (; i + lanes <= n; i += lanes) offset_lanes(d, p + 3 * i, error + 3 * i, normal + 3 * i, out + 3 * i);
+  const hn::CappedTag<float, 1> one;
+  for (; i < n; ++i) offset_lanes(one, p + 3 * i, error + 3 * i, normal + 3 * i, out + 3 * i);
+}
+
 }  // namespace pathlab::test::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -40,6 +69,10 @@ namespace pathlab::test {
 HWY_EXPORT(simd_warps);
 void simd_warps(const float* ux, const float* uy, float* x, float* y, float* z, float* s, float* c, std::size_t n) {
   HWY_DYNAMIC_DISPATCH(simd_warps)(ux, uy, x, y, z, s, c, n);
+}
+HWY_EXPORT(simd_offset_ray_origin);
+void simd_offset_ray_origin(const float* p, const float* error, const float* normal, float* out, std::size_t n) {
+  HWY_DYNAMIC_DISPATCH(simd_offset_ray_origin)(p, error, normal, out, n);
 }
 }  // namespace pathlab::test
 #endif

@@ -12,4 +12,9 @@ namespace pathlab::test {
 // dispatched target, then the tail at width 1.
 void simd_warps(const float* ux, const float* uy, float* x, float* y, float* z, float* s, float* c, std::size_t n);
 
+// For i in [0, n): out[3i..3i+2] = offset_ray_origin(p, error, normal) of
+// core/simd/lanes-inl.h, each argument three floats at [3i]. Full vectors
+// of the dispatched target, then the tail at Highway's width 1.
+void simd_offset_ray_origin(const float* p, const float* error, const float* normal, float* out, std::size_t n);
+
 }  // namespace pathlab::test

@@ -2,6 +2,7 @@
 // core/simd/*-inl.h: every SIMD target this machine runs computes, lane by
 // lane, the bits of the width-1 code that both tracers' scalar paths call.
 #include "core/error.h"
+#include "core/ray.h"
 #include "core/sampling.h"
 #include "core/simd/simd.h"
 #include "tests/simd_kernels.h"
@@ -10,6 +11,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
@@ -129,6 +131,77 @@ TEST(SimdWarps, EveryTargetComputesTheBitsOfTheWidthOneCode) {
           ADD_FAILURE() << simd_target_name(t) << ": " << names[k] << " of u = (" << ux[i] << ", " << uy[i]
                         << ") is " << out[k][i] << ", the width-1 code gives " << std::bit_cast<float>(want[5 * i + k]);
     EXPECT_EQ(differ, 0u) << simd_target_name(t) << ": values differing from the width-1 code, of " << 5 * n;
+  }
+}
+
+// offset_ray_origin: core's scalar function (lanes-inl.h's generic code at
+// lane1's width 1, whose NextFloat is core/ray.h's branches) and every
+// target's lanes (NextFloat by selects) step to the same floats, on points
+// where the stepping's cases meet: both zeros, denormals, the largest
+// floats and the infinities, no error across the surface (the fallback
+// offset), normals with zero and negative components. A NaN result (inf -
+// inf on the way) counts as equal to any NaN: the compiler may swap the
+// operands of an addition, and with them which NaN's sign comes out. NaN
+// points are not among the inputs: Highway's width-1 target (HWY_SCALAR,
+// which only these kernels run) takes Max's non-NaN operand where x86
+// takes the second; a ray from a NaN point is NaN whatever these bits, and
+// the film counts and drops its sample.
+TEST(SimdOffsetRayOrigin, EveryTargetComputesTheBitsOfCoresScalarFunction) {
+  const SimdChoice restore;
+  const float specials[] = {0.0f,
+                            -0.0f,
+                            std::numeric_limits<float>::denorm_min(),
+                            -std::numeric_limits<float>::denorm_min(),
+                            std::numeric_limits<float>::min(),
+                            1.0f,
+                            -1.0f,
+                            0x1p-100f,
+                            3.5e7f,
+                            -std::numeric_limits<float>::max(),
+                            std::numeric_limits<float>::max(),
+                            std::numeric_limits<float>::infinity(),
+                            -std::numeric_limits<float>::infinity()};
+  std::mt19937 g(5);
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(std::size(specials)) - 1);
+  std::uniform_real_distribution<float> u(-4.0f, 4.0f);
+  constexpr std::size_t n = 200003;  // not a multiple of any width: the tail runs at width 1
+  std::vector<float> p(3 * n), e(3 * n), nrm(3 * n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      // Half the points special coordinate by coordinate; the errors 0 a
+      // third of the time (the fallback); normals with zeros and signs.
+      p[3 * i + k] = i % 2 ? specials[pick(g)] : u(g);
+      e[3 * i + k] = i % 3 ? std::abs(u(g)) * 1e-6f : 0.0f;
+      nrm[3 * i + k] = i % 5 == 0 ? (k == 1 ? 0.0f : -0.5f) : u(g);
+    }
+  // p + offset exactly 0, then stepped up and down to the denormals.
+  for (std::size_t i = 0; i < 64; ++i) {
+    const float side = i % 2 ? 1.0f : -1.0f, d = std::ldexp(1.0f, -static_cast<int>(i));
+    for (int k = 0; k < 3; ++k) {
+      p[3 * i + k] = -side * d;
+      e[3 * i + k] = k == 2 ? d : 0.0f;
+      nrm[3 * i + k] = k == 2 ? side : 0.0f;
+    }
+  }
+  std::vector<std::uint32_t> want(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const vec3 o = offset_ray_origin(vec3(p[3 * i], p[3 * i + 1], p[3 * i + 2]),
+                                     vec3(e[3 * i], e[3 * i + 1], e[3 * i + 2]),
+                                     vec3(nrm[3 * i], nrm[3 * i + 1], nrm[3 * i + 2]));
+    for (int k = 0; k < 3; ++k) want[3 * i + k] = std::bit_cast<std::uint32_t>(o[k]);
+  }
+  for (SimdTarget t : supported_simd_targets()) {
+    select_simd_target(t);
+    std::vector<float> out(3 * n, std::numeric_limits<float>::quiet_NaN());
+    test::simd_offset_ray_origin(p.data(), e.data(), nrm.data(), out.data(), n);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < 3 * n; ++i)
+      if (std::bit_cast<std::uint32_t>(out[i]) != want[i] && !(std::isnan(out[i]) && std::isnan(std::bit_cast<float>(want[i]))) &&
+          differ++ < 5)
+        ADD_FAILURE() << simd_target_name(t) << ": coordinate " << i % 3 << " of p = (" << p[i - i % 3] << ", "
+                      << p[i - i % 3 + 1] << ", " << p[i - i % 3 + 2] << ") is " << out[i] << ", core's "
+                      << std::bit_cast<float>(want[i]);
+    EXPECT_EQ(differ, 0u) << simd_target_name(t);
   }
 }
 

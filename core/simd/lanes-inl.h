@@ -9,7 +9,7 @@
 // core/simd/simd.h and docs/one-estimator.md. In short: the order of every
 // sum and product is the scalar code's (GLM's dot is (x + y) + z, a vec3
 // times a float multiplies each component), no fused multiply-add, and
-// std::max(a, b) is hn::Max(b, a) (x86's max returns its second operand for
+// std::max(a, b) is Max(b, a) (x86's max returns its second operand for
 // a NaN or for -0 against +0, std::max its first).
 //
 // Highway's "-inl.h" convention: no include guard but the toggle below.
@@ -22,6 +22,8 @@
 
 #include <hwy/highway.h>
 
+#include "core/math.h"
+#include "core/simd/lane1.h"
 #include "core/sobol.h"
 
 #include <cmath>
@@ -36,9 +38,9 @@ template <class V>
 struct Vec3 {
   V x, y, z;
 };
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE Vec3<V> splat3(D d, float x, float y, float z) {
-  return {hn::Set(d, x), hn::Set(d, y), hn::Set(d, z)};
+  return {Set(d, x), Set(d, y), Set(d, z)};
 }
 template <class V>
 HWY_INLINE Vec3<V> operator+(const Vec3<V>& a, const Vec3<V>& b) {
@@ -64,19 +66,19 @@ HWY_INLINE Vec3<V> operator/(const Vec3<V>& a, V s) {
 }
 template <class V>
 HWY_INLINE Vec3<V> operator-(const Vec3<V>& a) {
-  return {hn::Neg(a.x), hn::Neg(a.y), hn::Neg(a.z)};
+  return {Neg(a.x), Neg(a.y), Neg(a.z)};
 }
 template <class V>
 HWY_INLINE Vec3<V> abs(const Vec3<V>& a) {
-  return {hn::Abs(a.x), hn::Abs(a.y), hn::Abs(a.z)};
+  return {Abs(a.x), Abs(a.y), Abs(a.z)};
 }
 template <class M, class V>
 HWY_INLINE Vec3<V> select(M m, const Vec3<V>& yes, const Vec3<V>& no) {
-  return {hn::IfThenElse(m, yes.x, no.x), hn::IfThenElse(m, yes.y, no.y), hn::IfThenElse(m, yes.z, no.z)};
+  return {IfThenElse(m, yes.x, no.x), IfThenElse(m, yes.y, no.y), IfThenElse(m, yes.z, no.z)};
 }
 template <class M, class V>
 HWY_INLINE Vec3<V> zero_unless(M m, const Vec3<V>& a) {
-  return {hn::IfThenElseZero(m, a.x), hn::IfThenElseZero(m, a.y), hn::IfThenElseZero(m, a.z)};
+  return {IfThenElseZero(m, a.x), IfThenElseZero(m, a.y), IfThenElseZero(m, a.z)};
 }
 // glm::dot: (x x' + y y') + z z'.
 template <class V>
@@ -84,62 +86,68 @@ HWY_INLINE V dot(const Vec3<V>& a, const Vec3<V>& b) {
   return (a.x * b.x + a.y * b.y) + a.z * b.z;
 }
 // glm::normalize: v * (1 / sqrt(v.v)).
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE Vec3<V> normalize(D d, const Vec3<V>& v) {
-  return (hn::Set(d, 1.0f) / hn::Sqrt(dot(v, v))) * v;
+  return (Set(d, 1.0f) / Sqrt(dot(v, v))) * v;
 }
-template <class D, class V = hn::Vec<D>>
-HWY_INLINE hn::Mask<D> is_black(D d, const Vec3<V>& a) {
-  const V zero = hn::Zero(d);
-  return hn::And(hn::And(a.x == zero, a.y == zero), a.z == zero);
+template <class D, class V = VecOf<D>>
+HWY_INLINE auto is_black(D d, const Vec3<V>& a) {
+  const V zero = Zero(d);
+  return And(And(a.x == zero, a.y == zero), a.z == zero);
 }
 
 // next_float_up / next_float_down (core/ray.h): the neighbouring float away
 // from (up) or towards minus infinity; NaN and the infinity in that
 // direction stay, 0 (either sign) becomes +-denorm_min.
-template <bool kUp, class D, class V = hn::Vec<D>>
-HWY_INLINE V next_float(D d, V v) {
+template <bool kUp, class D, class V = VecOf<D>>
+HWY_INLINE V NextFloat(D d, V v) {
   const hn::RebindToSigned<D> di;
-  const auto bits = hn::BitCast(di, v);
-  const auto one = hn::Set(di, 1);
-  const auto positive = hn::RebindMask(di, v > hn::Zero(d));
+  const auto bits = BitCast(di, v);
+  const auto one = Set(di, 1);
+  const auto positive = RebindMask(di, v > Zero(d));
   const auto away = bits + one, toward = bits - one;
-  auto r = kUp ? hn::IfThenElse(positive, away, toward) : hn::IfThenElse(positive, toward, away);
-  r = hn::IfThenElse(hn::RebindMask(di, v == hn::Zero(d)), hn::Set(di, kUp ? 1 : INT32_MIN + 1), r);
-  const V inf = hn::Set(d, kUp ? HUGE_VALF : -HUGE_VALF);
-  const auto keep = hn::Or(hn::IsNaN(v), v == inf);
-  return hn::IfThenElse(keep, v, hn::BitCast(d, r));
+  auto r = kUp ? IfThenElse(positive, away, toward) : IfThenElse(positive, toward, away);
+  r = IfThenElse(RebindMask(di, v == Zero(d)), Set(di, kUp ? 1 : INT32_MIN + 1), r);
+  const V inf = Set(d, kUp ? HUGE_VALF : -HUGE_VALF);
+  const auto keep = Or(IsNaN(v), v == inf);
+  return IfThenElse(keep, v, BitCast(d, r));
+}
+
+// c moved one float in the direction of o's sign: up for o > 0, down for
+// o < 0, unchanged for 0 or NaN. A primitive, like Highway's operations:
+// lane1 (core/simd/lane1.h) has its own, core/ray.h's branches (cheaper at
+// width 1 than computing both neighbours), which overload resolution
+// prefers for its lanes; tests/test_simd.cpp holds the two to one set of bits.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V StepAway(D d, V c, V o) {
+  return IfThenElse(o > Zero(d), NextFloat<true>(d, c), IfThenElse(o < Zero(d), NextFloat<false>(d, c), c));
 }
 
 // offset_ray_origin (core/ray.h): p moved off its surface along n by its
 // rounding error bound across the surface, then one float further.
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE Vec3<V> offset_ray_origin(D d, const Vec3<V>& p, const Vec3<V>& error, const Vec3<V>& n) {
   V dist = dot(abs(n), error);
   // No error across the surface (every vertex on a coordinate plane through
   // the origin): one float of the largest coordinate, at least 2^-100.
   // std::max(std::max(|x|, std::max(|y|, |z|)) * 2^-23, 2^-100), in Max's order.
   const Vec3<V> a = abs(p);
-  const V largest = hn::Max(hn::Max(a.z, a.y), a.x);
-  dist = hn::IfThenElse(dist == hn::Zero(d), hn::Max(hn::Set(d, 0x1p-100f), largest * hn::Set(d, 0x1p-23f)), dist);
+  const V largest = Max(Max(a.z, a.y), a.x);
+  dist = IfThenElse(dist == Zero(d), Max(Set(d, 0x1p-100f), largest * Set(d, 0x1p-23f)), dist);
   const Vec3<V> offset = dist * n;
   const Vec3<V> po = p + offset;
-  auto step = [d](V c, V o) {
-    c = hn::IfThenElse(o > hn::Zero(d), next_float<true>(d, c), c);
-    return hn::IfThenElse(o < hn::Zero(d), next_float<false>(d, c), c);
-  };
-  return {step(po.x, offset.x), step(po.y, offset.y), step(po.z, offset.z)};
+  return {StepAway(d, po.x, offset.x), StepAway(d, po.y, offset.y), StepAway(d, po.z, offset.z)};
 }
 
 // Frame(n) (core/math.h): the tangents s and t of Duff et al.'s
 // orthonormal basis about the unit normal n.
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE void frame(D d, const Vec3<V>& n, Vec3<V>& s, Vec3<V>& t) {
-  const V sign = hn::CopySign(hn::Set(d, 1.0f), n.z);
-  const V a = hn::Set(d, -1.0f) / (sign + n.z);
+  const V sign = CopySign(Set(d, 1.0f), n.z);
+  const V a = Set(d, -1.0f) / (sign + n.z);
   const V b = n.x * n.y * a;
-  s = {hn::Set(d, 1.0f) + sign * n.x * n.x * a, sign * b, hn::Neg(sign) * n.x};
-  t = {b, sign + n.y * n.y * a, hn::Neg(n.y)};
+  s = {Set(d, 1.0f) + sign * n.x * n.x * a, sign * b, Neg(sign) * n.x};
+  t = {b, sign + n.y * n.y * a, Neg(n.y)};
 }
 // Frame::to_world: s x + t y + n z.
 template <class V>
@@ -149,40 +157,39 @@ HWY_INLINE Vec3<V> to_world(const Vec3<V>& s, const Vec3<V>& t, const Vec3<V>& n
 
 // power_heuristic (core/sampling.h): a^2 / (a^2 + b^2) through the ratio;
 // 1 for an infinite a (a delta), 0 unless a > 0.
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE V power_heuristic(D d, V a, V b) {
   const V r = b / a;
-  const V w = hn::Set(d, 1.0f) / (hn::Set(d, 1.0f) + r * r);
-  return hn::IfThenElse(hn::IsInf(a), hn::Set(d, 1.0f), hn::IfThenElseZero(a > hn::Zero(d), w));
+  const V w = Set(d, 1.0f) / (Set(d, 1.0f) + r * r);
+  return IfThenElse(IsInf(a), Set(d, 1.0f), IfThenElseZero(a > Zero(d), w));
 }
 
 // area_to_solid_angle (core/sampling.h): pdf_area d^2 / |cos|, 0 edge-on.
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE V area_to_solid_angle(D d, V pdf_area, V dist, V cos_light) {
-  const V c = hn::Abs(cos_light);
-  return hn::IfThenElseZero(c > hn::Zero(d), pdf_area * dist * dist / c);
+  const V c = Abs(cos_light);
+  return IfThenElseZero(c > Zero(d), pdf_area * dist * dist / c);
 }
 
 // A point of a triangle from barycentrics b1, b2 and its rounding error
 // bound (triangle_point, core/geometry.cpp): b0 = (1 - b1) - b2,
 // p = (b0 p0 + b1 p1) + b2 p2, error = gamma(7) ((|b0 p0| + |b1 p1|) + |b2 p2|).
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE void triangle_point(D d, V b1, V b2, const Vec3<V>& p0, const Vec3<V>& p1, const Vec3<V>& p2, Vec3<V>& p,
                                Vec3<V>& error) {
-  constexpr float kGamma7 = (7.0f * 0x1p-24f) / (1.0f - 7.0f * 0x1p-24f);  // gamma_bound(7), core/geometry.h
-  const V b0 = hn::Set(d, 1.0f) - b1 - b2;
+  const V b0 = Set(d, 1.0f) - b1 - b2;
   const Vec3<V> a0 = b0 * p0, a1 = b1 * p1, a2 = b2 * p2;
   p = (a0 + a1) + a2;
-  error = hn::Set(d, kGamma7) * ((abs(a0) + abs(a1)) + abs(a2));
+  error = Set(d, gamma_bound(7)) * ((abs(a0) + abs(a1)) + abs(a2));
 }
 
 // square_to_uniform_triangle (core/sampling.cpp): barycentrics (b1, b2) =
 // (uy sqrt(ux), 1 - sqrt(ux)).
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE void uniform_triangle(D d, V ux, V uy, V& b1, V& b2) {
-  const V s = hn::Sqrt(ux);
+  const V s = Sqrt(ux);
   b1 = uy * s;
-  b2 = hn::Set(d, 1.0f) - s;
+  b2 = Set(d, 1.0f) - s;
 }
 
 // 64-bit lanes: z * c modulo 2^64. Highway 1.0 has no 64-bit multiply but

@@ -1,0 +1,137 @@
+// One lane as a plain scalar: the width-1 instantiation of the generic
+// per-lane code (core/simd/lanes-inl.h) that core's scalar functions call,
+// so that the reference tracer and the wavefront's lanes run one source.
+//
+// Why not Highway's own width 1: the build's baseline is Highway's
+// HWY_SCALAR target, whose Max, selects and bit casts go through branches
+// and memcpy; the generic offset_ray_origin cost 4x core's hand-written
+// scalar body there (docs/one-estimator.md). Here every operation is the
+// plain scalar expression the compiler already turns into one instruction
+// (maxss, a conditional move, a register move), and it has x86's semantics,
+// which the generic code is written against:
+//   Max(a, b) = a > b ? a : b and Min(a, b) = a < b ? a : b return the
+//   second operand when either is NaN or both are zero (maxps/minps);
+//   Sqrt is IEEE's correctly rounded square root (sqrtss = sqrtps lane).
+//
+// The generic code finds these by argument-dependent lookup: it calls its
+// operations unqualified (Max(a, b), Set(d, x)), and for Highway's vectors
+// and descriptors the same lookup finds Highway's. It names its vector type
+// VecOf<D> (below) rather than hn::Vec<D>.
+#pragma once
+
+#include "core/ray.h"
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+
+namespace pathlab {
+
+// The vector type of descriptor D, for Highway's descriptors and lane1's.
+template <class D>
+using VecOf = decltype(Zero(D()));
+
+namespace lane1 {
+
+// The descriptor: one lane of Lane (float or std::int32_t). Rebind is what
+// Highway's RebindToSigned<D> and friends read.
+template <typename Lane>
+struct One {
+  using T = Lane;
+  template <typename NewT>
+  using Rebind = One<NewT>;
+};
+
+// A lane and a lane's mask.
+template <typename T>
+struct V {
+  T raw;
+};
+struct M {
+  bool raw;
+};
+
+template <typename T>
+inline V<T> Set(One<T>, T x) {
+  return {x};
+}
+template <typename T>
+inline V<T> Zero(One<T>) {
+  return {T(0)};
+}
+
+template <typename T>
+inline V<T> operator+(V<T> a, V<T> b) {
+  return {static_cast<T>(a.raw + b.raw)};
+}
+template <typename T>
+inline V<T> operator-(V<T> a, V<T> b) {
+  return {static_cast<T>(a.raw - b.raw)};
+}
+template <typename T>
+inline V<T> operator*(V<T> a, V<T> b) {
+  return {static_cast<T>(a.raw * b.raw)};
+}
+template <typename T>
+inline V<T> operator/(V<T> a, V<T> b) {
+  return {static_cast<T>(a.raw / b.raw)};
+}
+template <typename T>
+inline M operator==(V<T> a, V<T> b) {
+  return {a.raw == b.raw};
+}
+template <typename T>
+inline M operator<(V<T> a, V<T> b) {
+  return {a.raw < b.raw};
+}
+template <typename T>
+inline M operator>(V<T> a, V<T> b) {
+  return {a.raw > b.raw};
+}
+
+inline M And(M a, M b) { return {a.raw && b.raw}; }
+inline M Or(M a, M b) { return {a.raw || b.raw}; }
+template <typename T>
+inline M RebindMask(One<T>, M m) {
+  return m;
+}
+
+template <typename T>
+inline V<T> IfThenElse(M m, V<T> yes, V<T> no) {
+  return m.raw ? yes : no;
+}
+template <typename T>
+inline V<T> IfThenElseZero(M m, V<T> yes) {
+  return m.raw ? yes : V<T>{T(0)};
+}
+template <typename T>
+inline V<T> IfThenZeroElse(M m, V<T> no) {
+  return m.raw ? V<T>{T(0)} : no;
+}
+
+// x86's maxps/minps, operand order included (see the top of the file).
+inline V<float> Max(V<float> a, V<float> b) { return a.raw > b.raw ? a : b; }
+inline V<float> Min(V<float> a, V<float> b) { return a.raw < b.raw ? a : b; }
+inline V<float> Sqrt(V<float> a) { return {std::sqrt(a.raw)}; }
+inline V<float> Abs(V<float> a) { return {std::fabs(a.raw)}; }
+inline V<float> Neg(V<float> a) { return {-a.raw}; }
+inline V<float> CopySign(V<float> magnitude, V<float> sign) { return {std::copysign(magnitude.raw, sign.raw)}; }
+inline M IsNaN(V<float> a) { return {std::isnan(a.raw)}; }
+inline M IsInf(V<float> a) { return {std::isinf(a.raw)}; }
+
+// c one float up for o > 0, down for o < 0 (lanes-inl.h's StepAway) by
+// core/ray.h's scalar primitives, whose branches are cheaper at width 1
+// than the form vector lanes need (both neighbours, then selects; held to
+// these bits by tests/test_simd.cpp).
+inline V<float> StepAway(One<float>, V<float> c, V<float> o) {
+  return {o.raw > 0.0f ? next_float_up(c.raw) : o.raw < 0.0f ? next_float_down(c.raw) : c.raw};
+}
+
+template <typename To, typename From>
+inline V<To> BitCast(One<To>, V<From> v) {
+  static_assert(sizeof(To) == sizeof(From));
+  return {std::bit_cast<To>(v.raw)};
+}
+
+}  // namespace lane1
+}  // namespace pathlab

@@ -1,0 +1,22 @@
+// core's scalar code calling the generic per-lane functions of
+// core/simd/lanes-inl.h at width 1, through lane1's plain scalars
+// (core/simd/lane1.h): one source for a step that the reference tracer and
+// the wavefront's lanes both take. Include only from core's .cpp files (it
+// includes lanes-inl.h at the build's static target).
+#pragma once
+
+#include "core/math.h"
+#include "core/simd/lane1.h"
+#include "core/simd/lanes-inl.h"
+
+namespace pathlab::width1 {
+
+namespace generic = pathlab::HWY_NAMESPACE;
+using F = lane1::V<float>;
+using F3 = generic::Vec3<F>;
+inline constexpr lane1::One<float> kScalar{};  // the descriptor: one plain float
+
+inline F3 lanes(const vec3& v) { return {{v.x}, {v.y}, {v.z}}; }
+inline vec3 scalars(const F3& v) { return vec3(v.x.raw, v.y.raw, v.z.raw); }
+
+}  // namespace pathlab::width1
