@@ -44,32 +44,28 @@ constexpr std::uint32_t reverse_bits(std::uint32_t v) {
   return (v >> 16) | (v << 16);
 }
 
-// Generator matrices, column j being the image of index bit j. Dimension 0
-// is the identity (van der Corput: index bit j becomes digit j + 1 after the
-// point). Dimension 1 is Pascal's matrix mod 2 (Sobol's direction numbers
-// for the primitive polynomial x + 1): digit i + 1 of column j is
-// binomial(j, i) mod 2, which by Lucas's theorem is 1 exactly when the bits
-// of i are a subset of the bits of j. Index bits from 32 on only reach
-// digits past the 32nd, which a 32-bit value drops.
-constexpr std::uint32_t pascal_column(unsigned j) {
-  std::uint32_t c = 0;
-  for (unsigned i = 0; i <= j && i < 32; ++i)
-    if ((i & j) == i) c |= 0x80000000u >> i;
-  return c;
-}
-inline constexpr std::array<std::uint32_t, 32> kPascal = [] {
-  std::array<std::uint32_t, 32> m{};
-  for (unsigned j = 0; j < 32; ++j) m[j] = pascal_column(j);
-  return m;
-}();
-
-// Point `index` of Sobol's sequence in dimension 0 or 1, unscrambled.
+// Point `index` of Sobol's sequence in dimension 0 or 1, unscrambled, from
+// its generator matrix (column j the image of index bit j; index bits from 32
+// on only reach digits past the 32nd, which a 32-bit value drops).
+// Dimension 0 is the identity (van der Corput: index bit j becomes digit
+// j + 1 after the point). Dimension 1 is Pascal's matrix mod 2 (Sobol's
+// direction numbers for the primitive polynomial x + 1): digit i + 1 of
+// column j is binomial(j, i) mod 2, 1 exactly when the bits of i are a
+// subset of the bits of j (Lucas). So digit i + 1 of the point is the parity
+// of the index's set bits j that contain i, a sum over supersets which five
+// butterflies compute for every i at once (f[i] ^= f[i + 2^b] where bit b of
+// i is clear), before the reversal into digit order. core/simd/sobol-inl.h
+// computes the same in lanes; tests/test_sobol.cpp checks it against the
+// binomials.
 constexpr std::uint32_t sample(std::uint64_t index, int dim) {
-  const auto low = static_cast<std::uint32_t>(index);
-  if (dim == 0) return reverse_bits(low);
-  std::uint32_t v = 0;
-  for (std::uint32_t a = low; a != 0; a &= a - 1) v ^= kPascal[static_cast<unsigned>(std::countr_zero(a))];
-  return v;
+  auto f = static_cast<std::uint32_t>(index);
+  if (dim == 0) return reverse_bits(f);
+  f ^= (f >> 1) & 0x55555555u;
+  f ^= (f >> 2) & 0x33333333u;
+  f ^= (f >> 4) & 0x0f0f0f0fu;
+  f ^= (f >> 8) & 0x00ff00ffu;
+  f ^= (f >> 16) & 0x0000ffffu;
+  return reverse_bits(f);
 }
 
 // A nested scrambling of v seeded by `seed`: digit k of the result is digit
