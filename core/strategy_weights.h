@@ -9,7 +9,6 @@
 //     light+bsdf 2 p_l / (p_l + p_b).
 #pragma once
 
-#include "core/faults.h"
 #include "core/light_bvh.h"
 #include "core/math.h"
 #include "core/sampling.h"
@@ -30,25 +29,17 @@ struct PreviousVertex {
   bool bsdf_technique = true;  // light+bsdf: that vertex chose BSDF sampling
 };
 
-inline float emission_weight(Strategy strategy, const PreviousVertex& prev, float light_pdf) {
-  if (prev.impulse || PATHLAB_FAULT(EmissionAfterNee)) return 1.0f;
-  switch (strategy) {
-    case Strategy::Cosine:
-    case Strategy::Bsdf: return 1.0f;
-    case Strategy::Light: return light_pdf > 0.0f ? 0.0f : 1.0f;  // what NEE cannot pick, only a ray finds
-    case Strategy::Mis: return power_heuristic(prev.pdf, light_pdf);
-    case Strategy::LightBsdf:
-      // f / (p_b / 2 + p_l / 2) = (f / p_b) * 2 p_b / (p_b + p_l).
-      return prev.bsdf_technique ? 2.0f * prev.pdf / (prev.pdf + light_pdf) : 0.0f;
-  }
-  return 0.0f;
-}
+// The weights above and Russian roulette's survival probability are the
+// generic functions of core/simd/lanes-inl.h at width 1
+// (core/strategy_weights.cpp): the wavefront's lanes run the same source.
+float emission_weight(Strategy strategy, const PreviousVertex& prev, float light_pdf);
+float light_sample_weight(Strategy strategy, float light_pdf, float bsdf_pdf);
 
-inline float light_sample_weight(Strategy strategy, float light_pdf, float bsdf_pdf) {
-  if (strategy == Strategy::Mis) return power_heuristic(light_pdf, bsdf_pdf);
-  if (strategy == Strategy::LightBsdf) return 2.0f * light_pdf / (light_pdf + bsdf_pdf);
-  return 1.0f;
-}
+// The probability that Russian roulette lets a path go on whose throughput
+// would become `throughput`: min(1, its largest component), so that paths
+// which carry little end early (dividing the survivors by it keeps the
+// estimate unbiased).
+float roulette_survival(const Spectrum& throughput);
 
 // The continuation `strategy` samples at s towards wo: cosine-weighted
 // (Surfel::scatter_cosine) for every surface but a pure impulse under

@@ -91,7 +91,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
   if (vertex > settings_.rr_depth) {
     // Survive in proportion to the throughput, so that paths which carry
     // little end early; dividing by the probability keeps the estimate unbiased.
-    survival = std::min(1.0f, max_component(beta * weight));
+    survival = roulette_survival(beta * weight);
     if (!(path.u(vertex, Dim::Roulette) < survival)) {
       if (path.observer) {
         path.observer->on_scatter({vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, Spectrum(0.0f)});

@@ -639,12 +639,8 @@ VF emission_weight(const Scene& sc, const Wave& w, std::size_t i0, M lit, VF lig
   const M impulse = load_mask(w, kPrevImpulse, i0, lit);
   const M bsdf_technique = load_mask(w, kPrevBsdfTechnique, i0, lit);
   const VF prev_pdf = load(w, kPrevPdf, i0, lit);
-  VF weight = k(1.0f);
-  if (sc.strategy == Strategy::Light) weight = hn::IfThenElse(light_pdf > k(0.0f), k(0.0f), k(1.0f));
-  if (sc.strategy == Strategy::Mis) weight = power_heuristic(DF(), prev_pdf, light_pdf);
-  if (sc.strategy == Strategy::LightBsdf)
-    weight = hn::IfThenElseZero(bsdf_technique, k(2.0f) * prev_pdf / (prev_pdf + light_pdf));
-  return hn::IfThenElseZero(lit, hn::IfThenElse(impulse, k(1.0f), weight));
+  return hn::IfThenElseZero(
+      lit, pathlab::HWY_NAMESPACE::emission_weight(DF(), sc.strategy, impulse, bsdf_technique, prev_pdf, light_pdf));
 }
 
 void add_emission(const Scene& sc, const Wave& w) {
@@ -957,10 +953,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
       V3 f;
       VF pdf_bsdf;
       eval_bsdf(sc, w, i0, shape, wo, n, ls.wi, ok, f, pdf_bsdf);
-      // light_sample_weight (core/strategy_weights.h).
-      VF weight = k(1.0f);
-      if (sc.strategy == Strategy::Mis) weight = power_heuristic(df, ls.pdf, pdf_bsdf);
-      if (sc.strategy == Strategy::LightBsdf) weight = k(2.0f) * ls.pdf / (ls.pdf + pdf_bsdf);
+      const VF weight = pathlab::HWY_NAMESPACE::light_sample_weight(df, sc.strategy, ls.pdf, pdf_bsdf);
       area.unoccluded = (weight / ls.pdf) * (f * ls.Le);
       std::copy(std::begin(ls.ray), std::end(ls.ray), area.ray);
     }
@@ -1041,8 +1034,7 @@ void scatter(const Scene& sc, const Wave& w) {
     const M rr = hn::And(ok, fmask(vertex > hn::Set(DI(), sc.rr_depth)));
     if (!hn::AllFalse(df, rr)) {
       const V3 bw = beta * weight;
-      // std::min(1.0f, std::max(bw.x, std::max(bw.y, bw.z))) (max_component), in Max/Min's operand order.
-      const VF survival = hn::Min(hn::Max(hn::Max(bw.z, bw.y), bw.x), k(1.0f));
+      const VF survival = pathlab::HWY_NAMESPACE::roulette_survival(df, bw);
       ok = hn::AndNot(hn::AndNot(rng.u(Dim::Roulette) < survival, rr), ok);
       weight = select(rr, weight / survival, weight);
     }

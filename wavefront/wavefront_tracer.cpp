@@ -643,7 +643,7 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
     Spectrum weight = bs->weight;
     float survival = 1.0f;
     if (v > settings_.rr_depth) {
-      survival = std::min(1.0f, max_component(w.beta[i] * weight));
+      survival = roulette_survival(w.beta[i] * weight);
       if (!(w.u(i, Dim::Roulette) < survival)) {
         if (obs) {
           obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, Spectrum(0.0f)});

@@ -23,6 +23,7 @@
 #include <hwy/highway.h>
 
 #include "core/math.h"
+#include "core/scene.h"
 #include "core/simd/lane1.h"
 #include "core/sobol.h"
 
@@ -162,6 +163,42 @@ HWY_INLINE V power_heuristic(D d, V a, V b) {
   const V r = b / a;
   const V w = Set(d, 1.0f) / (Set(d, 1.0f) + r * r);
   return IfThenElse(IsInf(a), Set(d, 1.0f), IfThenElseZero(a > Zero(d), w));
+}
+
+// emission_weight (core/strategy_weights.h): how much of the emission a ray
+// found `strategy` keeps, given how the vertex before chose the ray
+// (`impulse`: a camera ray or an impulse, 1; `bsdf_technique`: light+bsdf
+// chose BSDF sampling; `prev_pdf` its solid-angle density) and the density
+// with which next-event estimation would have sampled the emitter. The
+// strategy is the render's, the same in every lane.
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE V emission_weight(D d, Strategy strategy, M impulse, M bsdf_technique, V prev_pdf, V light_pdf) {
+  V weight = Set(d, 1.0f);  // cosine, bsdf
+  // light: 0 (NEE counted it) unless NEE could not pick it.
+  if (strategy == Strategy::Light) weight = IfThenElse(light_pdf > Zero(d), Zero(d), Set(d, 1.0f));
+  if (strategy == Strategy::Mis) weight = power_heuristic(d, prev_pdf, light_pdf);
+  // light+bsdf, the one-sample balance heuristic: f / (p_b / 2 + p_l / 2) =
+  // (f / p_b) 2 p_b / (p_b + p_l) after BSDF sampling, 0 after light sampling.
+  if (strategy == Strategy::LightBsdf)
+    weight = IfThenElseZero(bsdf_technique, Set(d, 2.0f) * prev_pdf / (prev_pdf + light_pdf));
+  return IfThenElse(impulse, Set(d, 1.0f), weight);
+}
+
+// light_sample_weight (core/strategy_weights.h): how much of a light sample
+// (next-event estimation) `strategy` keeps.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V light_sample_weight(D d, Strategy strategy, V light_pdf, V bsdf_pdf) {
+  if (strategy == Strategy::Mis) return power_heuristic(d, light_pdf, bsdf_pdf);
+  if (strategy == Strategy::LightBsdf) return Set(d, 2.0f) * light_pdf / (light_pdf + bsdf_pdf);
+  return Set(d, 1.0f);
+}
+
+// roulette_survival (core/strategy_weights.h): Russian roulette's survival
+// probability for a path whose throughput would become `throughput`,
+// std::min(1, max_component(throughput)) in Min's and Max's order.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V roulette_survival(D d, const Vec3<V>& throughput) {
+  return Min(Max(Max(throughput.z, throughput.y), throughput.x), Set(d, 1.0f));
 }
 
 // area_to_solid_angle (core/sampling.h): pdf_area d^2 / |cos|, 0 edge-on.

@@ -1,0 +1,26 @@
+#include "core/strategy_weights.h"
+
+#include "core/faults.h"
+#include "core/simd/width1.h"
+
+namespace pathlab {
+
+float emission_weight(Strategy strategy, const PreviousVertex& prev, float light_pdf) {
+  if (PATHLAB_FAULT(EmissionAfterNee)) return 1.0f;
+  using namespace width1;
+  return generic::emission_weight(kScalar, strategy, lane1::M{prev.impulse}, lane1::M{prev.bsdf_technique},
+                                  F{prev.pdf}, F{light_pdf})
+      .raw;
+}
+
+float light_sample_weight(Strategy strategy, float light_pdf, float bsdf_pdf) {
+  using namespace width1;
+  return generic::light_sample_weight(kScalar, strategy, F{light_pdf}, F{bsdf_pdf}).raw;
+}
+
+float roulette_survival(const Spectrum& throughput) {
+  using namespace width1;
+  return generic::roulette_survival(kScalar, lanes(throughput)).raw;
+}
+
+}  // namespace pathlab
