@@ -13,6 +13,7 @@
 #include "core/sampling.h"
 #include "tests/closed_mesh.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>

@@ -23,5 +23,4 @@ std::string processor() {
          (__builtin_cpu_supports("avx512f") ? "yes" : "no") + ")";
 }
 
-
 }  // namespace pathlab::bench

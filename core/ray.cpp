@@ -2,8 +2,6 @@
 
 #include "core/simd/width1.h"
 
-#include <algorithm>
-#include <cmath>
 
 namespace pathlab {
 

@@ -66,11 +66,11 @@ const char* light_sampler_name(LightSamplerKind k);
 std::optional<LightSamplerKind> parse_light_sampler(std::string_view name);
 
 // How Embree intersects triangles (RTC_SCENE_FLAG_ROBUST or not;
-// docs/scene-format.md, "Intersection"). A speed-for-accuracy trade with a
-// measured bias: bench/bench_watertight.cpp, docs/performance.md.
+// docs/scene-format.md, render.intersection). A speed-for-accuracy trade
+// with a measured bias: bench/bench_watertight.cpp, docs/performance.md.
 enum class Intersection : std::uint8_t {
   Robust,  // watertight: no ray slips between two triangles sharing an edge
-  Fast,    // Embree's fastest test; a few rays in 10^7 slip through shared edges
+  Fast,    // Embree's fastest test; about 1e-7 to 1e-6 of rays slip through shared edges
 };
 const char* intersection_name(Intersection i);
 std::optional<Intersection> parse_intersection(std::string_view name);

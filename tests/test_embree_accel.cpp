@@ -180,8 +180,8 @@ TEST(EmbreeAccel, CompactBvhFindsTheSameHits) {
 // Rays from inside a closed mesh aimed at points on its edges (the worst
 // case for a crack between two triangles) always hit it under
 // Intersection::Robust, in every batch mode; under Intersection::Fast
-// Embree's test lets some through - a few per cent of such rays, and about
-// 5e-7 of rays in random directions (bench/bench_watertight.cpp). The
+// Embree's test lets some through - a few per cent of such rays, and 1e-7
+// to 1e-6 of rays in random directions (bench/bench_watertight.cpp). The
 // second half shows the setting reaches Embree: if Embree's fast test ever
 // became watertight it would fail, and the setting's documented bias with it.
 TEST(EmbreeAccel, RobustIntersectionIsWatertightAtEdges) {
@@ -201,17 +201,25 @@ TEST(EmbreeAccel, RobustIntersectionIsWatertightAtEdges) {
   std::size_t leaks[2] = {0, 0};
   for (const Intersection mode : {Intersection::Robust, Intersection::Fast}) {
     const EmbreeAccel accel(shapes, {}, {}, BvhOptions{.intersection = mode});
+    std::vector<std::uint8_t> found_single;
     for (const RayBatchMode batch : {RayBatchMode::Single, RayBatchMode::Packet16, RayBatchMode::Stream}) {
       std::vector<RayHit> hits(kRays);
       std::vector<std::uint8_t> found(kRays), blocked(kRays);
       accel.intersect_batch(rays, hits, found, batch);
       accel.occluded_batch(rays, blocked, batch);
-      std::size_t missed = 0;
-      for (std::size_t i = 0; i < kRays; ++i) missed += (found[i] == 0) + (blocked[i] == 0);
+      std::size_t missed = 0, differ = 0;
+      if (found_single.empty()) found_single = found;
+      for (std::size_t i = 0; i < kRays; ++i) {
+        missed += (found[i] == 0) + (blocked[i] == 0);
+        differ += found[i] != found_single[i];
+      }
       SCOPED_TRACE(testing::Message() << intersection_name(mode) << ", batch mode " << static_cast<int>(batch));
       if (mode == Intersection::Robust) {
         EXPECT_EQ(missed, 0u);
       }
+      // Which rays slip through may not depend on how they reach Embree:
+      // the reference casts one ray at a time, the wavefront streams.
+      EXPECT_EQ(differ, 0u) << "rays found by one ray at a time but not in this batch mode, or the reverse";
       leaks[static_cast<int>(mode)] += missed;
     }
   }

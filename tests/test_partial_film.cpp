@@ -399,6 +399,9 @@ TEST_F(PiecesCli, ResumeRefusesAnotherSceneFileMeshSettingOrVersion) {
   r = resume({"--light-sampling", "solid_angle"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("setting light_sampling"), std::string::npos) << r.err;
+  r = resume({"--intersection", "fast"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("setting intersection"), std::string::npos) << r.err;
   write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1.5 0\nf 1 2 3\n");
   r = resume({});
   EXPECT_EQ(r.code, 2);

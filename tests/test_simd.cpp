@@ -135,7 +135,7 @@ TEST(SimdWarps, EveryTargetComputesTheBitsOfTheWidthOneCode) {
 }
 
 // offset_ray_origin: core's scalar function (lanes-inl.h's generic code at
-// lane1's width 1, whose NextFloat is core/ray.h's branches) and every
+// lane1's width 1, whose StepAway is core/ray.h's branches) and every
 // target's lanes (NextFloat by selects) step to the same floats, on points
 // where the stepping's cases meet: both zeros, denormals, the largest
 // floats and the infinities, no error across the surface (the fallback

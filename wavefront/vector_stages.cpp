@@ -114,7 +114,6 @@ using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::zsobol_top24;
 using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::offset_ray_origin;
-using pathlab::HWY_NAMESPACE::power_heuristic;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::splat3;
 using pathlab::HWY_NAMESPACE::to_world;
@@ -141,10 +140,7 @@ using DDI = hn::RebindToSigned<DD>;
 using VDI = hn::Vec<DDI>;
 using V3D = Vec3<VD>;
 
-constexpr float kInvPi = 1.0f / 3.14159265358979323846f;  // core/math.h
-constexpr float kGamma2 = (2.0f * 0x1p-24f) / (1.0f - 2.0f * 0x1p-24f);  // gamma_bound(2), core/geometry.h
-constexpr float kGamma3 = (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);
-constexpr float kGamma5 = (5.0f * 0x1p-24f) / (1.0f - 5.0f * 0x1p-24f);
+constexpr float kGamma2 = gamma_bound(2), kGamma3 = gamma_bound(3), kGamma5 = gamma_bound(5);  // core/math.h
 
 std::size_t lanes() { return hn::Lanes(DF()); }
 

@@ -52,7 +52,7 @@ void SceneOptions::add_to(CLI::App& cmd, bool with_spp, bool allow_both) {
       ->check(CLI::IsMember({"fast", "compact"}));
   cmd.add_option("--intersection", intersection,
                  "How Embree intersects triangles: robust (watertight: no ray slips between triangles sharing an "
-                 "edge) or fast (faster, e.g. 1.3x on small scenes; a few rays in 10^7 slip through edges: "
+                 "edge) or fast (faster, e.g. 1.3x on small scenes; about 1e-7 to 1e-6 of rays slip through edges: "
                  "docs/scene-format.md)")
       ->check(CLI::IsMember({"robust", "fast"}));
   cmd.add_option("--texture-filter", texture_filter,

@@ -21,7 +21,6 @@
 
 #include "core/ray.h"
 
-#include <bit>
 #include <cmath>
 #include <cstdint>
 
@@ -33,16 +32,17 @@ using VecOf = decltype(Zero(D()));
 
 namespace lane1 {
 
-// The descriptor: one lane of Lane (float or std::int32_t). Rebind is what
-// Highway's RebindToSigned<D> and friends read.
+// The descriptor: one lane of Lane. Only the operations the width-1 callers
+// instantiate are here (core/simd/width1.h lists those callers); a generic
+// function that needs another fails to compile at width 1 until it is added.
 template <typename Lane>
 struct One {
   using T = Lane;
-  template <typename NewT>
-  using Rebind = One<NewT>;
 };
 
-// A lane and a lane's mask.
+// A lane and a lane's mask. Abs is fabs: +0 for -0, as Highway's Abs (GLM's
+// abs keeps -0; triangle_point's error bound was -0 there, which no caller
+// tells from +0).
 template <typename T>
 struct V {
   T raw;
@@ -81,19 +81,8 @@ inline M operator==(V<T> a, V<T> b) {
   return {a.raw == b.raw};
 }
 template <typename T>
-inline M operator<(V<T> a, V<T> b) {
-  return {a.raw < b.raw};
-}
-template <typename T>
 inline M operator>(V<T> a, V<T> b) {
   return {a.raw > b.raw};
-}
-
-inline M And(M a, M b) { return {a.raw && b.raw}; }
-inline M Or(M a, M b) { return {a.raw || b.raw}; }
-template <typename T>
-inline M RebindMask(One<T>, M m) {
-  return m;
 }
 
 template <typename T>
@@ -104,10 +93,6 @@ template <typename T>
 inline V<T> IfThenElseZero(M m, V<T> yes) {
   return m.raw ? yes : V<T>{T(0)};
 }
-template <typename T>
-inline V<T> IfThenZeroElse(M m, V<T> no) {
-  return m.raw ? V<T>{T(0)} : no;
-}
 
 // x86's maxps/minps, operand order included (see the top of the file).
 inline V<float> Max(V<float> a, V<float> b) { return a.raw > b.raw ? a : b; }
@@ -116,7 +101,6 @@ inline V<float> Sqrt(V<float> a) { return {std::sqrt(a.raw)}; }
 inline V<float> Abs(V<float> a) { return {std::fabs(a.raw)}; }
 inline V<float> Neg(V<float> a) { return {-a.raw}; }
 inline V<float> CopySign(V<float> magnitude, V<float> sign) { return {std::copysign(magnitude.raw, sign.raw)}; }
-inline M IsNaN(V<float> a) { return {std::isnan(a.raw)}; }
 inline M IsInf(V<float> a) { return {std::isinf(a.raw)}; }
 
 // c one float up for o > 0, down for o < 0 (lanes-inl.h's StepAway) by
@@ -125,12 +109,6 @@ inline M IsInf(V<float> a) { return {std::isinf(a.raw)}; }
 // these bits by tests/test_simd.cpp).
 inline V<float> StepAway(One<float>, V<float> c, V<float> o) {
   return {o.raw > 0.0f ? next_float_up(c.raw) : o.raw < 0.0f ? next_float_down(c.raw) : c.raw};
-}
-
-template <typename To, typename From>
-inline V<To> BitCast(One<To>, V<From> v) {
-  static_assert(sizeof(To) == sizeof(From));
-  return {std::bit_cast<To>(v.raw)};
 }
 
 }  // namespace lane1

@@ -1,10 +1,12 @@
 // Geometry, hashing and weighting steps of the estimator over Highway's
 // vectors, for the wavefront's vectorised stages at the width of their SIMD
-// target (wavefront/vector_stages.cpp). Each mirrors a scalar function of
-// core, named at its definition; VectorStages.* holds them to its bits.
-// core's scalar code does not run these at width 1 yet: at the build's
-// baseline target (HWY_SCALAR) the branch-free forms cost several times the
-// scalar ones (docs/one-estimator.md). Every lane computes the
+// target (wavefront/vector_stages.cpp), and for core's scalar code at width
+// 1 through core/simd/lane1.h (core/simd/width1.h): each names the scalar
+// function of core that calls it or that it mirrors. The operations are
+// called unqualified and the vector type is VecOf<D>, so that argument-
+// dependent lookup finds Highway's for its vectors and lane1's for lane1's.
+// VectorStages.* and tests/test_simd.cpp hold the lanes to the width-1
+// bits. Every lane computes the
 // bits the scalar code computes; the rules that make it so are in
 // core/simd/simd.h and docs/one-estimator.md. In short: the order of every
 // sum and product is the scalar code's (GLM's dot is (x + y) + z, a vec3
@@ -229,6 +231,14 @@ HWY_INLINE void uniform_triangle(D d, V ux, V uy, V& b1, V& b2) {
   b2 = Set(d, 1.0f) - s;
 }
 
+// 64-bit lanes: the full 64-bit product of the low 32 bits of a and of b
+// (one 32 x 32 -> 64-bit multiply).
+template <class D64, class V64 = hn::Vec<D64>>
+HWY_INLINE V64 mul_wide32(D64, V64 a, V64 b) {
+  const hn::Repartition<std::uint32_t, D64> d32;
+  return hn::MulEven(hn::BitCast(d32, a), hn::BitCast(d32, b));
+}
+
 // 64-bit lanes: z * c modulo 2^64. Highway 1.0 has no 64-bit multiply but
 // AVX-512DQ's, so elsewhere it is three 32 x 32 -> 64-bit products.
 template <class D64, class V64 = hn::Vec<D64>>
@@ -239,11 +249,9 @@ HWY_INLINE V64 mul64(D64 d64, V64 z, std::uint64_t c) {
     return V64{_mm512_mullo_epi64(z.raw, _mm512_set1_epi64(static_cast<long long>(c)))};
   }
 #endif
-  const hn::Repartition<std::uint32_t, D64> d32;
   const V64 k = hn::Set(d64, c);
-  const V64 lo = hn::MulEven(hn::BitCast(d32, z), hn::BitCast(d32, k));
-  const V64 cross = hn::MulEven(hn::BitCast(d32, hn::ShiftRight<32>(z)), hn::BitCast(d32, k)) +
-                    hn::MulEven(hn::BitCast(d32, z), hn::BitCast(d32, hn::Set(d64, c >> 32)));
+  const V64 lo = mul_wide32(d64, z, k);
+  const V64 cross = mul_wide32(d64, hn::ShiftRight<32>(z), k) + mul_wide32(d64, z, hn::Set(d64, c >> 32));
   return lo + hn::ShiftLeft<32>(cross);
 }
 

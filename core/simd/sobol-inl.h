@@ -41,10 +41,6 @@ inline constexpr std::array<std::uint64_t, 3> kPermutations4Packed = [] {
 // render's), so the loop is the scalar one.
 template <class D64, class V64 = hn::Vec<D64>>
 HWY_INLINE V64 permute_digits(D64 d64, V64 index, unsigned bits, V64 seed) {
-  const hn::Repartition<std::uint32_t, D64> d32;
-  const auto mul32x32 = [d32](V64 a, std::uint64_t b) {  // a, b < 2^32: the full 64-bit product
-    return hn::MulEven(hn::BitCast(d32, a), hn::BitCast(d32, hn::Set(D64(), b)));
-  };
   const unsigned lone = bits & 1u;
   V64 out = hn::And(index, hn::Set(d64, ~((bits >= 64 ? 0ull : (1ull << bits)) - 1ull)));
   for (unsigned p = bits - 2; p + 2 > lone && p < 64; p -= 2) {  // digit in bits [p, p + 1]
@@ -55,8 +51,8 @@ HWY_INLINE V64 permute_digits(D64 d64, V64 index, unsigned bits, V64 seed) {
     // (h >> 32) % 24, exactly: for x < 2^32, x / 24 = (x * 0xaaaaaaab) >> 36
     // (a 32 x 32 -> 64-bit product), and q * 24 < 2^32.
     const V64 x = hn::ShiftRight<32>(h);
-    const V64 q = hn::ShiftRight<36>(mul32x32(x, 0xaaaaaaabull));
-    const V64 which = x - mul32x32(q, 24);
+    const V64 q = hn::ShiftRight<36>(mul_wide32(d64, x, hn::Set(d64, 0xaaaaaaabull)));
+    const V64 which = x - mul_wide32(d64, q, hn::Set(d64, 24));
     // Entry `which` of the packed table, then the digit's image in it.
     const V64 word = hn::IfThenElse(which < hn::Set(d64, 8), hn::Set(d64, kPermutations4Packed[0]),
                                     hn::IfThenElse(which < hn::Set(d64, 16), hn::Set(d64, kPermutations4Packed[1]),
@@ -89,8 +85,7 @@ HWY_INLINE V64 reverse_bits32(D64 d64, V64 v) {
 // The low 32 bits of a * b (each below 2^32), as a 32-bit multiply gives.
 template <class D64, class V64 = hn::Vec<D64>>
 HWY_INLINE V64 mul32(D64 d64, V64 a, V64 b) {
-  const hn::Repartition<std::uint32_t, D64> d32;
-  return hn::And(hn::MulEven(hn::BitCast(d32, a), hn::BitCast(d32, b)), hn::Set(d64, 0xffffffffu));
+  return hn::And(mul_wide32(d64, a, b), hn::Set(d64, 0xffffffffu));
 }
 
 // sobol::sample: point `index` (its low 32 bits) of Sobol's sequence in

@@ -2,8 +2,15 @@
 // core/simd/lanes-inl.h at width 1, through lane1's plain scalars
 // (core/simd/lane1.h): one source for a step that the reference tracer and
 // the wavefront's lanes both take. Include only from core's .cpp files (it
-// includes lanes-inl.h at the build's static target).
+// includes lanes-inl.h at the build's static target); today core/ray.cpp,
+// math.cpp, geometry.cpp, sampling.cpp and strategy_weights.cpp.
 #pragma once
+
+// In a foreach_target translation unit HWY_NAMESPACE would name the first
+// target's namespace (AVX-512 code) for the scalar callers below.
+#ifdef HWY_TARGET_INCLUDE
+#error "core/simd/width1.h is for core's scalar .cpp files, not foreach_target translation units"
+#endif
 
 #include "core/math.h"
 #include "core/simd/lane1.h"
