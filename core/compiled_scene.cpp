@@ -176,7 +176,7 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s, const 
     s->n = glm::normalize(place.to_normal * s->n);
   }
   shading_frame(shape, hit, ns_sum, s);
-  if (textures_ && (s->material->is_textured() || s->material->normal_map)) read_textures(shape, ray, hit, cone, params, s);
+  if (textures_ && s->material->reads_textures_at_hits()) read_textures(shape, ray, hit, cone, params, s);
 }
 
 void CompiledScene::resolve_shading(const RayHit& hit, Surfel* s) const {

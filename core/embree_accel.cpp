@@ -188,8 +188,8 @@ struct EmbreeAccel::Impl {
     RTCScene s = rtcNewScene(device);
     // ROBUST: no arithmetic shortcuts that could let a ray slip through an
     // edge shared by two triangles (Embree's watertight triangle test and
-    // conservative box tests); without it Embree is faster and leaks a few
-    // rays in 10^7 (bench/bench_watertight.cpp).
+    // conservative box tests); without it Embree is faster and 1e-7 to 1e-6
+    // of rays slip through (bench/bench_watertight.cpp).
     int flags = RTC_SCENE_FLAG_NONE;
     if (options.intersection == Intersection::Robust) flags |= RTC_SCENE_FLAG_ROBUST;
     if (options.compact) flags |= RTC_SCENE_FLAG_COMPACT;

@@ -192,6 +192,9 @@ struct Material {
   std::optional<NormalMap> normal_map{};
   bool emission_textured = false;  // `textured` holds Emission (kept by set_texture)
   bool is_textured() const { return !textured.empty(); }
+  // Whether resolving a hit on it reads textures: a textured parameter or a
+  // normal map (CompiledScene::resolve; alpha is Embree's filter's).
+  bool reads_textures_at_hits() const { return is_textured() || normal_map.has_value(); }
   const TexturedParam* texture_of(MaterialParam p) const;
   // Reads parameter `p` from `texture` from now on.
   void set_texture(MaterialParam p, const TextureRef& texture);

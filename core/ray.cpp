@@ -2,7 +2,6 @@
 
 #include "core/simd/width1.h"
 
-
 namespace pathlab {
 
 // The generic function (core/simd/lanes-inl.h) at width 1: the very code

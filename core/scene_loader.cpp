@@ -102,8 +102,8 @@ auto read_choice(const Node& value, const char* what, std::span<const std::strin
 }
 
 RenderSettings read_render(const Node& node) {
-  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh", "intersection",
-                   "texture_filter", "texture_cache_mb", "light_sampling", "light_sampler", "sampler"});
+  node.allow_only({"spp", "max_depth", "rr_depth", "strategy", "seed", "bsdf_sampling", "clamp", "min_pdf", "bvh",
+                   "intersection", "texture_filter", "texture_cache_mb", "light_sampling", "light_sampler", "sampler"});
   RenderSettings r;
   if (node.has("spp")) {
     const std::int64_t spp = node.child("spp").integer();

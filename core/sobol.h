@@ -56,14 +56,13 @@ constexpr std::uint32_t reverse_bits(std::uint32_t v) {
 // i is clear), before the reversal into digit order. core/simd/sobol-inl.h
 // computes the same in lanes; tests/test_sobol.cpp checks it against the
 // binomials.
+// Butterfly b (shift 2^b) updates the positions i whose bit b is clear.
+inline constexpr std::array<std::uint32_t, 5> kSupersetMasks = {0x55555555u, 0x33333333u, 0x0f0f0f0fu, 0x00ff00ffu,
+                                                                0x0000ffffu};
 constexpr std::uint32_t sample(std::uint64_t index, int dim) {
   auto f = static_cast<std::uint32_t>(index);
   if (dim == 0) return reverse_bits(f);
-  f ^= (f >> 1) & 0x55555555u;
-  f ^= (f >> 2) & 0x33333333u;
-  f ^= (f >> 4) & 0x0f0f0f0fu;
-  f ^= (f >> 8) & 0x00ff00ffu;
-  f ^= (f >> 16) & 0x0000ffffu;
+  for (unsigned b = 0; b < 5; ++b) f ^= (f >> (1u << b)) & kSupersetMasks[b];
   return reverse_bits(f);
 }
 

@@ -1,6 +1,6 @@
 // A closed mesh for watertightness checks: the icosahedron subdivided
 // `subdivisions` times (20 * 4^subdivisions triangles) and projected onto
-// the sphere of `radius` about the origin. Every edge is shared by exactly
+// the unit sphere. Every edge is shared by exactly
 // two triangles through the same two vertex indices, so a ray from inside
 // can leave only through a crack in the intersection test itself.
 #pragma once
@@ -9,14 +9,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <map>
 #include <utility>
 #include <vector>
 
 namespace pathlab::test {
 
-inline TriangleMesh icosphere(int subdivisions, float radius = 1.0f) {
+inline TriangleMesh icosphere(int subdivisions) {
   TriangleMesh m;
   const double g = (1.0 + std::sqrt(5.0)) / 2.0;
   const double corners[12][3] = {{-1, g, 0}, {1, g, 0},   {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
@@ -41,7 +40,7 @@ inline TriangleMesh icosphere(int subdivisions, float radius = 1.0f) {
     }
     t = std::move(next);
   }
-  for (const dvec3& q : p) m.positions.push_back(vec3(q * static_cast<double>(radius)));
+  for (const dvec3& q : p) m.positions.push_back(vec3(q));
   m.triangles = std::move(t);
   return m;
 }

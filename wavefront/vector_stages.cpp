@@ -1209,7 +1209,7 @@ void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {
   if (sc.instanced) hit.instance = w.u[kInstance][i];
   const pathlab::Scene& scene = sc.compiled->scene();
   const Material& m = scene.materials[scene.shapes[hit.shape].material];
-  const bool reads_textures = sc.textured && (m.is_textured() || m.normal_map);
+  const bool reads_textures = sc.textured && m.reads_textures_at_hits();
   Surfel s;
   if (hit.instance == kNoInstance && !reads_textures) {
     // The lanes placed the point, bit for bit as resolve() does: core adds

@@ -317,7 +317,7 @@ struct WavefrontTracer::VectorStages {
       const bool general = m.scatters() && (cosine || !in_lanes(m) || shading_frame(sh));
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
       f[vs::kTexturedEmission] = m.emission_textured ? 1.0f : 0.0f;
-      f[vs::kResolveByCore] = general && (shading_frame(sh) || m.is_textured() || m.normal_map) ? 1.0f : 0.0f;
+      f[vs::kResolveByCore] = general && (shading_frame(sh) || m.reads_textures_at_hits()) ? 1.0f : 0.0f;
       sc.general = sc.general || general;
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
     }

@@ -6,8 +6,7 @@
 // called unqualified and the vector type is VecOf<D>, so that argument-
 // dependent lookup finds Highway's for its vectors and lane1's for lane1's.
 // VectorStages.* and tests/test_simd.cpp hold the lanes to the width-1
-// bits. Every lane computes the
-// bits the scalar code computes; the rules that make it so are in
+// bits; the rules that make every lane compute them are in
 // core/simd/simd.h and docs/one-estimator.md. In short: the order of every
 // sum and product is the scalar code's (GLM's dot is (x + y) + z, a vec3
 // times a float multiplies each component), no fused multiply-add, and

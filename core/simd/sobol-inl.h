@@ -95,11 +95,8 @@ template <class D64, class V64 = hn::Vec<D64>>
 HWY_INLINE V64 sobol_sample(D64 d64, V64 index, int axis) {
   V64 f = hn::And(index, hn::Set(d64, 0xffffffffu));
   if (axis == 0) return reverse_bits32(d64, f);
-  f = hn::Xor(f, hn::And(hn::ShiftRight<1>(f), hn::Set(d64, 0x55555555u)));
-  f = hn::Xor(f, hn::And(hn::ShiftRight<2>(f), hn::Set(d64, 0x33333333u)));
-  f = hn::Xor(f, hn::And(hn::ShiftRight<4>(f), hn::Set(d64, 0x0f0f0f0fu)));
-  f = hn::Xor(f, hn::And(hn::ShiftRight<8>(f), hn::Set(d64, 0x00ff00ffu)));
-  f = hn::Xor(f, hn::And(hn::ShiftRight<16>(f), hn::Set(d64, 0x0000ffffu)));
+  for (unsigned b = 0; b < 5; ++b)
+    f = hn::Xor(f, hn::And(hn::ShiftRightSame(f, 1 << b), hn::Set(d64, sobol::kSupersetMasks[b])));
   return reverse_bits32(d64, f);
 }
 
