@@ -1,6 +1,7 @@
 #include "core/camera.h"
 
 #include "core/sampling.h"
+#include "core/simd/width1.h"
 
 namespace pathlab {
 
@@ -16,18 +17,15 @@ Camera::Camera(const CameraDesc& desc, int width, int height)
 }
 
 Ray Camera::generate_ray(vec2 film, vec2 u_lens) const {
-  // Film position -> point on the image plane at distance 1 along forward.
-  const float sx = (2.0f * film.x * inv_width_ - 1.0f) * tan_half_fov_ * aspect_;
-  const float sy = (1.0f - 2.0f * film.y * inv_height_) * tan_half_fov_;
-  const vec3 d = glm::normalize(forward_ + sx * right_ + sy * up_);
-  if (desc_.aperture_radius <= 0.0f) return Ray{desc_.position, d};
-
-  // Thin lens: every ray through this film point meets at the same point of
-  // the plane in focus, whatever point of the aperture it leaves from.
-  const vec3 focus = desc_.position + d * (desc_.focus_distance / glm::dot(d, forward_));
+  using namespace width1;
+  const generic::CameraPlane<F> plane{lanes(desc_.position), lanes(forward_), lanes(right_), lanes(up_),
+                                      F{tan_half_fov_}, F{aspect_}, F{inv_width_}, F{inv_height_}};
+  const F3 d = generic::camera_direction(kScalar, plane, F{film.x}, F{film.y});
+  if (desc_.aperture_radius <= 0.0f) return Ray{desc_.position, scalars(d)};
   const vec2 lens = desc_.aperture_radius * square_to_concentric_disk(u_lens);
-  const vec3 origin = desc_.position + lens.x * right_ + lens.y * up_;
-  return Ray{origin, glm::normalize(focus - origin)};
+  F3 origin, dir;
+  generic::thin_lens(kScalar, plane, F{desc_.focus_distance}, d, F{lens.x}, F{lens.y}, origin, dir);
+  return Ray{scalars(origin), scalars(dir)};
 }
 
 }  // namespace pathlab

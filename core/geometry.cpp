@@ -158,13 +158,14 @@ SurfacePoint triangle_point(const Shape& shape, std::uint32_t tri, vec2 b) {
 }
 
 SurfacePoint sphere_point(const Shape& shape, const vec3& p_approx) {
-  const vec3 dir = glm::normalize(p_approx - shape.center);
+  using namespace width1;
+  F3 p, error, n;
+  generic::sphere_point(kScalar, lanes(shape.center), F{shape.radius}, lane1::M{shape.flip_normals}, lanes(p_approx), p,
+                        error, n);
   SurfacePoint sp;
-  sp.p = shape.center + shape.radius * dir;
-  // Reprojection leaves a few ulps of the offset from the centre (PBR 6.8.4),
-  // plus the rounding of adding the centre back.
-  sp.p_error = gamma_bound(5) * glm::abs(shape.radius * dir) + gamma_bound(2) * glm::abs(sp.p);
-  sp.n = shape.flip_normals ? -dir : dir;
+  sp.p = scalars(p);
+  sp.p_error = scalars(error);
+  sp.n = scalars(n);
   return sp;
 }
 

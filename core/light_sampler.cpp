@@ -5,6 +5,7 @@
 #include "core/geometry.h"
 #include "core/sampling.h"
 #include "core/sampling_spherical.h"
+#include "core/simd/width1.h"
 
 #include <algorithm>
 #include <cmath>
@@ -69,6 +70,11 @@ double delta_power_over_4pi(const DeltaLight& light, float scene_radius) {
       return 0.25 * y * double(scene_radius) * double(scene_radius);
   }
   return 0.0;
+}
+
+LightQuery light_query(const Surfel& s, const vec3& wo) {
+  using namespace width1;
+  return {s.p, scalars(generic::facing_normal(kScalar, lanes(s.n), lanes(wo)))};
 }
 
 Ray shadow_ray(const Surfel& s, const LightSample& ls) {

@@ -109,10 +109,7 @@ std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene);
 // impulse NEE never connects through), or no normal when wo grazes. Both
 // tracers make the query of a vertex with this, for its light sample and
 // for the pdf of the emitter its BSDF ray finds (PreviousVertex::ref).
-inline LightQuery light_query(const Surfel& s, const vec3& wo) {
-  const float c = glm::dot(s.n, wo);
-  return {s.p, c > 0.0f ? s.n : c < 0.0f ? -s.n : vec3(0.0f)};
-}
+LightQuery light_query(const Surfel& s, const vec3& wo);
 
 class LightSampler {
  public:

@@ -6,6 +6,7 @@
 #include "core/bsdf/mirror.h"
 #include "core/faults.h"
 #include "core/geometry.h"
+#include "core/simd/width1.h"
 
 namespace pathlab {
 namespace {
@@ -227,28 +228,17 @@ std::optional<BsdfSample> Surfel::scatter_cosine(const vec3& wo, vec2 u) const {
 }
 
 Ray Surfel::spawn(const vec3& dir) const {
-  const vec3 side = glm::dot(dir, n) >= 0.0f ? n : -n;
-  return Ray{offset_ray_origin(p, p_error, side), dir, kInfinity};
+  using namespace width1;
+  return Ray{scalars(generic::spawn_origin(kScalar, lanes(p), lanes(p_error), lanes(n), lanes(dir))), dir, kInfinity};
 }
 
 Ray Surfel::spawn_to(const vec3& target, const vec3& target_error, const vec3& target_n) const {
-  const vec3 d0 = target - p;
-  const vec3 origin = offset_ray_origin(p, p_error, glm::dot(d0, n) >= 0.0f ? n : -n);
-  // The ray below reaches t = dist within gamma(2) |end - origin| of `end`,
-  // per axis: the difference and the division round once each, and the
-  // rounded length cancels (it is both tmax and the divisor). So the end
-  // moves off the target's surface by that reach (with a float to spare)
-  // beyond the target's own error: however long the ray, the point it
-  // stops at stays off the surface it aims at, for an intersector exact on
-  // the float ray (sphere_crossing; docs/ARCHITECTURE.md, Sphere hits).
-  const vec3 reach = gamma_bound(3) * glm::abs(target - origin);
-  const vec3 end = offset_ray_origin(target, target_error + reach,
-                                     glm::dot(origin - target, target_n) >= 0.0f ? target_n : -target_n);
-  const vec3 d = end - origin;
-  const float dist = glm::length(d);
-  // Both ends are strictly off their surfaces, so the full length is safe;
-  // any shorter would let light through an occluder next to the target.
-  return Ray{origin, d / dist, dist};
+  using namespace width1;
+  F3 origin, dir;
+  F dist;
+  generic::spawn_to(kScalar, lanes(p), lanes(p_error), lanes(n), lanes(target), lanes(target_error), lanes(target_n),
+                    origin, dir, dist);
+  return Ray{scalars(origin), scalars(dir), dist.raw};
 }
 
 }  // namespace pathlab

@@ -100,8 +100,14 @@ std::size_t compact(const Scene&, const Wave&, void*, std::uint32_t) { width_one
 std::size_t lanes() { return 1; }
 #else
 
-using pathlab::HWY_NAMESPACE::abs;
 using pathlab::HWY_NAMESPACE::area_to_solid_angle;
+using pathlab::HWY_NAMESPACE::camera_direction;
+using pathlab::HWY_NAMESPACE::CameraPlane;
+using pathlab::HWY_NAMESPACE::facing_normal;
+using pathlab::HWY_NAMESPACE::spawn_origin;
+using pathlab::HWY_NAMESPACE::spawn_to;
+using pathlab::HWY_NAMESPACE::sphere_point;
+using pathlab::HWY_NAMESPACE::thin_lens;
 using pathlab::HWY_NAMESPACE::bvh_field;
 using pathlab::HWY_NAMESPACE::bvh_importance;
 using pathlab::HWY_NAMESPACE::bvh_split;
@@ -112,8 +118,6 @@ using pathlab::HWY_NAMESPACE::is_black;
 using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::zsobol_top24;
-using pathlab::HWY_NAMESPACE::normalize;
-using pathlab::HWY_NAMESPACE::offset_ray_origin;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::splat3;
 using pathlab::HWY_NAMESPACE::to_world;
@@ -140,7 +144,6 @@ using DDI = hn::RebindToSigned<DD>;
 using VDI = hn::Vec<DDI>;
 using V3D = Vec3<VD>;
 
-constexpr float kGamma2 = gamma_bound(2), kGamma3 = gamma_bound(3), kGamma5 = gamma_bound(5);  // core/math.h
 
 std::size_t lanes() { return hn::Lanes(DF()); }
 
@@ -448,18 +451,13 @@ void for_each_lane(M m, std::size_t i0, Fn&& fn) {
     if (set[j] != 0) fn(i0 + j, j);
 }
 
-// light_query's normal (core/light_sampler.h): n turned to wo's side, 0 edge-on.
-V3 query_normal(const V3& n, const V3& wo) {
-  const VF c = dot(n, wo);
-  return select(c > k(0.0f), n, select(c < k(0.0f), -n, zero3()));
-}
-
 void generate_camera_rays(const Scene& sc, const Camera& c, const Wave& w) {
   const DF df;
-  const V3 position = splat3(df, c.position[0], c.position[1], c.position[2]);
-  const V3 forward = splat3(df, c.forward[0], c.forward[1], c.forward[2]);
-  const V3 right = splat3(df, c.right[0], c.right[1], c.right[2]);
-  const V3 up = splat3(df, c.up[0], c.up[1], c.up[2]);
+  const CameraPlane<VF> plane{splat3(df, c.position[0], c.position[1], c.position[2]),
+                              splat3(df, c.forward[0], c.forward[1], c.forward[2]),
+                              splat3(df, c.right[0], c.right[1], c.right[2]),
+                              splat3(df, c.up[0], c.up[1], c.up[2]),
+                              k(c.tan_half_fov), k(c.aspect), k(c.inv_width), k(c.inv_height)};
   const V3 zero = zero3(), one = splat3(df, 1.0f, 1.0f, 1.0f);
   for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
     const M in = live(w.n, i0);
@@ -472,24 +470,19 @@ void generate_camera_rays(const Scene& sc, const Camera& c, const Wave& w) {
     store(w, kFilmX, i0, in, fx);
     store(w, kFilmY, i0, in, fy);
     // Camera::generate_ray.
-    const VF sx = (k(2.0f) * fx * k(c.inv_width) - k(1.0f)) * k(c.tan_half_fov) * k(c.aspect);
-    const VF sy = (k(1.0f) - k(2.0f) * fy * k(c.inv_height)) * k(c.tan_half_fov);
-    const V3 d = normalize(df, (forward + sx * right) + sy * up);
+    const V3 d = camera_direction(df, plane, fx, fy);
     if (c.aperture_radius <= 0.0f) {
-      store3(w, kOx, i0, in, position);
+      store3(w, kOx, i0, in, plane.position);
       store3(w, kDx, i0, in, d);
     } else {
-      // Thin lens: through the point of the plane in focus.
-      const V3 focus = position + (k(c.focus_distance) / dot(d, forward)) * d;
       VF lx, ly;
       VF lu, lv;
       rng.u2(Dim::LensX, lu, lv);
       concentric_disk(df, lu, lv, lx, ly);
-      lx = k(c.aperture_radius) * lx;
-      ly = k(c.aperture_radius) * ly;
-      const V3 origin = (position + lx * right) + ly * up;
+      V3 origin, dir;
+      thin_lens(df, plane, k(c.focus_distance), d, k(c.aperture_radius) * lx, k(c.aperture_radius) * ly, origin, dir);
       store3(w, kOx, i0, in, origin);
-      store3(w, kDx, i0, in, normalize(df, focus - origin));
+      store3(w, kDx, i0, in, dir);
     }
     store(w, kTmax, i0, in, k(std::numeric_limits<float>::infinity()));
     if (sc.alpha) store(w, kAlphaKey, i0, in, hn::BitCast(DI(), rng.bits_high(Dim::Alpha)));
@@ -553,13 +546,9 @@ void resolve(const Scene& sc, const Wave& w) {
       // sphere_point (core/geometry.cpp) of origin + t dir.
       const VF t = load(w, kHitT, i0, sphere);
       const V3 o = load3(w, kOx, i0, sphere), d = load3(w, kDx, i0, sphere);
-      const V3 center = shape_value3(sphere, sc, shape, kCenter);
-      const VF radius = shape_value(sphere, sc, shape, kRadius);
-      const V3 dir = normalize(df, (o + t * d) - center);
-      const V3 rdir = radius * dir;
-      const V3 sp = center + rdir;
-      const V3 serr = k(kGamma5) * abs(rdir) + k(kGamma2) * abs(sp);
-      const V3 sn = select(shape_flag(sphere, sc, shape, kFlipped), -dir, dir);
+      V3 sp, serr, sn;
+      sphere_point(df, shape_value3(sphere, sc, shape, kCenter), shape_value(sphere, sc, shape, kRadius),
+                   shape_flag(sphere, sc, shape, kFlipped), o + t * d, sp, serr, sn);
       p = select(sphere, sp, p);
       error = select(sphere, serr, error);
       n = select(sphere, sn, n);
@@ -732,7 +721,7 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, const 
   if (sc.lights.bvh_nodes) {
     // LightSampler::pick under bvh: the grid point k of u_choice walks the
     // tree from light_query(s, wo) (no sky: every point is the tree's).
-    const V3 qn = query_normal(n, wo);
+    const V3 qn = facing_normal(df, n, wo);  // light_query's
     VD share[2], tree_light[2];
     for (int h = 0; h < 2; ++h) {
       const VD scaled = hn::Floor(half_d(u_choice, h) * hn::Set(DD(), 0x1p24));
@@ -777,13 +766,9 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, const 
   ok = hn::And(ok, hn::AndNot(hn::IsInf(pdf_light), pdf_light > k(0.0f)));  // seen edge-on
 
   // Surfel::spawn_to(lp, lerr, ln).
-  const V3 err = load3(w, kErrX, i0, ok);
-  const V3 origin = offset_ray_origin(df, sp, err, select(dot(d, n) >= k(0.0f), n, -n));
-  const V3 reach = k(kGamma3) * abs(lp - origin);  // the float ray's own reach error
-  const V3 end = offset_ray_origin(df, lp, lerr + reach, select(dot(origin - lp, ln) >= k(0.0f), ln, -ln));
-  const V3 dd = end - origin;
-  const VF len = hn::Sqrt(dot(dd, dd));
-  const V3 dir = dd / len;
+  V3 origin, dir;
+  VF len;
+  spawn_to(df, sp, load3(w, kErrX, i0, ok), n, lp, lerr, ln, origin, dir, len);
   const VF ray[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
   std::copy(std::begin(ray), std::end(ray), ls.ray);
   return ls;
@@ -1039,7 +1024,7 @@ void scatter(const Scene& sc, const Wave& w) {
     // PreviousVertex{s.p, pdf, impulse, bsdf_technique}.
     const V3 sp = load3(w, kPx, i0, ok);
     store3(w, kPrevX, i0, ok, sp);
-    store3(w, kPrevNx, i0, ok, query_normal(n, wo));
+    store3(w, kPrevNx, i0, ok, facing_normal(df, n, wo));  // light_query's
     store(w, kPrevPdf, i0, ok, pdf);
     store_mask(w, kPrevImpulse, i0, ok, impulse);
     M bsdf_technique = hn::FirstN(df, lanes());
@@ -1057,7 +1042,7 @@ void scatter(const Scene& sc, const Wave& w) {
 
     // Surfel::spawn(wi).
     const V3 err = load3(w, kErrX, i0, ok);
-    store3(w, kOx, i0, ok, offset_ray_origin(df, sp, err, select(dot(wi, n) >= k(0.0f), n, -n)));
+    store3(w, kOx, i0, ok, spawn_origin(df, sp, err, n, wi));
     store3(w, kDx, i0, ok, wi);
     store(w, kTmax, i0, ok, k(std::numeric_limits<float>::infinity()));
     if (sc.alpha) store(w, kAlphaKey, i0, ok, hn::BitCast(DI(), rng.bits_high(Dim::Alpha)));

@@ -84,6 +84,14 @@ template <typename T>
 inline M operator>(V<T> a, V<T> b) {
   return {a.raw > b.raw};
 }
+template <typename T>
+inline M operator>=(V<T> a, V<T> b) {
+  return {a.raw >= b.raw};
+}
+template <typename T>
+inline M operator<(V<T> a, V<T> b) {
+  return {a.raw < b.raw};
+}
 
 template <typename T>
 inline V<T> IfThenElse(M m, V<T> yes, V<T> no) {

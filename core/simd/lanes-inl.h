@@ -230,6 +230,79 @@ HWY_INLINE void uniform_triangle(D d, V ux, V uy, V& b1, V& b2) {
   b2 = Set(d, 1.0f) - s;
 }
 
+// sphere_point (core/geometry.cpp): an approximate point of a sphere
+// projected onto it, with its rounding error bound (PBR 6.8.4: a few ulps of
+// the offset from the centre, plus the rounding of adding the centre back)
+// and its normal (inwards where `flip`).
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE void sphere_point(D d, const Vec3<V>& center, V radius, M flip, const Vec3<V>& p_approx, Vec3<V>& p,
+                             Vec3<V>& error, Vec3<V>& n) {
+  const Vec3<V> dir = normalize(d, p_approx - center);
+  const Vec3<V> offset = radius * dir;
+  p = center + offset;
+  error = Set(d, gamma_bound(5)) * abs(offset) + Set(d, gamma_bound(2)) * abs(p);
+  n = select(flip, -dir, dir);
+}
+
+// n turned to wo's side, 0 where wo is edge-on: the normal of a light
+// query (light_query, core/light_sampler.h) and of the light BVH's.
+template <class D, class V = VecOf<D>>
+HWY_INLINE Vec3<V> facing_normal(D d, const Vec3<V>& n, const Vec3<V>& wo) {
+  const V c = dot(n, wo);
+  return select(c > Zero(d), n, select(c < Zero(d), -n, splat3(d, 0.0f, 0.0f, 0.0f)));
+}
+
+// Surfel::spawn (core/surfel.cpp): the origin of a ray leaving p (error
+// bound `error`, normal n) along dir, off the surface on dir's side.
+template <class D, class V = VecOf<D>>
+HWY_INLINE Vec3<V> spawn_origin(D d, const Vec3<V>& p, const Vec3<V>& error, const Vec3<V>& n, const Vec3<V>& dir) {
+  return offset_ray_origin(d, p, error, select(dot(dir, n) >= Zero(d), n, -n));
+}
+
+// Surfel::spawn_to (core/surfel.cpp): the shadow ray from p towards
+// `target` (its error bound and normal), both ends strictly off their
+// surfaces: the ray reaches t = dist within gamma(3) |end - origin| of its
+// end per axis (the difference and the division round once each, the
+// rounded length cancels), so the end moves off the target's surface by
+// that reach beyond the target's own error, however long the ray.
+template <class D, class V = VecOf<D>>
+HWY_INLINE void spawn_to(D d, const Vec3<V>& p, const Vec3<V>& error, const Vec3<V>& n, const Vec3<V>& target,
+                         const Vec3<V>& target_error, const Vec3<V>& target_n, Vec3<V>& origin, Vec3<V>& dir, V& dist) {
+  origin = spawn_origin(d, p, error, n, target - p);
+  const Vec3<V> reach = Set(d, gamma_bound(3)) * abs(target - origin);
+  const Vec3<V> end = spawn_origin(d, target, target_error + reach, target_n, origin - target);
+  const Vec3<V> to_end = end - origin;
+  dist = Sqrt(dot(to_end, to_end));
+  dir = to_end / dist;
+}
+
+// The camera's image plane (Camera::Plane, core/camera.h) in lanes.
+template <class V>
+struct CameraPlane {
+  Vec3<V> position, forward, right, up;
+  V tan_half_fov, aspect, inv_width, inv_height;
+};
+// Camera::generate_ray's direction through film position (fx, fy) in pixels:
+// the point of the image plane at distance 1 along forward.
+template <class D, class V = VecOf<D>>
+HWY_INLINE Vec3<V> camera_direction(D d, const CameraPlane<V>& c, V fx, V fy) {
+  const V one = Set(d, 1.0f), two = Set(d, 2.0f);
+  const V sx = (two * fx * c.inv_width - one) * c.tan_half_fov * c.aspect;
+  const V sy = (one - two * fy * c.inv_height) * c.tan_half_fov;
+  return normalize(d, (c.forward + sx * c.right) + sy * c.up);
+}
+// Camera::generate_ray's thin lens: the ray of direction `dir` (from
+// camera_direction) leaves the aperture's point (lx, ly) (the concentric
+// disk's point, times the radius) through that direction's point of the
+// plane in focus, so every ray through a film point meets there.
+template <class D, class V = VecOf<D>>
+HWY_INLINE void thin_lens(D d, const CameraPlane<V>& c, V focus_distance, const Vec3<V>& dir, V lx, V ly,
+                          Vec3<V>& origin, Vec3<V>& lens_dir) {
+  const Vec3<V> focus = c.position + (focus_distance / dot(dir, c.forward)) * dir;
+  origin = (c.position + lx * c.right) + ly * c.up;
+  lens_dir = normalize(d, focus - origin);
+}
+
 // 64-bit lanes: the full 64-bit product of the low 32 bits of a and of b
 // (one 32 x 32 -> 64-bit multiply).
 template <class D64, class V64 = hn::Vec<D64>>
