@@ -1,33 +1,27 @@
 #include "core/sampling.h"
 
-#include "core/simd/sampling-inl.h"
 #include "core/simd/width1.h"
-
-#include <hwy/highway.h>
 
 #include <algorithm>
 #include <cmath>
 
 namespace pathlab {
 
-// The warps written once for every SIMD width (core/simd/sampling-inl.h),
-// here at width 1 with the build's own instruction set.
-namespace {
-namespace hn = hwy::HWY_NAMESPACE;
-constexpr hn::CappedTag<float, 1> kOne;
-float lane(hn::Vec<decltype(kOne)> v) { return hn::GetLane(v); }
-}  // namespace
+// The warps are written once for every SIMD width (core/simd/sampling-inl.h)
+// and called here at width 1 (core/simd/width1.h).
 
 SinCos sin_cos_quarter(float x) {
-  hn::Vec<decltype(kOne)> s, c;
-  HWY_NAMESPACE::sin_cos_quarter(kOne, hn::Set(kOne, x), s, c);
-  return {lane(s), lane(c)};
+  using namespace width1;
+  F s, c;
+  generic::sin_cos_quarter(kScalar, F{x}, s, c);
+  return {s.raw, c.raw};
 }
 
 vec2 square_to_concentric_disk(vec2 u) {
-  hn::Vec<decltype(kOne)> x, y;
-  HWY_NAMESPACE::concentric_disk(kOne, hn::Set(kOne, u.x), hn::Set(kOne, u.y), x, y);
-  return vec2(lane(x), lane(y));
+  using namespace width1;
+  F x, y;
+  generic::concentric_disk(kScalar, F{u.x}, F{u.y}, x, y);
+  return vec2(x.raw, y.raw);
 }
 
 vec2 concentric_disk_to_square(vec2 p) {
@@ -54,12 +48,16 @@ vec2 concentric_disk_to_square(vec2 p) {
 }
 
 vec3 square_to_cosine_hemisphere(vec2 u) {
-  hn::Vec<decltype(kOne)> x, y, z;
-  HWY_NAMESPACE::cosine_hemisphere(kOne, hn::Set(kOne, u.x), hn::Set(kOne, u.y), x, y, z);
-  return vec3(lane(x), lane(y), lane(z));
+  using namespace width1;
+  F x, y, z;
+  generic::cosine_hemisphere(kScalar, F{u.x}, F{u.y}, x, y, z);
+  return vec3(x.raw, y.raw, z.raw);
 }
 
-float cosine_hemisphere_pdf(const vec3& w) { return w.z > 0.0f ? w.z * kInvPi : 0.0f; }
+float cosine_hemisphere_pdf(const vec3& w) {
+  using namespace width1;
+  return generic::cosine_hemisphere_pdf(kScalar, F{w.z}).raw;
+}
 
 vec2 cosine_hemisphere_to_square(const vec3& w) { return concentric_disk_to_square(vec2(w.x, w.y)); }
 

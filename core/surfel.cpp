@@ -6,6 +6,7 @@
 #include "core/bsdf/mirror.h"
 #include "core/faults.h"
 #include "core/geometry.h"
+#include "core/sampling.h"
 #include "core/simd/width1.h"
 
 namespace pathlab {
@@ -185,10 +186,9 @@ std::optional<BsdfSample> Surfel::scatter_in_frame(const vec3& wo, float u_lobe,
   }
   switch (m.type) {
     case MaterialType::Diffuse: {
-      vec3 wi = lambert::sample(u);
-      const float pdf = lambert::pdf(wi);
-      if (pdf <= 0.0f) return std::nullopt;  // u on the disk's rim: grazing, no energy
-      if (pdf < m.shading.min_pdf) return std::nullopt;
+      vec3 wi;
+      float pdf;
+      if (!lambert::sample(u, m.shading.min_pdf, &wi, &pdf)) return std::nullopt;
       wi.z *= side;
       if (PATHLAB_FAULT(BsdfPdfOff5Percent) || PATHLAB_FAULT(CosineDropped)) {
         const vec3 w = frame.to_world(wi);

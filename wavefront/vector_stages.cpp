@@ -22,6 +22,7 @@
 
 #include <hwy/highway.h>
 
+#include "core/bsdf/lambert-inl.h"
 #include "core/simd/lanes-inl.h"
 #include "core/simd/light_bvh-inl.h"
 #include "core/simd/sampling-inl.h"
@@ -115,6 +116,8 @@ using pathlab::HWY_NAMESPACE::concentric_disk;
 using pathlab::HWY_NAMESPACE::dot;
 using pathlab::HWY_NAMESPACE::frame;
 using pathlab::HWY_NAMESPACE::is_black;
+using pathlab::HWY_NAMESPACE::lambert_eval;
+using pathlab::HWY_NAMESPACE::lambert_sample;
 using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::zsobol_top24;
@@ -810,7 +813,7 @@ LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Str
 
 // Surfel::eval and Surfel::pdf towards wi for the lanes of ok (which lose
 // the lanes whose f is black): the Lambert lobe in the lanes (core/surfel.cpp,
-// bsdf/lambert.h: only the local z of wo and wi matters), the lanes of
+// bsdf/lambert-inl.h: only the local z of wo and wi matters), the lanes of
 // kShadeByCore by core, path by path.
 void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V3& wo, const V3& n, const V3& wi, M& ok,
                V3& f, VF& pdf_bsdf) {
@@ -821,11 +824,7 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), wo_z > k(0.0f)));
   VF wi_z = dot(wi, n);
   wi_z = hn::IfThenElse(wo_z < k(0.0f), hn::Neg(wi_z), wi_z);
-  const M upper = wi_z > k(0.0f);
-  const VF cos_pi = wi_z * k(kInvPi);
-  const V3 rho = shape_value3(ok, sc, shape, kAlbedo);
-  f = zero_unless(upper, cos_pi * rho);
-  pdf_bsdf = hn::IfThenElseZero(upper, cos_pi);
+  lambert_eval(df, shape_value3(ok, sc, shape, kAlbedo), wi_z, f, pdf_bsdf);
   if (const M general = load_mask(w, kShadeByCore, i0, ok); !hn::AllFalse(df, general)) {
     HWY_ALIGN float to[3][kMaxLanes], value[3][kMaxLanes] = {}, density[kMaxLanes] = {};
     hn::Store(wi.x, df, to[0]);
@@ -962,18 +961,16 @@ void scatter(const Scene& sc, const Wave& w) {
     VI vertex = load(w, kVertex, i0, in);
     const Streams rng = streams(sc, w, i0, vertex);
 
-    // square_to_cosine_hemisphere (core/sampling.cpp).
-    VF x, y, z;
+    // Surfel::scatter, Lambert (lambert::sample): nothing where the density
+    // is unusable.
+    V3 local;
+    VF pdf;
     VF du, dv;
     rng.u2(Dim::DirectionX, du, dv);
-    pathlab::HWY_NAMESPACE::cosine_hemisphere(df, du, dv, x, y, z);
-
-    // Surfel::scatter, Lambert: no sample on the disk's rim, or below min_pdf
-    // (pdf > 0 and !(pdf < min_pdf), a NaN pdf passing as in the scalar code).
-    VF pdf = hn::IfThenElseZero(z > k(0.0f), z * k(kInvPi));
+    const M usable = lambert_sample(df, du, dv, k(sc.min_pdf), local, pdf);
     const VI shape = load(w, kShape, i0, ok);
     const M general = load_mask(w, kShadeByCore, i0, ok);
-    ok = hn::Or(general, hn::And(ok, hn::And(hn::Not(pdf <= k(0.0f)), hn::Not(pdf < k(sc.min_pdf)))));
+    ok = hn::Or(general, hn::And(ok, usable));
     const V3 wo = -load3(w, kDx, i0, ok);
     const V3 n = load3(w, kNx, i0, ok);
     // Surfel::scatter: nothing from behind a one-sided material.
@@ -981,7 +978,7 @@ void scatter(const Scene& sc, const Wave& w) {
     V3 fs, ft;
     frame(df, n, fs, ft);
     const VF side = hn::IfThenElse(dot(wo, n) < k(0.0f), k(-1.0f), k(1.0f));
-    V3 wi = to_world(fs, ft, n, x, y, z * side);
+    V3 wi = to_world(fs, ft, n, local.x, local.y, local.z * side);
     V3 weight = shape_value3(ok, sc, shape, kAlbedo);
     M impulse = hn::FirstN(df, 0);
     if (const M g = hn::And(general, ok); !hn::AllFalse(df, g)) {

@@ -92,6 +92,10 @@ template <typename T>
 inline M operator<(V<T> a, V<T> b) {
   return {a.raw < b.raw};
 }
+template <typename T>
+inline M operator<=(V<T> a, V<T> b) {
+  return {a.raw <= b.raw};
+}
 
 template <typename T>
 inline V<T> IfThenElse(M m, V<T> yes, V<T> no) {
@@ -101,6 +105,12 @@ template <typename T>
 inline V<T> IfThenElseZero(M m, V<T> yes) {
   return m.raw ? yes : V<T>{T(0)};
 }
+template <typename T>
+inline V<T> IfThenZeroElse(M m, V<T> no) {
+  return m.raw ? V<T>{T(0)} : no;
+}
+inline M And(M a, M b) { return {a.raw && b.raw}; }
+inline M Not(M a) { return {!a.raw}; }
 
 // x86's maxps/minps, operand order included (see the top of the file).
 inline V<float> Max(V<float> a, V<float> b) { return a.raw > b.raw ? a : b; }

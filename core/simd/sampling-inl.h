@@ -16,6 +16,9 @@
 
 #include <hwy/highway.h>
 
+#include "core/math.h"
+#include "core/simd/lane1.h"
+
 HWY_BEFORE_NAMESPACE();
 namespace pathlab::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
@@ -23,17 +26,17 @@ namespace hn = hwy::HWY_NAMESPACE;
 // sin and cos of x for |x| <= pi/4: Cephes' single-precision minimax
 // polynomials (sinf, cosf), |error| < 2 ulp there, evaluated term by term
 // in this order (no FMA), so that every target and width rounds alike.
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE void sin_cos_quarter(D d, V x, V& sin, V& cos) {
   const V z = x * x;
-  sin = ((((hn::Set(d, -1.9515295891e-4f) * z) + hn::Set(d, 8.3321608736e-3f)) * z) - hn::Set(d, 1.6666654611e-1f)) *
+  sin = ((((Set(d, -1.9515295891e-4f) * z) + Set(d, 8.3321608736e-3f)) * z) - Set(d, 1.6666654611e-1f)) *
             z * x +
         x;
-  cos = ((((hn::Set(d, 2.443315711809948e-5f) * z) - hn::Set(d, 1.388731625493765e-3f)) * z +
-          hn::Set(d, 4.166664568298827e-2f)) *
+  cos = ((((Set(d, 2.443315711809948e-5f) * z) - Set(d, 1.388731625493765e-3f)) * z +
+          Set(d, 4.166664568298827e-2f)) *
              z * z -
-         hn::Set(d, 0.5f) * z) +
-        hn::Set(d, 1.0f);
+         Set(d, 0.5f) * z) +
+        Set(d, 1.0f);
 }
 
 // Shirley and Chiu's concentric map, square [0,1)^2 -> unit disk, area
@@ -41,27 +44,34 @@ HWY_INLINE void sin_cos_quarter(D d, V x, V& sin, V& cos) {
 // the point is o.x (cos t, sin t) with t = (pi/4)(o.y / o.x); in the top and
 // bottom ones o.y (sin p, cos p) with p = (pi/4)(o.x / o.y). The centre maps
 // to 0 (where both ratios are 0/0).
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE void concentric_disk(D d, V ux, V uy, V& x, V& y) {
-  const V ox = hn::Set(d, 2.0f) * ux - hn::Set(d, 1.0f);
-  const V oy = hn::Set(d, 2.0f) * uy - hn::Set(d, 1.0f);
-  const auto wide = hn::Abs(ox) > hn::Abs(oy);
-  const V r = hn::IfThenElse(wide, ox, oy);
+  const V ox = Set(d, 2.0f) * ux - Set(d, 1.0f);
+  const V oy = Set(d, 2.0f) * uy - Set(d, 1.0f);
+  const auto wide = Abs(ox) > Abs(oy);
+  const V r = IfThenElse(wide, ox, oy);
   V s, c;
-  sin_cos_quarter(d, hn::Set(d, 3.14159265358979323846f / 4.0f) * (hn::IfThenElse(wide, oy, ox) / r), s, c);
-  const auto centre = hn::And(ox == hn::Zero(d), oy == hn::Zero(d));
-  x = hn::IfThenZeroElse(centre, r * hn::IfThenElse(wide, c, s));
-  y = hn::IfThenZeroElse(centre, r * hn::IfThenElse(wide, s, c));
+  sin_cos_quarter(d, Set(d, 3.14159265358979323846f / 4.0f) * (IfThenElse(wide, oy, ox) / r), s, c);
+  const auto centre = And(ox == Zero(d), oy == Zero(d));
+  x = IfThenZeroElse(centre, r * IfThenElse(wide, c, s));
+  y = IfThenZeroElse(centre, r * IfThenElse(wide, s, c));
 }
 
 // Cosine-weighted direction about +z (Malley's method): the disk point
 // lifted to the hemisphere, z = sqrt(max(0, (1 - x x) - y y)). Max(v, 0)
 // in that order: x86's max returns its second operand for a NaN or for
 // -0 against +0, so this is std::max(0.0f, v) exactly, NaN included.
-template <class D, class V = hn::Vec<D>>
+template <class D, class V = VecOf<D>>
 HWY_INLINE void cosine_hemisphere(D d, V ux, V uy, V& x, V& y, V& z) {
   concentric_disk(d, ux, uy, x, y);
-  z = hn::Sqrt(hn::Max(hn::Set(d, 1.0f) - x * x - y * y, hn::Zero(d)));
+  z = Sqrt(Max(Set(d, 1.0f) - x * x - y * y, Zero(d)));
+}
+
+// cosine_hemisphere_pdf (core/sampling.h): cos / pi above the horizon
+// (z > 0), else 0.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V cosine_hemisphere_pdf(D d, V z) {
+  return IfThenElseZero(z > Zero(d), z * Set(d, kInvPi));
 }
 
 }  // namespace pathlab::HWY_NAMESPACE
