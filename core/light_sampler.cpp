@@ -44,9 +44,6 @@ void build_distribution(const std::vector<double>& weights, std::vector<float>* 
 
 constexpr std::uint32_t kGrid = 1u << 24;  // LightChoice numbers are multiples of 1 / kGrid
 
-// Test-only fault switches (core/faults.h); the identity in production.
-float faulty_distance(float dist) { return PATHLAB_FAULT(LightPdfWithoutDistance) ? 1.0f : dist; }
-
 }  // namespace
 
 float spot_profile(float cos_theta, float cos_outer, float cos_inner) {
@@ -247,8 +244,10 @@ float LightSampler::pick_pmf(const LightQuery& ref, std::size_t entry) const {
 }
 
 std::size_t LightSampler::pick(const std::vector<float>& cdf, float u) {
-  const auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
-  return std::min<std::size_t>(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
+  using namespace width1;
+  if (cdf.empty()) return 0;
+  const auto cdf_at = [&](lane1::M m, F i) { return F{m.raw ? cdf[static_cast<std::size_t>(i.raw)] : 0.0f}; };
+  return static_cast<std::size_t>(generic::pick_cdf(kScalar, lane1::M{true}, cdf.size(), F{u}, cdf_at).raw);
 }
 
 std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u_choice, vec2 u) const {
@@ -326,15 +325,18 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
   ls.p = sp.p;
   ls.p_error = sp.p_error;
   ls.n = sp.n;
-  const vec3 d = ls.p - ref;
-  ls.dist = glm::length(d);
-  if (!(ls.dist > 0.0f)) return std::nullopt;
-  ls.wi = d / ls.dist;
-  const float cos_light = glm::dot(ls.n, -ls.wi);
-  if (!m.two_sided_emission && cos_light <= 0.0f) return std::nullopt;  // back of a one-sided emitter
+  using namespace width1;
+  F3 wi;
+  F dist, cos_light;
+  if (!generic::light_point_seen(kScalar, lanes(ref), lanes(ls.p), lanes(ls.n), lane1::M{m.two_sided_emission}, wi,
+                                 dist, cos_light)
+           .raw)
+    return std::nullopt;  // no distance, or the back of a one-sided emitter
+  ls.wi = scalars(wi);
+  ls.dist = dist.raw;
   ls.pdf = view.density > 0.0 ? pmf * static_cast<float>(view.density)
-                              : pmf * area_to_solid_angle(area_density(e), faulty_distance(ls.dist), cos_light);
-  if (!(ls.pdf > 0.0f) || std::isinf(ls.pdf)) return std::nullopt;  // seen edge-on
+                              : generic::area_light_pdf(kScalar, F{pmf}, F{area_density(e)}, dist, cos_light).raw;
+  if (!generic::usable_light_pdf(kScalar, F{ls.pdf}).raw) return std::nullopt;  // seen edge-on
   if (!textured) {
     ls.Le = m.emission;
     return ls;
@@ -360,9 +362,9 @@ float LightSampler::pdf(const LightQuery& query, const Surfel& hit) const {
   // Under bvh a light the tree gives nothing from here has density 0 (not
   // 0 times a density that may be infinite edge-on).
   if (kind_ == LightSamplerKind::Bvh && pmf == 0.0f) return 0.0f;
-  const vec3 d = hit.p - ref;
-  const float dist = glm::length(d);
-  return pmf * area_to_solid_angle(area_density(entries_[i]), faulty_distance(dist), glm::dot(hit.n, d) / dist);
+  using namespace width1;
+  return generic::area_light_pdf_at(kScalar, lanes(ref), lanes(hit.p), lanes(hit.n), F{pmf}, F{area_density(entries_[i])})
+      .raw;
 }
 
 LightSampler::SolidAngleView LightSampler::solid_angle_view(const Entry& e, const vec3& ref) const {

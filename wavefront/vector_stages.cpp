@@ -25,6 +25,7 @@
 #include "core/bsdf/lambert-inl.h"
 #include "core/simd/lanes-inl.h"
 #include "core/simd/light_bvh-inl.h"
+#include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"
 #include "core/simd/sobol-inl.h"
 #include "core/rng.h"
@@ -101,7 +102,8 @@ std::size_t compact(const Scene&, const Wave&, void*, std::uint32_t) { width_one
 std::size_t lanes() { return 1; }
 #else
 
-using pathlab::HWY_NAMESPACE::area_to_solid_angle;
+using pathlab::HWY_NAMESPACE::area_light_pdf;
+using pathlab::HWY_NAMESPACE::area_light_pdf_at;
 using pathlab::HWY_NAMESPACE::camera_direction;
 using pathlab::HWY_NAMESPACE::CameraPlane;
 using pathlab::HWY_NAMESPACE::facing_normal;
@@ -118,6 +120,9 @@ using pathlab::HWY_NAMESPACE::frame;
 using pathlab::HWY_NAMESPACE::is_black;
 using pathlab::HWY_NAMESPACE::lambert_eval;
 using pathlab::HWY_NAMESPACE::lambert_sample;
+using pathlab::HWY_NAMESPACE::light_point_seen;
+using pathlab::HWY_NAMESPACE::pick_cdf;
+using pathlab::HWY_NAMESPACE::usable_light_pdf;
 using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::zsobol_top24;
@@ -354,20 +359,10 @@ Streams streams(const Scene& sc, const Wave& w, std::size_t i0, VI vertex) {
   return s;
 }
 
-// LightSampler::pick: the first entry whose cdf exceeds u (the last entry
-// if none does), as a branch-free binary search.
+// LightSampler::pick (pick_cdf) over the lights' cdf.
 VI pick(M m, const Lights& lights, VF u) {
-  const auto count = static_cast<std::int32_t>(lights.count);
-  std::int32_t step = 1;
-  while (step * 2 <= count) step *= 2;
-  VI idx = hn::Zero(DI());
-  for (; step > 0; step /= 2) {
-    const VI cand = idx + hn::Set(DI(), step);
-    const M valid = hn::And(m, fmask(hn::Not(cand > hn::Set(DI(), count))));
-    const VF c = light_value(valid, lights, cand - hn::Set(DI(), 1), kLightCdf);
-    idx = hn::IfThenElse(hn::RebindMask(DI(), hn::And(valid, c <= u)), cand, idx);
-  }
-  return hn::Min(idx, hn::Set(DI(), count - 1));
+  const auto cdf_at = [&](M valid, VF i) { return light_value(valid, lights, hn::ConvertTo(DI(), i), kLightCdf); };
+  return hn::ConvertTo(DI(), pick_cdf(DF(), m, lights.count, u, cdf_at));
 }
 
 // The light BVH (core/light_bvh.cpp), each half of a block in double lanes.
@@ -597,8 +592,6 @@ VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI 
   const VI first = shape_int(lit, sc, shape, kFirstLight);
   const M light = hn::And(lit, fmask(hn::Not(first < hn::Zero(DI()))));
   const VI entry = first + load(w, kPrim, i0, light);
-  const V3 d = load3(w, kPx, i0, light) - load3(w, kPrevX, i0, light);
-  const VF dist = hn::Sqrt(dot(d, d));
   const VF inv_area = light_value(light, sc.lights, entry, kLightInvArea);
   VF pmf = light_value(light, sc.lights, entry, kLightPmf);
   M pdf_zero = hn::FirstN(df, 0);
@@ -619,7 +612,8 @@ VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI 
     }
     pdf_zero = pmf == k(0.0f);  // a light the tree gives nothing from here: density 0
   }
-  return hn::IfThenZeroElse(pdf_zero, hn::IfThenElseZero(light, pmf * area_to_solid_angle(df, inv_area, dist, dot(n, d) / dist)));
+  const VF pdf = area_light_pdf_at(df, load3(w, kPrevX, i0, light), load3(w, kPx, i0, light), n, pmf, inv_area);
+  return hn::IfThenZeroElse(pdf_zero, hn::IfThenElseZero(light, pdf));
 }
 
 // emission_weight (core/strategy_weights.h) for the lanes of lit (0 elsewhere).
@@ -753,20 +747,12 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, const 
   V3 lp, lerr;
   triangle_point(df, b1, b2, p0, p1, p2, lp, lerr);
 
-  const V3 d = lp - sp;
-  const VF dist = hn::Sqrt(dot(d, d));
-  ok = hn::And(ok, dist > k(0.0f));
-  ls.wi = d / dist;
-  const V3& wi = ls.wi;
-  const VF cos_light = dot(ln, -wi);
-  // The back of a one-sided emitter: cos_light <= 0 (NaN passes, as in the scalar code).
-  ok = hn::And(ok, hn::Or(two_sided != k(0.0f), hn::Not(cos_light <= k(0.0f))));
-  // pmf * area_to_solid_angle(1 / area, dist, cos_light) (core/sampling.h).
+  VF dist, cos_light;
+  ok = hn::And(ok, light_point_seen(df, sp, lp, ln, two_sided != k(0.0f), ls.wi, dist, cos_light));
   const VF inv_area = light_value(ok, sc.lights, light, kLightInvArea);
   const VF pmf = sc.lights.bvh_nodes ? bvh_pmf : light_value(ok, sc.lights, light, kLightPmf);
-  const VF pdf_light = pmf * area_to_solid_angle(df, inv_area, dist, cos_light);
-  ls.pdf = pdf_light;
-  ok = hn::And(ok, hn::AndNot(hn::IsInf(pdf_light), pdf_light > k(0.0f)));  // seen edge-on
+  ls.pdf = area_light_pdf(df, pmf, inv_area, dist, cos_light);
+  ok = hn::And(ok, usable_light_pdf(df, ls.pdf));  // not seen edge-on
 
   // Surfel::spawn_to(lp, lerr, ln).
   V3 origin, dir;

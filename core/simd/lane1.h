@@ -111,6 +111,7 @@ inline V<T> IfThenZeroElse(M m, V<T> no) {
 }
 inline M And(M a, M b) { return {a.raw && b.raw}; }
 inline M Not(M a) { return {!a.raw}; }
+inline M Or(M a, M b) { return {a.raw || b.raw}; }
 
 // x86's maxps/minps, operand order included (see the top of the file).
 inline V<float> Max(V<float> a, V<float> b) { return a.raw > b.raw ? a : b; }

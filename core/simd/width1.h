@@ -15,6 +15,7 @@
 #include "core/math.h"
 #include "core/simd/lane1.h"
 #include "core/simd/lanes-inl.h"
+#include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"
 
 namespace pathlab::width1 {

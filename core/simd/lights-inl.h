@@ -1,0 +1,87 @@
+// LightSampler's steps (core/light_sampler.cpp) written once over Highway's
+// vectors: the pick from a cdf, and what an area light's point gives a
+// shading point (direction, distance, density). core/light_sampler.cpp calls
+// them at width 1 (core/simd/width1.h) for both tracers' scalar code, the
+// wavefront's vectorised stages at their SIMD width.
+//
+// Highway's "-inl.h" convention: no include guard but the toggle below.
+#if defined(PATHLAB_CORE_SIMD_LIGHTS_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef PATHLAB_CORE_SIMD_LIGHTS_INL_H_
+#undef PATHLAB_CORE_SIMD_LIGHTS_INL_H_
+#else
+#define PATHLAB_CORE_SIMD_LIGHTS_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+#include "core/faults.h"
+#include "core/simd/lane1.h"
+#include "core/simd/lanes-inl.h"
+
+#include <cstddef>
+
+HWY_BEFORE_NAMESPACE();
+namespace pathlab::HWY_NAMESPACE {
+
+// LightSampler::pick: the first of `count` entries whose cdf exceeds u, the
+// last if none does (std::upper_bound), as a branch-free binary search:
+// the number of entries whose cdf is <= u, at most count - 1. Indices are
+// float lanes (exact below 2^24 entries); cdf_at(m, i) is entry i's cdf in
+// the lanes of m (its caller's table lookup: a gather, a permute or a load).
+template <class D, class M, class Lookup, class V = VecOf<D>>
+HWY_INLINE V pick_cdf(D d, M m, std::size_t count, V u, const Lookup& cdf_at) {
+  std::size_t step = 1;
+  while (step * 2 <= count) step *= 2;
+  V idx = Zero(d);
+  const V n = Set(d, static_cast<float>(count));
+  for (; step > 0; step /= 2) {
+    const V cand = idx + Set(d, static_cast<float>(step));
+    const M valid = And(m, Not(cand > n));
+    idx = IfThenElse(And(valid, cdf_at(valid, cand - Set(d, 1.0f)) <= u), cand, idx);
+  }
+  return Min(idx, Set(d, static_cast<float>(count - 1)));
+}
+
+// An area light's point lp (normal ln) seen from ref: the direction wi, the
+// distance and the cosine at the light (LightSampler::sample). False where
+// the distance is not > 0 or the point shows its back to ref (cos_light <=
+// 0) and the emitter is one-sided (a NaN cosine passes, as in the scalar
+// code).
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE M light_point_seen(D d, const Vec3<V>& ref, const Vec3<V>& lp, const Vec3<V>& ln, M two_sided, Vec3<V>& wi,
+                              V& dist, V& cos_light) {
+  const Vec3<V> to = lp - ref;
+  dist = Sqrt(dot(to, to));
+  wi = to / dist;
+  cos_light = dot(ln, -wi);
+  return And(dist > Zero(d), Or(two_sided, Not(cos_light <= Zero(d))));
+}
+
+// The solid-angle density of an area light's point chosen with `pmf` and
+// the area density inv_area, at `dist` and `cos_light`: pmf inv_area d^2 /
+// |cos| (area_to_solid_angle), 0 edge-on.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V area_light_pdf(D d, V pmf, V inv_area, V dist, V cos_light) {
+  // The test-only fault (core/faults.h): no distance^2 in the conversion.
+  if (PATHLAB_FAULT(LightPdfWithoutDistance)) dist = Set(d, 1.0f);
+  return pmf * area_to_solid_angle(d, inv_area, dist, cos_light);
+}
+
+// LightSampler::pdf of an area light's point p (normal n) seen from ref.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V area_light_pdf_at(D d, const Vec3<V>& ref, const Vec3<V>& p, const Vec3<V>& n, V pmf, V inv_area) {
+  const Vec3<V> to = p - ref;
+  const V dist = Sqrt(dot(to, to));
+  return area_light_pdf(d, pmf, inv_area, dist, dot(n, to) / dist);
+}
+
+// A light sample's density is usable: > 0 and finite (not seen edge-on).
+template <class D, class V = VecOf<D>>
+HWY_INLINE auto usable_light_pdf(D d, V pdf) {
+  return And(pdf > Zero(d), Not(IsInf(pdf)));
+}
+
+}  // namespace pathlab::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // PATHLAB_CORE_SIMD_LIGHTS_INL_H_ toggle
