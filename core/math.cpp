@@ -14,4 +14,14 @@ Frame::Frame(const vec3& normal) : n(normal) {
   t = scalars(lt);
 }
 
+vec3 Frame::to_local(const vec3& v) const {
+  using namespace width1;
+  return scalars(generic::to_local(lanes(s), lanes(t), lanes(n), lanes(v)));
+}
+
+vec3 Frame::to_world(const vec3& v) const {
+  using namespace width1;
+  return scalars(generic::to_world(lanes(s), lanes(t), lanes(n), F{v.x}, F{v.y}, F{v.z}));
+}
+
 }  // namespace pathlab

@@ -64,8 +64,10 @@ struct Frame {
   // left-handed; the reflection models only read directions in it.
   Frame(const vec3& normal, const vec3& tangent, float handedness)
       : s(tangent), t(handedness * glm::cross(normal, tangent)), n(normal) {}
-  vec3 to_local(const vec3& v) const { return vec3(glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)); }
-  vec3 to_world(const vec3& v) const { return s * v.x + t * v.y + n * v.z; }
+  // v's coordinates in the frame, and back (core/math.cpp: the generic
+  // to_local and to_world of core/simd/lanes-inl.h at width 1).
+  vec3 to_local(const vec3& v) const;
+  vec3 to_world(const vec3& v) const;
 };
 
 }  // namespace pathlab

@@ -18,12 +18,11 @@ struct LocalDirs {
   vec3 wo, wi;
 };
 LocalDirs to_local_upper(const Frame& frame, const vec3& wo, const vec3& wi) {
-  LocalDirs d{frame.to_local(wo), frame.to_local(wi)};
-  if (d.wo.z < 0.0f) {
-    d.wo.z = -d.wo.z;
-    d.wi.z = -d.wi.z;
-  }
-  return d;
+  using namespace width1;
+  F3 wo_local, wi_local;
+  generic::to_local_upper(kScalar, lanes(frame.s), lanes(frame.t), lanes(frame.n), lanes(wo), lanes(wi), wo_local,
+                          wi_local);
+  return {scalars(wo_local), scalars(wi_local)};
 }
 
 // What shading reads of a material: its own constants, or the parameters
@@ -111,8 +110,9 @@ std::optional<BsdfSample> scatter_dielectric(const MaterialView& m, const Frame&
 
 Spectrum Surfel::emitted(const vec3& wo) const {
   if (!material->emits()) return Spectrum(0.0f);
-  if (material->two_sided_emission || glm::dot(n, wo) > 0.0f) return params ? params->emission : material->emission;
-  return Spectrum(0.0f);
+  using namespace width1;
+  return scalars(generic::emitted_towards(kScalar, lane1::M{material->two_sided_emission}, lanes(n), lanes(wo),
+                                          lanes(params ? params->emission : material->emission)));
 }
 
 // The shading-normal policy (surfel.h): with a shading normal, a reflection

@@ -106,6 +106,7 @@ using pathlab::HWY_NAMESPACE::area_light_pdf;
 using pathlab::HWY_NAMESPACE::area_light_pdf_at;
 using pathlab::HWY_NAMESPACE::camera_direction;
 using pathlab::HWY_NAMESPACE::CameraPlane;
+using pathlab::HWY_NAMESPACE::emitted_towards;
 using pathlab::HWY_NAMESPACE::facing_normal;
 using pathlab::HWY_NAMESPACE::spawn_origin;
 using pathlab::HWY_NAMESPACE::spawn_to;
@@ -128,6 +129,7 @@ using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::zsobol_top24;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::splat3;
+using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
 using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::uniform_triangle;
@@ -660,8 +662,8 @@ void add_emission(const Scene& sc, const Wave& w) {
       const VI shape = load(w, kShape, i0, found);
       const V3 wo = -load3(w, kDx, i0, found);
       const V3 n = load3(w, kNx, i0, found);
-      const M facing = hn::Or(shape_flag(found, sc, shape, kTwoSided), dot(n, wo) > k(0.0f));
-      V3 Le = zero_unless(hn::And(shape_flag(found, sc, shape, kEmits), facing), shape_value3(found, sc, shape, kEmission));
+      V3 Le = emitted_towards(df, shape_flag(found, sc, shape, kTwoSided), n, wo,
+                              zero_unless(shape_flag(found, sc, shape, kEmits), shape_value3(found, sc, shape, kEmission)));
       if (sc.textured) {
         // Textured emission: Surfel::emitted, path by path.
         const M textured = shape_flag(found, sc, shape, kTexturedEmission);
@@ -808,9 +810,11 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   // A one-sided material is black unless wo and wi both leave its front
   // (Surfel::eval); with wo in front, upper below is wi in front.
   if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), wo_z > k(0.0f)));
-  VF wi_z = dot(wi, n);
-  wi_z = hn::IfThenElse(wo_z < k(0.0f), hn::Neg(wi_z), wi_z);
-  lambert_eval(df, shape_value3(ok, sc, shape, kAlbedo), wi_z, f, pdf_bsdf);
+  // In the geometric normal's frame (the lanes' surfaces are flat).
+  V3 fs, ft, wo_local, wi_local;
+  frame(df, n, fs, ft);
+  to_local_upper(df, fs, ft, n, wo, wi, wo_local, wi_local);
+  lambert_eval(df, shape_value3(ok, sc, shape, kAlbedo), wi_local.z, f, pdf_bsdf);
   if (const M general = load_mask(w, kShadeByCore, i0, ok); !hn::AllFalse(df, general)) {
     HWY_ALIGN float to[3][kMaxLanes], value[3][kMaxLanes] = {}, density[kMaxLanes] = {};
     hn::Store(wi.x, df, to[0]);

@@ -151,10 +151,36 @@ HWY_INLINE void frame(D d, const Vec3<V>& n, Vec3<V>& s, Vec3<V>& t) {
   s = {Set(d, 1.0f) + sign * n.x * n.x * a, sign * b, Neg(sign) * n.x};
   t = {b, sign + n.y * n.y * a, Neg(n.y)};
 }
+// Frame::to_local: v's coordinates (v.s, v.t, v.n).
+template <class V>
+HWY_INLINE Vec3<V> to_local(const Vec3<V>& s, const Vec3<V>& t, const Vec3<V>& n, const Vec3<V>& v) {
+  return {dot(v, s), dot(v, t), dot(v, n)};
+}
 // Frame::to_world: s x + t y + n z.
 template <class V>
 HWY_INLINE Vec3<V> to_world(const Vec3<V>& s, const Vec3<V>& t, const Vec3<V>& n, V x, V y, V z) {
   return (x * s + y * t) + z * n;
+}
+
+// Surfel's local directions for its two-sided reflection models
+// (to_local_upper, core/surfel.cpp): wo and wi in the frame (s, t, n),
+// both flipped about the tangent plane where wo is below it, so that wo is
+// on +z.
+template <class D, class V = VecOf<D>>
+HWY_INLINE void to_local_upper(D d, const Vec3<V>& s, const Vec3<V>& t, const Vec3<V>& n, const Vec3<V>& wo,
+                               const Vec3<V>& wi, Vec3<V>& wo_local, Vec3<V>& wi_local) {
+  wo_local = to_local(s, t, n, wo);
+  wi_local = to_local(s, t, n, wi);
+  const auto below = wo_local.z < Zero(d);
+  wo_local.z = IfThenElse(below, Neg(wo_local.z), wo_local.z);
+  wi_local.z = IfThenElse(below, Neg(wi_local.z), wi_local.z);
+}
+
+// Surfel::emitted: the emission Le towards wo, 0 behind a one-sided
+// emitter (n the geometric normal).
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE Vec3<V> emitted_towards(D d, M two_sided, const Vec3<V>& n, const Vec3<V>& wo, const Vec3<V>& Le) {
+  return zero_unless(Or(two_sided, dot(n, wo) > Zero(d)), Le);
 }
 
 // power_heuristic (core/sampling.h): a^2 / (a^2 + b^2) through the ratio;
