@@ -89,21 +89,10 @@ std::optional<BsdfSample> scatter_closure(const MaterialView& m, const Frame& fr
 std::optional<BsdfSample> scatter_dielectric(const MaterialView& m, const Frame& frame, const vec3& wo, float u_lobe) {
   // The geometric normal's side is the outside: entering or leaving decides
   // eta (dielectric.h).
-  const vec3 wo_local = frame.to_local(wo);
-  if (wo_local.z == 0.0f) return std::nullopt;  // grazing exactly: no projected area, nothing scatters
-  const dielectric::Interface in = dielectric::at(wo_local, m.glass.ior);
-  const float F = PATHLAB_FAULT(DielectricFresnelIgnored) ? (in.F >= 1.0f ? 1.0f : 0.0f) : in.F;
-  // Reflect or refract with probability proportional to the energy each
-  // carries (absorbed otherwise), so that for white tints the weight is 1.
-  const float p_r = F * average(m.glass.reflectance);
-  const float p_t = (1.0f - F) * average(m.glass.transmittance);
-  if (u_lobe < p_r)
-    return BsdfSample{frame.to_world(dielectric::reflect(wo_local)), m.glass.reflectance * (F / p_r), p_r,
-                      Lobe::DielectricReflection, true};
-  if (u_lobe < p_r + p_t)
-    return BsdfSample{frame.to_world(dielectric::refract(wo_local, in)), m.glass.transmittance * ((1.0f - F) / p_t), p_t,
-                      Lobe::DielectricTransmission, true};
-  return std::nullopt;
+  dielectric::Sample ds;
+  if (!dielectric::sample(m.glass, u_lobe, frame.to_local(wo), &ds)) return std::nullopt;
+  return BsdfSample{frame.to_world(ds.wi), ds.weight, ds.pdf,
+                    ds.transmitted ? Lobe::DielectricTransmission : Lobe::DielectricReflection, true};
 }
 
 }  // namespace
@@ -201,11 +190,12 @@ std::optional<BsdfSample> Surfel::scatter_in_frame(const vec3& wo, float u_lobe,
       // The impulse is chosen with probability equal to its mean reflectance
       // (absorbed otherwise), so its weight stays near 1 and paths end in
       // proportion to the energy they would lose.
-      const float prob = std::min(1.0f, average(m.albedo));
-      if (!(u_lobe < prob)) return std::nullopt;
-      vec3 wi = mirror::reflect_local(wo_local);
+      vec3 wi;
+      Spectrum weight;
+      float prob;
+      if (!mirror::sample(m.albedo, u_lobe, wo_local, &wi, &weight, &prob)) return std::nullopt;
       wi.z *= side;
-      return BsdfSample{frame.to_world(wi), m.albedo / prob, prob, Lobe::MirrorImpulse, true};
+      return BsdfSample{frame.to_world(wi), weight, prob, Lobe::MirrorImpulse, true};
     }
     case MaterialType::Disney:       // only reached with a path that cannot shade it (never configured so)
     case MaterialType::Dielectric:   // handled above

@@ -1,36 +1,37 @@
 // The smooth dielectric interface: Fresnel reflection and Snell refraction,
 // both impulses. Local frame with z = the geometric normal of the FRONT
-// (outside) side; a direction with z > 0 is outside. eta = ior of the inside
-// relative to the outside.
+// (outside) side; a direction with z > 0 is outside. ior = the inside's
+// index relative to the outside's. The formulas are core/bsdf/
+// dielectric-inl.h's, here at width 1 (the wavefront's lanes call the
+// same); include from core's .cpp files only (core/simd/width1.h).
 #pragma once
 
-#include "core/bsdf/fresnel.h"
+#include "core/bsdf/dielectric-inl.h"
+#include "core/material.h"
+#include "core/simd/width1.h"
 
 namespace pathlab::dielectric {
 
-struct Interface {
-  float eta_rel;  // n_transmitted / n_incident for light arriving along wo
-  float cos_o;    // |wo.z|
-  float F;        // Fresnel reflectance (1 under total internal reflection)
+struct Sample {
+  vec3 wi;          // local
+  Spectrum weight;  // f |cos| / pdf
+  float pdf;        // the probability of the impulse chosen
+  bool transmitted;
 };
 
-inline Interface at(const vec3& wo_local, float ior) {
-  const bool entering = wo_local.z > 0.0f;
-  const float eta_rel = entering ? ior : 1.0f / ior;
-  const float cos_o = std::abs(wo_local.z);
-  return {eta_rel, cos_o, fresnel::dielectric(cos_o, eta_rel)};
-}
-
-inline vec3 reflect(const vec3& wo_local) { return vec3(-wo_local.x, -wo_local.y, wo_local.z); }
-
-// Snell refraction of wo through the interface (assumes no total internal
-// reflection, i.e. F < 1).
-inline vec3 refract(const vec3& wo_local, const Interface& in) {
-  const float sin2_t = (1.0f - in.cos_o * in.cos_o) / (in.eta_rel * in.eta_rel);
-  const float cos_t = std::sqrt(std::max(0.0f, 1.0f - sin2_t));  // F < 1 means sin2_t < 1; clamp rounding
-  const float side = wo_local.z > 0.0f ? 1.0f : -1.0f;
-  const vec3 t = -wo_local / in.eta_rel + vec3(0.0f, 0.0f, side * (in.cos_o / in.eta_rel - cos_t));
-  return glm::normalize(t);
+// Reflect or refract wo_local, chosen by u_lobe in proportion to the energy
+// each carries; false where wo grazes exactly or u_lobe falls in the
+// absorbed part.
+inline bool sample(const DielectricParams& glass, float u_lobe, const vec3& wo_local, Sample* out) {
+  using namespace width1;
+  F3 wi, weight;
+  F pdf;
+  lane1::M transmitted{false};
+  const bool ok = generic::dielectric_sample(kScalar, F{glass.ior}, lanes(glass.reflectance), lanes(glass.transmittance),
+                                             F{u_lobe}, lanes(wo_local), wi, weight, pdf, transmitted)
+                      .raw;
+  *out = {scalars(wi), scalars(weight), pdf.raw, transmitted.raw};
+  return ok;
 }
 
 }  // namespace pathlab::dielectric

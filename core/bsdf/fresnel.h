@@ -22,16 +22,9 @@ inline float schlick_weight(float c) {
 inline Spectrum schlick(const Spectrum& f0, float c) { return glm::mix(f0, Spectrum(1.0f), schlick_weight(c)); }
 inline float schlick(float f0, float c) { return f0 + (1.0f - f0) * schlick_weight(c); }
 
-// Unpolarised Fresnel reflectance of a smooth dielectric interface.
-inline float dielectric(float cos_i, float eta) {
-  cos_i = std::clamp(cos_i, 0.0f, 1.0f);
-  const float sin2_t = (1.0f - cos_i * cos_i) / (eta * eta);
-  if (sin2_t >= 1.0f) return 1.0f;  // total internal reflection
-  const float cos_t = std::sqrt(1.0f - sin2_t);
-  const float r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-  const float r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-  // At cos_i = 0 both ratios are -1 exactly (denominators > 0 since cos_t > 0).
-  return 0.5f * (r_par * r_par + r_perp * r_perp);
-}
+// Unpolarised Fresnel reflectance of a smooth dielectric interface
+// (core/bsdf/fresnel.cpp: the generic fresnel_dielectric of
+// core/bsdf/dielectric-inl.h at width 1, as the wavefront's lanes run it).
+float dielectric(float cos_i, float eta);
 
 }  // namespace pathlab::fresnel

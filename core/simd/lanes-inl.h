@@ -329,6 +329,12 @@ HWY_INLINE void thin_lens(D d, const CameraPlane<V>& c, V focus_distance, const 
   lens_dir = normalize(d, focus - origin);
 }
 
+// average (core/math.h): (x + y + z) / 3, as a product with 1/3.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V average(D d, const Vec3<V>& v) {
+  return ((v.x + v.y) + v.z) * Set(d, 1.0f / 3.0f);
+}
+
 // 64-bit lanes: the full 64-bit product of the low 32 bits of a and of b
 // (one 32 x 32 -> 64-bit multiply).
 template <class D64, class V64 = hn::Vec<D64>>
