@@ -22,7 +22,9 @@
 
 #include <hwy/highway.h>
 
+#include "core/bsdf/dielectric-inl.h"
 #include "core/bsdf/lambert-inl.h"
+#include "core/bsdf/mirror-inl.h"
 #include "core/simd/lanes-inl.h"
 #include "core/simd/light_bvh-inl.h"
 #include "core/simd/lights-inl.h"
@@ -120,7 +122,9 @@ using pathlab::HWY_NAMESPACE::dot;
 using pathlab::HWY_NAMESPACE::frame;
 using pathlab::HWY_NAMESPACE::is_black;
 using pathlab::HWY_NAMESPACE::lambert_eval;
+using pathlab::HWY_NAMESPACE::dielectric_sample;
 using pathlab::HWY_NAMESPACE::lambert_sample;
+using pathlab::HWY_NAMESPACE::mirror_sample;
 using pathlab::HWY_NAMESPACE::light_point_seen;
 using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::usable_light_pdf;
@@ -129,6 +133,7 @@ using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::zsobol_top24;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::splat3;
+using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
 using pathlab::HWY_NAMESPACE::triangle_point;
@@ -815,6 +820,12 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   frame(df, n, fs, ft);
   to_local_upper(df, fs, ft, n, wo, wi, wo_local, wi_local);
   lambert_eval(df, shape_value3(ok, sc, shape, kAlbedo), wi_local.z, f, pdf_bsdf);
+  if (sc.impulses) {
+    // A mirror's or a dielectric's f and pdf are 0 towards every direction (Surfel::eval, Surfel::pdf).
+    const M lambert = shape_value(ok, sc, shape, kLaneMaterial) == k(0.0f);
+    f = zero_unless(lambert, f);
+    pdf_bsdf = hn::IfThenElseZero(lambert, pdf_bsdf);
+  }
   if (const M general = load_mask(w, kShadeByCore, i0, ok); !hn::AllFalse(df, general)) {
     HWY_ALIGN float to[3][kMaxLanes], value[3][kMaxLanes] = {}, density[kMaxLanes] = {};
     hn::Store(wi.x, df, to[0]);
@@ -960,7 +971,10 @@ void scatter(const Scene& sc, const Wave& w) {
     const M usable = lambert_sample(df, du, dv, k(sc.min_pdf), local, pdf);
     const VI shape = load(w, kShape, i0, ok);
     const M general = load_mask(w, kShadeByCore, i0, ok);
-    ok = hn::Or(general, hn::And(ok, usable));
+    // The impulses' lanes (mirror, dielectric) decide their own below.
+    M impulses = hn::FirstN(df, 0);
+    if (sc.impulses) impulses = hn::AndNot(general, hn::And(ok, shape_value(ok, sc, shape, kLaneMaterial) != k(0.0f)));
+    ok = hn::Or(hn::Or(general, impulses), hn::And(ok, usable));
     const V3 wo = -load3(w, kDx, i0, ok);
     const V3 n = load3(w, kNx, i0, ok);
     // Surfel::scatter: nothing from behind a one-sided material.
@@ -971,6 +985,30 @@ void scatter(const Scene& sc, const Wave& w) {
     V3 wi = to_world(fs, ft, n, local.x, local.y, local.z * side);
     V3 weight = shape_value3(ok, sc, shape, kAlbedo);
     M impulse = hn::FirstN(df, 0);
+    if (const M im = hn::And(impulses, ok); !hn::AllFalse(df, im)) {
+      // Surfel::scatter_in_frame of a mirror (wo's side up, as the
+      // reflection models take it) and of a dielectric (the frame as is).
+      const VF u_lobe = rng.u(Dim::LobeChoice);
+      const VF material = shape_value(im, sc, shape, kLaneMaterial);
+      const M mirror = hn::And(im, material == k(static_cast<float>(kLaneMirror)));
+      const M glass = hn::And(im, material == k(static_cast<float>(kLaneDielectric)));
+      const V3 wo_local = to_local(fs, ft, n, wo);
+      V3 local_m, weight_m, local_g, weight_g;
+      VF pdf_m, pdf_g;
+      M transmitted;
+      const M mirrored = mirror_sample(df, weight, u_lobe, V3{wo_local.x, wo_local.y, wo_local.z * side}, local_m,
+                                       weight_m, pdf_m);
+      const M crossed = dielectric_sample(df, shape_value(glass, sc, shape, kIor), shape_value3(glass, sc, shape, kReflectance),
+                                          shape_value3(glass, sc, shape, kTransmittance), u_lobe, wo_local, local_g,
+                                          weight_g, pdf_g, transmitted);
+      const V3 wi_m = to_world(fs, ft, n, local_m.x, local_m.y, local_m.z * side);
+      const V3 wi_g = to_world(fs, ft, n, local_g.x, local_g.y, local_g.z);
+      wi = select(mirror, wi_m, select(glass, wi_g, wi));
+      weight = select(mirror, weight_m, select(glass, weight_g, weight));
+      pdf = hn::IfThenElse(mirror, pdf_m, hn::IfThenElse(glass, pdf_g, pdf));
+      impulse = im;
+      ok = hn::AndNot(hn::Or(hn::AndNot(mirrored, mirror), hn::AndNot(crossed, glass)), ok);
+    }
     if (const M g = hn::And(general, ok); !hn::AllFalse(df, g)) {
       // Any other material: Surfel::scatter, path by path.
       HWY_ALIGN float u[3][kMaxLanes], dir[3][kMaxLanes] = {}, wt[3][kMaxLanes] = {}, density[kMaxLanes] = {};
@@ -992,7 +1030,7 @@ void scatter(const Scene& sc, const Wave& w) {
       wi = select(g, load_lanes(dir), wi);
       weight = select(g, load_lanes(wt), weight);
       pdf = hn::IfThenElse(g, hn::Load(df, density), pdf);
-      impulse = hn::And(g, fmask(hn::Load(DI(), impulses) != hn::Zero(DI())));
+      impulse = hn::Or(impulse, hn::And(g, fmask(hn::Load(DI(), impulses) != hn::Zero(DI()))));
       ok = hn::AndNot(hn::AndNot(fmask(hn::Load(DI(), scattered) != hn::Zero(DI())), g), ok);
     }
     ok = hn::AndNot(is_black(df, weight), ok);

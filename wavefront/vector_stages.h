@@ -4,7 +4,7 @@
 // selected — for every scene (any camera, material, light, texture,
 // instance, alpha). The lanes do the camera, world-space hit points,
 // emission and its weight, triangle lights sampled by area, flat untextured
-// Lambert shading, roulette and compaction; everything else (other
+// Lambert, mirror and dielectric shading, roulette and compaction; everything else (other
 // materials, vertex normals, textures, instances, other lights) is core's,
 // called one path at a time between the lanes' steps (Scene::general,
 // general_lights, delta_lights, instanced, textured). `--simd scalar` runs
@@ -78,6 +78,9 @@ struct Scene {
   // BSDF is evaluated and sampled by core's Surfel, one path at a time;
   // resolve() keeps its shading frame from compiled->resolve() (kFsX...).
   bool general = false;
+  // Some shape the lanes shade is a mirror or a dielectric (ShapeField
+  // kLaneMaterial): else every lane shaded in the lanes is Lambert's.
+  bool impulses = false;
   const CompiledScene* compiled = nullptr;
   // Lights beyond triangles sampled by area (an environment, sun disks,
   // sphere lights, light_sampling solid_angle): compiled->lights() samples
@@ -131,8 +134,15 @@ enum ShapeField : int {
   kTexturedEmission = 19,  // 1 if its emission is textured (Surfel::emitted, path by path)
   kResolveByCore = 20,     // 1 if kGeneral and its Surfel needs CompiledScene::resolve (a shading frame of its
                            // own, textures); else resolve() makes its Frame(n) in the lanes
+  kLaneMaterial = 21,      // what the lanes shade it with (LaneMaterial), unless kGeneral
+  kIor = 22,               // a dielectric's DielectricParams
+  kReflectance = 23,       // 3 floats
+  kTransmittance = 26,     // 3 floats
   kShapeFields = 32,
 };
+
+// The materials the lanes shade (ShapeField kLaneMaterial), as floats.
+enum LaneMaterial : int { kLaneLambert = 0, kLaneMirror = 1, kLaneDielectric = 2 };
 
 // A camera (Camera::generate_ray).
 struct Camera {

@@ -188,9 +188,10 @@ struct WavefrontTracer::VectorStages {
     sc.strategy = settings.strategy;
     sc.rr_depth = settings.rr_depth;
     sc.max_vertex = settings.max_depth >= 0 ? settings.max_depth : kMaxVerticesUncapped;
-    // Flat Lambert surfaces (shaded by lambert.h, not through the Disney
-    // closure) are shaded in the lanes, with one min_pdf; any other surface
-    // that scatters by core's Surfel, path by path (vector_stages.h).
+    // Flat untextured Lambert surfaces (shaded by lambert.h, not through the
+    // Disney closure; with one min_pdf), mirrors and dielectrics are shaded
+    // in the lanes; any other surface that scatters by core's Surfel, path
+    // by path (vector_stages.h).
     const Scene& scene = compiled.scene();
     const Material* diffuse = nullptr;
     const bool cosine = settings.strategy == Strategy::Cosine;  // every surface by scatter_cosine
@@ -201,6 +202,7 @@ struct WavefrontTracer::VectorStages {
         v->general_materials.push_back("'" + m.name + "'");
         continue;
       }
+      if (m.type != MaterialType::Diffuse) continue;
       if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return no("materials with different min_pdf");
       diffuse = &m;
     }
@@ -318,7 +320,16 @@ struct WavefrontTracer::VectorStages {
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
       f[vs::kTexturedEmission] = m.emission_textured ? 1.0f : 0.0f;
       f[vs::kResolveByCore] = general && (shading_frame(sh) || m.reads_textures_at_hits()) ? 1.0f : 0.0f;
+      f[vs::kLaneMaterial] = m.type == MaterialType::Mirror       ? static_cast<float>(vs::kLaneMirror)
+                             : m.type == MaterialType::Dielectric ? static_cast<float>(vs::kLaneDielectric)
+                                                                  : static_cast<float>(vs::kLaneLambert);
+      f[vs::kIor] = m.glass.ior;
+      for (int c = 0; c < 3; ++c) {
+        f[vs::kReflectance + c] = m.glass.reflectance[c];
+        f[vs::kTransmittance + c] = m.glass.transmittance[c];
+      }
       sc.general = sc.general || general;
+      sc.impulses = sc.impulses || (m.scatters() && !general && m.is_pure_impulse());
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
     }
     sc.shape = v->shape.data();
@@ -347,10 +358,11 @@ struct WavefrontTracer::VectorStages {
   }
 
   // Whether the lanes shade m: Lambert, by lambert.h (every shading path but
-  // General, which shades it through the Disney closure; core/surfel.cpp).
+  // General, which shades it through the Disney closure; core/surfel.cpp),
+  // a mirror (mirror.h) or a dielectric (dielectric.h); untextured.
   static bool in_lanes(const Material& m) {
-    return m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General && !m.is_textured() &&
-           !m.normal_map;
+    const bool lambert = m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General;
+    return (lambert || m.is_pure_impulse()) && !m.is_textured() && !m.normal_map;
   }
   // Whether a shape shades in a frame of its own (not the geometric normal's).
   static bool shading_frame(const Shape& shape) { return shape.mesh.has_normals() || !shape.mesh.tangents.empty(); }
