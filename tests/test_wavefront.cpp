@@ -665,8 +665,8 @@ std::vector<VectorCase> vector_cases() {
   cases.push_back({"white-sphere-emissive-room.json", Strategy::Mis, 0.0f, 0, false, true, true, false, false, 0, true});
   cases.push_back({"white-sphere-emissive-room.json", Strategy::LightBsdf, 0.0f, -1, false, false, true, true, false, 0, true});
   cases.push_back({"", Strategy::LightBsdf, 0.0f, 0, false, true, true, false, true, 0, true});
-  // Materials shaded by core's Surfel between the lanes' steps: Disney (metallic; sheen and clearcoat), glass and
-  // a mirror, and Lambert through the closure (--general-shading).
+  // Materials shaded by core's Surfel between the lanes' steps: Disney (metallic; sheen and clearcoat), and Lambert
+  // through the closure (--general-shading); a glass box and a mirror wall, shaded in the lanes.
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"materials", st, 0.0f, 0});
   cases.push_back({"materials", Strategy::Mis, 0.2f, 0});

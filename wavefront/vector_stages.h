@@ -11,9 +11,10 @@
 // the scalar stages of wavefront_tracer.cpp.
 //
 // Written once (vector_stages.cpp, over Google Highway, compiled for every
-// target) on core's per-lane code (core/simd/*-inl.h; core's scalar code
-// runs sampling-inl.h at width 1, and has a scalar twin of the rest). Same paths: every lane computes what the scalar
-// code computes, operation for operation and in the same order, and Embree
+// target) on core's per-lane code (core/simd/*-inl.h, core/bsdf/*-inl.h,
+// which core's scalar functions run at width 1). Same paths: every lane
+// computes what the scalar code computes, operation for operation and in
+// the same order, and Embree
 // sees the same batches in the same order. tests/test_wavefront.cpp checks
 // every sample of several scenes bit for bit against the scalar stages at
 // every target the processor runs.
