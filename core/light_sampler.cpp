@@ -47,10 +47,8 @@ constexpr std::uint32_t kGrid = 1u << 24;  // LightChoice numbers are multiples 
 }  // namespace
 
 float spot_profile(float cos_theta, float cos_outer, float cos_inner) {
-  if (cos_theta >= cos_inner) return 1.0f;
-  if (cos_theta <= cos_outer) return 0.0f;
-  const float t = (cos_theta - cos_outer) / (cos_inner - cos_outer);
-  return t * t * (3.0f - 2.0f * t);
+  using namespace width1;
+  return generic::spot_profile(kScalar, F{cos_theta}, F{cos_outer}, F{cos_inner}).raw;
 }
 
 double delta_power_over_4pi(const DeltaLight& light, float scene_radius) {
@@ -426,26 +424,25 @@ std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_c
   LightSample ls;
   ls.light = static_cast<std::uint32_t>(i);
   ls.pdf = delta_pmf_[i];
-  if (light.kind == DeltaLight::Kind::Directional) {
-    // The shadow ray escapes (infinite): nothing may block it anywhere.
-    ls.wi = -light.direction;
-    ls.dist = kInfinity;
-    ls.infinite = true;
-    ls.Le = light.intensity;
-    return ls;
-  }
-  ls.p = light.position;
-  const vec3 d = ls.p - ref;
-  const float dist2 = glm::dot(d, d);
-  if (!(dist2 > 0.0f)) return std::nullopt;
-  ls.dist = std::sqrt(dist2);
-  ls.wi = d / ls.dist;
-  ls.n = -ls.wi;  // a point has no surface: its ray ends as if at one facing the shading point
-  ls.Le = light.intensity / dist2;
-  if (light.kind == DeltaLight::Kind::Spot) {
-    const float profile = spot_profile(glm::dot(-ls.wi, light.direction), light.cos_outer, light.cos_inner);
-    if (!(profile > 0.0f)) return std::nullopt;
-    ls.Le *= profile;
+  using namespace width1;
+  const bool directional = light.kind == DeltaLight::Kind::Directional;
+  F3 wi, Le;
+  F dist;
+  if (!generic::delta_light_seen(kScalar, lane1::M{directional}, lane1::M{light.kind == DeltaLight::Kind::Spot}, lanes(ref),
+                                 lanes(light.position), lanes(light.direction), lanes(light.intensity),
+                                 F{light.cos_outer}, F{light.cos_inner}, wi, dist, Le)
+           .raw)
+    return std::nullopt;  // at the point itself, or outside the spot's cone
+  ls.wi = scalars(wi);
+  ls.dist = dist.raw;
+  ls.Le = scalars(Le);
+  // A directional light's shadow ray escapes (infinite): nothing may block
+  // it anywhere. A point has no surface: its ray ends as if at one facing
+  // the shading point.
+  ls.infinite = directional;
+  if (!directional) {
+    ls.p = light.position;
+    ls.n = -ls.wi;
   }
   return ls;
 }

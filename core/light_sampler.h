@@ -176,6 +176,10 @@ class LightSampler {
   // The probability with which sample_delta picks delta light i (its index
   // among the non-black ones, LightSample::light).
   std::span<const float> delta_pmf() const { return delta_pmf_; }
+  // The delta lights sample_delta picks from (sampled_delta_lights()) and
+  // the cdf it picks by (pick(): the first entry exceeding u).
+  std::span<const DeltaLight> delta_lights() const { return deltas_; }
+  std::span<const float> delta_cdf() const { return delta_cdf_; }
 
   // How sample() places a point on an area light (the scene's
   // render.light_sampling when it was made).

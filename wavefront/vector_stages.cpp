@@ -57,14 +57,13 @@ void general_eval(const Scene& scene, const Wave& wave, std::size_t i, const flo
 // Surfel::scatter; false where it samples nothing.
 bool general_scatter(const Scene& scene, const Wave& wave, std::size_t i, float u_lobe, float u0, float u1,
                      GeneralSample* out);
-// Lights beyond triangles sampled by area (Scene::general_lights), or a
-// delta light (`delta`: u0, u1 unused), by core's LightSampler for the path
-// in slot i: a light sample and its shadow ray (origin, direction, tmax;
-// shadow_ray), false where sample() or sample_delta() gives none.
+// Lights beyond triangles sampled by area (Scene::general_lights), by
+// core's LightSampler for the path in slot i: a light sample and its shadow
+// ray (origin, direction, tmax; shadow_ray), false where sample() gives none.
 struct GeneralLight {
   float wi[3], Le[3], pdf, ray[7];
 };
-bool general_light(const Scene& scene, const Wave& wave, std::size_t i, bool delta, float u_choice, float u0, float u1,
+bool general_light(const Scene& scene, const Wave& wave, std::size_t i, float u_choice, float u0, float u1,
                    GeneralLight* out);
 // The light the path's ray finds: the sky along an escaped ray (Scene::sky;
 // LightSampler::sky), or the density with which the light sampler would
@@ -122,6 +121,7 @@ using pathlab::HWY_NAMESPACE::dot;
 using pathlab::HWY_NAMESPACE::frame;
 using pathlab::HWY_NAMESPACE::is_black;
 using pathlab::HWY_NAMESPACE::lambert_eval;
+using pathlab::HWY_NAMESPACE::delta_light_seen;
 using pathlab::HWY_NAMESPACE::dielectric_sample;
 using pathlab::HWY_NAMESPACE::lambert_sample;
 using pathlab::HWY_NAMESPACE::mirror_sample;
@@ -770,26 +770,53 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, const 
   return ls;
 }
 
-// Any other lights (Scene::general_lights), or a delta light (`delta`):
-// LightSampler::sample or sample_delta and shadow_ray by core, path by path
-// (general_light).
-LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, M& ok, bool delta) {
+// LightSampler::sample_delta and its shadow ray (shadow_ray: to the point,
+// or escaping along a directional light's direction), in the lanes; the
+// lanes of ok it gives no sample leave ok.
+LightLanes delta_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, const V3& sp, const V3& n,
+                       M& ok) {
+  const DF df;
+  const DeltaLights& d = sc.deltas;
+  const auto cdf_at = [&](M valid, VF i) { return gather(valid, d.cdf, hn::ConvertTo(DI(), i), 1, 0); };
+  const VI light = hn::ConvertTo(DI(), pick_cdf(df, ok, d.count, rng.u(Dim::DeltaLightChoice), cdf_at));
+  const auto field3 = [&](int f) { return gather3(ok, d.table, light, kDeltaFields, f); };
+  const VF kind = gather(ok, d.table, light, kDeltaFields, kDeltaKind);
+  const M directional = kind == k(2.0f), spot = kind == k(1.0f);
+  const V3 position = field3(kDeltaPosition);
+  LightLanes ls;
+  VF dist;
+  ok = hn::And(ok, delta_light_seen(df, directional, spot, sp, position, field3(kDeltaDirection), field3(kDeltaIntensity),
+                                    gather(ok, d.table, light, kDeltaFields, kDeltaCosOuter),
+                                    gather(ok, d.table, light, kDeltaFields, kDeltaCosInner), ls.wi, dist, ls.Le));
+  ls.pdf = gather(ok, d.table, light, kDeltaFields, kDeltaPmf);
+  // Surfel::spawn_to(position, 0, -wi) for a point or spot, Surfel::spawn(wi) for a directional light.
+  const V3 err = load3(w, kErrX, i0, ok);
+  V3 origin, dir;
+  VF len;
+  spawn_to(df, sp, err, n, position, zero3(), -ls.wi, origin, dir, len);
+  origin = select(directional, spawn_origin(df, sp, err, n, ls.wi), origin);
+  dir = select(directional, ls.wi, dir);
+  len = hn::IfThenElse(directional, k(std::numeric_limits<float>::infinity()), len);
+  const VF ray[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
+  std::copy(std::begin(ray), std::end(ray), ls.ray);
+  return ls;
+}
+
+// Any other lights (Scene::general_lights): LightSampler::sample and
+// shadow_ray by core, path by path (general_light).
+LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, M& ok) {
   const DF df;
   HWY_ALIGN float u[3][kMaxLanes] = {}, wi[3][kMaxLanes] = {}, Le[3][kMaxLanes] = {}, pdf[kMaxLanes] = {},
                 ray[7][kMaxLanes] = {};
   HWY_ALIGN std::int32_t sampled[kMaxLanes] = {};
-  if (delta) {
-    hn::Store(rng.u(Dim::DeltaLightChoice), df, u[0]);
-  } else {
-    hn::Store(rng.u(Dim::LightChoice), df, u[0]);
-    VF lu, lv;
-    rng.u2(Dim::LightX, lu, lv);
-    hn::Store(lu, df, u[1]);
-    hn::Store(lv, df, u[2]);
-  }
+  hn::Store(rng.u(Dim::LightChoice), df, u[0]);
+  VF lu, lv;
+  rng.u2(Dim::LightX, lu, lv);
+  hn::Store(lu, df, u[1]);
+  hn::Store(lv, df, u[2]);
   for_each_lane(ok, i0, [&](std::size_t i, std::size_t j) {
     GeneralLight gl;
-    if (!general_light(sc, w, i, delta, u[0][j], u[1][j], u[2][j], &gl)) return;
+    if (!general_light(sc, w, i, u[0][j], u[1][j], u[2][j], &gl)) return;
     sampled[j] = 1;
     for (int c = 0; c < 3; ++c) {
       wi[c][j] = gl.wi[c];
@@ -909,12 +936,12 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     const V3 n = load3(w, kNx, i0, alive);  // the frame's normal is the surface's
     const VI shape = load(w, kShape, i0, alive);
 
-    // A delta light, in every strategy (LightSampler::sample_delta, path by
-    // path): f Le / pdf, weight 1.
+    // A delta light, in every strategy (LightSampler::sample_delta): f Le /
+    // pdf, weight 1.
     ShadowLanes delta{hn::FirstN(df, 0), zero3(), {}};
     if (sc.delta_lights) {
       delta.ok = alive;
-      const LightLanes ls = other_light(sc, w, i0, rng, delta.ok, true);
+      const LightLanes ls = delta_light(sc, w, i0, rng, sp, n, delta.ok);
       V3 f;
       VF pdf_bsdf;
       eval_bsdf(sc, w, i0, shape, wo, n, ls.wi, delta.ok, f, pdf_bsdf);
@@ -930,7 +957,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     if (sc.strategy == Strategy::LightBsdf) ok = hn::And(ok, rng.u(Dim::Technique) < k(0.5f));
     if (!hn::AllFalse(df, ok)) {
       const LightLanes ls =
-          sc.general_lights ? other_light(sc, w, i0, rng, ok, false) : triangle_light(sc, w, i0, rng, sp, wo, n, ok);
+          sc.general_lights ? other_light(sc, w, i0, rng, ok) : triangle_light(sc, w, i0, rng, sp, wo, n, ok);
       V3 f;
       VF pdf_bsdf;
       eval_bsdf(sc, w, i0, shape, wo, n, ls.wi, ok, f, pdf_bsdf);
@@ -1295,13 +1322,12 @@ bool general_scatter(const Scene& sc, const Wave& w, std::size_t i, float u_lobe
   return true;
 }
 
-bool general_light(const Scene& sc, const Wave& w, std::size_t i, bool delta, float u_choice, float u0, float u1,
+bool general_light(const Scene& sc, const Wave& w, std::size_t i, float u_choice, float u0, float u1,
                    GeneralLight* out) {
   const Surfel s = shading_point(w, i);
   const vec3 wo = -at(w, kDx, i);
   const LightSampler& lights = sc.compiled->lights();
-  const std::optional<LightSample> ls =
-      delta ? lights.sample_delta(s.p, u_choice) : lights.sample(light_query(s, wo), u_choice, vec2(u0, u1));
+  const std::optional<LightSample> ls = lights.sample(light_query(s, wo), u_choice, vec2(u0, u1));
   if (!ls) return false;
   const Ray r = shadow_ray(s, *ls);
   for (int c = 0; c < 3; ++c) {

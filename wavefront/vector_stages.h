@@ -3,8 +3,9 @@
 // AVX-512, 8 with AVX2, 4 with SSE4, whichever core/simd/simd.h's dispatch
 // selected — for every scene (any camera, material, light, texture,
 // instance, alpha). The lanes do the camera, world-space hit points,
-// emission and its weight, triangle lights sampled by area, flat untextured
-// Lambert, mirror and dielectric shading, roulette and compaction; everything else (other
+// emission and its weight, triangle lights sampled by area, delta lights,
+// flat untextured Lambert, mirror and dielectric shading, roulette and
+// compaction; everything else (other
 // materials, vertex normals, textures, instances, other lights) is core's,
 // called one path at a time between the lanes' steps (Scene::general,
 // general_lights, delta_lights, instanced, textured). `--simd scalar` runs
@@ -65,6 +66,24 @@ enum LightField : int {
   kLightColumns = 19,
 };
 
+// The delta lights (point, spot, directional), as LightSampler::
+// sample_delta() picks and samples them.
+struct DeltaLights {
+  std::size_t count = 0;
+  const float* cdf = nullptr;    // LightSampler::delta_cdf()
+  const float* table = nullptr;  // per light, kDeltaFields floats (DeltaField)
+};
+enum DeltaField : int {
+  kDeltaKind = 0,        // 0 point, 1 spot, 2 directional (DeltaLight::Kind)
+  kDeltaPosition = 1,    // 3 floats
+  kDeltaDirection = 4,   // 3 floats
+  kDeltaIntensity = 7,   // 3 floats
+  kDeltaCosOuter = 10,
+  kDeltaCosInner = 11,
+  kDeltaPmf = 12,        // LightSampler::delta_pmf()
+  kDeltaFields = 16,
+};
+
 // What the stages read of the scene and the render settings.
 struct Scene {
   // The sampling strategy (core/scene.h). Under cosine every surface
@@ -96,8 +115,9 @@ struct Scene {
   // kQAlphaKey) into Embree, whose filter decides (core/alpha.h).
   bool alpha = false;
   // The scene has delta lights (point, spot, directional): each path samples
-  // one too (LightSampler::sample_delta, path by path), a second shadow ray.
+  // one too (LightSampler::sample_delta, in the lanes), a second shadow ray.
   bool delta_lights = false;
+  DeltaLights deltas;
   // The scene has textures: each path carries its ray cone (kConeWidth,
   // kConeSpread; CompiledScene::camera_cone, scattered_cone under
   // texture_filter, a TextureFilter), and a textured material's hit its

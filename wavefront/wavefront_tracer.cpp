@@ -165,7 +165,7 @@ std::size_t WavefrontTracer::scalar_bytes_per_path() {
 struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
-  std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns;
+  std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table;
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
   std::vector<std::string> general_materials, general;
@@ -224,9 +224,25 @@ struct WavefrontTracer::VectorStages {
     }
     // The lanes sample triangle lights by area; the rest is core's (below).
     const LightSampler& lights = compiled.lights();
-    // Delta lights: a second light sample and shadow ray per path, by core.
+    // Delta lights: a second light sample and shadow ray per path, in the lanes.
     sc.delta_lights = lights.has_delta_lights();
-    if (sc.delta_lights) v->general.push_back("the delta lights' samples");
+    if (sc.delta_lights) {
+      for (std::size_t i = 0; i < lights.delta_lights().size(); ++i) {
+        const DeltaLight& d = lights.delta_lights()[i];
+        float f[vs::kDeltaFields] = {};
+        f[vs::kDeltaKind] = d.kind == DeltaLight::Kind::Spot ? 1.0f : d.kind == DeltaLight::Kind::Directional ? 2.0f : 0.0f;
+        for (int c = 0; c < 3; ++c) {
+          f[vs::kDeltaPosition + c] = d.position[c];
+          f[vs::kDeltaDirection + c] = d.direction[c];
+          f[vs::kDeltaIntensity + c] = d.intensity[c];
+        }
+        f[vs::kDeltaCosOuter] = d.cos_outer;
+        f[vs::kDeltaCosInner] = d.cos_inner;
+        f[vs::kDeltaPmf] = lights.delta_pmf()[i];
+        v->delta_table.insert(v->delta_table.end(), std::begin(f), std::end(f));
+      }
+      sc.deltas = {lights.delta_lights().size(), lights.delta_cdf().data(), v->delta_table.data()};
+    }
     // The lanes sample triangle lights by area; any other light (or
     // solid-angle sampling) is sampled by LightSampler::sample(), path by path.
     std::vector<std::string> other_lights;

@@ -18,6 +18,7 @@
 #include "core/simd/lane1.h"
 #include "core/simd/lanes-inl.h"
 
+#include <cmath>
 #include <cstddef>
 
 HWY_BEFORE_NAMESPACE();
@@ -79,6 +80,38 @@ HWY_INLINE V area_light_pdf_at(D d, const Vec3<V>& ref, const Vec3<V>& p, const 
 template <class D, class V = VecOf<D>>
 HWY_INLINE auto usable_light_pdf(D d, V pdf) {
   return And(pdf > Zero(d), Not(IsInf(pdf)));
+}
+
+// spot_profile (core/scene.h): 1 for cos_theta >= cos_inner, 0 for
+// cos_theta <= cos_outer, a smoothstep in cos_theta between.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V spot_profile(D d, V cos_theta, V cos_outer, V cos_inner) {
+  const V t = (cos_theta - cos_outer) / (cos_inner - cos_outer);
+  const V smooth = t * t * (Set(d, 3.0f) - Set(d, 2.0f) * t);
+  return IfThenElse(cos_theta >= cos_inner, Set(d, 1.0f), IfThenElseZero(Not(cos_theta <= cos_outer), smooth));
+}
+
+// LightSampler::sample_delta's light, once picked, seen from ref: the
+// direction wi towards it, its distance and the radiance Le that arrives.
+// A directional light shines along `direction` from infinitely far (wi =
+// -direction, Le its intensity); a point or spot light at `position` sends
+// intensity / dist^2, a spot's times its profile about `direction`. False
+// where the point lies at ref (dist^2 not > 0) or ref is outside the spot's
+// cone.
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE M delta_light_seen(D d, M directional, M spot, const Vec3<V>& ref, const Vec3<V>& position,
+                              const Vec3<V>& direction, const Vec3<V>& intensity, V cos_outer, V cos_inner,
+                              Vec3<V>& wi, V& dist, Vec3<V>& Le) {
+  const Vec3<V> to = position - ref;
+  const V dist2 = dot(to, to);
+  const V r = Sqrt(dist2);
+  const Vec3<V> towards = to / r;
+  const V profile = spot_profile(d, dot(-towards, direction), cos_outer, cos_inner);
+  const Vec3<V> falloff = intensity / dist2;
+  wi = select(directional, -direction, towards);
+  dist = IfThenElse(directional, Set(d, HUGE_VALF), r);
+  Le = select(directional, intensity, select(spot, profile * falloff, falloff));
+  return Or(directional, And(dist2 > Zero(d), Or(Not(spot), profile > Zero(d))));
 }
 
 }  // namespace pathlab::HWY_NAMESPACE
