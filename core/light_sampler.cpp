@@ -244,6 +244,11 @@ float LightSampler::pick_pmf(const LightQuery& ref, std::size_t entry) const {
 std::size_t LightSampler::pick(const std::vector<float>& cdf, float u) {
   using namespace width1;
   if (cdf.empty()) return 0;
+  if (cdf.size() > kMaxExactFloatIndex) {
+    // Beyond the generic search's float indices: the same answer by integers.
+    const auto it = std::upper_bound(cdf.begin(), cdf.end(), u);
+    return std::min<std::size_t>(static_cast<std::size_t>(it - cdf.begin()), cdf.size() - 1);
+  }
   const auto cdf_at = [&](lane1::M m, F i) { return F{m.raw ? cdf[static_cast<std::size_t>(i.raw)] : 0.0f}; };
   return static_cast<std::size_t>(generic::pick_cdf(kScalar, lane1::M{true}, cdf.size(), F{u}, cdf_at).raw);
 }
@@ -333,7 +338,9 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
   ls.wi = scalars(wi);
   ls.dist = dist.raw;
   ls.pdf = view.density > 0.0 ? pmf * static_cast<float>(view.density)
-                              : generic::area_light_pdf(kScalar, F{pmf}, F{area_density(e)}, dist, cos_light).raw;
+                              : generic::area_light_pdf(kScalar, F{pmf}, F{area_density(e)}, dist, cos_light,
+                                                                        PATHLAB_FAULT(LightPdfWithoutDistance))
+                                                    .raw;
   if (!generic::usable_light_pdf(kScalar, F{ls.pdf}).raw) return std::nullopt;  // seen edge-on
   if (!textured) {
     ls.Le = m.emission;
@@ -361,7 +368,8 @@ float LightSampler::pdf(const LightQuery& query, const Surfel& hit) const {
   // 0 times a density that may be infinite edge-on).
   if (kind_ == LightSamplerKind::Bvh && pmf == 0.0f) return 0.0f;
   using namespace width1;
-  return generic::area_light_pdf_at(kScalar, lanes(ref), lanes(hit.p), lanes(hit.n), F{pmf}, F{area_density(entries_[i])})
+  return generic::area_light_pdf_at(kScalar, lanes(ref), lanes(hit.p), lanes(hit.n), F{pmf}, F{area_density(entries_[i])},
+                                    PATHLAB_FAULT(LightPdfWithoutDistance))
       .raw;
 }
 

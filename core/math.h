@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 
@@ -41,6 +42,10 @@ inline double luminance_double(const Spectrum& c) {
 inline bool is_black(const Spectrum& c) { return c.x == 0.0f && c.y == 0.0f && c.z == 0.0f; }
 inline bool is_finite(const vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 inline float sqr(float x) { return x * x; }
+
+// Whole numbers up to this are exact as floats: the most entries code that
+// indexes with float lanes (pick_cdf, core/simd/lights-inl.h) addresses.
+inline constexpr std::size_t kMaxExactFloatIndex = std::size_t{1} << 24;
 
 // gamma(n) of Higham / PBR: a bound on the relative error of n float
 // operations, n * eps / (1 - n * eps) with eps = 2^-24.

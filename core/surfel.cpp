@@ -90,7 +90,7 @@ std::optional<BsdfSample> scatter_dielectric(const MaterialView& m, const Frame&
   // The geometric normal's side is the outside: entering or leaving decides
   // eta (dielectric.h).
   dielectric::Sample ds;
-  if (!dielectric::sample(m.glass, u_lobe, frame.to_local(wo), &ds)) return std::nullopt;
+  if (!dielectric::sample(m.glass, u_lobe, frame.to_local(wo), &ds, PATHLAB_FAULT(DielectricFresnelIgnored))) return std::nullopt;
   return BsdfSample{frame.to_world(ds.wi), ds.weight, ds.pdf,
                     ds.transmitted ? Lobe::DielectricTransmission : Lobe::DielectricReflection, true};
 }

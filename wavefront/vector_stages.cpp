@@ -2,10 +2,10 @@
 // Highway's portable vectors and compiled for every x86 SIMD target
 // (foreach_target: AVX-512, AVX2, SSE4 — 16, 8 or 4 paths at a time);
 // HWY_DYNAMIC_DISPATCH runs the one core/simd/simd.h selected. The
-// per-lane geometry, hashing and weighting steps are core's
-// (core/simd/lanes-inl.h, core/simd/sampling-inl.h: the same source core's
-// scalar code runs at width 1); what is here is the stages' own business:
-// the wave's arrays, the scene tables, gathers and compaction.
+// per-lane steps of the estimator are core's (core/simd/*-inl.h,
+// core/bsdf/*-inl.h: the same source core's scalar code runs at width 1);
+// what is here is the stages' own business: the wave's arrays, the scene
+// tables, gathers, which step each lane takes, packing and compaction.
 //
 // Each step names the scalar code it computes. Every lane computes that
 // code's bits: the order of every sum and product is the scalar one, no
@@ -781,7 +781,7 @@ LightLanes delta_light(const Scene& sc, const Wave& w, std::size_t i0, const Str
   const VI light = hn::ConvertTo(DI(), pick_cdf(df, ok, d.count, rng.u(Dim::DeltaLightChoice), cdf_at));
   const auto field3 = [&](int f) { return gather3(ok, d.table, light, kDeltaFields, f); };
   const VF kind = gather(ok, d.table, light, kDeltaFields, kDeltaKind);
-  const M directional = kind == k(2.0f), spot = kind == k(1.0f);
+  const M directional = kind == k(static_cast<float>(kDeltaDirectional)), spot = kind == k(static_cast<float>(kDeltaSpot));
   const V3 position = field3(kDeltaPosition);
   LightLanes ls;
   VF dist;
@@ -849,7 +849,7 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   lambert_eval(df, shape_value3(ok, sc, shape, kAlbedo), wi_local.z, f, pdf_bsdf);
   if (sc.impulses) {
     // A mirror's or a dielectric's f and pdf are 0 towards every direction (Surfel::eval, Surfel::pdf).
-    const M lambert = shape_value(ok, sc, shape, kLaneMaterial) == k(0.0f);
+    const M lambert = shape_value(ok, sc, shape, kLaneMaterial) == k(static_cast<float>(kLaneLambert));
     f = zero_unless(lambert, f);
     pdf_bsdf = hn::IfThenElseZero(lambert, pdf_bsdf);
   }
@@ -1000,7 +1000,8 @@ void scatter(const Scene& sc, const Wave& w) {
     const M general = load_mask(w, kShadeByCore, i0, ok);
     // The impulses' lanes (mirror, dielectric) decide their own below.
     M impulses = hn::FirstN(df, 0);
-    if (sc.impulses) impulses = hn::AndNot(general, hn::And(ok, shape_value(ok, sc, shape, kLaneMaterial) != k(0.0f)));
+    if (sc.impulses)
+      impulses = hn::AndNot(general, hn::And(ok, shape_value(ok, sc, shape, kLaneMaterial) != k(static_cast<float>(kLaneLambert))));
     ok = hn::Or(hn::Or(general, impulses), hn::And(ok, usable));
     const V3 wo = -load3(w, kDx, i0, ok);
     const V3 n = load3(w, kNx, i0, ok);
@@ -1039,7 +1040,7 @@ void scatter(const Scene& sc, const Wave& w) {
     if (const M g = hn::And(general, ok); !hn::AllFalse(df, g)) {
       // Any other material: Surfel::scatter, path by path.
       HWY_ALIGN float u[3][kMaxLanes], dir[3][kMaxLanes] = {}, wt[3][kMaxLanes] = {}, density[kMaxLanes] = {};
-      HWY_ALIGN std::int32_t scattered[kMaxLanes] = {}, impulses[kMaxLanes] = {};
+      HWY_ALIGN std::int32_t scattered[kMaxLanes] = {}, impulse_of[kMaxLanes] = {};
       hn::Store(rng.u(Dim::LobeChoice), df, u[0]);
       hn::Store(du, df, u[1]);
       hn::Store(dv, df, u[2]);
@@ -1047,7 +1048,7 @@ void scatter(const Scene& sc, const Wave& w) {
         GeneralSample bs;
         if (!general_scatter(sc, w, i, u[0][j], u[1][j], u[2][j], &bs)) return;
         scattered[j] = 1;
-        impulses[j] = bs.impulse ? 1 : 0;
+        impulse_of[j] = bs.impulse ? 1 : 0;
         density[j] = bs.pdf;
         for (int c = 0; c < 3; ++c) {
           dir[c][j] = bs.wi[c];
@@ -1057,7 +1058,7 @@ void scatter(const Scene& sc, const Wave& w) {
       wi = select(g, load_lanes(dir), wi);
       weight = select(g, load_lanes(wt), weight);
       pdf = hn::IfThenElse(g, hn::Load(df, density), pdf);
-      impulse = hn::Or(impulse, hn::And(g, fmask(hn::Load(DI(), impulses) != hn::Zero(DI()))));
+      impulse = hn::Or(impulse, hn::And(g, fmask(hn::Load(DI(), impulse_of) != hn::Zero(DI()))));
       ok = hn::AndNot(hn::AndNot(fmask(hn::Load(DI(), scattered) != hn::Zero(DI())), g), ok);
     }
     ok = hn::AndNot(is_black(df, weight), ok);
@@ -1086,10 +1087,10 @@ void scatter(const Scene& sc, const Wave& w) {
     if (sc.textured && !hn::AllFalse(df, ok)) {
       // The ray cone after the scatter, path by path (core/ray_cone.h).
       HWY_ALIGN float density[kMaxLanes];
-      HWY_ALIGN std::int32_t impulses[kMaxLanes];
+      HWY_ALIGN std::int32_t impulse_at[kMaxLanes];
       hn::Store(pdf, df, density);
-      hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), impulse)), DI(), impulses);
-      for_each_lane(ok, i0, [&](std::size_t i, std::size_t j) { general_cone(sc, w, i, impulses[j] != 0, density[j]); });
+      hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), impulse)), DI(), impulse_at);
+      for_each_lane(ok, i0, [&](std::size_t i, std::size_t j) { general_cone(sc, w, i, impulse_at[j] != 0, density[j]); });
     }
 
     // Surfel::spawn(wi).

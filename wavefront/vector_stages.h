@@ -5,10 +5,9 @@
 // instance, alpha). The lanes do the camera, world-space hit points,
 // emission and its weight, triangle lights sampled by area, delta lights,
 // flat untextured Lambert, mirror and dielectric shading, roulette and
-// compaction; everything else (other
-// materials, vertex normals, textures, instances, other lights) is core's,
-// called one path at a time between the lanes' steps (Scene::general,
-// general_lights, delta_lights, instanced, textured). `--simd scalar` runs
+// compaction; everything else (other materials, vertex normals, textures,
+// instances, other lights) is core's, called one path at a time between
+// the lanes' steps (Scene::general, general_lights, instanced, textured). `--simd scalar` runs
 // the scalar stages of wavefront_tracer.cpp.
 //
 // Written once (vector_stages.cpp, over Google Highway, compiled for every
@@ -74,7 +73,7 @@ struct DeltaLights {
   const float* table = nullptr;  // per light, kDeltaFields floats (DeltaField)
 };
 enum DeltaField : int {
-  kDeltaKind = 0,        // 0 point, 1 spot, 2 directional (DeltaLight::Kind)
+  kDeltaKind = 0,        // DeltaKind, as a float
   kDeltaPosition = 1,    // 3 floats
   kDeltaDirection = 4,   // 3 floats
   kDeltaIntensity = 7,   // 3 floats
@@ -83,6 +82,8 @@ enum DeltaField : int {
   kDeltaPmf = 12,        // LightSampler::delta_pmf()
   kDeltaFields = 16,
 };
+
+enum DeltaKind : int { kDeltaPoint = 0, kDeltaSpot = 1, kDeltaDirectional = 2 };
 
 // What the stages read of the scene and the render settings.
 struct Scene {
@@ -151,7 +152,7 @@ enum ShapeField : int {
   kRadius = 15,        // a sphere's radius
   kFlipped = 16,       // 1 if a sphere's normals point inwards
   kOneSided = 17,      // 1 if its material is one-sided (black from behind the geometric normal)
-  kGeneral = 18,       // 1 if it is shaded by core's Surfel (not Lambert, or with vertex normals or tangents)
+  kGeneral = 18,       // 1 if it is shaded by core's Surfel (not flat untextured Lambert, mirror or glass)
   kTexturedEmission = 19,  // 1 if its emission is textured (Surfel::emitted, path by path)
   kResolveByCore = 20,     // 1 if kGeneral and its Surfel needs CompiledScene::resolve (a shading frame of its
                            // own, textures); else resolve() makes its Frame(n) in the lanes
@@ -265,8 +266,8 @@ std::size_t sample_lights(const Scene& scene, const Wave& wave);
 // The light of every visible sample, once Embree has filled kQOccluded
 // (kQPath says whose each packed shadow ray is).
 void add_light(const Wave& wave, std::size_t queries);
-// The continuation (Lambert in the lanes, any other surface by core's
-// Surfel::scatter), Russian roulette and the next ray.
+// The continuation (Lambert, mirrors and glass in the lanes, any other
+// surface by core's Surfel::scatter), Russian roulette and the next ray.
 void scatter(const Scene& scene, const Wave& wave);
 // Packs the survivors into slots [0, m) in order and returns m; each path
 // that ended is written to samples[its kOutIndex - first_slot] (an array of

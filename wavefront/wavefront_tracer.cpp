@@ -230,7 +230,10 @@ struct WavefrontTracer::VectorStages {
       for (std::size_t i = 0; i < lights.delta_lights().size(); ++i) {
         const DeltaLight& d = lights.delta_lights()[i];
         float f[vs::kDeltaFields] = {};
-        f[vs::kDeltaKind] = d.kind == DeltaLight::Kind::Spot ? 1.0f : d.kind == DeltaLight::Kind::Directional ? 2.0f : 0.0f;
+        const vs::DeltaKind kind = d.kind == DeltaLight::Kind::Spot          ? vs::kDeltaSpot
+                                   : d.kind == DeltaLight::Kind::Directional ? vs::kDeltaDirectional
+                                                                             : vs::kDeltaPoint;
+        f[vs::kDeltaKind] = static_cast<float>(kind);
         for (int c = 0; c < 3; ++c) {
           f[vs::kDeltaPosition + c] = d.position[c];
           f[vs::kDeltaDirection + c] = d.direction[c];
@@ -311,6 +314,8 @@ struct WavefrontTracer::VectorStages {
     // Gathers index these tables with 32-bit float indices: 32 per shape, 12 per triangle, 16 per light.
     if (compiled.triangles().size() >= (std::size_t{1} << 27)) return no("more than 2^27 triangles");
     if (scene.shapes.size() >= (std::size_t{1} << 24)) return no("more than 2^24 shapes");
+    // The light pick's indices are floats (pick_cdf, core/simd/lights-inl.h).
+    if (sc.lights.count > kMaxExactFloatIndex || sc.deltas.count > kMaxExactFloatIndex) return no("more than 2^24 lights");
     for (std::uint32_t i = 0; i < scene.shapes.size(); ++i) {
       const Shape& sh = scene.shapes[i];
       const Material& m = scene.materials[sh.material];
@@ -330,7 +335,8 @@ struct WavefrontTracer::VectorStages {
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
       f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
       sc.one_sided = sc.one_sided || m.one_sided;
-      // A Lambert mesh with vertex normals or tangents has a shading frame of its own: core's Surfel shades it.
+      // A Lambert, mirror or glass mesh with vertex normals or tangents has a shading frame of its own: core's
+      // Surfel shades it.
       if (m.scatters() && in_lanes(m) && shading_frame(sh)) v->general.push_back("the shading frame of " + sh.description);
       const bool general = m.scatters() && (cosine || !in_lanes(m) || shading_frame(sh));
       f[vs::kGeneral] = general ? 1.0f : 0.0f;

@@ -16,7 +16,6 @@
 
 #include <hwy/highway.h>
 
-#include "core/faults.h"
 #include "core/simd/lane1.h"
 #include "core/simd/lanes-inl.h"
 
@@ -43,18 +42,21 @@ HWY_INLINE V fresnel_dielectric(D d, V cos_i, V eta) {
 // reflectance tint, (1 - F) times the mean transmittance tint; absorbed
 // otherwise, so for white tints the weight is 1). False where u_lobe falls
 // in the absorbed part or wo grazes exactly (no projected area: nothing
-// scatters); `transmitted` says which impulse.
+// scatters); `transmitted` says which impulse. `fresnel_ignored` plants the
+// test-only fault DielectricFresnelIgnored (core/faults.h), which only
+// core's fault build passes (a parameter, so that this template is the same
+// in every translation unit).
 template <class D, class M, class V = VecOf<D>>
 HWY_INLINE auto dielectric_sample(D d, V ior, const Vec3<V>& reflectance, const Vec3<V>& transmittance, V u_lobe,
-                                  const Vec3<V>& wo_local, Vec3<V>& wi_local, Vec3<V>& weight, V& pdf, M& transmitted) {
+                                  const Vec3<V>& wo_local, Vec3<V>& wi_local, Vec3<V>& weight, V& pdf, M& transmitted,
+                                  bool fresnel_ignored = false) {
   const V zero = Zero(d), one = Set(d, 1.0f);
   // Entering (wo outside) or leaving decides the relative index.
   const auto entering = wo_local.z > zero;
   const V eta = IfThenElse(entering, ior, one / ior);
   const V cos_o = Abs(wo_local.z);
   V F = fresnel_dielectric(d, cos_o, eta);
-  // The test-only fault (core/faults.h): Fresnel reflection dropped, total internal reflection kept.
-  if (PATHLAB_FAULT(DielectricFresnelIgnored)) F = IfThenElseZero(F >= one, one);
+  if (fresnel_ignored) F = IfThenElseZero(F >= one, one);  // Fresnel reflection dropped, total internal reflection kept
   const V p_r = F * average(d, reflectance);
   const V p_t = (one - F) * average(d, transmittance);
   const auto reflected = u_lobe < p_r;

@@ -21,14 +21,15 @@ struct Sample {
 
 // Reflect or refract wo_local, chosen by u_lobe in proportion to the energy
 // each carries; false where wo grazes exactly or u_lobe falls in the
-// absorbed part.
-inline bool sample(const DielectricParams& glass, float u_lobe, const vec3& wo_local, Sample* out) {
+// absorbed part. `fresnel_ignored`: the test-only fault (surfel.cpp).
+inline bool sample(const DielectricParams& glass, float u_lobe, const vec3& wo_local, Sample* out,
+                   bool fresnel_ignored = false) {
   using namespace width1;
   F3 wi, weight;
   F pdf;
   lane1::M transmitted{false};
   const bool ok = generic::dielectric_sample(kScalar, F{glass.ior}, lanes(glass.reflectance), lanes(glass.transmittance),
-                                             F{u_lobe}, lanes(wo_local), wi, weight, pdf, transmitted)
+                                             F{u_lobe}, lanes(wo_local), wi, weight, pdf, transmitted, fresnel_ignored)
                       .raw;
   *out = {scalars(wi), scalars(weight), pdf.raw, transmitted.raw};
   return ok;

@@ -27,7 +27,7 @@ namespace pathlab::HWY_NAMESPACE {
 template <class D, class V = VecOf<D>>
 HWY_INLINE void lambert_eval(D d, const Vec3<V>& albedo, V cos_i, Vec3<V>& f, V& pdf) {
   pdf = cosine_hemisphere_pdf(d, cos_i);
-  f = zero_unless(cos_i > Zero(d), pdf * albedo);
+  f = zero_unless(cos_i > Zero(d), (cos_i * Set(d, kInvPi)) * albedo);
 }
 
 // lambert::sample: a cosine-weighted local direction wi and its density,

@@ -1,6 +1,6 @@
 // LightSampler's steps (core/light_sampler.cpp) written once over Highway's
-// vectors: the pick from a cdf, and what an area light's point gives a
-// shading point (direction, distance, density). core/light_sampler.cpp calls
+// vectors: the pick from a cdf, what an area light's point gives a shading
+// point (direction, distance, density), and what a delta light does. core/light_sampler.cpp calls
 // them at width 1 (core/simd/width1.h) for both tracers' scalar code, the
 // wavefront's vectorised stages at their SIMD width.
 //
@@ -14,7 +14,6 @@
 
 #include <hwy/highway.h>
 
-#include "core/faults.h"
 #include "core/simd/lane1.h"
 #include "core/simd/lanes-inl.h"
 
@@ -26,8 +25,9 @@ namespace pathlab::HWY_NAMESPACE {
 
 // LightSampler::pick: the first of `count` entries whose cdf exceeds u, the
 // last if none does (std::upper_bound), as a branch-free binary search:
-// the number of entries whose cdf is <= u, at most count - 1. Indices are
-// float lanes (exact below 2^24 entries); cdf_at(m, i) is entry i's cdf in
+// the number of entries that u is not below, at most count - 1 (a NaN u
+// is below nothing, as upper_bound's !(u < cdf) has it). Indices are float
+// lanes, exact for count <= kMaxExactFloatIndex (core/math.h); cdf_at(m, i) is entry i's cdf in
 // the lanes of m (its caller's table lookup: a gather, a permute or a load).
 template <class D, class M, class Lookup, class V = VecOf<D>>
 HWY_INLINE V pick_cdf(D d, M m, std::size_t count, V u, const Lookup& cdf_at) {
@@ -38,7 +38,7 @@ HWY_INLINE V pick_cdf(D d, M m, std::size_t count, V u, const Lookup& cdf_at) {
   for (; step > 0; step /= 2) {
     const V cand = idx + Set(d, static_cast<float>(step));
     const M valid = And(m, Not(cand > n));
-    idx = IfThenElse(And(valid, cdf_at(valid, cand - Set(d, 1.0f)) <= u), cand, idx);
+    idx = IfThenElse(And(valid, Not(u < cdf_at(valid, cand - Set(d, 1.0f)))), cand, idx);
   }
   return Min(idx, Set(d, static_cast<float>(count - 1)));
 }
@@ -60,20 +60,22 @@ HWY_INLINE M light_point_seen(D d, const Vec3<V>& ref, const Vec3<V>& lp, const 
 
 // The solid-angle density of an area light's point chosen with `pmf` and
 // the area density inv_area, at `dist` and `cos_light`: pmf inv_area d^2 /
-// |cos| (area_to_solid_angle), 0 edge-on.
+// |cos| (area_to_solid_angle), 0 edge-on. `drop_distance` plants the
+// test-only fault LightPdfWithoutDistance (core/faults.h: no d^2), which
+// only core's fault build passes (a parameter, not the macro here, so that
+// this template is the same in every translation unit).
 template <class D, class V = VecOf<D>>
-HWY_INLINE V area_light_pdf(D d, V pmf, V inv_area, V dist, V cos_light) {
-  // The test-only fault (core/faults.h): no distance^2 in the conversion.
-  if (PATHLAB_FAULT(LightPdfWithoutDistance)) dist = Set(d, 1.0f);
-  return pmf * area_to_solid_angle(d, inv_area, dist, cos_light);
+HWY_INLINE V area_light_pdf(D d, V pmf, V inv_area, V dist, V cos_light, bool drop_distance = false) {
+  return pmf * area_to_solid_angle(d, inv_area, drop_distance ? Set(d, 1.0f) : dist, cos_light);
 }
 
 // LightSampler::pdf of an area light's point p (normal n) seen from ref.
 template <class D, class V = VecOf<D>>
-HWY_INLINE V area_light_pdf_at(D d, const Vec3<V>& ref, const Vec3<V>& p, const Vec3<V>& n, V pmf, V inv_area) {
+HWY_INLINE V area_light_pdf_at(D d, const Vec3<V>& ref, const Vec3<V>& p, const Vec3<V>& n, V pmf, V inv_area,
+                               bool drop_distance = false) {
   const Vec3<V> to = p - ref;
   const V dist = Sqrt(dot(to, to));
-  return area_light_pdf(d, pmf, inv_area, dist, dot(n, to) / dist);
+  return area_light_pdf(d, pmf, inv_area, dist, dot(n, to) / dist, drop_distance);
 }
 
 // A light sample's density is usable: > 0 and finite (not seen edge-on).
