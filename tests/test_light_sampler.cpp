@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include <limits>
 #include <map>
 
@@ -47,6 +50,31 @@ std::map<std::uint32_t, std::uint64_t> count_every_pick(const LightSampler& ligh
   if (lo > 0) counts[0] = lo;
   if (lo < (std::uint64_t{1} << 24)) counts[1] = (std::uint64_t{1} << 24) - lo;
   return counts;
+}
+
+// The pick is a branch-free binary search written once for the lanes and
+// core (pick_cdf): it must give std::upper_bound's entry (clamped to the
+// last) for every u, including u equal to an entry, runs of equal entries
+// (lights of power 0), 0, 1, the infinities and NaN (the last entry).
+TEST(LightSampler, PickFromACdfIsUpperBoundsEntry) {
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  std::uint64_t state = 12345;
+  auto next = [&state] { return static_cast<float>((state = state * 6364136223846793005ull + 1442695040888963407ull) >> 40) * 0x1p-24f; };
+  for (std::size_t n : {1u, 2u, 3u, 5u, 16u, 17u, 100u, 1000u}) {
+    std::vector<float> cdf(n);
+    float running = 0.0f;
+    for (std::size_t i = 0; i < n; ++i) cdf[i] = running += (i % 3 == 1 ? 0.0f : next());  // runs of ties
+    for (float& c : cdf) c /= running;
+    cdf.back() = 1.0f;
+    std::vector<float> us = {0.0f, -0.0f, 1.0f, 0x1p-24f, 1.0f - 0x1p-24f, inf, -inf, nan};
+    for (float c : cdf) us.insert(us.end(), {c, std::nextafter(c, 0.0f), std::nextafter(c, 2.0f)});
+    for (int k = 0; k < 200; ++k) us.push_back(next());
+    for (float u : us) {
+      const std::size_t expected =
+          std::min<std::size_t>(static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()), n - 1);
+      ASSERT_EQ(LightSampler::pick(cdf, u), expected) << n << " entries, u " << u;
+    }
+  }
 }
 
 TEST(LightSampler, PickProbabilityIsWhatThePdfDividesBy) {
