@@ -216,7 +216,7 @@ class LightSampler {
   // first_entry + k), or -1 if the shape is not sampled as a light.
   std::int64_t first_entry(std::uint32_t shape) const { return first_entry_[shape]; }
 
- // The entry of a cdf that u picks: the first whose cdf exceeds u (std::
+  // The entry of a cdf that u picks: the first whose cdf exceeds u (std::
   // upper_bound), the last if none does (a NaN u too). The generic pick_cdf
   // of core/simd/lights-inl.h at width 1, the search the wavefront's lanes run.
   static std::size_t pick(const std::vector<float>& cdf, float u);

@@ -90,7 +90,8 @@ std::optional<BsdfSample> scatter_dielectric(const MaterialView& m, const Frame&
   // The geometric normal's side is the outside: entering or leaving decides
   // eta (dielectric.h).
   dielectric::Sample ds;
-  if (!dielectric::sample(m.glass, u_lobe, frame.to_local(wo), &ds, PATHLAB_FAULT(DielectricFresnelIgnored))) return std::nullopt;
+  if (!dielectric::sample(m.glass, u_lobe, frame.to_local(wo), &ds, PATHLAB_FAULT(DielectricFresnelIgnored)))
+    return std::nullopt;
   return BsdfSample{frame.to_world(ds.wi), ds.weight, ds.pdf,
                     ds.transmitted ? Lobe::DielectricTransmission : Lobe::DielectricReflection, true};
 }
@@ -187,9 +188,7 @@ std::optional<BsdfSample> Surfel::scatter_in_frame(const vec3& wo, float u_lobe,
       return BsdfSample{frame.to_world(wi), m.albedo, pdf, Lobe::Lambert, false};
     }
     case MaterialType::Mirror: {
-      // The impulse is chosen with probability equal to its mean reflectance
-      // (absorbed otherwise), so its weight stays near 1 and paths end in
-      // proportion to the energy they would lose.
+      // Chosen with probability equal to its mean reflectance (mirror.h).
       vec3 wi;
       Spectrum weight;
       float prob;

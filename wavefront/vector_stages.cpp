@@ -105,40 +105,40 @@ std::size_t lanes() { return 1; }
 
 using pathlab::HWY_NAMESPACE::area_light_pdf;
 using pathlab::HWY_NAMESPACE::area_light_pdf_at;
-using pathlab::HWY_NAMESPACE::camera_direction;
-using pathlab::HWY_NAMESPACE::CameraPlane;
-using pathlab::HWY_NAMESPACE::emitted_towards;
-using pathlab::HWY_NAMESPACE::facing_normal;
-using pathlab::HWY_NAMESPACE::spawn_origin;
-using pathlab::HWY_NAMESPACE::spawn_to;
-using pathlab::HWY_NAMESPACE::sphere_point;
-using pathlab::HWY_NAMESPACE::thin_lens;
 using pathlab::HWY_NAMESPACE::bvh_field;
 using pathlab::HWY_NAMESPACE::bvh_importance;
 using pathlab::HWY_NAMESPACE::bvh_split;
+using pathlab::HWY_NAMESPACE::camera_direction;
+using pathlab::HWY_NAMESPACE::CameraPlane;
 using pathlab::HWY_NAMESPACE::concentric_disk;
+using pathlab::HWY_NAMESPACE::delta_light_seen;
+using pathlab::HWY_NAMESPACE::dielectric_sample;
 using pathlab::HWY_NAMESPACE::dot;
+using pathlab::HWY_NAMESPACE::emitted_towards;
+using pathlab::HWY_NAMESPACE::facing_normal;
 using pathlab::HWY_NAMESPACE::frame;
 using pathlab::HWY_NAMESPACE::is_black;
 using pathlab::HWY_NAMESPACE::lambert_eval;
-using pathlab::HWY_NAMESPACE::delta_light_seen;
-using pathlab::HWY_NAMESPACE::dielectric_sample;
 using pathlab::HWY_NAMESPACE::lambert_sample;
-using pathlab::HWY_NAMESPACE::mirror_sample;
 using pathlab::HWY_NAMESPACE::light_point_seen;
-using pathlab::HWY_NAMESPACE::pick_cdf;
-using pathlab::HWY_NAMESPACE::usable_light_pdf;
+using pathlab::HWY_NAMESPACE::mirror_sample;
 using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
-using pathlab::HWY_NAMESPACE::zsobol_top24;
+using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::select;
+using pathlab::HWY_NAMESPACE::spawn_origin;
+using pathlab::HWY_NAMESPACE::spawn_to;
+using pathlab::HWY_NAMESPACE::sphere_point;
 using pathlab::HWY_NAMESPACE::splat3;
+using pathlab::HWY_NAMESPACE::thin_lens;
 using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
 using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::uniform_triangle;
+using pathlab::HWY_NAMESPACE::usable_light_pdf;
 using pathlab::HWY_NAMESPACE::zero_unless;
+using pathlab::HWY_NAMESPACE::zsobol_top24;
 
 using DF = hn::ScalableTag<float>;
 using DI = hn::RebindToSigned<DF>;
@@ -158,7 +158,6 @@ using MD = hn::Mask<DD>;
 using DDI = hn::RebindToSigned<DD>;
 using VDI = hn::Vec<DDI>;
 using V3D = Vec3<VD>;
-
 
 std::size_t lanes() { return hn::Lanes(DF()); }
 
@@ -791,12 +790,14 @@ LightLanes delta_light(const Scene& sc, const Wave& w, std::size_t i0, const Str
   ls.pdf = gather(ok, d.table, light, kDeltaFields, kDeltaPmf);
   // Surfel::spawn_to(position, 0, -wi) for a point or spot, Surfel::spawn(wi) for a directional light.
   const V3 err = load3(w, kErrX, i0, ok);
-  V3 origin, dir;
-  VF len;
-  spawn_to(df, sp, err, n, position, zero3(), -ls.wi, origin, dir, len);
-  origin = select(directional, spawn_origin(df, sp, err, n, ls.wi), origin);
-  dir = select(directional, ls.wi, dir);
-  len = hn::IfThenElse(directional, k(std::numeric_limits<float>::infinity()), len);
+  V3 origin = zero3(), dir = zero3();
+  VF len = hn::Zero(df);
+  if (!hn::AllFalse(df, hn::AndNot(directional, ok))) spawn_to(df, sp, err, n, position, zero3(), -ls.wi, origin, dir, len);
+  if (const M along = hn::And(directional, ok); !hn::AllFalse(df, along)) {
+    origin = select(along, spawn_origin(df, sp, err, n, ls.wi), origin);
+    dir = select(along, ls.wi, dir);
+    len = hn::IfThenElse(along, k(std::numeric_limits<float>::infinity()), len);
+  }
   const VF ray[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
   std::copy(std::begin(ray), std::end(ray), ls.ray);
   return ls;
@@ -939,7 +940,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     // A delta light, in every strategy (LightSampler::sample_delta): f Le /
     // pdf, weight 1.
     ShadowLanes delta{hn::FirstN(df, 0), zero3(), {}};
-    if (sc.delta_lights) {
+    if (sc.deltas.count != 0) {
       delta.ok = alive;
       const LightLanes ls = delta_light(sc, w, i0, rng, sp, n, delta.ok);
       V3 f;
@@ -971,7 +972,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     // path each belongs to (add_light); each counts as one of its path's rays.
     // A vertex's shadow rays share its alpha key (core/alpha.h).
     const VU alpha_keys = sc.alpha ? rng.bits_high(Dim::Alpha) : hn::Zero(DU());
-    queries += pack_shadow_rays(w, i0, queries, sc.delta_lights ? &delta : nullptr, area, sc.alpha ? &alpha_keys : nullptr);
+    queries += pack_shadow_rays(w, i0, queries, sc.deltas.count != 0 ? &delta : nullptr, area, sc.alpha ? &alpha_keys : nullptr);
     const VI rays = load(w, kRays, i0, alive);
     store(w, kRays, i0, alive,
           rays + hn::IfThenElseZero(hn::RebindMask(DI(), delta.ok), hn::Set(DI(), 1)) +
@@ -1013,35 +1014,46 @@ void scatter(const Scene& sc, const Wave& w) {
     V3 wi = to_world(fs, ft, n, local.x, local.y, local.z * side);
     V3 weight = shape_value3(ok, sc, shape, kAlbedo);
     M impulse = hn::FirstN(df, 0);
-    if (const M im = hn::And(impulses, ok); !hn::AllFalse(df, im)) {
+    const M im = hn::And(impulses, ok), g = hn::And(general, ok);
+    // The lobe choice, drawn once for the impulses' lanes and core's.
+    const VF u_lobe = hn::AllFalse(df, hn::Or(im, g)) ? hn::Zero(df) : rng.u(Dim::LobeChoice);
+    if (!hn::AllFalse(df, im)) {
       // Surfel::scatter_in_frame of a mirror (wo's side up, as the
       // reflection models take it) and of a dielectric (the frame as is).
-      const VF u_lobe = rng.u(Dim::LobeChoice);
       const VF material = shape_value(im, sc, shape, kLaneMaterial);
       const M mirror = hn::And(im, material == k(static_cast<float>(kLaneMirror)));
       const M glass = hn::And(im, material == k(static_cast<float>(kLaneDielectric)));
       const V3 wo_local = to_local(fs, ft, n, wo);
-      V3 local_m, weight_m, local_g, weight_g;
-      VF pdf_m, pdf_g;
-      M transmitted;
-      const M mirrored = mirror_sample(df, weight, u_lobe, V3{wo_local.x, wo_local.y, wo_local.z * side}, local_m,
-                                       weight_m, pdf_m);
-      const M crossed = dielectric_sample(df, shape_value(glass, sc, shape, kIor), shape_value3(glass, sc, shape, kReflectance),
-                                          shape_value3(glass, sc, shape, kTransmittance), u_lobe, wo_local, local_g,
-                                          weight_g, pdf_g, transmitted);
-      const V3 wi_m = to_world(fs, ft, n, local_m.x, local_m.y, local_m.z * side);
-      const V3 wi_g = to_world(fs, ft, n, local_g.x, local_g.y, local_g.z);
-      wi = select(mirror, wi_m, select(glass, wi_g, wi));
-      weight = select(mirror, weight_m, select(glass, weight_g, weight));
-      pdf = hn::IfThenElse(mirror, pdf_m, hn::IfThenElse(glass, pdf_g, pdf));
+      if (!hn::AllFalse(df, mirror)) {
+        V3 local_m, weight_m;
+        VF pdf_m;
+        const M mirrored = mirror_sample(df, weight, u_lobe, V3{wo_local.x, wo_local.y, wo_local.z * side}, local_m,
+                                         weight_m, pdf_m);
+        wi = select(mirror, to_world(fs, ft, n, local_m.x, local_m.y, local_m.z * side), wi);
+        weight = select(mirror, weight_m, weight);
+        pdf = hn::IfThenElse(mirror, pdf_m, pdf);
+        ok = hn::AndNot(hn::AndNot(mirrored, mirror), ok);
+      }
+      if (!hn::AllFalse(df, glass)) {
+        V3 local_g, weight_g;
+        VF pdf_g;
+        M transmitted;
+        const M crossed = dielectric_sample(df, shape_value(glass, sc, shape, kIor),
+                                            shape_value3(glass, sc, shape, kReflectance),
+                                            shape_value3(glass, sc, shape, kTransmittance), u_lobe, wo_local, local_g,
+                                            weight_g, pdf_g, transmitted);
+        wi = select(glass, to_world(fs, ft, n, local_g.x, local_g.y, local_g.z), wi);
+        weight = select(glass, weight_g, weight);
+        pdf = hn::IfThenElse(glass, pdf_g, pdf);
+        ok = hn::AndNot(hn::AndNot(crossed, glass), ok);
+      }
       impulse = im;
-      ok = hn::AndNot(hn::Or(hn::AndNot(mirrored, mirror), hn::AndNot(crossed, glass)), ok);
     }
-    if (const M g = hn::And(general, ok); !hn::AllFalse(df, g)) {
+    if (!hn::AllFalse(df, g)) {
       // Any other material: Surfel::scatter, path by path.
       HWY_ALIGN float u[3][kMaxLanes], dir[3][kMaxLanes] = {}, wt[3][kMaxLanes] = {}, density[kMaxLanes] = {};
       HWY_ALIGN std::int32_t scattered[kMaxLanes] = {}, impulse_of[kMaxLanes] = {};
-      hn::Store(rng.u(Dim::LobeChoice), df, u[0]);
+      hn::Store(u_lobe, df, u[0]);
       hn::Store(du, df, u[1]);
       hn::Store(dv, df, u[2]);
       for_each_lane(g, i0, [&](std::size_t i, std::size_t j) {

@@ -115,9 +115,9 @@ struct Scene {
   // Some material has alpha: every ray carries its alpha key (kAlphaKey,
   // kQAlphaKey) into Embree, whose filter decides (core/alpha.h).
   bool alpha = false;
-  // The scene has delta lights (point, spot, directional): each path samples
-  // one too (LightSampler::sample_delta, in the lanes), a second shadow ray.
-  bool delta_lights = false;
+  // The scene's delta lights (point, spot, directional); with any, each path
+  // samples one too (LightSampler::sample_delta, in the lanes), a second
+  // shadow ray.
   DeltaLights deltas;
   // The scene has textures: each path carries its ray cone (kConeWidth,
   // kConeSpread; CompiledScene::camera_cone, scattered_cone under

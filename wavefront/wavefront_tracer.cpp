@@ -225,8 +225,7 @@ struct WavefrontTracer::VectorStages {
     // The lanes sample triangle lights by area; the rest is core's (below).
     const LightSampler& lights = compiled.lights();
     // Delta lights: a second light sample and shadow ray per path, in the lanes.
-    sc.delta_lights = lights.has_delta_lights();
-    if (sc.delta_lights) {
+    if (lights.has_delta_lights()) {
       for (std::size_t i = 0; i < lights.delta_lights().size(); ++i) {
         const DeltaLight& d = lights.delta_lights()[i];
         float f[vs::kDeltaFields] = {};

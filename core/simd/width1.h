@@ -2,8 +2,8 @@
 // core/simd/lanes-inl.h at width 1, through lane1's plain scalars
 // (core/simd/lane1.h): one source for a step that the reference tracer and
 // the wavefront's lanes both take. Include only from core's .cpp files (it
-// includes lanes-inl.h at the build's static target); today core/ray.cpp,
-// math.cpp, geometry.cpp, sampling.cpp and strategy_weights.cpp.
+// includes the generic headers at the build's static target): core's
+// scalar functions that have a generic form, and core/bsdf's width-1 headers.
 #pragma once
 
 // In a foreach_target translation unit HWY_NAMESPACE would name the first
