@@ -41,6 +41,10 @@ struct Closure {
   float ax = 1.0f, ay = 1.0f;
   float clearcoat = 0.0f;   // 0.25 clearcoat
   float clearcoat_alpha = 0.1f;
+  // ln and log2 of clearcoat_alpha^2, for GTR1's D and its sampling (core/
+  // bsdf/microfacet-inl.h): per material, so that no lane needs a logarithm.
+  float clearcoat_log_a2 = gtr1::log_alpha2(clearcoat_alpha);
+  float clearcoat_log2_a2 = gtr1::log2_alpha2(clearcoat_alpha);
   EnergyTables energy{};    // on: the lobes are coupled (energy.h)
 };
 
@@ -60,6 +64,8 @@ inline Closure make_closure(const DisneyParams& p) {
   c.ay = a.y;
   c.clearcoat = 0.25f * p.clearcoat;
   c.clearcoat_alpha = gtr1::alpha_from_gloss(p.clearcoat_gloss);
+  c.clearcoat_log_a2 = gtr1::log_alpha2(c.clearcoat_alpha);
+  c.clearcoat_log2_a2 = gtr1::log2_alpha2(c.clearcoat_alpha);
   if (p.energy_compensation) c.energy = make_energy_tables(c);
   return c;
 }

@@ -10,14 +10,10 @@
 
 namespace pathlab::fresnel {
 
-inline float schlick_weight(float c) {
-  // c is a dot product of unit vectors and can round a hair above 1 (or, for
-  // a denormal input, below 0): clamp so that the weight stays in [0, 1]
-  // and never turns negative.
-  const float m = std::clamp(1.0f - c, 0.0f, 1.0f);
-  const float m2 = m * m;
-  return m2 * m2 * m;
-}
+// c is a dot product of unit vectors and can round a hair above 1 (or, for
+// a denormal input, below 0): 1 - c is clamped so that the weight stays in
+// [0, 1] (core/bsdf/disney-inl.h's schlick_weight at width 1).
+float schlick_weight(float c);
 
 inline Spectrum schlick(const Spectrum& f0, float c) { return glm::mix(f0, Spectrum(1.0f), schlick_weight(c)); }
 inline float schlick(float f0, float c) { return f0 + (1.0f - f0) * schlick_weight(c); }

@@ -117,6 +117,11 @@ inline M Or(M a, M b) { return {a.raw || b.raw}; }
 inline V<float> Max(V<float> a, V<float> b) { return a.raw > b.raw ? a : b; }
 inline V<float> Min(V<float> a, V<float> b) { return a.raw < b.raw ? a : b; }
 inline V<float> Sqrt(V<float> a) { return {std::sqrt(a.raw)}; }
+inline V<double> Sqrt(V<double> a) { return {std::sqrt(a.raw)}; }
+// To the nearest integer, halves to even (roundps's nearest mode; the
+// default rounding mode's nearbyint).
+inline V<float> Round(V<float> a) { return {std::nearbyint(a.raw)}; }
+inline bool AllFalse(One<float>, M m) { return !m.raw; }
 inline V<float> Abs(V<float> a) { return {std::fabs(a.raw)}; }
 inline V<float> Neg(V<float> a) { return {-a.raw}; }
 inline V<float> CopySign(V<float> magnitude, V<float> sign) { return {std::copysign(magnitude.raw, sign.raw)}; }
@@ -129,6 +134,9 @@ inline M IsInf(V<float> a) { return {std::isinf(a.raw)}; }
 inline V<float> StepAway(One<float>, V<float> c, V<float> o) {
   return {o.raw > 0.0f ? next_float_up(c.raw) : o.raw < 0.0f ? next_float_down(c.raw) : c.raw};
 }
+
+// 2^n for a whole n in [-126, 127] (lanes-inl.h's Pow2I; exact both ways).
+inline V<float> Pow2I(One<float>, V<float> n) { return {std::ldexp(1.0f, static_cast<int>(n.raw))}; }
 
 }  // namespace lane1
 }  // namespace pathlab

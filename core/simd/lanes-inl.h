@@ -125,6 +125,49 @@ HWY_INLINE V StepAway(D d, V c, V o) {
   return IfThenElse(o > Zero(d), NextFloat<true>(d, c), IfThenElse(o < Zero(d), NextFloat<false>(d, c), c));
 }
 
+// 2^n for a whole n in [-126, 127]: the float whose exponent field is
+// n + 127. A primitive: lane1 has its own (ldexp); both are exact.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V Pow2I(D d, V n) {
+  const hn::RebindToSigned<D> di;
+  return BitCast(d, hn::ShiftLeft<23>(hn::ConvertTo(di, n) + Set(di, 127)));
+}
+
+// fn(dd, a, b) computed in double lanes (dd a descriptor of doubles) for two
+// vec3s of float lanes, the result rounded to float once: for the few steps
+// that need double's precision (microfacet-inl.h's half_vector). A
+// primitive: here each half of the float lanes in turn, promoted exactly;
+// lane1's below, one double.
+// (Not at Highway's HWY_SCALAR target, which has no halves: the build's
+// static target, where only lane1 calls it.)
+#if HWY_TARGET != HWY_SCALAR
+template <class D, class Fn, class V = VecOf<D>>
+HWY_INLINE Vec3<V> InDouble3(D d, Fn&& fn, const Vec3<V>& a, const Vec3<V>& b) {
+  const hn::Half<D> dh;
+  const hn::Rebind<double, decltype(dh)> dd;
+  const auto half = [&](const Vec3<V>& v, bool upper) {
+    const auto wide = [&](V x) { return hn::PromoteTo(dd, upper ? hn::UpperHalf(dh, x) : hn::LowerHalf(dh, x)); };
+    return Vec3<VecOf<decltype(dd)>>{wide(v.x), wide(v.y), wide(v.z)};
+  };
+  const auto lo = fn(dd, half(a, false), half(b, false));
+  const auto hi = fn(dd, half(a, true), half(b, true));
+  const auto narrow = [&](VecOf<decltype(dd)> l, VecOf<decltype(dd)> h) {
+    return hn::Combine(d, hn::DemoteTo(dh, h), hn::DemoteTo(dh, l));
+  };
+  return {narrow(lo.x, hi.x), narrow(lo.y, hi.y), narrow(lo.z, hi.z)};
+}
+#endif
+// lane1's InDouble3: one double each, the result rounded to float once.
+template <class Fn>
+HWY_INLINE Vec3<lane1::V<float>> InDouble3(lane1::One<float>, Fn&& fn, const Vec3<lane1::V<float>>& a,
+                                           const Vec3<lane1::V<float>>& b) {
+  using F1 = lane1::V<float>;
+  using D1 = lane1::V<double>;
+  const auto wide = [](const Vec3<F1>& v) { return Vec3<D1>{{v.x.raw}, {v.y.raw}, {v.z.raw}}; };
+  const Vec3<D1> r = fn(lane1::One<double>{}, wide(a), wide(b));
+  return {{static_cast<float>(r.x.raw)}, {static_cast<float>(r.y.raw)}, {static_cast<float>(r.z.raw)}};
+}
+
 // offset_ray_origin (core/ray.h): p moved off its surface along n by its
 // rounding error bound across the surface, then one float further.
 template <class D, class V = VecOf<D>>

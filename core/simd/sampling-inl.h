@@ -18,6 +18,7 @@
 
 #include "core/math.h"
 #include "core/simd/lane1.h"
+#include "core/simd/lanes-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace pathlab::HWY_NAMESPACE {
@@ -37,6 +38,42 @@ HWY_INLINE void sin_cos_quarter(D d, V x, V& sin, V& cos) {
              z * z -
          Set(d, 0.5f) * z) +
         Set(d, 1.0f);
+}
+
+// sin and cos of 2 pi u for u in [0, 1] (an azimuth from a uniform
+// number): u in quarter turns, 4u = q + f with q the nearest whole number
+// (exact: 4u and 4u - q are floats), sin_cos_quarter of f pi/2 in
+// [-pi/4, pi/4], then turned by q quarter turns. Within 2 ulp of libm's
+// sinf/cosf of the angle (tests/test_simd.cpp), and the same bits on every
+// target and width, as libm's are not.
+template <class D, class V = VecOf<D>>
+HWY_INLINE void sin_cos_turn(D d, V u, V& sin, V& cos) {
+  const V t = Set(d, 4.0f) * u;
+  const V q = Round(t);
+  V s, c;
+  sin_cos_quarter(d, (t - q) * Set(d, 3.14159265358979323846f / 2.0f), s, c);
+  // q mod 4: 0 (c, s), 1 (-s, c), 2 (-c, -s), 3 (s, -c), 4 as 0.
+  const auto q1 = q == Set(d, 1.0f), q2 = q == Set(d, 2.0f), q3 = q == Set(d, 3.0f);
+  const auto swap = Or(q1, q3);
+  const V cs = IfThenElse(swap, s, c), sn = IfThenElse(swap, c, s);
+  cos = IfThenElse(Or(q1, q2), Neg(cs), cs);
+  sin = IfThenElse(Or(q2, q3), Neg(sn), sn);
+}
+
+// 2^y for y in [-126, 127]: y = n + f with n the nearest whole number and f
+// in [-1/2, 1/2] (exact), 2^f by Cephes' single-precision minimax
+// polynomial (exp2f, relative error < 2e-7), evaluated term by term, times
+// 2^n exactly (Pow2I, core/simd/lanes-inl.h).
+template <class D, class V = VecOf<D>>
+HWY_INLINE V exp2_lanes(D d, V y) {
+  const V n = Round(y);
+  const V f = y - n;
+  const V p = (((((Set(d, 1.535336188319500e-4f) * f + Set(d, 1.339887440266574e-3f)) * f +
+                  Set(d, 9.618437357674640e-3f)) * f +
+                 Set(d, 5.550332471162809e-2f)) * f +
+                Set(d, 2.402264791363012e-1f)) * f +
+               Set(d, 6.931472028550421e-1f)) * f;
+  return (Set(d, 1.0f) + p) * Pow2I(d, n);
 }
 
 // Shirley and Chiu's concentric map, square [0,1)^2 -> unit disk, area
