@@ -100,6 +100,16 @@ Scene cornell_with_materials() {
   return s;
 }
 
+// cornell_with_materials() with tangents on the velvet box (a shading
+// frame: core's Surfel shades it) beside the gold one (shaded in the lanes):
+// Disney surfaces of both kinds in one scene.
+Scene cornell_with_framed_velvet() {
+  Scene s = cornell_with_materials();
+  Shape& velvet = s.shapes.at(2);
+  velvet.mesh.tangents.assign(velvet.mesh.positions.size(), glm::vec4(0.6f, 0.0f, 0.8f, 1.0f));
+  return s;
+}
+
 // The Cornell box with tangents on its floor (glTF TANGENT without NORMAL):
 // a tangent frame rotates the directions Lambert sampling draws.
 Scene cornell_with_tangents() {
@@ -132,6 +142,7 @@ Scene load_case(const SameSeedCase& c) {
   Scene s = c.scene.empty()          ? builtin_cornell_box()
             : c.scene == "every-light" ? cornell_with_every_light()
             : c.scene == "materials" ? cornell_with_materials()
+            : c.scene == "framed-velvet" ? cornell_with_framed_velvet()
             : c.scene == "tangents"  ? cornell_with_tangents()
             : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
             : c.scene == "instanced" ? test::cornell_with_instances()
@@ -689,6 +700,8 @@ std::vector<VectorCase> vector_cases() {
     cases.push_back({"", st, 0.0f, 0, false, false, false, false, false, 0, false, false, true});
   cases.push_back({"materials", Strategy::Mis, 0.0f, 0, false, false, false, false, false, 0, true, false, true});
   cases.push_back({"bulb", Strategy::Mis, 0.0f, 0, false, false, true, false, false, 0, true});
+  // Disney surfaces shaded in the lanes beside one shaded by core (its shading frame).
+  for (Strategy st : {Strategy::Bsdf, Strategy::Mis}) cases.push_back({"framed-velvet", st, 0.0f, 0});
   // Textures (albedo, Disney parameters, a normal map, a mirror's reflectance, an emitter's radiance), read by
   // CompiledScene::resolve with each path's ray cone.
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})

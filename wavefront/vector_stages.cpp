@@ -23,6 +23,7 @@
 #include <hwy/highway.h>
 
 #include "core/bsdf/dielectric-inl.h"
+#include "core/bsdf/disney-inl.h"
 #include "core/bsdf/lambert-inl.h"
 #include "core/bsdf/mirror-inl.h"
 #include "core/simd/lanes-inl.h"
@@ -40,6 +41,7 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
 
 #ifndef PATHLAB_VECTOR_STAGES_GENERAL
 #define PATHLAB_VECTOR_STAGES_GENERAL
@@ -112,7 +114,11 @@ using pathlab::HWY_NAMESPACE::camera_direction;
 using pathlab::HWY_NAMESPACE::CameraPlane;
 using pathlab::HWY_NAMESPACE::concentric_disk;
 using pathlab::HWY_NAMESPACE::delta_light_seen;
+using pathlab::HWY_NAMESPACE::ClosureLanes;
 using pathlab::HWY_NAMESPACE::dielectric_sample;
+using pathlab::HWY_NAMESPACE::disney_eval;
+using pathlab::HWY_NAMESPACE::disney_pdf;
+using pathlab::HWY_NAMESPACE::disney_sample;
 using pathlab::HWY_NAMESPACE::dot;
 using pathlab::HWY_NAMESPACE::emitted_towards;
 using pathlab::HWY_NAMESPACE::facing_normal;
@@ -124,6 +130,7 @@ using pathlab::HWY_NAMESPACE::light_point_seen;
 using pathlab::HWY_NAMESPACE::mirror_sample;
 using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
+using pathlab::HWY_NAMESPACE::NoEnergy;
 using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::spawn_origin;
@@ -137,6 +144,7 @@ using pathlab::HWY_NAMESPACE::to_world;
 using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::uniform_triangle;
 using pathlab::HWY_NAMESPACE::usable_light_pdf;
+using pathlab::HWY_NAMESPACE::VndfLobes;
 using pathlab::HWY_NAMESPACE::zero_unless;
 using pathlab::HWY_NAMESPACE::zsobol_top24;
 
@@ -832,6 +840,30 @@ LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Str
   return ls;
 }
 
+// Each lane's shape's Disney closure (ShapeField kDiffuse...; no Lambert lobe).
+ClosureLanes<VF> closure_lanes(M m, const Scene& sc, VI shape) {
+  const auto f = [&](ShapeField field) { return shape_value(m, sc, shape, field); };
+  return {zero3(),        shape_value3(m, sc, shape, kDiffuse), f(kRoughness), f(kSubsurface),
+          shape_value3(m, sc, shape, kSheen), f(kSpecular), shape_value3(m, sc, shape, kSpec0), f(kAx), f(kAy),
+          f(kClearcoat),  f(kClearcoatAlpha), f(kClearcoatLogA2), f(kClearcoatLog2A2)};
+}
+
+// fn(std::integral_constant<unsigned, F>) for the Disney lobes of the scene
+// (Scene::disney), so that the lanes shade with the lobes core's
+// ShadingPath compiles in.
+template <class Fn>
+void with_disney_lobes(const Scene& sc, Fn&& fn) {
+  constexpr unsigned kLobes = 1u, kCoat = 2u;  // disney::Features
+  if (sc.disney == (kLobes | kCoat)) fn(std::integral_constant<unsigned, kLobes | kCoat>{});
+  else fn(std::integral_constant<unsigned, kLobes>{});
+}
+
+// The lanes of m that the lanes shade as Disney materials.
+M disney_lanes(M m, const Scene& sc, VI shape) {
+  if (sc.disney == 0 || hn::AllFalse(DF(), m)) return hn::FirstN(DF(), 0);
+  return hn::And(m, shape_value(m, sc, shape, kLaneMaterial) == k(static_cast<float>(kLaneDisney)));
+}
+
 // Surfel::eval and Surfel::pdf towards wi for the lanes of ok (which lose
 // the lanes whose f is black): the Lambert lobe in the lanes (core/surfel.cpp,
 // bsdf/lambert-inl.h: only the local z of wo and wi matters), the lanes of
@@ -853,6 +885,15 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
     const M lambert = shape_value(ok, sc, shape, kLaneMaterial) == k(static_cast<float>(kLaneLambert));
     f = zero_unless(lambert, f);
     pdf_bsdf = hn::IfThenElseZero(lambert, pdf_bsdf);
+  }
+  if (const M dm = disney_lanes(hn::AndNot(load_mask(w, kShadeByCore, i0, ok), ok), sc, shape); !hn::AllFalse(df, dm)) {
+    // Surfel::eval and Surfel::pdf of a Disney material (disney::eval, disney::pdf).
+    const ClosureLanes<VF> c = closure_lanes(dm, sc, shape);
+    with_disney_lobes(sc, [&](auto lobes) {
+      constexpr unsigned F = decltype(lobes)::value;
+      f = select(dm, disney_eval<F>(df, c, wo_local, wi_local, NoEnergy{}, {}), f);
+      pdf_bsdf = hn::IfThenElse(dm, disney_pdf<F>(df, c, wo_local, wi_local, VndfLobes{}, false, NoEnergy{}, {}), pdf_bsdf);
+    });
   }
   if (const M general = load_mask(w, kShadeByCore, i0, ok); !hn::AllFalse(df, general)) {
     HWY_ALIGN float to[3][kMaxLanes], value[3][kMaxLanes] = {}, density[kMaxLanes] = {};
@@ -999,11 +1040,15 @@ void scatter(const Scene& sc, const Wave& w) {
     const M usable = lambert_sample(df, du, dv, k(sc.min_pdf), local, pdf);
     const VI shape = load(w, kShape, i0, ok);
     const M general = load_mask(w, kShadeByCore, i0, ok);
-    // The impulses' lanes (mirror, dielectric) decide their own below.
+    // The impulses' lanes (mirror, dielectric) and the Disney lanes decide their own below.
     M impulses = hn::FirstN(df, 0);
-    if (sc.impulses)
-      impulses = hn::AndNot(general, hn::And(ok, shape_value(ok, sc, shape, kLaneMaterial) != k(static_cast<float>(kLaneLambert))));
-    ok = hn::Or(hn::Or(general, impulses), hn::And(ok, usable));
+    if (sc.impulses) {
+      const VF material = shape_value(ok, sc, shape, kLaneMaterial);
+      impulses = hn::AndNot(general, hn::And(ok, hn::Or(material == k(static_cast<float>(kLaneMirror)),
+                                                        material == k(static_cast<float>(kLaneDielectric)))));
+    }
+    const M disney = disney_lanes(hn::AndNot(general, ok), sc, shape);
+    ok = hn::Or(hn::Or(hn::Or(general, impulses), disney), hn::And(ok, usable));
     const V3 wo = -load3(w, kDx, i0, ok);
     const V3 n = load3(w, kNx, i0, ok);
     // Surfel::scatter: nothing from behind a one-sided material.
@@ -1014,9 +1059,30 @@ void scatter(const Scene& sc, const Wave& w) {
     V3 wi = to_world(fs, ft, n, local.x, local.y, local.z * side);
     V3 weight = shape_value3(ok, sc, shape, kAlbedo);
     M impulse = hn::FirstN(df, 0);
-    const M im = hn::And(impulses, ok), g = hn::And(general, ok);
-    // The lobe choice, drawn once for the impulses' lanes and core's.
-    const VF u_lobe = hn::AllFalse(df, hn::Or(im, g)) ? hn::Zero(df) : rng.u(Dim::LobeChoice);
+    const M im = hn::And(impulses, ok), g = hn::And(general, ok), dm = hn::And(disney, ok);
+    // The lobe choice, drawn once for the impulses' lanes, the Disney lanes and core's.
+    const VF u_lobe = hn::AllFalse(df, hn::Or(hn::Or(im, g), dm)) ? hn::Zero(df) : rng.u(Dim::LobeChoice);
+    if (!hn::AllFalse(df, dm)) {
+      // Surfel::scatter_in_frame of a Disney material (wo's side up, as the
+      // reflection models take it): a direction from the lobes' mixture,
+      // weighted by f cos over the mixture's density there (scatter_closure).
+      const ClosureLanes<VF> c = closure_lanes(dm, sc, shape);
+      const V3 wo_local = to_local(fs, ft, n, wo);
+      const V3 wo_up{wo_local.x, wo_local.y, wo_local.z * side};
+      with_disney_lobes(sc, [&](auto lobes) {
+        constexpr unsigned F = decltype(lobes)::value;
+        V3 local_d;
+        VF family;
+        M drawn = disney_sample<F>(df, c, wo_up, u_lobe, du, dv, VndfLobes{}, false, NoEnergy{}, local_d, family);
+        const VF pdf_d = disney_pdf<F>(df, c, wo_up, local_d, VndfLobes{}, false, NoEnergy{}, {});
+        drawn = hn::And(drawn, hn::And(pdf_d > k(0.0f), hn::Not(pdf_d < k(sc.min_pdf))));
+        const V3 f = disney_eval<F>(df, c, wo_up, local_d, NoEnergy{}, {});
+        wi = select(dm, to_world(fs, ft, n, local_d.x, local_d.y, local_d.z * side), wi);
+        weight = select(dm, f / pdf_d, weight);
+        pdf = hn::IfThenElse(dm, pdf_d, pdf);
+        ok = hn::AndNot(hn::AndNot(drawn, dm), ok);
+      });
+    }
     if (!hn::AllFalse(df, im)) {
       // Surfel::scatter_in_frame of a mirror (wo's side up, as the
       // reflection models take it) and of a dielectric (the frame as is).

@@ -102,6 +102,11 @@ struct Scene {
   // Some shape the lanes shade is a mirror or a dielectric (ShapeField
   // kLaneMaterial): else every lane shaded in the lanes is Lambert's.
   bool impulses = false;
+  // Some shape the lanes shade is a Disney material (flat, untextured, VNDF
+  // sampling, no energy compensation): the lobes every Disney surface of the
+  // scene is shaded with (disney::Features: kDisneyLobes, with kClearcoat
+  // if the scene has a clear coat, as core's ShadingPath says); else 0.
+  unsigned disney = 0;
   const CompiledScene* compiled = nullptr;
   // Lights beyond triangles sampled by area (an environment, sun disks,
   // sphere lights, light_sampling solid_angle): compiled->lights() samples
@@ -130,7 +135,7 @@ struct Scene {
   bool zsobol = false;
   unsigned zsobol_bits = 0;
   Lights lights;
-  // Per shape, 32 floats (ShapeField): its material's albedo, emission and
+  // Per shape, 48 floats (ShapeField): its material's albedo, emission and
   // flags, its first light entry, and its geometry.
   const float* shape = nullptr;
   // The same by column when there are at most 16 shapes (else null): field
@@ -160,11 +165,24 @@ enum ShapeField : int {
   kIor = 22,               // a dielectric's DielectricParams
   kReflectance = 23,       // 3 floats
   kTransmittance = 26,     // 3 floats
-  kShapeFields = 32,
+  // A Disney material's disney::Closure (kLaneDisney; core/bsdf/closure.h).
+  kDiffuse = 29,           // 3 floats
+  kRoughness = 32,
+  kSubsurface = 33,
+  kSheen = 34,             // 3 floats
+  kSpecular = 37,
+  kSpec0 = 38,             // 3 floats
+  kAx = 41,
+  kAy = 42,
+  kClearcoat = 43,
+  kClearcoatAlpha = 44,
+  kClearcoatLogA2 = 45,
+  kClearcoatLog2A2 = 46,
+  kShapeFields = 48,
 };
 
 // The materials the lanes shade (ShapeField kLaneMaterial), as floats.
-enum LaneMaterial : int { kLaneLambert = 0, kLaneMirror = 1, kLaneDielectric = 2 };
+enum LaneMaterial : int { kLaneLambert = 0, kLaneMirror = 1, kLaneDielectric = 2, kLaneDisney = 3 };
 
 // A camera (Camera::generate_ray).
 struct Camera {

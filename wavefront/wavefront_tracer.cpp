@@ -1,5 +1,6 @@
 #include "wavefront/wavefront_tracer.h"
 
+#include "core/bsdf/disney.h"
 #include "core/faults.h"
 #include "core/parallel.h"
 #include "core/rng.h"
@@ -189,8 +190,8 @@ struct WavefrontTracer::VectorStages {
     sc.rr_depth = settings.rr_depth;
     sc.max_vertex = settings.max_depth >= 0 ? settings.max_depth : kMaxVerticesUncapped;
     // Flat untextured Lambert surfaces (shaded by lambert.h, not through the
-    // Disney closure; with one min_pdf), mirrors and dielectrics are shaded
-    // in the lanes; any other surface that scatters by core's Surfel, path
+    // Disney closure), Disney surfaces (disney-inl.h; with one min_pdf),
+    // mirrors and dielectrics are shaded in the lanes; any other surface that scatters by core's Surfel, path
     // by path (vector_stages.h).
     const Scene& scene = compiled.scene();
     const Material* diffuse = nullptr;
@@ -202,7 +203,8 @@ struct WavefrontTracer::VectorStages {
         v->general_materials.push_back("'" + m.name + "'");
         continue;
       }
-      if (m.type != MaterialType::Diffuse) continue;
+      if (m.type == MaterialType::Disney) sc.disney = disney_features(m);
+      if (m.type != MaterialType::Diffuse && m.type != MaterialType::Disney) continue;
       if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return no("materials with different min_pdf");
       diffuse = &m;
     }
@@ -310,7 +312,7 @@ struct WavefrontTracer::VectorStages {
       }
     }
     // Per shape: its material's parameters and its geometry.
-    // Gathers index these tables with 32-bit float indices: 32 per shape, 12 per triangle, 16 per light.
+    // Gathers index these tables with 32-bit float indices: 48 per shape, 12 per triangle, 16 per light.
     if (compiled.triangles().size() >= (std::size_t{1} << 27)) return no("more than 2^27 triangles");
     if (scene.shapes.size() >= (std::size_t{1} << 24)) return no("more than 2^24 shapes");
     // The light pick's indices are floats (pick_cdf, core/simd/lights-inl.h).
@@ -343,12 +345,28 @@ struct WavefrontTracer::VectorStages {
       f[vs::kResolveByCore] = general && (shading_frame(sh) || m.reads_textures_at_hits()) ? 1.0f : 0.0f;
       f[vs::kLaneMaterial] = m.type == MaterialType::Mirror       ? static_cast<float>(vs::kLaneMirror)
                              : m.type == MaterialType::Dielectric ? static_cast<float>(vs::kLaneDielectric)
+                             : m.type == MaterialType::Disney     ? static_cast<float>(vs::kLaneDisney)
                                                                   : static_cast<float>(vs::kLaneLambert);
       f[vs::kIor] = m.glass.ior;
       for (int c = 0; c < 3; ++c) {
         f[vs::kReflectance + c] = m.glass.reflectance[c];
         f[vs::kTransmittance + c] = m.glass.transmittance[c];
       }
+      const disney::Closure& c = m.closure;
+      for (int k = 0; k < 3; ++k) {
+        f[vs::kDiffuse + k] = c.diffuse[k];
+        f[vs::kSheen + k] = c.sheen[k];
+        f[vs::kSpec0 + k] = c.spec0[k];
+      }
+      f[vs::kRoughness] = c.roughness;
+      f[vs::kSubsurface] = c.subsurface;
+      f[vs::kSpecular] = c.specular;
+      f[vs::kAx] = c.ax;
+      f[vs::kAy] = c.ay;
+      f[vs::kClearcoat] = c.clearcoat;
+      f[vs::kClearcoatAlpha] = c.clearcoat_alpha;
+      f[vs::kClearcoatLogA2] = c.clearcoat_log_a2;
+      f[vs::kClearcoatLog2A2] = c.clearcoat_log2_a2;
       sc.general = sc.general || general;
       sc.impulses = sc.impulses || (m.scatters() && !general && m.is_pure_impulse());
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
@@ -383,7 +401,20 @@ struct WavefrontTracer::VectorStages {
   // a mirror (mirror.h) or a dielectric (dielectric.h); untextured.
   static bool in_lanes(const Material& m) {
     const bool lambert = m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General;
-    return (lambert || m.is_pure_impulse()) && !m.is_textured() && !m.normal_map;
+    return (lambert || m.is_pure_impulse() || disney_features(m) != 0) && !m.is_textured() && !m.normal_map;
+  }
+  // The lobes the lanes shade a Disney material with (Scene::disney): those
+  // of the scene's shading path, under VNDF sampling and without energy
+  // compensation (core's alone: cospow.h, the energy tables); 0 if not in lanes.
+  static unsigned disney_features(const Material& m) {
+    if (m.type != MaterialType::Disney || m.shading.sampling != BsdfSampling::Vndf || m.closure.energy.on) return 0;
+    switch (m.shading.path) {
+      case ShadingPath::Disney: return disney::kDisneyLobes;
+      case ShadingPath::DisneyClearcoat: return disney::kDisneyLobes | disney::kClearcoat;
+      case ShadingPath::LambertOnly:
+      case ShadingPath::General: break;
+    }
+    return 0;
   }
   // Whether a shape shades in a frame of its own (not the geometric normal's).
   static bool shading_frame(const Shape& shape) { return shape.mesh.has_normals() || !shape.mesh.tangents.empty(); }

@@ -161,18 +161,18 @@ struct VndfLobes {
 
 // No energy compensation (the lanes' materials).
 struct NoEnergy {
-  static constexpr bool on = false;
+  static constexpr bool on = false;  // the methods are never called
   template <class D, class V = VecOf<D>>
-  Vec3<V> specular_transmit(D, V) const {
-    return {};
+  Vec3<V> specular_transmit(D d, V) const {
+    return {Zero(d), Zero(d), Zero(d)};
   }
   template <class D, class V = VecOf<D>>
-  V coat_transmit(D, V) const {
-    return {};
+  V coat_transmit(D d, V) const {
+    return Zero(d);
   }
   template <class D, class V = VecOf<D>>
-  Vec3<V> diffuse_scale(D) const {
-    return {};
+  Vec3<V> diffuse_scale(D d) const {
+    return {Zero(d), Zero(d), Zero(d)};
   }
 };
 
