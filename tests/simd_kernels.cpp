@@ -4,6 +4,7 @@
 
 #include <hwy/highway.h>
 
+#include "core/bsdf/disney-inl.h"
 #include "core/simd/lanes-inl.h"
 #include "core/simd/sampling-inl.h"
 
@@ -59,6 +60,52 @@ void simd_offset_ray_origin(const float* p, const float* error, const float* nor
   for (; i < n; ++i) offset_lanes(one, p + 3 * i, error + 3 * i, normal + 3 * i, out + 3 * i);
 }
 
+template <unsigned F>
+void disney_lanes(const float* in, float* out, std::size_t n) {
+  using D = hn::ScalableTag<float>;
+  using V = hn::Vec<D>;
+  const D d;
+  const std::size_t lanes = hn::Lanes(d);
+  for (std::size_t i = 0; i < n; i += lanes) {
+    const auto at = [&](int k) { return hn::LoadU(d, in + k * n + i); };
+    const auto at3 = [&](int k) { return warps::Vec3<V>{at(k), at(k + 1), at(k + 2)}; };
+    const V zero = hn::Zero(d);
+    const warps::ClosureLanes<V> c{{zero, zero, zero}, at3(0), at(3), at(4), at3(5), at(8), at3(9), at(12), at(13),
+                                   at(14), at(15), at(16), at(17)};
+    const warps::Vec3<V> wo = at3(18), wi = at3(21);
+    const warps::NoEnergy energy;
+    const warps::VndfLobes lobes;
+    const auto put = [&](int k, V v) { hn::StoreU(v, d, out + k * n + i); };
+    const warps::Vec3<V> f = warps::disney_eval<F>(d, c, wo, wi, energy, {});
+    put(0, f.x), put(1, f.y), put(2, f.z);
+    put(3, warps::disney_pdf<F>(d, c, wo, wi, lobes, false, energy, {}));
+    V p[3];
+    warps::disney_lobe_probabilities<F>(d, c, wo.z, false, energy, p);
+    put(4, p[0]), put(5, p[1]), put(6, p[2]);
+    warps::Vec3<V> s;
+    V family;
+    const auto drawn = warps::disney_sample<F>(d, c, wo, at(24), at(25), at(26), lobes, false, energy, s, family);
+    put(7, s.x), put(8, s.y), put(9, s.z);
+    put(10, hn::IfThenElseZero(drawn, hn::Set(d, 1.0f)));
+    put(11, family);
+  }
+}
+
+void simd_disney(bool clearcoat, const float* in, float* out, std::size_t n) {
+  if (clearcoat) disney_lanes<3u>(in, out, n);
+  else disney_lanes<1u>(in, out, n);
+}
+
+void simd_transcendentals(const float* u, const float* y, float* sin, float* cos, float* exp2, std::size_t n) {
+  const hn::ScalableTag<float> d;
+  for (std::size_t i = 0; i < n; i += hn::Lanes(d)) {
+    hn::Vec<decltype(d)> s, c;
+    warps::sin_cos_turn(d, hn::LoadU(d, u + i), s, c);
+    hn::StoreU(s, d, sin + i), hn::StoreU(c, d, cos + i);
+    hn::StoreU(warps::exp2_lanes(d, hn::LoadU(d, y + i)), d, exp2 + i);
+  }
+}
+
 }  // namespace pathlab::test::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -69,6 +116,14 @@ namespace pathlab::test {
 HWY_EXPORT(simd_warps);
 void simd_warps(const float* ux, const float* uy, float* x, float* y, float* z, float* s, float* c, std::size_t n) {
   HWY_DYNAMIC_DISPATCH(simd_warps)(ux, uy, x, y, z, s, c, n);
+}
+HWY_EXPORT(simd_disney);
+void simd_disney(bool clearcoat, const float* in, float* out, std::size_t n) {
+  HWY_DYNAMIC_DISPATCH(simd_disney)(clearcoat, in, out, n);
+}
+HWY_EXPORT(simd_transcendentals);
+void simd_transcendentals(const float* u, const float* y, float* sin, float* cos, float* exp2, std::size_t n) {
+  HWY_DYNAMIC_DISPATCH(simd_transcendentals)(u, y, sin, cos, exp2, n);
 }
 HWY_EXPORT(simd_offset_ray_origin);
 void simd_offset_ray_origin(const float* p, const float* error, const float* normal, float* out, std::size_t n) {

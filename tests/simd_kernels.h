@@ -17,4 +17,20 @@ void simd_warps(const float* ux, const float* uy, float* x, float* y, float* z, 
 // of the dispatched target, then the tail at Highway's width 1.
 void simd_offset_ray_origin(const float* p, const float* error, const float* normal, float* out, std::size_t n);
 
+// The Disney model of core/bsdf/disney-inl.h in lanes, with the lobes
+// kDisneyLobes | kClearcoat (clearcoat) or kDisneyLobes, VNDF sampling, no
+// energy compensation. `in` holds kDisneyKernelInputs arrays of n floats
+// (the closure's fields in ClosureLanes' order without the Lambert lobe:
+// diffuse 3, roughness, subsurface, sheen 3, specular, spec0 3, ax, ay,
+// clearcoat, clearcoat_alpha, its ln(a^2) and log2(a^2); then wo 3, wi 3,
+// u_lobe, ux, uy); `out` kDisneyKernelOutputs arrays of n: eval's f 3, pdf,
+// the lobe probabilities 3, the sample's wi 3, whether it was drawn (1 or
+// 0) and its family. n must be a multiple of the widest vector (16).
+inline constexpr int kDisneyKernelInputs = 28, kDisneyKernelOutputs = 12;
+void simd_disney(bool clearcoat, const float* in, float* out, std::size_t n);
+
+// sin_cos_turn(u) and exp2_lanes(y) of core/simd/sampling-inl.h for i in
+// [0, n), n a multiple of 16.
+void simd_transcendentals(const float* u, const float* y, float* sin, float* cos, float* exp2, std::size_t n);
+
 }  // namespace pathlab::test

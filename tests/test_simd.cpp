@@ -1,10 +1,12 @@
 // Highway's dynamic dispatch (core/simd/simd.h) and the per-lane code of
 // core/simd/*-inl.h: every SIMD target this machine runs computes, lane by
 // lane, the bits of the width-1 code that both tracers' scalar paths call.
+#include "core/bsdf/disney.h"
 #include "core/error.h"
 #include "core/ray.h"
 #include "core/sampling.h"
 #include "core/simd/simd.h"
+#include "core/simd/width1.h"
 #include "tests/simd_kernels.h"
 
 #include <gtest/gtest.h>
@@ -14,6 +16,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <string>
@@ -202,6 +205,156 @@ TEST(SimdOffsetRayOrigin, EveryTargetComputesTheBitsOfCoresScalarFunction) {
                       << p[i - i % 3 + 1] << ", " << p[i - i % 3 + 2] << ") is " << out[i] << ", core's "
                       << std::bit_cast<float>(want[i]);
     EXPECT_EQ(differ, 0u) << simd_target_name(t);
+  }
+}
+
+
+// sin_cos_turn and exp2_lanes (core/simd/sampling-inl.h), pathlab's own
+// transcendentals for the lanes: within a few ulps of libm, and the same
+// bits on every target and at width 1 (libm's are not the lanes').
+TEST(SimdTranscendentals, CloseToLibmAndTheSameBitsOnEveryTarget) {
+  const SimdChoice restore;
+  std::mt19937 g(20261203);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  std::vector<float> u = {0.0f, 0.125f, 0.25f, 0.375f, 0.5f, 0.625f, 0.75f, 0.875f, std::nextafter(1.0f, 0.0f), 1.0f,
+                          1e-30f, std::nextafter(0.125f, 0.0f), std::nextafter(0.125f, 1.0f)};
+  std::vector<float> y = {0.0f, -0.5f, 0.5f, -1.0f, -19.93f, -126.0f, 127.0f, -0.49999997f, 1e-30f, -1e-30f};
+  while (u.size() < (1u << 16)) u.push_back(uniform(g));
+  while (y.size() < u.size()) y.push_back(-20.0f * uniform(g));  // GTR1's range: log2(a^2) >= log2(1e-6)
+  const std::size_t n = u.size();
+  // The width-1 code (lane1), as core's scalar callers run it.
+  std::vector<float> want[3] = {std::vector<float>(n), std::vector<float>(n), std::vector<float>(n)};
+  for (std::size_t i = 0; i < n; ++i) {
+    width1::F s, c;
+    width1::generic::sin_cos_turn(width1::kScalar, width1::F{u[i]}, s, c);
+    want[0][i] = s.raw, want[1][i] = c.raw;
+    want[2][i] = width1::generic::exp2_lanes(width1::kScalar, width1::F{y[i]}).raw;
+  }
+  double worst_trig = 0.0, worst_exp = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double phi = 2.0 * 3.14159265358979323846 * double(u[i]);
+    worst_trig = std::max({worst_trig, std::abs(double(want[0][i]) - std::sin(phi)), std::abs(double(want[1][i]) - std::cos(phi))});
+    worst_exp = std::max(worst_exp, std::abs(double(want[2][i]) / std::exp2(double(y[i])) - 1.0));
+  }
+  // sin and cos within 2 ulp of 1 (plus the float rounding of the angle
+  // pi/2 f); 2^y within 4e-7 relative (the polynomial's 2e-7 and the rounding).
+  EXPECT_LT(worst_trig, 3.0 * 0x1p-24) << "sin_cos_turn against libm's double sin and cos";
+  EXPECT_LT(worst_exp, 4e-7) << "exp2_lanes against libm's double exp2";
+  EXPECT_EQ(want[0][0], 0.0f);
+  EXPECT_EQ(want[1][0], 1.0f);
+  EXPECT_EQ(want[2][0], 1.0f);
+  for (SimdTarget t : supported_simd_targets()) {
+    select_simd_target(t);
+    std::vector<float> got[3] = {std::vector<float>(n), std::vector<float>(n), std::vector<float>(n)};
+    test::simd_transcendentals(u.data(), y.data(), got[0].data(), got[1].data(), got[2].data(), n);
+    for (int k = 0; k < 3; ++k)
+      EXPECT_EQ(std::memcmp(got[k].data(), want[k].data(), n * sizeof(float)), 0)
+          << simd_target_name(t) << ": output " << k << " (sin, cos, exp2) differs from the width-1 code's";
+  }
+}
+
+// The Disney model in lanes (core/bsdf/disney-inl.h): eval, pdf, the lobe
+// probabilities and sample at every target give the bits of core's
+// disney::eval, pdf, lobe_probabilities and sample (the same source at
+// width 1), on closures from the parameters' corners and at random, views
+// from normal to 1e-6 of grazing, directions on both sides, and u at 0 and
+// just below 1. NaN equals NaN (none is expected).
+TEST(SimdDisney, EveryTargetComputesTheBitsOfCoresDisneyModel) {
+  const SimdChoice restore;
+  std::mt19937 g(1203);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  const auto unit = [&](float z) {
+    const float phi = 6.2831853f * uniform(g), s = std::sqrt(std::max(0.0f, 1.0f - z * z));
+    return vec3(s * std::cos(phi), s * std::sin(phi), z);
+  };
+  const float corner[] = {0.0f, 1.0f};
+  std::vector<disney::Closure> closures;
+  for (float metallic : corner)
+    for (float roughness : {0.0f, 0.25f, 1.0f})
+      for (float clearcoat : corner) {
+        DisneyParams p;
+        p.metallic = metallic;
+        p.roughness = roughness;
+        p.clearcoat = clearcoat;
+        p.sheen = 1.0f - metallic;
+        p.anisotropic = roughness == 0.25f ? 0.9f : 0.0f;
+        p.subsurface = roughness;
+        closures.push_back(disney::make_closure(p));
+      }
+  while (closures.size() < 64) {
+    DisneyParams p;
+    p.base_color = Spectrum(uniform(g), uniform(g), uniform(g));
+    for (float* x : {&p.metallic, &p.subsurface, &p.specular, &p.specular_tint, &p.roughness, &p.anisotropic, &p.sheen,
+                     &p.sheen_tint, &p.clearcoat, &p.clearcoat_gloss})
+      *x = uniform(g);
+    closures.push_back(disney::make_closure(p));
+  }
+  constexpr std::size_t kPerClosure = 1024;  // a multiple of every vector width
+  const std::size_t n = closures.size() * kPerClosure;
+  std::vector<float> in(test::kDisneyKernelInputs * n);
+  const auto put = [&](int k, std::size_t i, float v) { in[k * n + i] = v; };
+  for (std::size_t ci = 0; ci < closures.size(); ++ci) {
+    const disney::Closure& c = closures[ci];
+    for (std::size_t j = 0; j < kPerClosure; ++j) {
+      const std::size_t i = ci * kPerClosure + j;
+      const float fields[18] = {c.diffuse.x, c.diffuse.y, c.diffuse.z, c.roughness,  c.subsurface,       c.sheen.x,
+                                c.sheen.y,   c.sheen.z,   c.specular,  c.spec0.x,    c.spec0.y,          c.spec0.z,
+                                c.ax,        c.ay,        c.clearcoat, c.clearcoat_alpha, c.clearcoat_log_a2,
+                                c.clearcoat_log2_a2};
+      for (int k = 0; k < 18; ++k) put(k, i, fields[k]);
+      const float views[] = {1.0f, 0.5f, 1e-2f, 1e-4f, 1e-6f};
+      const vec3 wo = unit(j < 5 ? views[j] : uniform(g));
+      const vec3 wi = unit(j % 7 == 0 ? -uniform(g) : uniform(g));
+      const float u[3] = {uniform(g), j % 11 == 0 ? 0.0f : uniform(g), j % 13 == 0 ? std::nextafter(1.0f, 0.0f) : uniform(g)};
+      for (int k = 0; k < 3; ++k) put(18 + k, i, wo[k]), put(21 + k, i, wi[k]), put(24 + k, i, u[k]);
+    }
+  }
+  for (const bool clearcoat : {true, false}) {
+    // The width-1 code: what both tracers' scalar paths call.
+    std::vector<float> want(test::kDisneyKernelOutputs * n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const disney::Closure& c = closures[i / kPerClosure];
+      const vec3 wo(in[18 * n + i], in[19 * n + i], in[20 * n + i]), wi(in[21 * n + i], in[22 * n + i], in[23 * n + i]);
+      const unsigned features = clearcoat ? disney::kDisneyLobes | disney::kClearcoat : disney::kDisneyLobes;
+      const Spectrum f = clearcoat ? disney::eval<disney::kDisneyLobes | disney::kClearcoat>(c, wo, wi)
+                                   : disney::eval<disney::kDisneyLobes>(c, wo, wi);
+      const float pdf = clearcoat ? disney::pdf<disney::kDisneyLobes | disney::kClearcoat>(c, wo, wi, BsdfSampling::Vndf)
+                                  : disney::pdf<disney::kDisneyLobes>(c, wo, wi, BsdfSampling::Vndf);
+      const disney::LobeProbabilities p = disney::lobe_probabilities(c, wo, features, BsdfSampling::Vndf);
+      const float u_lobe = in[24 * n + i];
+      const vec2 u(in[25 * n + i], in[26 * n + i]);
+      const auto s = clearcoat ? disney::sample<disney::kDisneyLobes | disney::kClearcoat>(c, wo, u_lobe, u, BsdfSampling::Vndf)
+                               : disney::sample<disney::kDisneyLobes>(c, wo, u_lobe, u, BsdfSampling::Vndf);
+      const float family = !s                                   ? -1.0f
+                           : s->lobe == Lobe::Specular          ? 1.0f
+                           : s->lobe == Lobe::Clearcoat         ? 2.0f
+                                                                : 0.0f;
+      const float v[12] = {f.x, f.y, f.z, pdf, p[0], p[1], p[2], s ? s->wi.x : 0.0f, s ? s->wi.y : 0.0f,
+                           s ? s->wi.z : 0.0f, s ? 1.0f : 0.0f, family};
+      for (int k = 0; k < 12; ++k) want[k * n + i] = v[k];
+    }
+    const char* names[12] = {"f.r", "f.g", "f.b", "pdf", "p diffuse", "p specular", "p clearcoat",
+                             "wi.x", "wi.y", "wi.z", "drawn", "family"};
+    for (SimdTarget t : supported_simd_targets()) {
+      if (t == SimdTarget::Scalar) continue;  // Highway's one-lane target: the kernels' tails elsewhere, not here
+      select_simd_target(t);
+      std::vector<float> got(test::kDisneyKernelOutputs * n, std::numeric_limits<float>::quiet_NaN());
+      test::simd_disney(clearcoat, in.data(), got.data(), n);
+      std::size_t differ = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const bool drawn = want[10 * n + i] != 0.0f;
+        for (int k = 0; k < 12; ++k) {
+          if ((k >= 7 && k <= 9 && !drawn) || (k == 11 && !drawn)) continue;  // no sample: its direction is not read
+          const float a = got[k * n + i], b = want[k * n + i];
+          const bool same = std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b) || (std::isnan(a) && std::isnan(b));
+          if (!same && differ++ < 5)
+            ADD_FAILURE() << simd_target_name(t) << (clearcoat ? " (clearcoat)" : "") << ": " << names[k] << " of input " << i
+                          << " is " << a << ", the width-1 code gives " << b;
+        }
+      }
+      EXPECT_EQ(differ, 0u) << simd_target_name(t) << (clearcoat ? " (clearcoat)" : "") << ": values differing, of "
+                            << 12 * n;
+    }
   }
 }
 

@@ -138,9 +138,18 @@ HWY_INLINE V Pow2I(D d, V n) {
 // that need double's precision (microfacet-inl.h's half_vector). A
 // primitive: here each half of the float lanes in turn, promoted exactly;
 // lane1's below, one double.
-// (Not at Highway's HWY_SCALAR target, which has no halves: the build's
-// static target, where only lane1 calls it.)
-#if HWY_TARGET != HWY_SCALAR
+#if HWY_TARGET == HWY_SCALAR
+// Highway's one-lane target has no halves: its one float promoted.
+template <class D, class Fn, class V = VecOf<D>>
+HWY_INLINE Vec3<V> InDouble3(D d, Fn&& fn, const Vec3<V>& a, const Vec3<V>& b) {
+  const hn::Rebind<double, D> dd;
+  const auto wide = [&](const Vec3<V>& v) {
+    return Vec3<VecOf<decltype(dd)>>{hn::PromoteTo(dd, v.x), hn::PromoteTo(dd, v.y), hn::PromoteTo(dd, v.z)};
+  };
+  const auto r = fn(dd, wide(a), wide(b));
+  return {hn::DemoteTo(d, r.x), hn::DemoteTo(d, r.y), hn::DemoteTo(d, r.z)};
+}
+#else
 template <class D, class Fn, class V = VecOf<D>>
 HWY_INLINE Vec3<V> InDouble3(D d, Fn&& fn, const Vec3<V>& a, const Vec3<V>& b) {
   const hn::Half<D> dh;
