@@ -70,8 +70,7 @@ Scene cornell_with_bulb() {
   return scene;
 }
 
-// The Cornell box with every kind of material the vectorised stages hand to
-// core's Surfel: the short box gold (Disney, metallic), the tall one glass,
+// The Cornell box with every kind of material: the short box gold (Disney, metallic), the tall one glass,
 // the back wall a clear-coated velvet (Disney sheen and clearcoat) and the
 // red wall a mirror.
 Scene cornell_with_materials() {
@@ -100,13 +99,31 @@ Scene cornell_with_materials() {
   return s;
 }
 
-// cornell_with_materials() with tangents on the velvet box (a shading
-// frame: core's Surfel shades it) beside the gold one (shaded in the lanes):
+// cornell_with_materials() with tangents on the velvet back wall (a shading
+// frame: core's Surfel shades it) beside the gold box (shaded in the lanes):
 // Disney surfaces of both kinds in one scene.
 Scene cornell_with_framed_velvet() {
   Scene s = cornell_with_materials();
   Shape& velvet = s.shapes.at(2);
   velvet.mesh.tangents.assign(velvet.mesh.positions.size(), glm::vec4(0.6f, 0.0f, 0.8f, 1.0f));
+  return s;
+}
+
+// cornell_with_materials() whose velvet back wall is an anisotropic
+// clear-coated lacquer with energy compensation (its tables gathered in the
+// lanes), beside the gold box without.
+Scene cornell_with_compensated_lacquer() {
+  Scene s = cornell_with_materials();
+  DisneyParams lacquer;
+  lacquer.base_color = Spectrum(0.6f, 0.1f, 0.05f);
+  lacquer.roughness = 0.4f;
+  lacquer.anisotropic = 0.8f;
+  lacquer.clearcoat = 1.0f;
+  lacquer.energy_compensation = true;
+  Material m = disney_material(lacquer);
+  m.name = "lacquer";
+  s.materials.push_back(std::move(m));
+  s.shapes.at(2).material = static_cast<std::uint32_t>(s.materials.size() - 1);
   return s;
 }
 
@@ -143,6 +160,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "every-light" ? cornell_with_every_light()
             : c.scene == "materials" ? cornell_with_materials()
             : c.scene == "framed-velvet" ? cornell_with_framed_velvet()
+            : c.scene == "compensated" ? cornell_with_compensated_lacquer()
             : c.scene == "tangents"  ? cornell_with_tangents()
             : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
             : c.scene == "instanced" ? test::cornell_with_instances()
@@ -700,8 +718,12 @@ std::vector<VectorCase> vector_cases() {
     cases.push_back({"", st, 0.0f, 0, false, false, false, false, false, 0, false, false, true});
   cases.push_back({"materials", Strategy::Mis, 0.0f, 0, false, false, false, false, false, 0, true, false, true});
   cases.push_back({"bulb", Strategy::Mis, 0.0f, 0, false, false, true, false, false, 0, true});
-  // Disney surfaces shaded in the lanes beside one shaded by core (its shading frame).
+  // Disney surfaces shaded in the lanes beside one shaded by core (its shading frame); energy compensation's
+  // tables gathered in the lanes (a coated sphere; the materials' box with an anisotropic, compensated lacquer).
   for (Strategy st : {Strategy::Bsdf, Strategy::Mis}) cases.push_back({"framed-velvet", st, 0.0f, 0});
+  cases.push_back({"coated-sphere-compensated.json", Strategy::Mis, 0.0f, 0});
+  cases.push_back({"compensated", Strategy::Mis, 0.0f, 0});
+  cases.push_back({"compensated", Strategy::LightBsdf, 0.0f, 0, false, true, false, false, true});
   // Textures (albedo, Disney parameters, a normal map, a mirror's reflectance, an emitter's radiance), read by
   // CompiledScene::resolve with each path's ray cone.
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})

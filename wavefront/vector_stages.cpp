@@ -848,6 +848,46 @@ ClosureLanes<VF> closure_lanes(M m, const Scene& sc, VI shape) {
           f(kClearcoat),  f(kClearcoatAlpha), f(kClearcoatLogA2), f(kClearcoatLog2A2)};
 }
 
+// Energy compensation's layers for the lanes of `on` (disney-inl.h's
+// Energy), from their materials' tables in Scene::energy (`base`: each
+// lane's first float there).
+struct LaneEnergy {
+  M lanes_on;
+  VI base;
+  const float* table;
+  static constexpr bool any() { return true; }
+  M on(DF) const { return lanes_on; }
+  VF at(VI index) const {
+    return hn::IfThenElseZero(lanes_on, hn::GatherIndex(DF(), table, hn::IfThenElseZero(hn::RebindMask(DI(), lanes_on), base + index)));
+  }
+  V3 specular_transmit(DF d, VF mu) const {
+    return pathlab::HWY_NAMESPACE::specular_transmit(d, mu, [&](VF i) {
+      const VI at3 = hn::Set(DI(), kEnergySpecular) + hn::ConvertTo(DI(), i) * hn::Set(DI(), 3);
+      return V3{at(at3), at(at3 + hn::Set(DI(), 1)), at(at3 + hn::Set(DI(), 2))};
+    });
+  }
+  VF coat_transmit(DF d, VF mu) const {
+    return pathlab::HWY_NAMESPACE::coat_transmit(
+        d, mu, [&](VF i) { return at(hn::Set(DI(), kEnergyCoat) + hn::ConvertTo(DI(), i)); });
+  }
+  V3 diffuse_scale(DF) const {
+    return {at(hn::Set(DI(), kEnergyDiffuseScale)), at(hn::Set(DI(), kEnergyDiffuseScale + 1)),
+            at(hn::Set(DI(), kEnergyDiffuseScale + 2))};
+  }
+};
+
+// fn(energy) for the Disney lanes of m: a LaneEnergy if some have energy
+// tables, else NoEnergy (nothing of it compiled into the call).
+template <class Fn>
+void with_energy(M m, const Scene& sc, VI shape, Fn&& fn) {
+  if (sc.energy) {
+    const VI base = shape_int(m, sc, shape, kEnergy);
+    const M on = hn::And(m, hn::RebindMask(DF(), base > hn::Set(DI(), -1)));
+    if (!hn::AllFalse(DF(), on)) return fn(LaneEnergy{on, base, sc.energy});
+  }
+  fn(NoEnergy{});
+}
+
 // fn(std::integral_constant<unsigned, F>) for the Disney lobes of the scene
 // (Scene::disney), so that the lanes shade with the lobes core's
 // ShadingPath compiles in.
@@ -891,8 +931,10 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
     const ClosureLanes<VF> c = closure_lanes(dm, sc, shape);
     with_disney_lobes(sc, [&](auto lobes) {
       constexpr unsigned F = decltype(lobes)::value;
-      f = select(dm, disney_eval<F>(df, c, wo_local, wi_local, NoEnergy{}, {}), f);
-      pdf_bsdf = hn::IfThenElse(dm, disney_pdf<F>(df, c, wo_local, wi_local, VndfLobes{}, false, NoEnergy{}, {}), pdf_bsdf);
+      with_energy(dm, sc, shape, [&](const auto& energy) {
+        f = select(dm, disney_eval<F>(df, c, wo_local, wi_local, energy, {}), f);
+        pdf_bsdf = hn::IfThenElse(dm, disney_pdf<F>(df, c, wo_local, wi_local, VndfLobes{}, false, energy, {}), pdf_bsdf);
+      });
     });
   }
   if (const M general = load_mask(w, kShadeByCore, i0, ok); !hn::AllFalse(df, general)) {
@@ -1047,8 +1089,8 @@ void scatter(const Scene& sc, const Wave& w) {
       impulses = hn::AndNot(general, hn::And(ok, hn::Or(material == k(static_cast<float>(kLaneMirror)),
                                                         material == k(static_cast<float>(kLaneDielectric)))));
     }
-    const M disney = disney_lanes(hn::AndNot(general, ok), sc, shape);
-    ok = hn::Or(hn::Or(hn::Or(general, impulses), disney), hn::And(ok, usable));
+    const M disneys = disney_lanes(hn::AndNot(general, ok), sc, shape);
+    ok = hn::Or(hn::Or(hn::Or(general, impulses), disneys), hn::And(ok, usable));
     const V3 wo = -load3(w, kDx, i0, ok);
     const V3 n = load3(w, kNx, i0, ok);
     // Surfel::scatter: nothing from behind a one-sided material.
@@ -1059,7 +1101,7 @@ void scatter(const Scene& sc, const Wave& w) {
     V3 wi = to_world(fs, ft, n, local.x, local.y, local.z * side);
     V3 weight = shape_value3(ok, sc, shape, kAlbedo);
     M impulse = hn::FirstN(df, 0);
-    const M im = hn::And(impulses, ok), g = hn::And(general, ok), dm = hn::And(disney, ok);
+    const M im = hn::And(impulses, ok), g = hn::And(general, ok), dm = hn::And(disneys, ok);
     // The lobe choice, drawn once for the impulses' lanes, the Disney lanes and core's.
     const VF u_lobe = hn::AllFalse(df, hn::Or(hn::Or(im, g), dm)) ? hn::Zero(df) : rng.u(Dim::LobeChoice);
     if (!hn::AllFalse(df, dm)) {
@@ -1071,16 +1113,18 @@ void scatter(const Scene& sc, const Wave& w) {
       const V3 wo_up{wo_local.x, wo_local.y, wo_local.z * side};
       with_disney_lobes(sc, [&](auto lobes) {
         constexpr unsigned F = decltype(lobes)::value;
+        with_energy(dm, sc, shape, [&](const auto& energy) {
         V3 local_d;
         VF family;
-        M drawn = disney_sample<F>(df, c, wo_up, u_lobe, du, dv, VndfLobes{}, false, NoEnergy{}, local_d, family);
-        const VF pdf_d = disney_pdf<F>(df, c, wo_up, local_d, VndfLobes{}, false, NoEnergy{}, {});
+        M drawn = disney_sample<F>(df, c, wo_up, u_lobe, du, dv, VndfLobes{}, false, energy, local_d, family);
+        const VF pdf_d = disney_pdf<F>(df, c, wo_up, local_d, VndfLobes{}, false, energy, {});
         drawn = hn::And(drawn, hn::And(pdf_d > k(0.0f), hn::Not(pdf_d < k(sc.min_pdf))));
-        const V3 f = disney_eval<F>(df, c, wo_up, local_d, NoEnergy{}, {});
+        const V3 f = disney_eval<F>(df, c, wo_up, local_d, energy, {});
         wi = select(dm, to_world(fs, ft, n, local_d.x, local_d.y, local_d.z * side), wi);
         weight = select(dm, f / pdf_d, weight);
         pdf = hn::IfThenElse(dm, pdf_d, pdf);
         ok = hn::AndNot(hn::AndNot(drawn, dm), ok);
+        });
       });
     }
     if (!hn::AllFalse(df, im)) {

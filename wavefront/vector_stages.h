@@ -4,8 +4,8 @@
 // selected — for every scene (any camera, material, light, texture,
 // instance, alpha). The lanes do the camera, world-space hit points,
 // emission and its weight, triangle lights sampled by area, delta lights,
-// flat untextured Lambert, mirror and dielectric shading, roulette and
-// compaction; everything else (other materials, vertex normals, textures,
+// flat untextured Lambert, Disney (VNDF sampling), mirror and dielectric
+// shading, roulette and compaction; everything else (other materials, vertex normals, textures,
 // instances, other lights) is core's, called one path at a time between
 // the lanes' steps (Scene::general, general_lights, instanced, textured). `--simd scalar` runs
 // the scalar stages of wavefront_tracer.cpp.
@@ -100,12 +100,13 @@ struct Scene {
   // resolve() keeps its shading frame from compiled->resolve() (kFsX...).
   bool general = false;
   // Some shape the lanes shade is a mirror or a dielectric (ShapeField
-  // kLaneMaterial): else every lane shaded in the lanes is Lambert's.
+  // kLaneMaterial): else every lane shaded in the lanes is Lambert's or
+  // Disney's.
   bool impulses = false;
-  // Some shape the lanes shade is a Disney material (flat, untextured, VNDF
-  // sampling, no energy compensation): the lobes every Disney surface of the
-  // scene is shaded with (disney::Features: kDisneyLobes, with kClearcoat
-  // if the scene has a clear coat, as core's ShadingPath says); else 0.
+  // Some material the lanes shade is Disney's (flat, untextured, VNDF
+  // sampling): the lobes every Disney material of the scene is shaded with
+  // (disney::Features: kDisneyLobes, with kClearcoat if the scene has a
+  // clear coat, as core's ShadingPath says); else 0.
   unsigned disney = 0;
   const CompiledScene* compiled = nullptr;
   // Lights beyond triangles sampled by area (an environment, sun disks,
@@ -135,6 +136,10 @@ struct Scene {
   bool zsobol = false;
   unsigned zsobol_bits = 0;
   Lights lights;
+  // Energy compensation's tables (core/bsdf/energy.h) of the Disney
+  // materials the lanes shade that have them, kEnergyFloats floats each
+  // (EnergyField), at ShapeField kEnergy; null if none.
+  const float* energy = nullptr;
   // Per shape, 48 floats (ShapeField): its material's albedo, emission and
   // flags, its first light entry, and its geometry.
   const float* shape = nullptr;
@@ -157,7 +162,7 @@ enum ShapeField : int {
   kRadius = 15,        // a sphere's radius
   kFlipped = 16,       // 1 if a sphere's normals point inwards
   kOneSided = 17,      // 1 if its material is one-sided (black from behind the geometric normal)
-  kGeneral = 18,       // 1 if it is shaded by core's Surfel (not flat untextured Lambert, mirror or glass)
+  kGeneral = 18,       // 1 if it is shaded by core's Surfel (not flat untextured Lambert, Disney, mirror or glass)
   kTexturedEmission = 19,  // 1 if its emission is textured (Surfel::emitted, path by path)
   kResolveByCore = 20,     // 1 if kGeneral and its Surfel needs CompiledScene::resolve (a shading frame of its
                            // own, textures); else resolve() makes its Frame(n) in the lanes
@@ -178,7 +183,16 @@ enum ShapeField : int {
   kClearcoatAlpha = 44,
   kClearcoatLogA2 = 45,
   kClearcoatLog2A2 = 46,
+  kEnergy = 47,            // bits of an int32: its energy tables' first float in Scene::energy, -1 if none
   kShapeFields = 48,
+};
+
+// A Disney material's EnergyTables in Scene::energy.
+enum EnergyField : int {
+  kEnergySpecular = 0,        // kEnergyTableSize entries of 3 floats
+  kEnergyCoat = 99,           // kEnergyTableSize floats
+  kEnergyDiffuseScale = 132,  // 3 floats
+  kEnergyFloats = 135,
 };
 
 // The materials the lanes shade (ShapeField kLaneMaterial), as floats.
@@ -284,8 +298,8 @@ std::size_t sample_lights(const Scene& scene, const Wave& wave);
 // The light of every visible sample, once Embree has filled kQOccluded
 // (kQPath says whose each packed shadow ray is).
 void add_light(const Wave& wave, std::size_t queries);
-// The continuation (Lambert, mirrors and glass in the lanes, any other
-// surface by core's Surfel::scatter), Russian roulette and the next ray.
+// The continuation (Lambert, Disney, mirrors and glass in the lanes, any
+// other surface by core's Surfel::scatter), Russian roulette and the next ray.
 void scatter(const Scene& scene, const Wave& wave);
 // Packs the survivors into slots [0, m) in order and returns m; each path
 // that ended is written to samples[its kOutIndex - first_slot] (an array of

@@ -166,7 +166,7 @@ std::size_t WavefrontTracer::scalar_bytes_per_path() {
 struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
-  std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table;
+  std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table, energy;
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
   std::vector<std::string> general_materials, general;
@@ -203,7 +203,11 @@ struct WavefrontTracer::VectorStages {
         v->general_materials.push_back("'" + m.name + "'");
         continue;
       }
-      if (m.type == MaterialType::Disney) sc.disney = disney_features(m);
+      if (const unsigned lobes = disney_features(m); lobes != 0) {
+        // The lobes are the scene's ShadingPath's, the same for every material (configure_shading).
+        if (sc.disney != 0 && sc.disney != lobes) return no("Disney materials shaded with different lobes");
+        sc.disney = lobes;
+      }
       if (m.type != MaterialType::Diffuse && m.type != MaterialType::Disney) continue;
       if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return no("materials with different min_pdf");
       diffuse = &m;
@@ -317,6 +321,7 @@ struct WavefrontTracer::VectorStages {
     if (scene.shapes.size() >= (std::size_t{1} << 24)) return no("more than 2^24 shapes");
     // The light pick's indices are floats (pick_cdf, core/simd/lights-inl.h).
     if (sc.lights.count > kMaxExactFloatIndex || sc.deltas.count > kMaxExactFloatIndex) return no("more than 2^24 lights");
+    std::vector<std::int32_t> energy_at;  // per material: its tables' offset in v->energy, -1 if not there yet
     for (std::uint32_t i = 0; i < scene.shapes.size(); ++i) {
       const Shape& sh = scene.shapes[i];
       const Material& m = scene.materials[sh.material];
@@ -367,10 +372,28 @@ struct WavefrontTracer::VectorStages {
       f[vs::kClearcoatAlpha] = c.clearcoat_alpha;
       f[vs::kClearcoatLogA2] = c.clearcoat_log_a2;
       f[vs::kClearcoatLog2A2] = c.clearcoat_log2_a2;
+      f[vs::kEnergy] = std::bit_cast<float>(std::int32_t{-1});
+      if (m.type == MaterialType::Disney && c.energy.on && !general) {
+        // Its energy tables, once per material.
+        const std::size_t mi = static_cast<std::size_t>(&m - scene.materials.data());
+        if (energy_at.size() <= mi) energy_at.resize(scene.materials.size(), -1);
+        if (energy_at[mi] < 0) {
+          energy_at[mi] = static_cast<std::int32_t>(v->energy.size());
+          for (const Spectrum& e : c.energy.specular) v->energy.insert(v->energy.end(), {e.x, e.y, e.z});
+          v->energy.insert(v->energy.end(), c.energy.coat.begin(), c.energy.coat.end());
+          const Spectrum& k = c.energy.diffuse_scale;
+          v->energy.insert(v->energy.end(), {k.x, k.y, k.z});
+        }
+        f[vs::kEnergy] = std::bit_cast<float>(energy_at[mi]);
+      }
       sc.general = sc.general || general;
       sc.impulses = sc.impulses || (m.scatters() && !general && m.is_pure_impulse());
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
     }
+    static_assert(vs::kEnergyCoat == 3 * disney::kEnergyTableSize &&
+                  vs::kEnergyDiffuseScale == vs::kEnergyCoat + disney::kEnergyTableSize &&
+                  vs::kEnergyFloats == vs::kEnergyDiffuseScale + 3);
+    sc.energy = v->energy.empty() ? nullptr : v->energy.data();
     sc.shape = v->shape.data();
     sc.compiled = &compiled;
     sc.shape_count = scene.shapes.size();
@@ -404,10 +427,10 @@ struct WavefrontTracer::VectorStages {
     return (lambert || m.is_pure_impulse() || disney_features(m) != 0) && !m.is_textured() && !m.normal_map;
   }
   // The lobes the lanes shade a Disney material with (Scene::disney): those
-  // of the scene's shading path, under VNDF sampling and without energy
-  // compensation (core's alone: cospow.h, the energy tables); 0 if not in lanes.
+  // of the scene's shading path, under VNDF sampling (cospow.h's lobes are
+  // core's alone); 0 if not in lanes.
   static unsigned disney_features(const Material& m) {
-    if (m.type != MaterialType::Disney || m.shading.sampling != BsdfSampling::Vndf || m.closure.energy.on) return 0;
+    if (m.type != MaterialType::Disney || m.shading.sampling != BsdfSampling::Vndf) return 0;
     switch (m.shading.path) {
       case ShadingPath::Disney: return disney::kDisneyLobes;
       case ShadingPath::DisneyClearcoat: return disney::kDisneyLobes | disney::kClearcoat;

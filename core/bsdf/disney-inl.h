@@ -11,9 +11,8 @@
 //  - the glossy lobes' sampler: `Lobes` with specular_pdf/_sample and
 //    clearcoat_pdf/_sample; VndfLobes below (exact visible normals, the
 //    default) is generic, disney.cpp's Cospow lobes are core's only;
-//  - energy compensation (core/bsdf/energy.h): `Energy` with `on` and the
-//    layers' transmittances; NoEnergy below for the lanes, which leave
-//    compensated materials to core;
+//  - energy compensation (core/bsdf/energy.h): `Energy` (below) with the
+//    layers' transmittances, from each lane's tables; NoEnergy for none;
 //  - DisneyFaults: the test-only planted bugs core's fault build passes
 //    (core/faults.h), all false elsewhere.
 //
@@ -27,6 +26,7 @@
 
 #include <hwy/highway.h>
 
+#include "core/bsdf/energy.h"
 #include "core/bsdf/microfacet-inl.h"
 #include "core/math.h"
 #include "core/simd/lane1.h"
@@ -159,9 +159,18 @@ struct VndfLobes {
   }
 };
 
-// No energy compensation (the lanes' materials).
+// Energy compensation's layers (core/bsdf/energy.h), for the lanes whose
+// material has its tables: where `on`, f and the lobe probabilities are
+// coupled, elsewhere they are Burley's. An Energy has any() (some lane is
+// on), on() (the mask), and the transmittances specular_transmit(d, mu),
+// coat_transmit(d, mu) and diffuse_scale(d), looked up by the functions
+// below from its tables. NoEnergy: none (its lookups are never called).
 struct NoEnergy {
-  static constexpr bool on = false;  // the methods are never called
+  static constexpr bool any() { return false; }
+  template <class D>
+  auto on(D d) const {
+    return Zero(d) > Zero(d);
+  }
   template <class D, class V = VecOf<D>>
   Vec3<V> specular_transmit(D d, V) const {
     return {Zero(d), Zero(d), Zero(d)};
@@ -175,6 +184,41 @@ struct NoEnergy {
     return {Zero(d), Zero(d), Zero(d)};
   }
 };
+
+// energy_table_position: view cosine mu's place in the tables, entry i (a
+// whole number, as a float) and the weight w of entry i + 1; mu outside
+// (0, 1] (NaN too) as its nearest end.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V energy_table_position(D d, V mu, V& i) {
+  const V m = IfThenElseZero(mu > Zero(d), Min(Set(d, 1.0f), mu));  // std::min(mu, 1)
+  const V t = Sqrt(m) * Set(d, static_cast<float>(disney::kEnergyTableSize - 1));
+  i = Min(Set(d, static_cast<float>(disney::kEnergyTableSize - 2)), Floor(t));  // t >= 0: the int conversion
+  return t - i;
+}
+
+// EnergyTables::specular_transmit: 1 - the specular albedo at mu, per
+// channel, clamped to [0, 1] (glm::clamp's order); `entry(i)` the table's
+// entry i (a Vec3 of lanes).
+template <class D, class Entry, class V = VecOf<D>>
+HWY_INLINE Vec3<V> specular_transmit(D d, V mu, Entry&& entry) {
+  V i;
+  const V w = energy_table_position(d, mu, i);
+  const Vec3<V> a = entry(i), b = entry(i + Set(d, 1.0f));
+  const V keep = Set(d, 1.0f) - w;  // glm::mix(a, b, w) = a (1 - w) + b w
+  const auto clamp = [&](V x) { return Min(Set(d, 1.0f), Max(Zero(d), Set(d, 1.0f) - x)); };
+  return {clamp(a.x * keep + b.x * w), clamp(a.y * keep + b.y * w), clamp(a.z * keep + b.z * w)};
+}
+
+// EnergyTables::coat_transmit: 1 - the clearcoat's albedo at mu, clamped to
+// [0, 1] (std::clamp's order); `entry(i)` the table's entry i.
+template <class D, class Entry, class V = VecOf<D>>
+HWY_INLINE V coat_transmit(D d, V mu, Entry&& entry) {
+  V i;
+  const V w = energy_table_position(d, mu, i);
+  const V a = entry(i), b = entry(i + Set(d, 1.0f));
+  const V x = Set(d, 1.0f) - (a + (b - a) * w);
+  return IfThenElse(x < Zero(d), Zero(d), IfThenElse(Set(d, 1.0f) < x, Set(d, 1.0f), x));
+}
 
 // Both directions strictly above the surface: every term needs them (a
 // direction exactly in the surface carries no projected area).
@@ -209,10 +253,11 @@ HWY_INLINE void disney_lobe_probabilities(D d, const ClosureLanes<V>& c, V wo_z,
     e[2] = c.clearcoat * (Set(d, 0.04f) + Set(d, 0.96f) * Fw);
     present2 = c.clearcoat > zero;
   }
-  if (energy.on) {  // what the layers above let through, seen from wo
+  if (energy.any()) {  // what the layers above let through, seen from wo
+    const auto on = energy.on(d);
     const V coat = (F & kClearcoat) != 0 ? energy.coat_transmit(d, wo_z) : one;
-    e[0] = e[0] * (coat * luminance(d, energy.diffuse_scale(d) * energy.specular_transmit(d, wo_z)));
-    e[1] = e[1] * coat;
+    e[0] = IfThenElse(on, e[0] * (coat * luminance(d, energy.diffuse_scale(d) * energy.specular_transmit(d, wo_z))), e[0]);
+    e[1] = IfThenElse(on, e[1] * coat, e[1]);
   }
   // Cospow: the cosine lobe is always kept (disney.h).
   if (cospow && (F & kDisneyLobes) != 0) present0 = zero == zero;
@@ -271,6 +316,8 @@ HWY_INLINE Vec3<V> disney_eval(D d, const ClosureLanes<V>& c, const Vec3<V>& wo,
                                const Energy& energy, const disney::DisneyFaults& faults) {
   constexpr unsigned kDisneyLobes = 1u, kClearcoat = 2u, kLambertLobe = 4u;
   const V zero = Zero(d);
+  const auto above = disney_above(d, wo, wi, faults);
+  if (AllFalse(d, above)) return {zero, zero, zero};  // nothing to compute (every light sample below, at width 1)
   const V NL = wi.z, NV = wo.z;
   Vec3<V> f{zero, zero, zero};
   if constexpr ((F & kLambertLobe) != 0) f = f + (NL * Set(d, kInvPi)) * c.lambert;
@@ -280,17 +327,20 @@ HWY_INLINE Vec3<V> disney_eval(D d, const ClosureLanes<V>& c, const Vec3<V>& wo,
     const V FH = schlick_weight(d, LdotH);
     if constexpr ((F & kDisneyLobes) != 0) {
       Vec3<V> base = diffuse_family(d, c, NL, NV, LdotH);
-      if (energy.on && !faults.diffuse_not_coupled)
-        base = base * ((energy.diffuse_scale(d) * energy.specular_transmit(d, NV)) * energy.specular_transmit(d, NL));
+      if (energy.any() && !faults.diffuse_not_coupled)
+        base = select(energy.on(d),
+                      base * ((energy.diffuse_scale(d) * energy.specular_transmit(d, NV)) * energy.specular_transmit(d, NL)),
+                      base);
       f = f + (base + specular_family(d, c, wo, wi, h, FH, faults));
     }
     if constexpr ((F & kClearcoat) != 0) {
-      if (energy.on && !faults.coat_not_coupled) f = (energy.coat_transmit(d, NV) * energy.coat_transmit(d, NL)) * f;
+      if (energy.any() && !faults.coat_not_coupled)
+        f = select(energy.on(d), (energy.coat_transmit(d, NV) * energy.coat_transmit(d, NL)) * f, f);
       const V coat = clearcoat_family(d, c, wo, wi, h, FH);
       f = f + Vec3<V>{coat, coat, coat};
     }
   }
-  return zero_unless(disney_above(d, wo, wi, faults), f);
+  return zero_unless(above, f);
 }
 
 // The solid-angle density of disney_sample at wi.
@@ -298,12 +348,14 @@ template <unsigned F, class D, class Lobes, class Energy, class V = VecOf<D>>
 HWY_INLINE V disney_pdf(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, const Vec3<V>& wi, const Lobes& lobes,
                         bool cospow, const Energy& energy, const disney::DisneyFaults& faults) {
   constexpr unsigned kDisneyLobes = 1u, kClearcoat = 2u;
+  const auto above = disney_above(d, wo, wi, faults);
+  if (AllFalse(d, above)) return Zero(d);
   V p[3];
   disney_lobe_probabilities<F>(d, c, wo.z, cospow, energy, p);
   V density = p[0] * cosine_hemisphere_pdf(d, wi.z);
   if constexpr ((F & kDisneyLobes) != 0) density = density + p[1] * lobes.specular_pdf(d, c, wo, wi, faults);
   if constexpr ((F & kClearcoat) != 0) density = density + p[2] * lobes.clearcoat_pdf(d, c, wo, wi);
-  return IfThenElseZero(disney_above(d, wo, wi, faults), density);
+  return IfThenElseZero(above, density);
 }
 
 // A direction from the mixture for the lanes of the returned mask: u_lobe

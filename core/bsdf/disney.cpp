@@ -23,7 +23,8 @@ ClosureLanes<F> lanes_of(const Closure& c) {
 // The closure's energy tables (energy.h) as disney-inl.h's Energy reads them.
 struct TableEnergy {
   const EnergyTables& tables;
-  bool on = tables.on;
+  bool any() const { return tables.on; }
+  lane1::M on(lane1::One<float>) const { return {tables.on}; }
   F3 specular_transmit(lane1::One<float>, F mu) const { return lanes(tables.specular_transmit(mu.raw)); }
   F coat_transmit(lane1::One<float>, F mu) const { return F{tables.coat_transmit(mu.raw)}; }
   F3 diffuse_scale(lane1::One<float>) const { return lanes(tables.diffuse_scale); }
@@ -90,18 +91,21 @@ bool above(const vec3& wo, const vec3& wi) { return generic::disney_above(kScala
 }  // namespace
 
 LobeProbabilities lobe_probabilities(const Closure& c, const vec3& wo, unsigned features, BsdfSampling sampling) {
-  F p[3];
+  F p[3] = {};
   const ClosureLanes<F> cl = lanes_of(c);
   const TableEnergy energy{c.energy};
   const bool cospow = sampling == BsdfSampling::Cospow;
-  switch (features) {
-    case kDisneyLobes: generic::disney_lobe_probabilities<kDisneyLobes>(kScalar, cl, F{wo.z}, cospow, energy, p); break;
-    case kDisneyLobes | kClearcoat:
-      generic::disney_lobe_probabilities<kDisneyLobes | kClearcoat>(kScalar, cl, F{wo.z}, cospow, energy, p);
-      break;
-    case kClearcoat: generic::disney_lobe_probabilities<kClearcoat>(kScalar, cl, F{wo.z}, cospow, energy, p); break;
-    case kLambertLobe: generic::disney_lobe_probabilities<kLambertLobe>(kScalar, cl, F{wo.z}, cospow, energy, p); break;
-    default: generic::disney_lobe_probabilities<kGeneral>(kScalar, cl, F{wo.z}, cospow, energy, p); break;
+  // Every feature set (disney::Features) to its instantiation.
+  const auto at = [&]<unsigned Fs>() { generic::disney_lobe_probabilities<Fs>(kScalar, cl, F{wo.z}, cospow, energy, p); };
+  switch (features & kGeneral) {
+    case 0: at.operator()<0>(); break;
+    case 1: at.operator()<1>(); break;
+    case 2: at.operator()<2>(); break;
+    case 3: at.operator()<3>(); break;
+    case 4: at.operator()<4>(); break;
+    case 5: at.operator()<5>(); break;
+    case 6: at.operator()<6>(); break;
+    default: at.operator()<7>(); break;
   }
   return {p[0].raw, p[1].raw, p[2].raw};
 }
@@ -155,7 +159,9 @@ Spectrum lobe_eval(const Closure& c, SampledLobe lobe, const vec3& wo, const vec
   const F FH = generic::schlick_weight(kScalar, LdotH);
   switch (lobe) {
     case SampledLobe::Diffuse:
-      return c.lambert * (wi.z * kInvPi) + scalars(generic::diffuse_family(kScalar, cl, i.z, o.z, LdotH));
+      return c.lambert * (wi.z * kInvPi) +
+             c.diffuse * generic::disney_diffuse_cos(kScalar, cl.roughness, cl.subsurface, i.z, o.z, LdotH).raw +
+             c.sheen * generic::sheen_cos(kScalar, i.z, LdotH).raw;
     case SampledLobe::Specular: return scalars(generic::specular_family(kScalar, cl, o, i, h, FH, faults()));
     case SampledLobe::Clearcoat: return Spectrum(generic::clearcoat_family(kScalar, cl, o, i, h, FH).raw);
     case SampledLobe::Count: break;

@@ -1,9 +1,11 @@
 // Burley's "principled" BRDF (Burley 2012, "Physically-Based Shading at
 // Disney", and its reference disney.brdf), composed from the lobes of this
-// folder: Disney diffuse with the subsurface approximation
-// (disney_diffuse.h), sheen (sheen.h), anisotropic GGX with separable Smith
-// masking-shadowing and Schlick Fresnel (microfacet.h, fresnel.h), and the
-// GTR1 clearcoat (gtr1.h).
+// folder: Disney diffuse with the subsurface approximation and sheen
+// (disney-inl.h), anisotropic GGX with separable Smith masking-shadowing
+// (microfacet-inl.h) and Schlick Fresnel, and the GTR1 clearcoat
+// (microfacet-inl.h). The formulas are written once over Highway's vectors
+// in disney-inl.h and microfacet-inl.h: disney.cpp calls them at width 1,
+// the wavefront's lanes at their SIMD width.
 //
 //   f = (1 - metallic) (Cd mix(Fd, ss, subsurface) / pi + sheen Csheen FH)
 //     + D_GTR2 F_s G_s / (4 NL NV)        F_s = mix(Cspec0, 1, FH)

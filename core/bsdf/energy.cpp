@@ -2,7 +2,9 @@
 
 #include "core/bsdf/closure.h"
 #include "core/bsdf/disney.h"
+#include "core/bsdf/disney-inl.h"
 #include "core/bsdf/quadrature.h"
+#include "core/simd/width1.h"
 
 #include <map>
 #include <mutex>
@@ -103,6 +105,16 @@ EnergyTables compute(const Closure& compensated) {
 }
 
 }  // namespace
+
+Spectrum EnergyTables::specular_transmit(float mu) const {
+  using namespace width1;
+  return scalars(generic::specular_transmit(kScalar, F{mu}, [&](F i) { return lanes(specular[static_cast<int>(i.raw)]); }));
+}
+
+float EnergyTables::coat_transmit(float mu) const {
+  using namespace width1;
+  return generic::coat_transmit(kScalar, F{mu}, [&](F i) { return F{coat[static_cast<int>(i.raw)]}; }).raw;
+}
 
 EnergyTables make_energy_tables(const Closure& c) {
   static std::mutex mutex;

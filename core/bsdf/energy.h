@@ -53,7 +53,9 @@ struct EnergyTables {
   std::array<float, kEnergyTableSize> coat{};         // upper bounds of Ec
   Spectrum diffuse_scale{1.0f};                        // k
 
-  // The fraction each layer lets through at view cosine mu, in [0, 1].
+  // The fraction each layer lets through at view cosine mu, in [0, 1]:
+  // linear between the entries at view cosines m_i (core/bsdf/disney-inl.h's
+  // specular_transmit and coat_transmit at width 1, as the lanes run them).
   Spectrum specular_transmit(float mu) const;
   float coat_transmit(float mu) const;
 };
@@ -61,25 +63,5 @@ struct EnergyTables {
 // The tables for closure `c` (its own `energy` is ignored). Tables are
 // computed once per distinct closure and cached (0.05-0.2 s each).
 EnergyTables make_energy_tables(const Closure& c);
-
-// Position of view cosine mu in the tables: entry i and the weight of i + 1.
-inline float energy_table_position(float mu, int& i) {
-  const float m = mu > 0.0f ? std::min(mu, 1.0f) : 0.0f;  // also NaN -> 0
-  const float t = std::sqrt(m) * static_cast<float>(kEnergyTableSize - 1);
-  i = std::min(kEnergyTableSize - 2, static_cast<int>(t));
-  return t - static_cast<float>(i);
-}
-
-inline Spectrum EnergyTables::specular_transmit(float mu) const {
-  int i;
-  const float w = energy_table_position(mu, i);
-  return glm::clamp(Spectrum(1.0f) - glm::mix(specular[i], specular[i + 1], w), 0.0f, 1.0f);
-}
-
-inline float EnergyTables::coat_transmit(float mu) const {
-  int i;
-  const float w = energy_table_position(mu, i);
-  return std::clamp(1.0f - (coat[i] + (coat[i + 1] - coat[i]) * w), 0.0f, 1.0f);
-}
 
 }  // namespace pathlab::disney

@@ -18,10 +18,7 @@ inline float alpha_from_gloss(float gloss) { return 0.1f + (0.001f - 0.1f) * glo
 inline float log_alpha2(float a) { return std::log(a * a); }
 inline float log2_alpha2(float a) { return std::log2(a * a); }
 
+// D at cos_h (the closed-form tests read it; the model calls microfacet-inl.h).
 float D(float cos_h, float a);
-// smithG_GGX(c, a) / (2 c): 1 / (c + sqrt(a^2 + c^2 - a^2 c^2)), finite at c = 0.
-float g(float c, float a);
-// A half vector with density D(h) cos(theta_h).
-vec3 sample(vec2 u, float a);
 
 }  // namespace pathlab::gtr1

@@ -19,22 +19,13 @@ inline vec2 alpha_from(float roughness, float anisotropic) {
   return vec2(std::max(kMinAlpha, a / aspect), std::max(kMinAlpha, a * aspect));
 }
 
+// GGX's D(h) (the closed-form tests read it; the model calls microfacet-inl.h).
 struct Ggx {
   float ax, ay;
-
   float D(const vec3& h) const;
-  // g(w) = G1(w) / (2 wz), finite at wz = 0; 0 below the surface.
-  float g(const vec3& w) const;
-  float G1(const vec3& w) const { return 2.0f * w.z * g(w); }
-  // A visible normal for wo (wo.z >= 0), from two uniform numbers.
-  vec3 sample_visible(const vec3& wo, vec2 u) const;
 };
 
 // Mirror reflection of wo about the unit normal h.
 vec3 reflect(const vec3& wo, const vec3& h);
-
-// The half vector of two directions on the same side (z > 0), computed in
-// double (microfacet-inl.h says why); the zero vector if they are opposite.
-vec3 half_vector(const vec3& wo, const vec3& wi);
 
 }  // namespace pathlab::microfacet

@@ -121,6 +121,7 @@ inline V<double> Sqrt(V<double> a) { return {std::sqrt(a.raw)}; }
 // To the nearest integer, halves to even (roundps's nearest mode; the
 // default rounding mode's nearbyint).
 inline V<float> Round(V<float> a) { return {std::nearbyint(a.raw)}; }
+inline V<float> Floor(V<float> a) { return {std::floor(a.raw)}; }
 inline bool AllFalse(One<float>, M m) { return !m.raw; }
 inline V<float> Abs(V<float> a) { return {std::fabs(a.raw)}; }
 inline V<float> Neg(V<float> a) { return {-a.raw}; }
