@@ -78,13 +78,13 @@ void disney_lanes(const float* in, float* out, std::size_t n) {
     const auto put = [&](int k, V v) { hn::StoreU(v, d, out + k * n + i); };
     const warps::Vec3<V> f = warps::disney_eval<F>(d, c, wo, wi, energy, {});
     put(0, f.x), put(1, f.y), put(2, f.z);
-    put(3, warps::disney_pdf<F>(d, c, wo, wi, lobes, false, energy, {}));
+    put(3, warps::disney_pdf<F>(d, c, wo, wi, lobes, energy, {}));
     V p[3];
     warps::disney_lobe_probabilities<F>(d, c, wo.z, false, energy, p);
     put(4, p[0]), put(5, p[1]), put(6, p[2]);
     warps::Vec3<V> s;
     V family;
-    const auto drawn = warps::disney_sample<F>(d, c, wo, at(24), at(25), at(26), lobes, false, energy, s, family);
+    const auto drawn = warps::disney_sample<F>(d, c, wo, at(24), at(25), at(26), lobes, energy, s, family);
     put(7, s.x), put(8, s.y), put(9, s.z);
     put(10, hn::IfThenElseZero(drawn, hn::Set(d, 1.0f)));
     put(11, family);

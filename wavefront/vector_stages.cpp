@@ -876,26 +876,24 @@ struct LaneEnergy {
   }
 };
 
-// fn(energy) for the Disney lanes of m: a LaneEnergy if some have energy
-// tables, else NoEnergy (nothing of it compiled into the call).
+// fn(std::integral_constant<unsigned, F>, energy) for the Disney lanes of m:
+// F the lobes of the scene (Scene::disney), so that the lanes shade with the
+// lobes core's ShadingPath compiles in; energy a LaneEnergy if some of the
+// lanes' materials have energy tables, else NoEnergy (nothing of it
+// compiled into the call).
 template <class Fn>
-void with_energy(M m, const Scene& sc, VI shape, Fn&& fn) {
+void with_disney_model(M m, const Scene& sc, VI shape, Fn&& fn) {
+  constexpr unsigned kLobes = 1u, kCoat = 2u;  // disney::Features
+  const auto with_lobes = [&](const auto& energy) {
+    if (sc.disney == (kLobes | kCoat)) fn(std::integral_constant<unsigned, kLobes | kCoat>{}, energy);
+    else fn(std::integral_constant<unsigned, kLobes>{}, energy);
+  };
   if (sc.energy) {
     const VI base = shape_int(m, sc, shape, kEnergy);
     const M on = hn::And(m, hn::RebindMask(DF(), base > hn::Set(DI(), -1)));
-    if (!hn::AllFalse(DF(), on)) return fn(LaneEnergy{on, base, sc.energy});
+    if (!hn::AllFalse(DF(), on)) return with_lobes(LaneEnergy{on, base, sc.energy});
   }
-  fn(NoEnergy{});
-}
-
-// fn(std::integral_constant<unsigned, F>) for the Disney lobes of the scene
-// (Scene::disney), so that the lanes shade with the lobes core's
-// ShadingPath compiles in.
-template <class Fn>
-void with_disney_lobes(const Scene& sc, Fn&& fn) {
-  constexpr unsigned kLobes = 1u, kCoat = 2u;  // disney::Features
-  if (sc.disney == (kLobes | kCoat)) fn(std::integral_constant<unsigned, kLobes | kCoat>{});
-  else fn(std::integral_constant<unsigned, kLobes>{});
+  with_lobes(NoEnergy{});
 }
 
 // The lanes of m that the lanes shade as Disney materials.
@@ -929,12 +927,10 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   if (const M dm = disney_lanes(hn::AndNot(load_mask(w, kShadeByCore, i0, ok), ok), sc, shape); !hn::AllFalse(df, dm)) {
     // Surfel::eval and Surfel::pdf of a Disney material (disney::eval, disney::pdf).
     const ClosureLanes<VF> c = closure_lanes(dm, sc, shape);
-    with_disney_lobes(sc, [&](auto lobes) {
+    with_disney_model(dm, sc, shape, [&](auto lobes, const auto& energy) {
       constexpr unsigned F = decltype(lobes)::value;
-      with_energy(dm, sc, shape, [&](const auto& energy) {
-        f = select(dm, disney_eval<F>(df, c, wo_local, wi_local, energy, {}), f);
-        pdf_bsdf = hn::IfThenElse(dm, disney_pdf<F>(df, c, wo_local, wi_local, VndfLobes{}, false, energy, {}), pdf_bsdf);
-      });
+      f = select(dm, disney_eval<F>(df, c, wo_local, wi_local, energy, {}), f);
+      pdf_bsdf = hn::IfThenElse(dm, disney_pdf<F>(df, c, wo_local, wi_local, VndfLobes{}, energy, {}), pdf_bsdf);
     });
   }
   if (const M general = load_mask(w, kShadeByCore, i0, ok); !hn::AllFalse(df, general)) {
@@ -1111,20 +1107,18 @@ void scatter(const Scene& sc, const Wave& w) {
       const ClosureLanes<VF> c = closure_lanes(dm, sc, shape);
       const V3 wo_local = to_local(fs, ft, n, wo);
       const V3 wo_up{wo_local.x, wo_local.y, wo_local.z * side};
-      with_disney_lobes(sc, [&](auto lobes) {
+      with_disney_model(dm, sc, shape, [&](auto lobes, const auto& energy) {
         constexpr unsigned F = decltype(lobes)::value;
-        with_energy(dm, sc, shape, [&](const auto& energy) {
         V3 local_d;
         VF family;
-        M drawn = disney_sample<F>(df, c, wo_up, u_lobe, du, dv, VndfLobes{}, false, energy, local_d, family);
-        const VF pdf_d = disney_pdf<F>(df, c, wo_up, local_d, VndfLobes{}, false, energy, {});
+        M drawn = disney_sample<F>(df, c, wo_up, u_lobe, du, dv, VndfLobes{}, energy, local_d, family);
+        const VF pdf_d = disney_pdf<F>(df, c, wo_up, local_d, VndfLobes{}, energy, {});
         drawn = hn::And(drawn, hn::And(pdf_d > k(0.0f), hn::Not(pdf_d < k(sc.min_pdf))));
         const V3 f = disney_eval<F>(df, c, wo_up, local_d, energy, {});
         wi = select(dm, to_world(fs, ft, n, local_d.x, local_d.y, local_d.z * side), wi);
         weight = select(dm, f / pdf_d, weight);
         pdf = hn::IfThenElse(dm, pdf_d, pdf);
         ok = hn::AndNot(hn::AndNot(drawn, dm), ok);
-        });
       });
     }
     if (!hn::AllFalse(df, im)) {

@@ -121,6 +121,8 @@ HWY_INLINE V sheen_cos(D d, V NL, V LdotH) {
 // where it falls below the surface (it has f = 0: the pdf counts that mass
 // as lost).
 struct VndfLobes {
+  // Whether the mixture keeps the cosine lobe whatever the material (disney.h: cospow's tails need it).
+  static constexpr bool kKeepsCosine = false;
   template <class D, class V = VecOf<D>>
   HWY_INLINE V specular_pdf(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, const Vec3<V>& wi,
                             const disney::DisneyFaults& faults) const {
@@ -346,12 +348,12 @@ HWY_INLINE Vec3<V> disney_eval(D d, const ClosureLanes<V>& c, const Vec3<V>& wo,
 // The solid-angle density of disney_sample at wi.
 template <unsigned F, class D, class Lobes, class Energy, class V = VecOf<D>>
 HWY_INLINE V disney_pdf(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, const Vec3<V>& wi, const Lobes& lobes,
-                        bool cospow, const Energy& energy, const disney::DisneyFaults& faults) {
+                        const Energy& energy, const disney::DisneyFaults& faults) {
   constexpr unsigned kDisneyLobes = 1u, kClearcoat = 2u;
   const auto above = disney_above(d, wo, wi, faults);
   if (AllFalse(d, above)) return Zero(d);
   V p[3];
-  disney_lobe_probabilities<F>(d, c, wo.z, cospow, energy, p);
+  disney_lobe_probabilities<F>(d, c, wo.z, Lobes::kKeepsCosine, energy, p);
   V density = p[0] * cosine_hemisphere_pdf(d, wi.z);
   if constexpr ((F & kDisneyLobes) != 0) density = density + p[1] * lobes.specular_pdf(d, c, wo, wi, faults);
   if constexpr ((F & kClearcoat) != 0) density = density + p[2] * lobes.clearcoat_pdf(d, c, wo, wi);
@@ -365,11 +367,11 @@ HWY_INLINE V disney_pdf(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, const 
 // lost).
 template <unsigned F, class D, class Lobes, class Energy, class V = VecOf<D>>
 HWY_INLINE auto disney_sample(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, V u_lobe, V ux, V uy,
-                              const Lobes& lobes, bool cospow, const Energy& energy, Vec3<V>& wi, V& family) {
+                              const Lobes& lobes, const Energy& energy, Vec3<V>& wi, V& family) {
   constexpr unsigned kDisneyLobes = 1u, kClearcoat = 2u;
   const V zero = Zero(d);
   V p[3];
-  disney_lobe_probabilities<F>(d, c, wo.z, cospow, energy, p);
+  disney_lobe_probabilities<F>(d, c, wo.z, Lobes::kKeepsCosine, energy, p);
   const auto up = wo.z > zero;
   const auto diffuse = And(up, u_lobe < p[0]);
   auto specular = zero > zero, coat = specular;
@@ -380,31 +382,25 @@ HWY_INLINE auto disney_sample(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, 
     specular = And(And(up, Not(diffuse)), take);
   }
   if constexpr ((F & kClearcoat) != 0) coat = And(And(And(up, Not(diffuse)), Not(specular)), p[2] > zero);
-  // Each family's direction where some lane draws from it.
+  // Each family's direction where some lane draws from it: draw(lanes,
+  // sampler), sampler(w) giving the lanes whose w is above the surface.
   wi = {zero, zero, zero};
   auto ok = zero > zero;
-  if (!AllFalse(d, diffuse)) {
+  const auto draw = [&](auto lanes, auto&& sampler) {
+    if (AllFalse(d, lanes)) return;
     Vec3<V> w;
+    const auto above = sampler(w);
+    wi = select(lanes, w, wi);
+    ok = Or(ok, And(lanes, above));
+  };
+  draw(diffuse, [&](Vec3<V>& w) {
     cosine_hemisphere(d, ux, uy, w.x, w.y, w.z);
-    wi = select(diffuse, w, wi);
-    ok = Or(ok, And(diffuse, w.z > zero));  // the disk's rim: grazing, no energy
-  }
-  if constexpr ((F & kDisneyLobes) != 0) {
-    if (!AllFalse(d, specular)) {
-      Vec3<V> w;
-      const auto above = lobes.specular_sample(d, c, wo, ux, uy, w);
-      wi = select(specular, w, wi);
-      ok = Or(ok, And(specular, above));
-    }
-  }
-  if constexpr ((F & kClearcoat) != 0) {
-    if (!AllFalse(d, coat)) {
-      Vec3<V> w;
-      const auto above = lobes.clearcoat_sample(d, c, wo, ux, uy, w);
-      wi = select(coat, w, wi);
-      ok = Or(ok, And(coat, above));
-    }
-  }
+    return w.z > zero;  // the disk's rim: grazing, no energy
+  });
+  if constexpr ((F & kDisneyLobes) != 0)
+    draw(specular, [&](Vec3<V>& w) { return lobes.specular_sample(d, c, wo, ux, uy, w); });
+  if constexpr ((F & kClearcoat) != 0)
+    draw(coat, [&](Vec3<V>& w) { return lobes.clearcoat_sample(d, c, wo, ux, uy, w); });
   family = IfThenElse(specular, Set(d, 1.0f), IfThenElseZero(coat, Set(d, 2.0f)));
   return ok;
 }
