@@ -286,11 +286,10 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
     const SunDisk* sun = &suns_[i - static_cast<std::size_t>(suns_.front().entry)];
     // Uniform in the cone, by 1 - cos theta = u.x (1 - cos alpha): sin theta
     // from that difference keeps the disk's size exact for a tiny sun.
-    const float one_minus_cos = u.x * sun->one_minus_cos;
-    const float sin_theta = std::sqrt(std::max(0.0f, one_minus_cos * (2.0f - one_minus_cos)));
-    const float phi = 2.0f * kPi * u.y;
-    const vec3 local(sin_theta * std::cos(phi), sin_theta * std::sin(phi), 1.0f - one_minus_cos);
-    ls.wi = glm::normalize(sun->frame.to_world(local));
+    using namespace width1;
+    const Frame& f = sun->frame;
+    ls.wi = scalars(generic::sun_direction(kScalar, lanes(f.s), lanes(f.t), lanes(f.n), F{sun->one_minus_cos}, F{u.x},
+                                           F{u.y}));
     ls.dist = kInfinity;
     ls.infinite = true;
     const Sky sky_there = sky(ls.wi);
@@ -394,20 +393,14 @@ LightSampler::SolidAngleView LightSampler::solid_angle_view(const Entry& e, cons
   return view;
 }
 
-bool LightSampler::SunDisk::contains(const vec3& dir) const {
-  // By the sine: the cosine of a 0.27 degree cone is 1 - 1.1e-5, which float
-  // resolves only to about 0.5 %; the cross product keeps full precision.
-  if (!(glm::dot(dir, frame.n) > 0.0f)) return false;
-  const vec3 c = glm::cross(dir, frame.n);
-  return glm::dot(c, c) <= sin2;
-}
-
 void LightSampler::add_suns(const vec3& dir, Spectrum* Le, float* pdf) const {
+  using namespace width1;
+  F3 L = lanes(*Le);
+  F p{*pdf};
   for (const SunDisk& sun : suns_)
-    if (sun.contains(dir)) {
-      *Le += sun.Le;
-      *pdf += pmf_[static_cast<std::size_t>(sun.entry)] * sun.cone_pdf;
-    }
+    generic::add_sun(kScalar, lanes(dir), lanes(sun.frame.n), F{sun.sin2}, lanes(sun.Le), F{sun_pdf(sun)}, L, p);
+  *Le = scalars(L);
+  *pdf = p.raw;
 }
 
 LightSampler::Sky LightSampler::sky(const vec3& dir) const {

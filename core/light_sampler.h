@@ -212,6 +212,29 @@ class LightSampler {
   std::span<const float> pmf() const { return pmf_; }
   // True if an environment or a sun disk is sampled (a light escaping rays find).
   bool samples_environment() const { return env_index_ >= 0 || !suns_.empty(); }
+
+  // The sky as sample() and sky() see it, for code that samples it in bulk
+  // (the wavefront's lanes; core/simd/lights-inl.h has the steps): the
+  // environment's entry (-1 if it is not sampled: none, or black) and the
+  // sun disks, the last entries in order. A sun disk is radiance Le within
+  // the cone of half-angle alpha about frame.n (the direction towards the
+  // sun); sun_pdf() is its pick probability times the cone's density.
+  struct SunDisk {
+    Frame frame;
+    float one_minus_cos = 0.0f;  // 1 - cos alpha, computed as 2 sin^2(alpha / 2)
+    float sin2 = 0.0f;           // sin^2 alpha
+    float cone_pdf = 0.0f;       // 1 / (2 pi (1 - cos alpha))
+    Spectrum Le{0.0f};           // E / (pi sin^2 alpha)
+    std::int64_t entry = -1;     // its entry in entries_
+  };
+  std::int64_t environment_entry() const { return env_index_; }
+  std::span<const SunDisk> sun_disks() const { return suns_; }
+  float sun_pdf(const SunDisk& sun) const { return pmf_[static_cast<std::size_t>(sun.entry)] * sun.cone_pdf; }
+  // Under `bvh`: the sky's entries (environment, then sun disks) and the
+  // grid points [sky_starts()[j], sky_starts()[j + 1]) of LightChoice that
+  // pick sky entry j (the tree takes [0, bvh_grid())); empty under `power`.
+  std::span<const std::size_t> sky_entries() const { return sky_entry_; }
+  std::span<const std::uint32_t> sky_starts() const { return sky_start_; }
   // The entry of shape `shape`'s triangle 0 (its triangle k is entry
   // first_entry + k), or -1 if the shape is not sampled as a light.
   std::int64_t first_entry(std::uint32_t shape) const { return first_entry_[shape]; }
@@ -239,17 +262,6 @@ class LightSampler {
   SolidAngleView solid_angle_view(const Entry& e, const vec3& ref) const;
   static float area_density(const Entry& e);  // 1 / area
 
-  // A sun disk: radiance Le within the cone of half-angle alpha about frame.n
-  // (the direction towards the sun).
-  struct SunDisk {
-    Frame frame;
-    float one_minus_cos = 0.0f;  // 1 - cos alpha, computed as 2 sin^2(alpha / 2)
-    float sin2 = 0.0f;           // sin^2 alpha
-    float cone_pdf = 0.0f;       // 1 / (2 pi (1 - cos alpha))
-    Spectrum Le{0.0f};           // E / (pi sin^2 alpha)
-    std::int64_t entry = -1;     // its entry in entries_
-    bool contains(const vec3& dir) const;
-  };
   // Adds the radiance and density (with its pick probability) of every sun
   // disk whose cone holds `dir`.
   void add_suns(const vec3& dir, Spectrum* Le, float* pdf) const;

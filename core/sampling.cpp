@@ -62,10 +62,10 @@ float cosine_hemisphere_pdf(const vec3& w) {
 vec2 cosine_hemisphere_to_square(const vec3& w) { return concentric_disk_to_square(vec2(w.x, w.y)); }
 
 vec3 square_to_uniform_sphere(vec2 u) {
-  const float z = 1.0f - 2.0f * u.x;
-  const float r = std::sqrt(std::max(0.0f, 1.0f - z * z));
-  const float phi = 2.0f * kPi * u.y;
-  return vec3(r * std::cos(phi), r * std::sin(phi), z);
+  using namespace width1;
+  F x, y, z;
+  generic::uniform_sphere(kScalar, F{u.x}, F{u.y}, x, y, z);
+  return vec3(x.raw, y.raw, z.raw);
 }
 
 vec2 uniform_sphere_to_square(const vec3& w) {

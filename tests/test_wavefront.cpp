@@ -155,6 +155,25 @@ Scene cornell_with_every_light() {
   return s;
 }
 
+// The Cornell box under a sky beside its ceiling light: an environment of
+// one radiance and two sun disks through the open front, the small one
+// inside the wide one's cone (a direction in both carries both).
+Scene cornell_with_sky() {
+  Scene s = builtin_cornell_box();
+  s.environment = Spectrum(0.2f, 0.3f, 0.4f);
+  DeltaLight wide;
+  wide.kind = DeltaLight::Kind::Directional;
+  wide.direction = glm::normalize(vec3(0.3f, -0.4f, -1.0f));
+  wide.intensity = Spectrum(3.0f, 2.5f, 2.0f);
+  wide.angular_radius = 0.3f;
+  DeltaLight small = wide;
+  small.direction = glm::normalize(vec3(0.35f, -0.45f, -1.0f));
+  small.intensity = Spectrum(1.0f, 2.0f, 4.0f);
+  small.angular_radius = 0.05f;
+  s.delta_lights = {wide, small};
+  return s;
+}
+
 Scene load_case(const SameSeedCase& c) {
   Scene s = c.scene.empty()          ? builtin_cornell_box()
             : c.scene == "every-light" ? cornell_with_every_light()
@@ -170,6 +189,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "textured"  ? test::cornell_with_textures()
             : c.scene == "many"      ? test::cornell_with_many_lights()
             : c.scene == "bulb"      ? cornell_with_bulb()
+            : c.scene == "sky"       ? cornell_with_sky()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -244,6 +264,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("alpha");      // the instanced Cornell box with partial coverage (test_scenes.h)
   scenes.push_back("textured");   // the Cornell box reading textures everywhere (test_scenes.h)
   scenes.push_back("bulb");       // the Cornell box with a sphere light seen from outside (above)
+  scenes.push_back("sky");        // the Cornell box under an environment and two sun disks (above)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
@@ -260,7 +281,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   // (furnace-box), the sky beside an empty tree (envmap), delta lights; and
   // with solid-angle sampling.
   for (const std::string& s : {std::string("many"), std::string("furnace-box.json"), std::string("envmap"),
-                               std::string("delta")})
+                               std::string("delta"), std::string("sky")})
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st, LightSampling::Area, LightSamplerKind::Bvh});
   for (Strategy st : {Strategy::Light, Strategy::Mis})
     cases.push_back({"many", st, LightSampling::SolidAngle, LightSamplerKind::Bvh});
@@ -706,8 +727,9 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf}) cases.push_back({"smooth", st, 0.0f, 0});
   cases.push_back({"smooth", Strategy::Mis, 0.0f, 0, false, true, false, true});
   cases.push_back({"tangents", Strategy::Mis, 0.0f, 0});
-  // Lights sampled by core's LightSampler between the lanes' steps: an environment image (with triangle lights),
-  // a constant environment, a sun disk, a sphere light, solid-angle sampling, with the light BVH.
+  // Lights sampled by core's LightSampler between the lanes' steps (an environment image with triangle lights, a
+  // sphere light, solid-angle sampling, with the light BVH), and the sky in the lanes (a constant environment, a
+  // sun disk).
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"envmap", st, 0.0f, 0});
   for (const char* s : {"sphere-in-environment.json", "sun-disk-plane.json", "glass-sphere-tinted.json",
@@ -738,6 +760,16 @@ std::vector<VectorCase> vector_cases() {
     cases.push_back({"every-light", st, 0.0f, 0});
   cases.push_back({"every-light", Strategy::Mis, 0.0f, 0, false, false, false, false, true, 0, false, false, true});
   cases.push_back({"envmap-sun-plane.json", Strategy::LightBsdf, 0.0f, 0});
+  // The sky in the lanes beside triangle lights: an environment of one radiance and two sun disks, one inside the
+  // other (sun-disk-plane: a sun alone; furnace-sphere, sphere-in-environment: an environment alone), picked by
+  // power or by the light BVH's grid (the sky's share beside the tree's).
+  for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"sky", st, 0.0f, 0});
+  for (Strategy st : {Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"sky", st, 0.0f, 0, false, false, false, false, false, 0, true});
+  cases.push_back({"sky", Strategy::Mis, 0.0f, -1, true, true, false, true, true, 0, true});
+  cases.push_back({"sky", Strategy::LightBsdf, 0.0f, 0, false, false, true, false, false, 0, false});
+  cases.push_back({"sun-disk-plane.json", Strategy::Light, 0.0f, 0, false, false, false, false, false, 0, true});
   // Strategy cosine: every surface scattered by core's Surfel::scatter_cosine (impulses by scatter).
   for (const char* sc : {"", "materials", "textured"}) cases.push_back({sc, Strategy::Cosine, 0.0f, 0});
   // Alpha: every ray's key made in the lanes (camera, continuation and shadow rays, compacted with the path).

@@ -105,6 +105,7 @@ std::size_t compact(const Scene&, const Wave&, void*, std::uint32_t) { width_one
 std::size_t lanes() { return 1; }
 #else
 
+using pathlab::HWY_NAMESPACE::add_sun;
 using pathlab::HWY_NAMESPACE::area_light_pdf;
 using pathlab::HWY_NAMESPACE::area_light_pdf_at;
 using pathlab::HWY_NAMESPACE::bvh_field;
@@ -136,12 +137,14 @@ using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::spawn_origin;
 using pathlab::HWY_NAMESPACE::spawn_to;
 using pathlab::HWY_NAMESPACE::sphere_point;
+using pathlab::HWY_NAMESPACE::sun_direction;
 using pathlab::HWY_NAMESPACE::splat3;
 using pathlab::HWY_NAMESPACE::thin_lens;
 using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
 using pathlab::HWY_NAMESPACE::triangle_point;
+using pathlab::HWY_NAMESPACE::uniform_sphere;
 using pathlab::HWY_NAMESPACE::uniform_triangle;
 using pathlab::HWY_NAMESPACE::usable_light_pdf;
 using pathlab::HWY_NAMESPACE::VndfLobes;
@@ -639,6 +642,19 @@ VF emission_weight(const Scene& sc, const Wave& w, std::size_t i0, M lit, VF lig
       lit, pathlab::HWY_NAMESPACE::emission_weight(DF(), sc.strategy, impulse, bsdf_technique, prev_pdf, light_pdf));
 }
 
+// LightSampler::sky along dir in the lanes of m: the environment's
+// radiance and density, then each sun disk's that dir is in.
+void sky_along(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) {
+  const DF df;
+  Le = zero_unless(m, splat3(df, s.Le[0], s.Le[1], s.Le[2]));
+  pdf = hn::IfThenElseZero(m, k(s.pdf));
+  for (std::size_t j = 0; j < s.suns; ++j) {
+    const float* sun = s.sun + j * kSunFields;
+    add_sun(df, dir, splat3(df, sun[kSunN], sun[kSunN + 1], sun[kSunN + 2]), k(sun[kSunSin2]),
+            splat3(df, sun[kSunLe], sun[kSunLe + 1], sun[kSunLe + 2]), k(sun[kSunPdf]), Le, pdf);
+  }
+}
+
 void add_emission(const Scene& sc, const Wave& w) {
   const DF df;
   const V3 zero = zero3();
@@ -657,15 +673,23 @@ void add_emission(const Scene& sc, const Wave& w) {
       L_new = select(refused, nan, L_new);
     }
     if (const M sky = hn::AndNot(refused, escaped); sc.sky && !hn::AllFalse(df, sky)) {
-      // The environment along the ray (LightSampler::sky), path by path.
-      HWY_ALIGN float radiance[3][kMaxLanes] = {}, density[kMaxLanes] = {};
-      for_each_lane(sky, i0, [&](std::size_t i, std::size_t j) {
-        float Le[3];
-        general_sky(sc, w, i, Le, &density[j]);
-        for (int c = 0; c < 3; ++c) radiance[c][j] = Le[c];
-      });
-      const V3 Le = load_lanes(radiance);
-      const VF weight = emission_weight(sc, w, i0, hn::AndNot(is_black(df, Le), sky), hn::Load(df, density));
+      // The environment and sun disks along the ray (LightSampler::sky): in
+      // the lanes, or path by path with an environment image.
+      V3 Le;
+      VF density;
+      if (sc.general_lights) {
+        HWY_ALIGN float radiance[3][kMaxLanes] = {}, densities[kMaxLanes] = {};
+        for_each_lane(sky, i0, [&](std::size_t i, std::size_t j) {
+          float e[3];
+          general_sky(sc, w, i, e, &densities[j]);
+          for (int c = 0; c < 3; ++c) radiance[c][j] = e[c];
+        });
+        Le = load_lanes(radiance);
+        density = hn::Load(df, densities);
+      } else {
+        sky_along(sc.skies, sky, load3(w, kDx, i0, sky), Le, density);
+      }
+      const VF weight = emission_weight(sc, w, i0, hn::AndNot(is_black(df, Le), sky), density);
       L_new = select(sky, L + beta * (weight * Le), L_new);
     }
     M alive = hn::FirstN(df, 0);
@@ -718,40 +742,65 @@ struct LightLanes {
   VF ray[7];
 };
 
-// LightSampler::sample for triangle lights sampled by area, in the lanes;
-// the lanes of ok it gives no sample leave ok.
-LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, const V3& sp, const V3& wo,
+// LightSampler::pick from the shading point sp (normal n, towards the
+// viewer wo): each lane's light entry and its probability; the lanes of ok
+// it picks nothing for (the tree gives them nothing) leave ok.
+VI pick_light(const Scene& sc, VF u_choice, const V3& sp, const V3& n, const V3& wo, M& ok, VF& pmf) {
+  const DF df;
+  const Lights& lights = sc.lights;
+  if (!lights.bvh) {
+    const VI light = pick(ok, lights, u_choice);
+    pmf = light_value(ok, lights, light, kLightPmf);
+    return light;
+  }
+  // Under bvh: the grid point k of u_choice walks the tree from
+  // light_query(s, wo) below bvh_grid, else picks the sky's entry j with
+  // k in [starts[j], starts[j + 1]).
+  VD grid_k[2];
+  for (int h = 0; h < 2; ++h) {
+    const VD scaled = hn::Floor(half_d(u_choice, h) * hn::Set(DD(), 0x1p24));
+    grid_k[h] = hn::IfThenElse(scaled < hn::Zero(DD()), hn::Zero(DD()),
+                               hn::IfThenElse(hn::Set(DD(), 0x1p24 - 1) < scaled, hn::Set(DD(), 0x1p24 - 1), scaled));
+  }
+  const VF grid_point = join_f(grid_k[0], grid_k[1]);  // exact: below 2^24
+  const M tree = lights.bvh_nodes ? hn::And(ok, grid_point < k(static_cast<float>(lights.bvh_grid))) : hn::FirstN(df, 0);
+  const M sky = hn::AndNot(tree, ok);
+  VI light = hn::Zero(DI());
+  pmf = hn::Zero(df);
+  M picked = sky;
+  if (!hn::AllFalse(df, tree)) {
+    const V3 qn = facing_normal(df, n, wo);  // light_query's
+    VD share[2], tree_light[2];
+    for (int h = 0; h < 2; ++h)
+      bvh_pick(lights, half_d(sp, h), half_d(qn, h), grid_k[h], hn::Set(DD(), static_cast<double>(lights.bvh_grid)),
+               half_mask(tree, h), tree_light[h], share[h]);
+    const VF shares = join_f(share[0], share[1]);
+    const M tree_ok = hn::And(tree, shares > k(0.0f));
+    picked = hn::Or(picked, tree_ok);
+    pmf = hn::IfThenElseZero(tree_ok, shares * k(0x1p-24f));
+    const VI tl = hn::IfThenElseZero(hn::RebindMask(DI(), tree_ok), hn::ConvertTo(DI(), join_f(tree_light[0], tree_light[1])));
+    light = hn::IfThenElseZero(hn::RebindMask(DI(), tree_ok), hn::GatherIndex(DI(), lights.bvh_entry, tl));
+  }
+  if (!hn::AllFalse(df, sky)) {
+    // upper_bound(starts, k) - 1: the last j whose start k is not below.
+    const Sky& s = sc.skies;
+    VF entry = k(s.entries[0]);
+    for (std::size_t j = 1; j < s.count; ++j) entry = hn::IfThenElse(grid_point < k(s.starts[j]), entry, k(s.entries[j]));
+    light = hn::IfThenElse(hn::RebindMask(DI(), sky), hn::ConvertTo(DI(), entry), light);
+    pmf = hn::IfThenElse(sky, light_value(sky, lights, light, kLightPmf), pmf);
+  }
+  ok = picked;
+  return light;
+}
+
+// LightSampler::sample's point on a triangle light, uniform in area
+// (square_to_uniform_triangle, triangle_point), with the density pmf /
+// area in solid angle, in the lanes of ok; those it gives no sample leave ok.
+LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, VF pmf, VF lu, VF lv, const V3& sp,
                           const V3& n, M& ok) {
   const DF df;
   LightLanes ls;
-  // LightSampler::sample: pick a triangle, then a point uniformly on it
-  // (square_to_uniform_triangle, triangle_point).
-  const VF u_choice = rng.u(Dim::LightChoice);
-  VI light;
-  VF bvh_pmf = hn::Zero(df);
-  if (sc.lights.bvh_nodes) {
-    // LightSampler::pick under bvh: the grid point k of u_choice walks the
-    // tree from light_query(s, wo) (no sky: every point is the tree's).
-    const V3 qn = facing_normal(df, n, wo);  // light_query's
-    VD share[2], tree_light[2];
-    for (int h = 0; h < 2; ++h) {
-      const VD scaled = hn::Floor(half_d(u_choice, h) * hn::Set(DD(), 0x1p24));
-      const VD grid_k = hn::IfThenElse(scaled < hn::Zero(DD()), hn::Zero(DD()),
-                                       hn::IfThenElse(hn::Set(DD(), 0x1p24 - 1) < scaled, hn::Set(DD(), 0x1p24 - 1), scaled));
-      bvh_pick(sc.lights, half_d(sp, h), half_d(qn, h), grid_k, hn::Set(DD(), static_cast<double>(sc.lights.bvh_grid)),
-               half_mask(ok, h), tree_light[h], share[h]);
-    }
-    const VF shares = join_f(share[0], share[1]);
-    ok = hn::And(ok, shares > k(0.0f));
-    bvh_pmf = shares * k(0x1p-24f);
-    const VI tl = hn::IfThenElseZero(hn::RebindMask(DI(), ok), hn::ConvertTo(DI(), join_f(tree_light[0], tree_light[1])));
-    light = hn::IfThenElseZero(hn::RebindMask(DI(), ok), hn::GatherIndex(DI(), sc.lights.bvh_entry, tl));
-  } else {
-    light = pick(ok, sc.lights, u_choice);
-  }
   VF b1, b2;
-  VF lu, lv;
-  rng.u2(Dim::LightX, lu, lv);
   uniform_triangle(df, lu, lv, b1, b2);
   const V3 p0 = light_value3(ok, sc.lights, light, kLightP0), p1 = light_value3(ok, sc.lights, light, kLightP1),
            p2 = light_value3(ok, sc.lights, light, kLightP2), ln = light_value3(ok, sc.lights, light, kLightNormal),
@@ -764,7 +813,6 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, const 
   VF dist, cos_light;
   ok = hn::And(ok, light_point_seen(df, sp, lp, ln, two_sided != k(0.0f), ls.wi, dist, cos_light));
   const VF inv_area = light_value(ok, sc.lights, light, kLightInvArea);
-  const VF pmf = sc.lights.bvh_nodes ? bvh_pmf : light_value(ok, sc.lights, light, kLightPmf);
   ls.pdf = area_light_pdf(df, pmf, inv_area, dist, cos_light);
   ok = hn::And(ok, usable_light_pdf(df, ls.pdf));  // not seen edge-on
 
@@ -774,6 +822,72 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, const 
   spawn_to(df, sp, load3(w, kErrX, i0, ok), n, lp, lerr, ln, origin, dir, len);
   const VF ray[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
   std::copy(std::begin(ray), std::end(ray), ls.ray);
+  return ls;
+}
+
+// LightSampler::sample of the sky's entries in the lanes of ok: a uniform
+// direction for the environment, one in its cone for a sun disk, with the
+// sky's radiance and density there (one technique for the whole sky), and
+// the shadow ray escaping along it (Surfel::spawn). A sun disk's lanes whose
+// direction rounded out of every cone leave ok.
+LightLanes sky_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, VF lu, VF lv, const V3& sp, const V3& n,
+                     M& ok) {
+  const DF df;
+  const Sky& s = sc.skies;
+  LightLanes ls;
+  ls.wi = zero3();
+  M sun_lanes = hn::FirstN(df, 0);
+  if (const M env = hn::And(ok, hn::RebindMask(DF(), light == hn::Set(DI(), static_cast<std::int32_t>(s.environment))));
+      s.environment >= 0 && !hn::AllFalse(df, env)) {
+    V3 wi;
+    uniform_sphere(df, lu, lv, wi.x, wi.y, wi.z);
+    ls.wi = select(env, wi, ls.wi);
+  }
+  for (std::size_t j = 0; j < s.suns; ++j) {
+    const float* sun = s.sun + j * kSunFields;
+    const M at_sun = hn::And(ok, hn::RebindMask(DF(), light == hn::Set(DI(), static_cast<std::int32_t>(sun[kSunEntry]))));
+    if (hn::AllFalse(df, at_sun)) continue;
+    sun_lanes = hn::Or(sun_lanes, at_sun);
+    const auto at = [&](int f) { return splat3(df, sun[f], sun[f + 1], sun[f + 2]); };
+    ls.wi = select(at_sun, sun_direction(df, at(kSunS), at(kSunT), at(kSunN), k(sun[kSunOneMinusCos]), lu, lv), ls.wi);
+  }
+  sky_along(s, ok, ls.wi, ls.Le, ls.pdf);
+  // A sun's direction rounded out of its cone (the environment's lanes keep theirs, as sample() does).
+  ok = hn::AndNot(hn::And(sun_lanes, hn::Or(hn::Not(ls.pdf > k(0.0f)), is_black(df, ls.Le))), ok);
+  const V3 origin = spawn_origin(df, sp, load3(w, kErrX, i0, ok), n, ls.wi);
+  const VF ray[7] = {origin.x, origin.y, origin.z, ls.wi.x, ls.wi.y, ls.wi.z, k(std::numeric_limits<float>::infinity())};
+  std::copy(std::begin(ray), std::end(ray), ls.ray);
+  return ls;
+}
+
+// LightSampler::sample for triangle lights sampled by area and the sky of
+// Sky, in the lanes of ok; those it gives no sample leave ok.
+LightLanes area_or_sky_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, const V3& sp,
+                             const V3& wo, const V3& n, M& ok) {
+  const DF df;
+  VF pmf;
+  const VI light = pick_light(sc, rng.u(Dim::LightChoice), sp, n, wo, ok, pmf);
+  VF lu, lv;
+  rng.u2(Dim::LightX, lu, lv);
+  const M sky = hn::And(ok, hn::RebindMask(DF(), hn::Not(light < hn::Set(DI(), static_cast<std::int32_t>(sc.skies.first_entry)))));
+  M triangles = hn::AndNot(sky, ok);
+  if (hn::AllFalse(df, sky)) {
+    const LightLanes ls = triangle_light(sc, w, i0, light, pmf, lu, lv, sp, n, triangles);
+    ok = triangles;
+    return ls;
+  }
+  M skies = sky;
+  const LightLanes from_sky = sky_light(sc, w, i0, light, lu, lv, sp, n, skies);
+  if (hn::AllFalse(df, triangles)) {
+    ok = skies;
+    return from_sky;
+  }
+  LightLanes ls = triangle_light(sc, w, i0, light, pmf, lu, lv, sp, n, triangles);
+  ls.wi = select(sky, from_sky.wi, ls.wi);
+  ls.Le = select(sky, from_sky.Le, ls.Le);
+  ls.pdf = hn::IfThenElse(sky, from_sky.pdf, ls.pdf);
+  for (int a = 0; a < 7; ++a) ls.ray[a] = hn::IfThenElse(sky, from_sky.ray[a], ls.ray[a]);
+  ok = hn::Or(triangles, skies);
   return ls;
 }
 
@@ -1037,7 +1151,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     if (sc.strategy == Strategy::LightBsdf) ok = hn::And(ok, rng.u(Dim::Technique) < k(0.5f));
     if (!hn::AllFalse(df, ok)) {
       const LightLanes ls =
-          sc.general_lights ? other_light(sc, w, i0, rng, ok) : triangle_light(sc, w, i0, rng, sp, wo, n, ok);
+          sc.general_lights ? other_light(sc, w, i0, rng, ok) : area_or_sky_light(sc, w, i0, rng, sp, wo, n, ok);
       V3 f;
       VF pdf_bsdf;
       eval_bsdf(sc, w, i0, shape, wo, n, ls.wi, ok, f, pdf_bsdf);

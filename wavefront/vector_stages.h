@@ -3,7 +3,8 @@
 // AVX-512, 8 with AVX2, 4 with SSE4, whichever core/simd/simd.h's dispatch
 // selected — for every scene (any camera, material, light, texture,
 // instance, alpha). The lanes do the camera, world-space hit points,
-// emission and its weight, triangle lights sampled by area, delta lights,
+// emission and its weight, triangle lights sampled by area, a uniform
+// environment and sun disks, delta lights,
 // flat untextured Lambert, Disney (VNDF sampling), mirror and dielectric
 // shading, roulette and compaction; everything else (other materials, vertex normals, textures,
 // instances, other lights) is core's, called one path at a time between
@@ -35,7 +36,8 @@ enum class Strategy : std::uint8_t;  // core/scene.h
 
 namespace pathlab::vector_stages {
 
-// The area lights, as LightSampler::sample() picks and samples them.
+// The area lights and the sky, as LightSampler::sample() picks and samples
+// them: entries [0, Sky::first_entry) are triangles, the rest the sky's.
 struct Lights {
   std::size_t count = 0;
   const float* cdf = nullptr;       // LightSampler::cdf()
@@ -49,7 +51,10 @@ struct Lights {
   // rows (kLightCdf...). A lookup is then one permute of a register
   // instead of a gather from memory.
   const float* columns = nullptr;
-  // Under `light_sampler: bvh` (else bvh_nodes is null): the tree, kBvhFields
+  // Under `light_sampler: bvh`: `bvh`; the grid points of LightChoice below
+  // bvh_grid walk the tree (if any), the rest pick the sky's entries (Sky).
+  bool bvh = false;
+  // The tree (else bvh_nodes is null): kBvhFields
   // doubles per node (core/simd/light_bvh-inl.h, BvhField); per tree light its
   // trail (LightBvh::trails) and entry; per entry its tree light or -1; the
   // grid points of LightChoice that walk the tree (LightSampler::bvh_grid).
@@ -85,6 +90,31 @@ enum DeltaField : int {
 
 enum DeltaKind : int { kDeltaPoint = 0, kDeltaSpot = 1, kDeltaDirectional = 2 };
 
+// The sky when the lanes sample it (an environment of one radiance, sun
+// disks; not an environment image): LightSampler::sample's sky entries and
+// LightSampler::sky() of an escaped ray.
+struct Sky {
+  std::size_t first_entry = 0;   // the first of the sky's light entries (Lights)
+  std::int64_t environment = -1; // the environment's entry, or -1 if it is not sampled
+  float Le[3] = {};              // the environment's radiance (0 without one)
+  float pdf = 0.0f;              // its pick probability / 4 pi (0 if it is not sampled)
+  std::size_t suns = 0;
+  const float* sun = nullptr;    // per sun disk kSunFields floats (SunField)
+  // Under `bvh`: the grid bounds of the sky's entries (LightSampler::
+  // sky_starts, as floats: exact, at most 2^24) and the entries (sky_entries).
+  std::size_t count = 0;
+  const float* starts = nullptr;
+  const float* entries = nullptr;
+};
+enum SunField : int {
+  kSunS = 0, kSunT = 3, kSunN = 6,  // LightSampler::SunDisk::frame
+  kSunOneMinusCos = 9, kSunSin2 = 10,
+  kSunPdf = 11,                     // LightSampler::sun_pdf
+  kSunLe = 12,                      // 3 floats
+  kSunEntry = 15,                   // its light entry
+  kSunFields = 16,
+};
+
 // What the stages read of the scene and the render settings.
 struct Scene {
   // The sampling strategy (core/scene.h). Under cosine every surface
@@ -109,12 +139,15 @@ struct Scene {
   // clear coat, as core's ShadingPath says); else 0.
   unsigned disney = 0;
   const CompiledScene* compiled = nullptr;
-  // Lights beyond triangles sampled by area (an environment, sun disks,
-  // sphere lights, light_sampling solid_angle): compiled->lights() samples
-  // them and gives their densities, path by path; `sky`: escaped rays find
-  // an environment (LightSampler::sky).
+  // Lights beyond triangles sampled by area and the sky of Sky (an
+  // environment image, sphere lights, light_sampling solid_angle, emitters
+  // placed by instances or textured): compiled->lights() samples them all
+  // and gives their densities, path by path; `sky`: escaped rays find an
+  // environment or a sun disk (LightSampler::sky; in the lanes by `skies`
+  // unless general_lights).
   bool general_lights = false;
   bool sky = false;
+  Sky skies;
   // The scene places shapes by instances: hits on them (kInstance set) are
   // resolved by compiled->resolve(), path by path.
   bool instanced = false;

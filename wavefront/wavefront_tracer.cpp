@@ -166,7 +166,8 @@ std::size_t WavefrontTracer::scalar_bytes_per_path() {
 struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
-  std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table, energy;
+  std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table, energy, sun_table,
+      sky_starts, sky_entries;
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
   std::vector<std::string> general_materials, general;
@@ -251,10 +252,11 @@ struct WavefrontTracer::VectorStages {
       }
       sc.deltas = {lights.delta_lights().size(), lights.delta_cdf().data(), v->delta_table.data()};
     }
-    // The lanes sample triangle lights by area; any other light (or
-    // solid-angle sampling) is sampled by LightSampler::sample(), path by path.
+    // The lanes sample triangle lights by area, an environment of one
+    // radiance and sun disks; any other light (or solid-angle sampling) is
+    // sampled by LightSampler::sample(), path by path.
     std::vector<std::string> other_lights;
-    if (lights.samples_environment()) other_lights.push_back("the environment");
+    if (scene.environment_map) other_lights.push_back("the environment image");
     for (std::uint32_t i = 0; i < scene.shapes.size(); ++i)
       if (scene.shapes[i].kind == Shape::Kind::Sphere && lights.first_entry(i) >= 0) {
         other_lights.push_back("sphere lights");
@@ -279,9 +281,46 @@ struct WavefrontTracer::VectorStages {
       for (std::size_t i = 0; i < other_lights.size(); ++i) what += (i ? ", " : "") + other_lights[i];
       v->general.push_back(what + ")");
     }
-    // The tables the lanes' own sampler reads (triangles by area).
+    // The tables the lanes' own sampler reads (triangles by area, then the sky).
     if (!sc.general_lights) {
-      for (const LightSampler::Entry& e : lights.entries()) {
+      vs::Sky& sky = sc.skies;
+      const std::span<const LightSampler::SunDisk> suns = lights.sun_disks();
+      const std::int64_t env = lights.environment_entry();
+      sky.first_entry = env >= 0 ? static_cast<std::size_t>(env)
+                        : suns.empty() ? lights.entries().size()
+                                       : static_cast<std::size_t>(suns.front().entry);
+      sky.environment = env;
+      const Spectrum env_Le = scene.environment.value_or(Spectrum(0.0f));
+      for (int c = 0; c < 3; ++c) sky.Le[c] = env_Le[c];
+      sky.pdf = env >= 0 ? lights.pmf()[static_cast<std::size_t>(env)] * kInv4Pi : 0.0f;  // LightSampler::sky's
+      for (const LightSampler::SunDisk& sun : suns) {
+        float f[vs::kSunFields] = {};
+        for (int c = 0; c < 3; ++c) {
+          f[vs::kSunS + c] = sun.frame.s[c];
+          f[vs::kSunT + c] = sun.frame.t[c];
+          f[vs::kSunN + c] = sun.frame.n[c];
+          f[vs::kSunLe + c] = sun.Le[c];
+        }
+        f[vs::kSunOneMinusCos] = sun.one_minus_cos;
+        f[vs::kSunSin2] = sun.sin2;
+        f[vs::kSunPdf] = lights.sun_pdf(sun);
+        f[vs::kSunEntry] = static_cast<float>(sun.entry);
+        v->sun_table.insert(v->sun_table.end(), std::begin(f), std::end(f));
+      }
+      sky.suns = suns.size();
+      sky.sun = v->sun_table.data();
+      for (const std::uint32_t start : lights.sky_starts()) v->sky_starts.push_back(static_cast<float>(start));
+      for (const std::size_t entry : lights.sky_entries()) v->sky_entries.push_back(static_cast<float>(entry));
+      sky.count = v->sky_entries.size();
+      sky.starts = v->sky_starts.data();
+      sky.entries = v->sky_entries.data();
+      for (std::size_t i = 0; i < lights.entries().size(); ++i) {
+        if (i >= sky.first_entry) {  // the sky's: no triangle
+          v->light_triangle.insert(v->light_triangle.end(), 16, 0.0f);
+          v->inv_area.push_back(0.0f);
+          continue;
+        }
+        const LightSampler::Entry& e = lights.entries()[i];
         const Shape& shape = scene.shapes[e.shape];
         const Material& m = scene.materials[shape.material];
         const Triangle& t = e.triangle;
@@ -302,6 +341,7 @@ struct WavefrontTracer::VectorStages {
       }
       sc.lights = {n_lights, lights.cdf().data(), lights.pmf().data(), v->inv_area.data(), v->light_triangle.data(),
                    v->light_columns.empty() ? nullptr : v->light_columns.data()};
+      sc.lights.bvh = lights.light_sampler() == LightSamplerKind::Bvh;
       if (const LightBvh* bvh = lights.bvh(); bvh && !bvh->empty()) {
         // The light BVH as the stages walk it (core/simd/light_bvh-inl.h).
         v->bvh_nodes = bvh->node_table();

@@ -87,6 +87,11 @@ template <class V>
 HWY_INLINE V dot(const Vec3<V>& a, const Vec3<V>& b) {
   return (a.x * b.x + a.y * b.y) + a.z * b.z;
 }
+// glm::cross: (a.y b.z - b.y a.z, a.z b.x - b.z a.x, a.x b.y - b.x a.y).
+template <class V>
+HWY_INLINE Vec3<V> cross(const Vec3<V>& a, const Vec3<V>& b) {
+  return {a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y};
+}
 // glm::normalize: v * (1 / sqrt(v.v)).
 template <class D, class V = VecOf<D>>
 HWY_INLINE Vec3<V> normalize(D d, const Vec3<V>& v) {

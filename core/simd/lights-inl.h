@@ -16,6 +16,7 @@
 
 #include "core/simd/lane1.h"
 #include "core/simd/lanes-inl.h"
+#include "core/simd/sampling-inl.h"
 
 #include <cmath>
 #include <cstddef>
@@ -114,6 +115,38 @@ HWY_INLINE M delta_light_seen(D d, M directional, M spot, const Vec3<V>& ref, co
   dist = IfThenElse(directional, Set(d, HUGE_VALF), r);
   Le = select(directional, intensity, select(spot, profile * falloff, falloff));
   return Or(directional, And(dist2 > Zero(d), Or(Not(spot), profile > Zero(d))));
+}
+
+// Sun disks (LightSampler's SunDisk): a cone of directions of half-angle
+// alpha about n, the direction towards the sun.
+//
+// Whether dir (unit) lies in the cone, by the sine: the cosine of a 0.27
+// degree cone is 1 - 1.1e-5, which float resolves only to about 0.5 %; the
+// cross product keeps full precision (sin2 = sin^2 alpha).
+template <class D, class V = VecOf<D>>
+HWY_INLINE auto sun_contains(D d, const Vec3<V>& dir, const Vec3<V>& n, V sin2) {
+  const Vec3<V> c = cross(dir, n);
+  return And(dot(dir, n) > Zero(d), dot(c, c) <= sin2);
+}
+// A direction uniform in the cone (frame s, t, n), by 1 - cos theta = ux (1
+// - cos alpha): sin theta from that difference keeps a tiny sun's size exact.
+template <class D, class V = VecOf<D>>
+HWY_INLINE Vec3<V> sun_direction(D d, const Vec3<V>& s, const Vec3<V>& t, const Vec3<V>& n, V one_minus_cos_alpha,
+                                 V ux, V uy) {
+  const V one_minus_cos = ux * one_minus_cos_alpha;
+  const V sin_theta = Sqrt(Max(one_minus_cos * (Set(d, 2.0f) - one_minus_cos), Zero(d)));
+  V sin_phi, cos_phi;
+  sin_cos_turn(d, uy, sin_phi, cos_phi);
+  return normalize(d, to_world(s, t, n, sin_theta * cos_phi, sin_theta * sin_phi, Set(d, 1.0f) - one_minus_cos));
+}
+// The sky along dir gains a sun disk's radiance Le and density pdf_sun (its
+// pick probability times the cone's 1 / solid angle) where dir is in it.
+template <class D, class V = VecOf<D>>
+HWY_INLINE void add_sun(D d, const Vec3<V>& dir, const Vec3<V>& n, V sin2, const Vec3<V>& sun_Le, V pdf_sun,
+                        Vec3<V>& Le, V& pdf) {
+  const auto in = sun_contains(d, dir, n, sin2);
+  Le = select(in, Le + sun_Le, Le);
+  pdf = IfThenElse(in, pdf + pdf_sun, pdf);
 }
 
 }  // namespace pathlab::HWY_NAMESPACE

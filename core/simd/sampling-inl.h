@@ -76,6 +76,20 @@ HWY_INLINE V exp2_lanes(D d, V y) {
   return (Set(d, 1.0f) + p) * Pow2I(d, n);
 }
 
+// A uniform direction on the unit sphere (square_to_uniform_sphere,
+// core/sampling.h): z = 1 - 2 u.x, then the azimuth 2 pi u.y at radius
+// sqrt(max(0, 1 - z z)) (Max(v, 0) in that order is std::max(0.0f, v), NaN
+// included: cosine_hemisphere says why).
+template <class D, class V = VecOf<D>>
+HWY_INLINE void uniform_sphere(D d, V ux, V uy, V& x, V& y, V& z) {
+  z = Set(d, 1.0f) - Set(d, 2.0f) * ux;
+  const V r = Sqrt(Max(Set(d, 1.0f) - z * z, Zero(d)));
+  V s, c;
+  sin_cos_turn(d, uy, s, c);
+  x = r * c;
+  y = r * s;
+}
+
 // Shirley and Chiu's concentric map, square [0,1)^2 -> unit disk, area
 // preserving. With o = 2u - 1: in the left and right wedges (|o.x| > |o.y|)
 // the point is o.x (cos t, sin t) with t = (pi/4)(o.y / o.x); in the top and
