@@ -1,6 +1,7 @@
 #include "core/environment_map.h"
 
 #include "core/error.h"
+#include "core/simd/width1.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -39,30 +40,39 @@ EnvironmentMap::EnvironmentMap(Image texels, const mat3& to_world, std::string s
   distribution_ = Distribution2D(weights, static_cast<std::size_t>(w), static_cast<std::size_t>(h));
 }
 
+// The convention's steps are core/simd/environment-inl.h's, at width 1: the
+// wavefront's lanes run the same source.
+
 vec2 EnvironmentMap::direction_to_uv(const vec3& d) {
-  // atan2 in (-pi, pi]: the half turn below 0 is the second half of the map.
-  float u = std::atan2(d.x, -d.z) * kInv2Pi;
-  if (u < 0.0f) u += 1.0f;
-  // theta by atan2 of the direction's sine and cosine: acos(d.y) loses all
-  // precision near the poles, where d.y rounds to 1 long before d.x, d.z do.
-  const float v = std::atan2(std::sqrt(d.x * d.x + d.z * d.z), d.y) * kInvPi;
-  // u = 1 - tiny may round to 1 above; it is the left edge of column 0 again.
-  return vec2(u < 1.0f ? u : 0.0f, v);
+  using namespace width1;
+  F u, v;
+  generic::env_direction_to_uv(kScalar, lanes(d), u, v);
+  return vec2(u.raw, v.raw);
 }
 
 vec3 EnvironmentMap::uv_to_direction(vec2 uv) {
-  const float theta = kPi * uv.y, phi = 2.0f * kPi * uv.x;
-  const float sin_theta = std::sin(theta);
-  return vec3(sin_theta * std::sin(phi), std::cos(theta), -sin_theta * std::cos(phi));
+  using namespace width1;
+  F sin_theta;
+  return scalars(generic::env_uv_to_direction(kScalar, F{uv.x}, F{uv.y}, sin_theta));
 }
 
 glm::ivec2 EnvironmentMap::texel_of(vec2 uv) const {
-  return glm::ivec2(std::clamp(static_cast<int>(uv.x * static_cast<float>(width())), 0, width() - 1),
-                    std::clamp(static_cast<int>(uv.y * static_cast<float>(height())), 0, height() - 1));
+  using namespace width1;
+  return glm::ivec2(static_cast<int>(generic::env_texel(kScalar, F{uv.x}, F{static_cast<float>(width())}).raw),
+                    static_cast<int>(generic::env_texel(kScalar, F{uv.y}, F{static_cast<float>(height())}).raw));
 }
 
+namespace {
+// m v for a rotation m, as the lanes compute it: (m[0] v.x + m[1] v.y) + m[2] v.z, glm's order.
+vec3 rotate(const mat3& m, const vec3& v) {
+  using namespace width1;
+  return scalars(generic::to_world(lanes(m[0]), lanes(m[1]), lanes(m[2]), F{v.x}, F{v.y}, F{v.z}));
+}
+}  // namespace
+
 EnvironmentMap::Lookup EnvironmentMap::lookup(const vec3& dir) const {
-  const vec3 local = to_local_ * dir;
+  using namespace width1;
+  const vec3 local = rotate(to_local_, dir);
   const glm::ivec2 t = texel_of(direction_to_uv(local));
   Lookup out;
   out.radiance = texels_.at(t.x, t.y);
@@ -70,24 +80,27 @@ EnvironmentMap::Lookup EnvironmentMap::lookup(const vec3& dir) const {
   // map's (u, v) -> direction is 1 / (2 pi^2 sin theta) at that point. From
   // x and z, not 1 - y^2, which is 0 within 3e-4 rad of a pole in float.
   const float sin_theta = std::sqrt(local.x * local.x + local.z * local.z);
-  if (sin_theta > 0.0f)
-    out.pdf = distribution_.pdf(static_cast<std::size_t>(t.x), static_cast<std::size_t>(t.y)) /
-              (2.0f * kPi * kPi * sin_theta);
+  out.pdf = generic::env_solid_angle_pdf(
+                kScalar, F{distribution_.pdf(static_cast<std::size_t>(t.x), static_cast<std::size_t>(t.y))},
+                F{sin_theta})
+                .raw;
   return out;
 }
 
 std::optional<EnvironmentMap::Sample> EnvironmentMap::sample(vec2 u) const {
+  using namespace width1;
   const Distribution2D::Sample s = distribution_.sample(u);
-  const float sin_theta = std::sin(kPi * s.p.y);
-  if (!(s.pdf > 0.0f) || !(sin_theta > 0.0f)) return std::nullopt;
+  F sin_theta;
+  const F3 local = generic::env_uv_to_direction(kScalar, F{s.p.x}, F{s.p.y}, sin_theta);
+  if (!(s.pdf > 0.0f) || !(sin_theta.raw > 0.0f)) return std::nullopt;
   Sample out;
-  out.wi = glm::normalize(to_world_ * uv_to_direction(s.p));
+  out.wi = scalars(generic::normalize(kScalar, lanes(rotate(to_world_, scalars(local)))));
   // The density and radiance of the texel drawn (as pbrt-v4's
   // ImageInfiniteLight does), not of a lookup of wi: a point drawn within
   // rounding of a texel's edge can map back into the neighbour, and next to
   // a sun that neighbour may be black (density 0). They equal pdf(wi) and
   // radiance(wi) everywhere else.
-  out.pdf = s.pdf / (2.0f * kPi * kPi * sin_theta);
+  out.pdf = generic::env_solid_angle_pdf(kScalar, F{s.pdf}, sin_theta).raw;
   if (std::isinf(out.pdf)) return std::nullopt;
   out.radiance = texels_.at(static_cast<int>(s.x), static_cast<int>(s.y));
   return out;

@@ -54,6 +54,10 @@ class EnvironmentMap {
   int height() const { return texels_.height; }
   const Image& texels() const { return texels_; }
   const mat3& to_world() const { return to_world_; }
+  const mat3& to_local() const { return to_local_; }
+  // The importance sampler's density in (u, v) (row y of the map is row y
+  // of the distribution), for code that samples the map in bulk.
+  const Distribution2D& distribution() const { return distribution_; }
   const std::string& source() const { return source_; }  // the file, for messages
 
   // Radiance arriving from world direction `dir` (unit): the radiance of

@@ -129,12 +129,12 @@ Distribution1D::Sample Distribution1D::sample(float u) const {
   // so whenever cdf[j] <= u the search moves past it. u < 1 = cdf[n].
   const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
   const std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - cdf_.begin()) - 1, n_ - 1);
-  const float width = cdf_[i + 1] - cdf_[i];
-  const float t = width > 0.0f ? std::clamp((u - cdf_[i]) / width, 0.0f, 1.0f) : 0.0f;
-  // Kept inside the cell: (i + t) / n may round up to its upper edge.
-  const float upper = std::nextafter(static_cast<float>(i + 1) / static_cast<float>(n_), 0.0f);
-  const float x = std::min((static_cast<float>(i) + t) / static_cast<float>(n_), upper);
-  return {x, pdf(i), i};
+  // Placed in the cell by where u falls in it (core/simd/sampling-inl.h's
+  // piecewise_point, which the wavefront's lanes run on the same cdf).
+  using namespace width1;
+  const F x = generic::piecewise_point(kScalar, F{u}, F{cdf_[i]}, F{cdf_[i + 1]}, F{static_cast<float>(i)},
+                                       F{static_cast<float>(n_)});
+  return {x.raw, pdf(i), i};
 }
 
 Distribution2D::Distribution2D(std::span<const float> weights, std::size_t width, std::size_t height) {

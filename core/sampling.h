@@ -79,6 +79,8 @@ class Distribution1D {
   // The cell i with cdf[i] <= u < cdf[i + 1] (zero-width cells skipped),
   // and x placed in it by where u falls between the two.
   Sample sample(float u) const;
+  // n + 1 entries from 0 to 1 (all 0 without density): cell i spans [cdf[i], cdf[i + 1]).
+  std::span<const float> cdf() const { return cdf_; }
 
  private:
   std::size_t n_ = 0;
@@ -104,6 +106,10 @@ class Distribution2D {
   };
   // u.y picks the row, u.x the column within it.
   Sample sample(vec2 u) const;
+  // The rows' distribution and each row's columns', for code that samples
+  // it in bulk (the wavefront's lanes).
+  const Distribution1D& marginal() const { return marginal_; }
+  const Distribution1D& conditional(std::size_t y) const { return conditional_[y]; }
 
  private:
   Distribution1D marginal_;

@@ -106,6 +106,12 @@ void simd_transcendentals(const float* u, const float* y, float* sin, float* cos
   }
 }
 
+void simd_atan2(const float* y, const float* x, float* out, std::size_t n) {
+  const hn::ScalableTag<float> d;
+  for (std::size_t i = 0; i < n; i += hn::Lanes(d))
+    hn::StoreU(warps::atan2_lanes(d, hn::LoadU(d, y + i), hn::LoadU(d, x + i)), d, out + i);
+}
+
 }  // namespace pathlab::test::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -124,6 +130,10 @@ void simd_disney(bool clearcoat, const float* in, float* out, std::size_t n) {
 HWY_EXPORT(simd_transcendentals);
 void simd_transcendentals(const float* u, const float* y, float* sin, float* cos, float* exp2, std::size_t n) {
   HWY_DYNAMIC_DISPATCH(simd_transcendentals)(u, y, sin, cos, exp2, n);
+}
+HWY_EXPORT(simd_atan2);
+void simd_atan2(const float* y, const float* x, float* out, std::size_t n) {
+  HWY_DYNAMIC_DISPATCH(simd_atan2)(y, x, out, n);
 }
 HWY_EXPORT(simd_offset_ray_origin);
 void simd_offset_ray_origin(const float* p, const float* error, const float* normal, float* out, std::size_t n) {

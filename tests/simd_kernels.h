@@ -32,5 +32,7 @@ void simd_disney(bool clearcoat, const float* in, float* out, std::size_t n);
 // sin_cos_turn(u) and exp2_lanes(y) of core/simd/sampling-inl.h for i in
 // [0, n), n a multiple of 16.
 void simd_transcendentals(const float* u, const float* y, float* sin, float* cos, float* exp2, std::size_t n);
+// atan2_lanes(y[i], x[i]) (sampling-inl.h) into out; n a multiple of 16.
+void simd_atan2(const float* y, const float* x, float* out, std::size_t n);
 
 }  // namespace pathlab::test

@@ -136,6 +136,13 @@ inline V<float> StepAway(One<float>, V<float> c, V<float> o) {
   return {o.raw > 0.0f ? next_float_up(c.raw) : o.raw < 0.0f ? next_float_down(c.raw) : c.raw};
 }
 
+// The float next to v towards +infinity (kUp) or -infinity: lanes-inl.h's
+// NextFloat, by libm at width 1 (the same bits).
+template <bool kUp>
+inline V<float> NextFloat(One<float>, V<float> v) {
+  return {std::nextafter(v.raw, kUp ? HUGE_VALF : -HUGE_VALF)};
+}
+
 // 2^n for a whole n in [-126, 127] (lanes-inl.h's Pow2I; exact both ways).
 inline V<float> Pow2I(One<float>, V<float> n) { return {std::ldexp(1.0f, static_cast<int>(n.raw))}; }
 

@@ -76,6 +76,45 @@ HWY_INLINE V exp2_lanes(D d, V y) {
   return (Set(d, 1.0f) + p) * Pow2I(d, n);
 }
 
+// atan2(y, x) in [-pi, pi]: Cephes' single-precision atanf polynomial
+// (|error| < 2 ulp on [0, tan(pi/8)]) of the ratio of the smaller |coordinate|
+// to the larger (in [0, 1]; above tan(pi/8) reduced about pi/4), then turned
+// to the octant and quadrant of (x, y), with y's sign. Within 3e-7 of libm's
+// double atan2 (tests/test_simd.cpp). (0, 0) gives 0 with y's sign, -0 for
+// x included (libm: pi for x = -0).
+template <class D, class V = VecOf<D>>
+HWY_INLINE V atan2_lanes(D d, V y, V x) {
+  const V ay = Abs(y), ax = Abs(x);
+  const auto steep = ay > ax;
+  const V num = IfThenElse(steep, ax, ay), den = IfThenElse(steep, ay, ax);
+  const V t = IfThenZeroElse(den == Zero(d), num / den);
+  const auto above = t > Set(d, 0.4142135623730950f);
+  const V r = IfThenElse(above, (t - Set(d, 1.0f)) / (t + Set(d, 1.0f)), t);
+  const V z = r * r;
+  const V p = ((((Set(d, 8.05374449538e-2f) * z - Set(d, 1.38776856032e-1f)) * z + Set(d, 1.99777106478e-1f)) * z -
+               Set(d, 3.33329491539e-1f)) *
+              z) *
+                 r +
+             r;
+  V a = IfThenElse(above, p + Set(d, 0.78539816339744830962f), p);
+  a = IfThenElse(steep, Set(d, 1.57079632679489661923f) - a, a);
+  a = IfThenElse(x < Zero(d), Set(d, 3.14159265358979323846f) - a, a);
+  return CopySign(a, y);
+}
+
+// Distribution1D::sample's point in cell i of n whose cdf runs from lo to
+// hi: where u falls between the two, kept inside the cell ((i + t) / n may
+// round up to its upper edge). i and n are whole floats (exact below 2^24).
+template <class D, class V = VecOf<D>>
+HWY_INLINE V piecewise_point(D d, V u, V lo, V hi, V i, V n) {
+  const V width = hi - lo;
+  const V r = (u - lo) / width;
+  const V clamped = IfThenElse(r < Zero(d), Zero(d), IfThenElse(Set(d, 1.0f) < r, Set(d, 1.0f), r));
+  const V t = IfThenElseZero(width > Zero(d), clamped);
+  const V upper = NextFloat<false>(d, (i + Set(d, 1.0f)) / n);
+  return Min((i + t) / n, upper);
+}
+
 // A uniform direction on the unit sphere (square_to_uniform_sphere,
 // core/sampling.h): z = 1 - 2 u.x, then the azimuth 2 pi u.y at radius
 // sqrt(max(0, 1 - z z)) (Max(v, 0) in that order is std::max(0.0f, v), NaN

@@ -14,6 +14,7 @@
 
 #include "core/math.h"
 #include "core/simd/lane1.h"
+#include "core/simd/environment-inl.h"
 #include "core/simd/lanes-inl.h"
 #include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"

@@ -1,0 +1,68 @@
+// An environment image's lat-long convention (core/environment_map.h)
+// written once over Highway's vectors: a direction in the map's frame to its
+// (u, v) and back, and (u, v) to its texel. core/environment_map.cpp calls
+// them at width 1 (core/simd/width1.h) for both tracers' scalar code, the
+// wavefront's vectorised stages at their SIMD width (an escaped ray's sky
+// and the map's light samples).
+//
+// Highway's "-inl.h" convention: no include guard but the toggle below.
+#if defined(PATHLAB_CORE_SIMD_ENVIRONMENT_INL_H_) == defined(HWY_TARGET_TOGGLE)
+#ifdef PATHLAB_CORE_SIMD_ENVIRONMENT_INL_H_
+#undef PATHLAB_CORE_SIMD_ENVIRONMENT_INL_H_
+#else
+#define PATHLAB_CORE_SIMD_ENVIRONMENT_INL_H_
+#endif
+
+#include <hwy/highway.h>
+
+#include "core/math.h"
+#include "core/simd/lane1.h"
+#include "core/simd/lanes-inl.h"
+#include "core/simd/sampling-inl.h"
+
+HWY_BEFORE_NAMESPACE();
+namespace pathlab::HWY_NAMESPACE {
+
+// EnvironmentMap::direction_to_uv: u by the azimuth atan2(x, -z) (the half
+// turn below 0 is the map's second half; u = 1 - tiny rounding up to 1 is
+// the left edge of column 0 again), v by theta = atan2(sin theta, y): acos(y)
+// loses all precision near the poles, where y rounds to 1 long before x and
+// z do.
+template <class D, class V = VecOf<D>>
+HWY_INLINE void env_direction_to_uv(D d, const Vec3<V>& local, V& u, V& v) {
+  V a = atan2_lanes(d, local.x, Neg(local.z)) * Set(d, kInv2Pi);
+  a = IfThenElse(a < Zero(d), a + Set(d, 1.0f), a);
+  u = IfThenElseZero(a < Set(d, 1.0f), a);
+  v = atan2_lanes(d, Sqrt(local.x * local.x + local.z * local.z), local.y) * Set(d, kInvPi);
+}
+
+// EnvironmentMap::uv_to_direction, with sin theta: theta = pi v, phi = 2 pi u,
+// d = (sin theta sin phi, cos theta, -sin theta cos phi).
+template <class D, class V = VecOf<D>>
+HWY_INLINE Vec3<V> env_uv_to_direction(D d, V u, V v, V& sin_theta) {
+  V cos_theta, sin_phi, cos_phi;
+  sin_cos_turn(d, Set(d, 0.5f) * v, sin_theta, cos_theta);
+  sin_cos_turn(d, u, sin_phi, cos_phi);
+  return {sin_theta * sin_phi, cos_theta, Neg(sin_theta) * cos_phi};
+}
+
+// EnvironmentMap::texel_of along one axis: the cell of uv in [0, 1] among
+// `size` (whole float), clamped to [0, size - 1] (NaN to 0: x86's max
+// returns its second operand, lane1's too).
+template <class D, class V = VecOf<D>>
+HWY_INLINE V env_texel(D d, V uv, V size) {
+  return Min(Max(Floor(uv * size), Zero(d)), size - Set(d, 1.0f));
+}
+
+// The density in solid angle of a direction whose lat-long cell has density
+// `uv_pdf` in (u, v) (Distribution2D::pdf), at sin theta: uv_pdf / (2 pi^2
+// sin theta), 0 at a pole.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V env_solid_angle_pdf(D d, V uv_pdf, V sin_theta) {
+  return IfThenElseZero(sin_theta > Zero(d), uv_pdf / (Set(d, 2.0f * kPi * kPi) * sin_theta));
+}
+
+}  // namespace pathlab::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#endif  // PATHLAB_CORE_SIMD_ENVIRONMENT_INL_H_ toggle
