@@ -174,6 +174,16 @@ Scene cornell_with_sky() {
   return s;
 }
 
+// cornell_with_sky() whose environment is an image, turned (envmap-direct's
+// map): the texels drawn and looked up beside triangle lights and sun disks.
+Scene cornell_with_sky_image() {
+  Scene s = cornell_with_sky();
+  s.environment.reset();
+  s.environment_map =
+      load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / "envmap-direct.json").environment_map;
+  return s;
+}
+
 Scene load_case(const SameSeedCase& c) {
   Scene s = c.scene.empty()          ? builtin_cornell_box()
             : c.scene == "every-light" ? cornell_with_every_light()
@@ -190,6 +200,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "many"      ? test::cornell_with_many_lights()
             : c.scene == "bulb"      ? cornell_with_bulb()
             : c.scene == "sky"       ? cornell_with_sky()
+            : c.scene == "sky-image" ? cornell_with_sky_image()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -265,6 +276,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("textured");   // the Cornell box reading textures everywhere (test_scenes.h)
   scenes.push_back("bulb");       // the Cornell box with a sphere light seen from outside (above)
   scenes.push_back("sky");        // the Cornell box under an environment and two sun disks (above)
+  scenes.push_back("sky-image");  // the same under an environment image (above)
   std::vector<SameSeedCase> cases;
   for (const std::string& s : scenes)
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st});
@@ -281,7 +293,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   // (furnace-box), the sky beside an empty tree (envmap), delta lights; and
   // with solid-angle sampling.
   for (const std::string& s : {std::string("many"), std::string("furnace-box.json"), std::string("envmap"),
-                               std::string("delta"), std::string("sky")})
+                               std::string("delta"), std::string("sky"), std::string("sky-image")})
     for (Strategy st : test::kAllStrategies) cases.push_back({s, st, LightSampling::Area, LightSamplerKind::Bvh});
   for (Strategy st : {Strategy::Light, Strategy::Mis})
     cases.push_back({"many", st, LightSampling::SolidAngle, LightSamplerKind::Bvh});
@@ -727,9 +739,8 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf}) cases.push_back({"smooth", st, 0.0f, 0});
   cases.push_back({"smooth", Strategy::Mis, 0.0f, 0, false, true, false, true});
   cases.push_back({"tangents", Strategy::Mis, 0.0f, 0});
-  // Lights sampled by core's LightSampler between the lanes' steps (an environment image with triangle lights, a
-  // sphere light, solid-angle sampling, with the light BVH), and the sky in the lanes (a constant environment, a
-  // sun disk).
+  // Lights sampled by core's LightSampler between the lanes' steps (a sphere light, solid-angle sampling, with the
+  // light BVH), and the sky in the lanes (an environment image, a constant environment, a sun disk).
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"envmap", st, 0.0f, 0});
   for (const char* s : {"sphere-in-environment.json", "sun-disk-plane.json", "glass-sphere-tinted.json",
@@ -770,6 +781,16 @@ std::vector<VectorCase> vector_cases() {
   cases.push_back({"sky", Strategy::Mis, 0.0f, -1, true, true, false, true, true, 0, true});
   cases.push_back({"sky", Strategy::LightBsdf, 0.0f, 0, false, false, true, false, false, 0, false});
   cases.push_back({"sun-disk-plane.json", Strategy::Light, 0.0f, 0, false, false, false, false, false, 0, true});
+  // An environment image in the lanes (its texels drawn by the importance sampler, looked up by escaped rays):
+  // alone over a diffuse sphere and a metal ground ("envmap", above), with a sun disk (envmap-sun-plane), and
+  // beside triangle lights and two sun disks, by power and by the light BVH.
+  for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"sky-image", st, 0.0f, 0});
+  for (Strategy st : {Strategy::Light, Strategy::Mis})
+    cases.push_back({"sky-image", st, 0.0f, 0, false, false, false, false, false, 0, true});
+  cases.push_back({"sky-image", Strategy::Mis, 0.0f, -1, true, true, true, true, true, 0, false});
+  cases.push_back({"envmap", Strategy::Mis, 0.0f, 0, false, false, false, false, true, 0, true});
+  cases.push_back({"envmap-sun-plane.json", Strategy::Mis, 0.0f, 0});
   // Strategy cosine: every surface scattered by core's Surfel::scatter_cosine (impulses by scatter).
   for (const char* sc : {"", "materials", "textured"}) cases.push_back({sc, Strategy::Cosine, 0.0f, 0});
   // Alpha: every ray's key made in the lanes (camera, continuation and shadow rays, compacted with the path).
@@ -832,8 +853,8 @@ TEST(Wavefront, VectorisedForEverySceneAtAVectorTarget) {
   // Shading frames of their own (vertex normals, tangents): core's Surfel shades those shapes too.
   EXPECT_EQ(vectorised(cornell_with_tangents(), Strategy::Mis), any);
   EXPECT_EQ(vectorised(test::cornell_with_smooth_sphere(), Strategy::Mis), any);
-  // Lights the lanes do not sample (solid-angle sampling, sphere lights, an environment) are sampled by core's
-  // LightSampler between them.
+  // Lights the lanes do not sample (solid-angle sampling, sphere lights) are sampled by core's LightSampler
+  // between them; the sky (an environment, an image, sun disks) in them.
   Scene solid_angle = cornell;
   solid_angle.render.light_sampling = LightSampling::SolidAngle;
   EXPECT_EQ(vectorised(solid_angle, Strategy::Mis), any);

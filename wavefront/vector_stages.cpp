@@ -26,6 +26,7 @@
 #include "core/bsdf/disney-inl.h"
 #include "core/bsdf/lambert-inl.h"
 #include "core/bsdf/mirror-inl.h"
+#include "core/simd/environment-inl.h"
 #include "core/simd/lanes-inl.h"
 #include "core/simd/light_bvh-inl.h"
 #include "core/simd/lights-inl.h"
@@ -122,6 +123,10 @@ using pathlab::HWY_NAMESPACE::disney_pdf;
 using pathlab::HWY_NAMESPACE::disney_sample;
 using pathlab::HWY_NAMESPACE::dot;
 using pathlab::HWY_NAMESPACE::emitted_towards;
+using pathlab::HWY_NAMESPACE::env_direction_to_uv;
+using pathlab::HWY_NAMESPACE::env_solid_angle_pdf;
+using pathlab::HWY_NAMESPACE::env_texel;
+using pathlab::HWY_NAMESPACE::env_uv_to_direction;
 using pathlab::HWY_NAMESPACE::facing_normal;
 using pathlab::HWY_NAMESPACE::frame;
 using pathlab::HWY_NAMESPACE::is_black;
@@ -132,7 +137,9 @@ using pathlab::HWY_NAMESPACE::mirror_sample;
 using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::NoEnergy;
+using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::pick_cdf;
+using pathlab::HWY_NAMESPACE::piecewise_point;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::spawn_origin;
 using pathlab::HWY_NAMESPACE::spawn_to;
@@ -642,17 +649,96 @@ VF emission_weight(const Scene& sc, const Wave& w, std::size_t i0, M lit, VF lig
       lit, pathlab::HWY_NAMESPACE::emission_weight(DF(), sc.strategy, impulse, bsdf_technique, prev_pdf, light_pdf));
 }
 
-// LightSampler::sky along dir in the lanes of m: the environment's
-// radiance and density, then each sun disk's that dir is in.
-void sky_along(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) {
+// An environment image's rotation (GLM's columns) applied to v, as
+// core/environment_map.cpp's rotate: (m[0] v.x + m[1] v.y) + m[2] v.z.
+V3 rotate(const float* m, const V3& v) {
   const DF df;
-  Le = zero_unless(m, splat3(df, s.Le[0], s.Le[1], s.Le[2]));
-  pdf = hn::IfThenElseZero(m, k(s.pdf));
+  return to_world(splat3(df, m[0], m[1], m[2]), splat3(df, m[3], m[4], m[5]), splat3(df, m[6], m[7], m[8]), v.x, v.y,
+                  v.z);
+}
+
+// The texel (x, y) of an environment image in the lanes of m: its index in
+// the texels, and its cell's density in (u, v) (Distribution2D::pdf:
+// the row's pdf times the column's, each its cdf step times its count).
+struct EnvTexel {
+  VI index;
+  VF uv_pdf;
+};
+EnvTexel env_texel_at(const Sky& s, M m, VF x, VF y) {
+  const VI xi = hn::ConvertTo(DI(), x), yi = hn::ConvertTo(DI(), y);
+  const VI width = hn::Set(DI(), static_cast<std::int32_t>(s.width));
+  const VI column = yi * (width + hn::Set(DI(), 1)) + xi;  // in the rows' column cdfs
+  const VF row_pdf = (gather(m, s.row_cdf, yi, 1, 1) - gather(m, s.row_cdf, yi, 1, 0)) * k(s.height);
+  const VF column_pdf = (gather(m, s.column_cdf, column, 1, 1) - gather(m, s.column_cdf, column, 1, 0)) * k(s.width);
+  return {yi * width + xi, row_pdf * column_pdf};
+}
+
+// EnvironmentMap::lookup in the lanes of m: the radiance of the texel dir
+// falls in, and the density in solid angle with which the map is sampled
+// there (sin theta from the direction itself).
+void env_lookup(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) {
+  const DF df;
+  const V3 local = rotate(s.to_local, dir);
+  VF u, v;
+  env_direction_to_uv(df, local, u, v);
+  const EnvTexel t = env_texel_at(s, m, env_texel(df, u, k(s.width)), env_texel(df, v, k(s.height)));
+  Le = gather3(m, s.image, t.index, 3, 0);
+  pdf = hn::IfThenElseZero(m, env_solid_angle_pdf(df, t.uv_pdf, hn::Sqrt(local.x * local.x + local.z * local.z)));
+}
+
+// EnvironmentMap::sample in the lanes of ok (u = (ux, uy)): Distribution2D::
+// sample (uy the row, ux the column in it: pick_cdf over each cdf's upper
+// ends, then piecewise_point), the direction of the point drawn, and the
+// radiance and density of the texel drawn; the lanes it gives none leave ok.
+void env_sample(const Sky& s, VF ux, VF uy, M& ok, V3& wi, V3& Le, VF& pdf) {
+  const DF df;
+  const auto row_cdf = [&](M valid, VF i) { return gather(valid, s.row_cdf, hn::ConvertTo(DI(), i), 1, 1); };
+  const VF y = pick_cdf(df, ok, static_cast<std::size_t>(s.height), uy, row_cdf);
+  const VI yi = hn::ConvertTo(DI(), y);
+  const VF row_lo = gather(ok, s.row_cdf, yi, 1, 0), row_hi = gather(ok, s.row_cdf, yi, 1, 1);
+  const VF row_pdf = (row_hi - row_lo) * k(s.height);
+  const VF py = piecewise_point(df, uy, row_lo, row_hi, y, k(s.height));
+  ok = hn::And(ok, row_pdf > k(0.0f));
+  const VI row = yi * hn::Set(DI(), static_cast<std::int32_t>(s.width) + 1);
+  const auto column_cdf = [&](M valid, VF i) { return gather(valid, s.column_cdf, row + hn::ConvertTo(DI(), i), 1, 1); };
+  const VF x = pick_cdf(df, ok, static_cast<std::size_t>(s.width), ux, column_cdf);
+  const VI at = row + hn::ConvertTo(DI(), x);
+  const VF column_lo = gather(ok, s.column_cdf, at, 1, 0), column_hi = gather(ok, s.column_cdf, at, 1, 1);
+  const VF px = piecewise_point(df, ux, column_lo, column_hi, x, k(s.width));
+  const VF uv_pdf = row_pdf * ((column_hi - column_lo) * k(s.width));
+  VF sin_theta;
+  const V3 local = env_uv_to_direction(df, px, py, sin_theta);
+  ok = hn::And(ok, hn::And(uv_pdf > k(0.0f), sin_theta > k(0.0f)));
+  wi = normalize(df, rotate(s.to_world, local));
+  pdf = env_solid_angle_pdf(df, uv_pdf, sin_theta);
+  ok = hn::AndNot(hn::IsInf(pdf), ok);
+  Le = gather3(ok, s.image, yi * hn::Set(DI(), static_cast<std::int32_t>(s.width)) + hn::ConvertTo(DI(), x), 3, 0);
+}
+
+// The sun disks' radiance and density along dir added to Le and pdf.
+void add_suns(const Sky& s, const V3& dir, V3& Le, VF& pdf) {
+  const DF df;
   for (std::size_t j = 0; j < s.suns; ++j) {
     const float* sun = s.sun + j * kSunFields;
     add_sun(df, dir, splat3(df, sun[kSunN], sun[kSunN + 1], sun[kSunN + 2]), k(sun[kSunSin2]),
             splat3(df, sun[kSunLe], sun[kSunLe + 1], sun[kSunLe + 2]), k(sun[kSunPdf]), Le, pdf);
   }
+}
+
+// LightSampler::sky along dir in the lanes of m: the environment's
+// radiance and density (an image's texel, or the one radiance), then each
+// sun disk's that dir is in.
+void sky_along(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) {
+  const DF df;
+  if (s.image) {
+    VF map_pdf;
+    env_lookup(s, m, dir, Le, map_pdf);
+    pdf = k(s.pmf) * map_pdf;
+  } else {
+    Le = zero_unless(m, splat3(df, s.Le[0], s.Le[1], s.Le[2]));
+    pdf = hn::IfThenElseZero(m, k(s.pdf));
+  }
+  add_suns(s, dir, Le, pdf);
 }
 
 void add_emission(const Scene& sc, const Wave& w) {
@@ -835,10 +921,21 @@ LightLanes sky_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, V
   const DF df;
   const Sky& s = sc.skies;
   LightLanes ls;
-  ls.wi = zero3();
+  ls.wi = ls.Le = zero3();
+  ls.pdf = hn::Zero(df);
   M sun_lanes = hn::FirstN(df, 0);
-  if (const M env = hn::And(ok, hn::RebindMask(DF(), light == hn::Set(DI(), static_cast<std::int32_t>(s.environment))));
-      s.environment >= 0 && !hn::AllFalse(df, env)) {
+  const M env = hn::And(ok, hn::RebindMask(DF(), light == hn::Set(DI(), static_cast<std::int32_t>(s.environment))));
+  const bool image = s.image && s.environment >= 0 && !hn::AllFalse(df, env);
+  V3 image_Le;
+  VF image_pdf;
+  if (image) {
+    // The texel drawn's radiance and density (EnvironmentMap::sample), then the sun disks there.
+    M drawn = env;
+    env_sample(s, lu, lv, drawn, ls.wi, image_Le, image_pdf);
+    image_pdf = k(s.pmf) * image_pdf;
+    add_suns(s, ls.wi, image_Le, image_pdf);
+    ok = hn::Or(hn::AndNot(env, ok), drawn);
+  } else if (s.environment >= 0 && !hn::AllFalse(df, env)) {
     V3 wi;
     uniform_sphere(df, lu, lv, wi.x, wi.y, wi.z);
     ls.wi = select(env, wi, ls.wi);
@@ -851,7 +948,13 @@ LightLanes sky_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, V
     const auto at = [&](int f) { return splat3(df, sun[f], sun[f + 1], sun[f + 2]); };
     ls.wi = select(at_sun, sun_direction(df, at(kSunS), at(kSunT), at(kSunN), k(sun[kSunOneMinusCos]), lu, lv), ls.wi);
   }
-  sky_along(s, ok, ls.wi, ls.Le, ls.pdf);
+  // Under an image, its lanes carry the texel drawn (above); the rest the sky along their direction.
+  const M along = image ? hn::AndNot(env, ok) : ok;
+  if (!hn::AllFalse(df, along)) sky_along(s, along, ls.wi, ls.Le, ls.pdf);
+  if (image) {
+    ls.Le = select(env, image_Le, ls.Le);
+    ls.pdf = hn::IfThenElse(env, image_pdf, ls.pdf);
+  }
   // A sun's direction rounded out of its cone (the environment's lanes keep theirs, as sample() does).
   ok = hn::AndNot(hn::And(sun_lanes, hn::Or(hn::Not(ls.pdf > k(0.0f)), is_black(df, ls.Le))), ok);
   const V3 origin = spawn_origin(df, sp, load3(w, kErrX, i0, ok), n, ls.wi);

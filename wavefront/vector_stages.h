@@ -3,8 +3,8 @@
 // AVX-512, 8 with AVX2, 4 with SSE4, whichever core/simd/simd.h's dispatch
 // selected — for every scene (any camera, material, light, texture,
 // instance, alpha). The lanes do the camera, world-space hit points,
-// emission and its weight, triangle lights sampled by area, a uniform
-// environment and sun disks, delta lights,
+// emission and its weight, triangle lights sampled by area, the environment
+// (one radiance or an image) and sun disks, delta lights,
 // flat untextured Lambert, Disney (VNDF sampling), mirror and dielectric
 // shading, roulette and compaction; everything else (other materials, vertex normals, textures,
 // instances, other lights) is core's, called one path at a time between
@@ -90,14 +90,24 @@ enum DeltaField : int {
 
 enum DeltaKind : int { kDeltaPoint = 0, kDeltaSpot = 1, kDeltaDirectional = 2 };
 
-// The sky when the lanes sample it (an environment of one radiance, sun
-// disks; not an environment image): LightSampler::sample's sky entries and
-// LightSampler::sky() of an escaped ray.
+// The sky (an environment of one radiance or an image, sun disks):
+// LightSampler::sample's sky entries and LightSampler::sky() of an escaped ray.
 struct Sky {
   std::size_t first_entry = 0;   // the first of the sky's light entries (Lights)
   std::int64_t environment = -1; // the environment's entry, or -1 if it is not sampled
-  float Le[3] = {};              // the environment's radiance (0 without one)
-  float pdf = 0.0f;              // its pick probability / 4 pi (0 if it is not sampled)
+  float Le[3] = {};              // an environment of one radiance: it (0 without one)
+  float pdf = 0.0f;              // and its pick probability / 4 pi (0 if it is not sampled)
+  float pmf = 0.0f;              // the environment's pick probability (0 if it is not sampled)
+  // An environment image (else image is null; core/environment_map.h): its
+  // texels (RGB, row-major), width and height (whole floats), the rotations
+  // from the world to its frame and back (GLM's columns), and its importance
+  // sampler's cdfs (Distribution2D): the rows' (height + 1 floats), then
+  // each row's columns' (width + 1 floats a row).
+  const float* image = nullptr;
+  float width = 0.0f, height = 0.0f;
+  float to_local[9] = {}, to_world[9] = {};
+  const float* row_cdf = nullptr;
+  const float* column_cdf = nullptr;
   std::size_t suns = 0;
   const float* sun = nullptr;    // per sun disk kSunFields floats (SunField)
   // Under `bvh`: the grid bounds of the sky's entries (LightSampler::
@@ -139,9 +149,9 @@ struct Scene {
   // clear coat, as core's ShadingPath says); else 0.
   unsigned disney = 0;
   const CompiledScene* compiled = nullptr;
-  // Lights beyond triangles sampled by area and the sky of Sky (an
-  // environment image, sphere lights, light_sampling solid_angle, emitters
-  // placed by instances or textured): compiled->lights() samples them all
+  // Lights beyond triangles sampled by area and the sky of Sky (sphere
+  // lights, light_sampling solid_angle, emitters placed by instances or
+  // textured): compiled->lights() samples them all
   // and gives their densities, path by path; `sky`: escaped rays find an
   // environment or a sun disk (LightSampler::sky; in the lanes by `skies`
   // unless general_lights).

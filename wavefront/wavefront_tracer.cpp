@@ -1,6 +1,7 @@
 #include "wavefront/wavefront_tracer.h"
 
 #include "core/bsdf/disney.h"
+#include "core/environment_map.h"
 #include "core/faults.h"
 #include "core/parallel.h"
 #include "core/rng.h"
@@ -167,7 +168,7 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table, energy, sun_table,
-      sky_starts, sky_entries;
+      sky_starts, sky_entries, env_row_cdf, env_column_cdf;
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
   std::vector<std::string> general_materials, general;
@@ -256,7 +257,9 @@ struct WavefrontTracer::VectorStages {
     // radiance and sun disks; any other light (or solid-angle sampling) is
     // sampled by LightSampler::sample(), path by path.
     std::vector<std::string> other_lights;
-    if (scene.environment_map) other_lights.push_back("the environment image");
+    if (const EnvironmentMap* map = scene.environment_map.get();
+        map && std::size_t(map->width()) * std::size_t(map->height() + 1) * 3 >= (std::size_t{1} << 31))
+      other_lights.push_back("an environment image of 2^29 texels or more");  // beyond the gathers' indices
     for (std::uint32_t i = 0; i < scene.shapes.size(); ++i)
       if (scene.shapes[i].kind == Shape::Kind::Sphere && lights.first_entry(i) >= 0) {
         other_lights.push_back("sphere lights");
@@ -292,7 +295,27 @@ struct WavefrontTracer::VectorStages {
       sky.environment = env;
       const Spectrum env_Le = scene.environment.value_or(Spectrum(0.0f));
       for (int c = 0; c < 3; ++c) sky.Le[c] = env_Le[c];
-      sky.pdf = env >= 0 ? lights.pmf()[static_cast<std::size_t>(env)] * kInv4Pi : 0.0f;  // LightSampler::sky's
+      sky.pmf = env >= 0 ? lights.pmf()[static_cast<std::size_t>(env)] : 0.0f;
+      sky.pdf = sky.pmf * kInv4Pi;  // LightSampler::sky's
+      if (const EnvironmentMap* map = scene.environment_map.get()) {
+        sky.image = &map->texels().pixels.front().x;
+        sky.width = static_cast<float>(map->width());
+        sky.height = static_cast<float>(map->height());
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r) {
+            sky.to_local[3 * c + r] = map->to_local()[c][r];
+            sky.to_world[3 * c + r] = map->to_world()[c][r];
+          }
+        const Distribution2D& dist = map->distribution();
+        const std::span<const float> rows = dist.marginal().cdf();
+        v->env_row_cdf.assign(rows.begin(), rows.end());
+        for (int y = 0; y < map->height(); ++y) {
+          const std::span<const float> columns = dist.conditional(static_cast<std::size_t>(y)).cdf();
+          v->env_column_cdf.insert(v->env_column_cdf.end(), columns.begin(), columns.end());
+        }
+        sky.row_cdf = v->env_row_cdf.data();
+        sky.column_cdf = v->env_column_cdf.data();
+      }
       for (const LightSampler::SunDisk& sun : suns) {
         float f[vs::kSunFields] = {};
         for (int c = 0; c < 3; ++c) {
