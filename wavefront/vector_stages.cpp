@@ -604,6 +604,8 @@ void resolve(const Scene& sc, const Wave& w) {
       }
     }
     store_mask(w, kShadeByCore, i0, found, general);
+    // A frame of its own (kFramed) comes from core's resolve_shading; the lanes shade in it.
+    if (sc.framed) by_core = hn::Or(by_core, shape_flag(hn::AndNot(general, found), sc, shape, kFramed));
     if (sc.textured) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kTexturedEmission));
     for_each_lane(by_core, i0, [&](std::size_t i, std::size_t) { general_resolve(sc, w, i); });
   }
@@ -1123,6 +1125,17 @@ M disney_lanes(M m, const Scene& sc, VI shape) {
 // the lanes whose f is black): the Lambert lobe in the lanes (core/surfel.cpp,
 // bsdf/lambert-inl.h: only the local z of wo and wi matters), the lanes of
 // kShadeByCore by core, path by path.
+// The lanes of m whose hit shades in a frame of its own (ShapeField kFramed;
+// not core's: kShadeByCore), and that frame, as resolve() kept it.
+M framed_lanes(const Wave& w, std::size_t i0, M m, const Scene& sc, VI shape) {
+  return hn::AndNot(load_mask(w, kShadeByCore, i0, m), shape_flag(m, sc, shape, kFramed));
+}
+void load_frame(const Wave& w, std::size_t i0, M framed, V3& fs, V3& ft, V3& fn) {
+  fs = select(framed, load3(w, kFsX, i0, framed), fs);
+  ft = select(framed, load3(w, kFtX, i0, framed), ft);
+  fn = select(framed, load3(w, kFnX, i0, framed), fn);
+}
+
 void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V3& wo, const V3& n, const V3& wi, M& ok,
                V3& f, VF& pdf_bsdf) {
   const DF df;
@@ -1130,10 +1143,21 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   // A one-sided material is black unless wo and wi both leave its front
   // (Surfel::eval); with wo in front, upper below is wi in front.
   if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), wo_z > k(0.0f)));
-  // In the geometric normal's frame (the lanes' surfaces are flat).
-  V3 fs, ft, wo_local, wi_local;
+  // In the geometric normal's frame, or the hit's own (kFramed).
+  V3 fs, ft, fn = n, wo_local, wi_local;
   frame(df, n, fs, ft);
-  to_local_upper(df, fs, ft, n, wo, wi, wo_local, wi_local);
+  if (sc.framed) {
+    if (const M framed = framed_lanes(w, i0, ok, sc, shape); !hn::AllFalse(df, framed)) {
+      load_frame(w, i0, framed, fs, ft, fn);
+      // Surfel::eval: a one-sided material's wi in front too (not implied by wo's side in a frame of its own), and
+      // under a shading normal wo and wi on one geometric side.
+      const VF wi_z = dot(wi, n);
+      if (sc.one_sided)
+        ok = hn::AndNot(hn::And(hn::And(framed, shape_flag(framed, sc, shape, kOneSided)), hn::Not(wi_z > k(0.0f))), ok);
+      ok = hn::AndNot(hn::And(load_mask(w, kShadingNormal, i0, framed), hn::Not(wi_z * wo_z > k(0.0f))), ok);
+    }
+  }
+  to_local_upper(df, fs, ft, fn, wo, wi, wo_local, wi_local);
   lambert_eval(df, shape_value3(ok, sc, shape, kAlbedo), wi_local.z, f, pdf_bsdf);
   if (sc.impulses) {
     // A mirror's or a dielectric's f and pdf are 0 towards every direction (Surfel::eval, Surfel::pdf).
@@ -1308,10 +1332,16 @@ void scatter(const Scene& sc, const Wave& w) {
     const V3 n = load3(w, kNx, i0, ok);
     // Surfel::scatter: nothing from behind a one-sided material.
     if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), dot(wo, n) > k(0.0f)));
-    V3 fs, ft;
+    // The geometric normal's frame, or the hit's own (kFramed, as resolve() kept it).
+    V3 fs, ft, fn = n;
     frame(df, n, fs, ft);
-    const VF side = hn::IfThenElse(dot(wo, n) < k(0.0f), k(-1.0f), k(1.0f));
-    V3 wi = to_world(fs, ft, n, local.x, local.y, local.z * side);
+    M framed = hn::FirstN(df, 0);
+    if (sc.framed) {
+      framed = framed_lanes(w, i0, ok, sc, shape);
+      if (!hn::AllFalse(df, framed)) load_frame(w, i0, framed, fs, ft, fn);
+    }
+    const VF side = hn::IfThenElse(dot(wo, fn) < k(0.0f), k(-1.0f), k(1.0f));
+    V3 wi = to_world(fs, ft, fn, local.x, local.y, local.z * side);
     V3 weight = shape_value3(ok, sc, shape, kAlbedo);
     M impulse = hn::FirstN(df, 0);
     const M im = hn::And(impulses, ok), g = hn::And(general, ok), dm = hn::And(disneys, ok);
@@ -1322,7 +1352,7 @@ void scatter(const Scene& sc, const Wave& w) {
       // reflection models take it): a direction from the lobes' mixture,
       // weighted by f cos over the mixture's density there (scatter_closure).
       const ClosureLanes<VF> c = closure_lanes(dm, sc, shape);
-      const V3 wo_local = to_local(fs, ft, n, wo);
+      const V3 wo_local = to_local(fs, ft, fn, wo);
       const V3 wo_up{wo_local.x, wo_local.y, wo_local.z * side};
       with_disney_model(dm, sc, shape, [&](auto lobes, const auto& energy) {
         constexpr unsigned F = decltype(lobes)::value;
@@ -1332,11 +1362,16 @@ void scatter(const Scene& sc, const Wave& w) {
         const VF pdf_d = disney_pdf<F>(df, c, wo_up, local_d, VndfLobes{}, energy, {});
         drawn = hn::And(drawn, hn::And(pdf_d > k(0.0f), hn::Not(pdf_d < k(sc.min_pdf))));
         const V3 f = disney_eval<F>(df, c, wo_up, local_d, energy, {});
-        wi = select(dm, to_world(fs, ft, n, local_d.x, local_d.y, local_d.z * side), wi);
+        wi = select(dm, to_world(fs, ft, fn, local_d.x, local_d.y, local_d.z * side), wi);
         weight = select(dm, f / pdf_d, weight);
         pdf = hn::IfThenElse(dm, pdf_d, pdf);
         ok = hn::AndNot(hn::AndNot(drawn, dm), ok);
       });
+    }
+    if (const M shading_normal = hn::And(framed, load_mask(w, kShadingNormal, i0, framed));
+        !hn::AllFalse(df, shading_normal)) {
+      // Surfel::scatter under a shading normal: wi on wo's geometric side.
+      ok = hn::AndNot(hn::And(shading_normal, hn::Not(dot(wi, n) * dot(wo, n) > k(0.0f))), ok);
     }
     if (!hn::AllFalse(df, im)) {
       // Surfel::scatter_in_frame of a mirror (wo's side up, as the
@@ -1344,13 +1379,13 @@ void scatter(const Scene& sc, const Wave& w) {
       const VF material = shape_value(im, sc, shape, kLaneMaterial);
       const M mirror = hn::And(im, material == k(static_cast<float>(kLaneMirror)));
       const M glass = hn::And(im, material == k(static_cast<float>(kLaneDielectric)));
-      const V3 wo_local = to_local(fs, ft, n, wo);
+      const V3 wo_local = to_local(fs, ft, fn, wo);
       if (!hn::AllFalse(df, mirror)) {
         V3 local_m, weight_m;
         VF pdf_m;
         const M mirrored = mirror_sample(df, weight, u_lobe, V3{wo_local.x, wo_local.y, wo_local.z * side}, local_m,
                                          weight_m, pdf_m);
-        wi = select(mirror, to_world(fs, ft, n, local_m.x, local_m.y, local_m.z * side), wi);
+        wi = select(mirror, to_world(fs, ft, fn, local_m.x, local_m.y, local_m.z * side), wi);
         weight = select(mirror, weight_m, weight);
         pdf = hn::IfThenElse(mirror, pdf_m, pdf);
         ok = hn::AndNot(hn::AndNot(mirrored, mirror), ok);
@@ -1363,7 +1398,7 @@ void scatter(const Scene& sc, const Wave& w) {
                                             shape_value3(glass, sc, shape, kReflectance),
                                             shape_value3(glass, sc, shape, kTransmittance), u_lobe, wo_local, local_g,
                                             weight_g, pdf_g, transmitted);
-        wi = select(glass, to_world(fs, ft, n, local_g.x, local_g.y, local_g.z), wi);
+        wi = select(glass, to_world(fs, ft, fn, local_g.x, local_g.y, local_g.z), wi);
         weight = select(glass, weight_g, weight);
         pdf = hn::IfThenElse(glass, pdf_g, pdf);
         ok = hn::AndNot(hn::AndNot(crossed, glass), ok);

@@ -5,11 +5,13 @@
 // instance, alpha). The lanes do the camera, world-space hit points,
 // emission and its weight, triangle lights sampled by area, the environment
 // (one radiance or an image) and sun disks, delta lights,
-// flat untextured Lambert, Disney (VNDF sampling), mirror and dielectric
-// shading, roulette and compaction; everything else (other materials, vertex normals, textures,
-// instances, other lights) is core's, called one path at a time between
-// the lanes' steps (Scene::general, general_lights, instanced, textured). `--simd scalar` runs
-// the scalar stages of wavefront_tracer.cpp.
+// untextured Lambert and Disney (VNDF sampling) in the geometric normal's
+// frame or the hit's own (vertex normals, tangents: Scene::framed), flat
+// mirror and dielectric shading, roulette and compaction; everything else
+// (other materials, the frames of vertex normals, textures, instances,
+// other lights) is core's, called one path at a time between the lanes'
+// steps (Scene::general, framed, general_lights, instanced, textured).
+// `--simd scalar` runs the scalar stages of wavefront_tracer.cpp.
 //
 // Written once (vector_stages.cpp, over Google Highway, compiled for every
 // target) on core's per-lane code (core/simd/*-inl.h, core/bsdf/*-inl.h,
@@ -139,6 +141,9 @@ struct Scene {
   // BSDF is evaluated and sampled by core's Surfel, one path at a time;
   // resolve() keeps its shading frame from compiled->resolve() (kFsX...).
   bool general = false;
+  // Some shape the lanes shade has a shading frame of its own (ShapeField
+  // kFramed): its hits' frames come from core (resolve), the rest is the lanes'.
+  bool framed = false;
   // Some shape the lanes shade is a mirror or a dielectric (ShapeField
   // kLaneMaterial): else every lane shaded in the lanes is Lambert's or
   // Disney's.
@@ -227,7 +232,9 @@ enum ShapeField : int {
   kClearcoatLogA2 = 45,
   kClearcoatLog2A2 = 46,
   kEnergy = 47,            // bits of an int32: its energy tables' first float in Scene::energy, -1 if none
-  kShapeFields = 48,
+  kFramed = 48,            // 1 if the lanes shade it in a frame of its own (vertex normals, tangents), which
+                           // CompiledScene::resolve_shading makes path by path (kFsX..., kShadingNormal)
+  kShapeFields = 49,
 };
 
 // A Disney material's EnergyTables in Scene::energy.

@@ -379,7 +379,7 @@ struct WavefrontTracer::VectorStages {
       }
     }
     // Per shape: its material's parameters and its geometry.
-    // Gathers index these tables with 32-bit float indices: 48 per shape, 12 per triangle, 16 per light.
+    // Gathers index these tables with 32-bit float indices: 49 per shape, 12 per triangle, 16 per light.
     if (compiled.triangles().size() >= (std::size_t{1} << 27)) return no("more than 2^27 triangles");
     if (scene.shapes.size() >= (std::size_t{1} << 24)) return no("more than 2^24 shapes");
     // The light pick's indices are floats (pick_cdf, core/simd/lights-inl.h).
@@ -404,11 +404,15 @@ struct WavefrontTracer::VectorStages {
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
       f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
       sc.one_sided = sc.one_sided || m.one_sided;
-      // A Lambert, mirror or glass mesh with vertex normals or tangents has a shading frame of its own: core's
-      // Surfel shades it.
+      // A mesh with vertex normals or tangents has a shading frame of its own, made by core
+      // (CompiledScene::resolve_shading) path by path; the lanes shade it under Lambert or Disney, core's Surfel
+      // a mirror or glass (their side rules under a shading normal).
       if (m.scatters() && in_lanes(m) && shading_frame(sh)) v->general.push_back("the shading frame of " + sh.description);
-      const bool general = m.scatters() && (cosine || !in_lanes(m) || shading_frame(sh));
+      const bool framed = m.scatters() && !cosine && in_lanes(m) && shading_frame(sh) && !m.is_pure_impulse();
+      const bool general = m.scatters() && (cosine || !in_lanes(m) || (shading_frame(sh) && !framed));
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
+      f[vs::kFramed] = framed ? 1.0f : 0.0f;
+      sc.framed = sc.framed || framed;
       f[vs::kTexturedEmission] = m.emission_textured ? 1.0f : 0.0f;
       f[vs::kResolveByCore] = general && (shading_frame(sh) || m.reads_textures_at_hits()) ? 1.0f : 0.0f;
       f[vs::kLaneMaterial] = m.type == MaterialType::Mirror       ? static_cast<float>(vs::kLaneMirror)
