@@ -100,12 +100,30 @@ Scene cornell_with_materials() {
 }
 
 // cornell_with_materials() with tangents on the velvet back wall (a shading
-// frame: core's Surfel shades it) beside the gold box (shaded in the lanes):
+// frame of its own: kFramed) beside the gold box (the geometric normal's):
 // Disney surfaces of both kinds in one scene.
 Scene cornell_with_framed_velvet() {
   Scene s = cornell_with_materials();
   Shape& velvet = s.shapes.at(2);
   velvet.mesh.tangents.assign(velvet.mesh.positions.size(), glm::vec4(0.6f, 0.0f, 0.8f, 1.0f));
+  return s;
+}
+
+// The Cornell box with a smooth UV sphere (vertex normals: a shading normal
+// at almost every hit) of an anisotropic clear-coated Disney plastic, shaded
+// in the lanes in the frame core interpolated (kFramed).
+Scene cornell_with_smooth_plastic() {
+  Scene s = test::cornell_with_smooth_sphere();
+  DisneyParams plastic;
+  plastic.base_color = Spectrum(0.2f, 0.4f, 0.7f);
+  plastic.roughness = 0.35f;
+  plastic.anisotropic = 0.6f;
+  plastic.sheen = 0.5f;
+  plastic.clearcoat = 0.8f;
+  Material m = disney_material(plastic);
+  m.name = "plastic";
+  s.materials.push_back(std::move(m));
+  s.shapes.back().material = static_cast<std::uint32_t>(s.materials.size() - 1);
   return s;
 }
 
@@ -200,6 +218,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "many"      ? test::cornell_with_many_lights()
             : c.scene == "bulb"      ? cornell_with_bulb()
             : c.scene == "sky"       ? cornell_with_sky()
+            : c.scene == "smooth-plastic" ? cornell_with_smooth_plastic()
             : c.scene == "sky-image" ? cornell_with_sky_image()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
@@ -735,12 +754,19 @@ std::vector<VectorCase> vector_cases() {
   cases.push_back({"materials", Strategy::Mis, 0.0f, 0, false, true, false, true});
   cases.push_back({"materials", Strategy::LightBsdf, 0.0f, 0, false, false, true, false, true, 0, true});
   cases.push_back({"", Strategy::Mis, 0.0f, 0, false, false, false, false, false, 0, false, true});
-  // Shapes with a shading frame of their own, shaded by core's Surfel: vertex normals, tangents.
-  for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf}) cases.push_back({"smooth", st, 0.0f, 0});
+  // Shapes with a shading frame of their own (vertex normals, tangents), made by core, shaded in the lanes
+  // (kFramed): Lambert, and a Disney plastic under a shading normal; more than 16 shapes (gathered) too.
+  for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"smooth", st, 0.0f, 0});
   cases.push_back({"smooth", Strategy::Mis, 0.0f, 0, false, true, false, true});
+  cases.push_back({"smooth", Strategy::LightBsdf, 0.0f, -1, false, false, true, false, true});
   cases.push_back({"tangents", Strategy::Mis, 0.0f, 0});
-  // Lights sampled by core's LightSampler between the lanes' steps (a sphere light, solid-angle sampling, with the
-  // light BVH), and the sky in the lanes (an environment image, a constant environment, a sun disk).
+  for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"smooth-plastic", st, 0.0f, 0});
+  cases.push_back({"smooth-plastic", Strategy::Mis, 0.0f, -1, true, true, true, true, true, 0, true});
+  // Lights in the lanes beside the Cornell box's triangles: the sky (an environment image, a constant environment,
+  // a sun disk) and sphere lights sampled by area (seen from outside: "bulb"; from inside: the rooms of
+  // mirror-sphere-gray-room and white-sphere-emissive-room); under solid-angle sampling by core's LightSampler.
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"envmap", st, 0.0f, 0});
   for (const char* s : {"sphere-in-environment.json", "sun-disk-plane.json", "glass-sphere-tinted.json",
@@ -751,8 +777,9 @@ std::vector<VectorCase> vector_cases() {
     cases.push_back({"", st, 0.0f, 0, false, false, false, false, false, 0, false, false, true});
   cases.push_back({"materials", Strategy::Mis, 0.0f, 0, false, false, false, false, false, 0, true, false, true});
   cases.push_back({"bulb", Strategy::Mis, 0.0f, 0, false, false, true, false, false, 0, true});
-  // Disney surfaces shaded in the lanes beside one shaded by core (its shading frame); energy compensation's
-  // tables gathered in the lanes (a coated sphere; the materials' box with an anisotropic, compensated lacquer).
+  // Disney surfaces shaded in the lanes in the geometric normal's frame beside one in its own (tangents); energy
+  // compensation's tables gathered in the lanes (a coated sphere; the materials' box with an anisotropic,
+  // compensated lacquer).
   for (Strategy st : {Strategy::Bsdf, Strategy::Mis}) cases.push_back({"framed-velvet", st, 0.0f, 0});
   cases.push_back({"coated-sphere-compensated.json", Strategy::Mis, 0.0f, 0});
   cases.push_back({"compensated", Strategy::Mis, 0.0f, 0});
@@ -850,11 +877,11 @@ TEST(Wavefront, VectorisedForEverySceneAtAVectorTarget) {
   // Materials the lanes do not shade are shaded by core's Surfel between them.
   EXPECT_EQ(vectorised(cornell, Strategy::Mis, true), any);  // --general-shading
   EXPECT_EQ(vectorised(cornell_with_materials(), Strategy::Mis), any);
-  // Shading frames of their own (vertex normals, tangents): core's Surfel shades those shapes too.
+  // Shading frames of their own (vertex normals, tangents): made by core, shaded in the lanes.
   EXPECT_EQ(vectorised(cornell_with_tangents(), Strategy::Mis), any);
   EXPECT_EQ(vectorised(test::cornell_with_smooth_sphere(), Strategy::Mis), any);
-  // Lights the lanes do not sample (solid-angle sampling, sphere lights) are sampled by core's LightSampler
-  // between them; the sky (an environment, an image, sun disks) in them.
+  // Lights the lanes do not sample (solid-angle sampling) are sampled by core's LightSampler between them; the
+  // sky (an environment, an image, sun disks) and sphere lights in them.
   Scene solid_angle = cornell;
   solid_angle.render.light_sampling = LightSampling::SolidAngle;
   EXPECT_EQ(vectorised(solid_angle, Strategy::Mis), any);

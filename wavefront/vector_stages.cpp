@@ -762,7 +762,7 @@ void add_emission(const Scene& sc, const Wave& w) {
     }
     if (const M sky = hn::AndNot(refused, escaped); sc.sky && !hn::AllFalse(df, sky)) {
       // The environment and sun disks along the ray (LightSampler::sky): in
-      // the lanes, or path by path with an environment image.
+      // the lanes, or path by path when core samples the lights (general_lights).
       V3 Le;
       VF density;
       if (sc.general_lights) {
@@ -852,7 +852,8 @@ VI pick_light(const Scene& sc, VF u_choice, const V3& sp, const V3& n, const V3&
   }
   const VF grid_point = join_f(grid_k[0], grid_k[1]);  // exact: below 2^24
   const M tree = lights.bvh_nodes ? hn::And(ok, grid_point < k(static_cast<float>(lights.bvh_grid))) : hn::FirstN(df, 0);
-  const M sky = hn::AndNot(tree, ok);
+  // Without a sky the grid is the tree's (an empty tree picks nothing, as LightBvh::pick).
+  const M sky = sc.skies.count != 0 ? hn::AndNot(tree, ok) : hn::FirstN(df, 0);
   VI light = hn::Zero(DI());
   pmf = hn::Zero(df);
   M picked = sky;
@@ -881,9 +882,10 @@ VI pick_light(const Scene& sc, VF u_choice, const V3& sp, const V3& n, const V3&
   return light;
 }
 
-// LightSampler::sample's point on a triangle light, uniform in area
-// (square_to_uniform_triangle, triangle_point), with the density pmf /
-// area in solid angle, in the lanes of ok; those it gives no sample leave ok.
+// LightSampler::sample's point on a triangle or sphere light, uniform in
+// area (square_to_uniform_triangle and triangle_point; sample_sphere), with
+// the density pmf / area in solid angle, in the lanes of ok; those it gives
+// no sample leave ok.
 LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, VF pmf, VF lu, VF lv, const V3& sp,
                           const V3& n, M& ok) {
   const DF df;
@@ -891,12 +893,25 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI lig
   VF b1, b2;
   uniform_triangle(df, lu, lv, b1, b2);
   const V3 p0 = light_value3(ok, sc.lights, light, kLightP0), p1 = light_value3(ok, sc.lights, light, kLightP1),
-           p2 = light_value3(ok, sc.lights, light, kLightP2), ln = light_value3(ok, sc.lights, light, kLightNormal),
-           Le = light_value3(ok, sc.lights, light, kLightLe);
+           p2 = light_value3(ok, sc.lights, light, kLightP2), Le = light_value3(ok, sc.lights, light, kLightLe);
+  V3 ln = light_value3(ok, sc.lights, light, kLightNormal);
   ls.Le = Le;
   const VF two_sided = light_value(ok, sc.lights, light, kLightTwoSided);
   V3 lp, lerr;
   triangle_point(df, b1, b2, p0, p1, p2, lp, lerr);
+  if (sc.lights.sphere) {
+    if (const M sphere = hn::And(ok, gather(ok, sc.lights.sphere, light, 1, 0) != k(0.0f)); !hn::AllFalse(df, sphere)) {
+      // sample_sphere: a uniform direction from the centre, projected onto the sphere.
+      V3 dir, s_p, s_err, s_n;
+      uniform_sphere(df, lu, lv, dir.x, dir.y, dir.z);
+      const V3 center = p0;
+      const VF radius = p1.x;
+      sphere_point(df, center, radius, p1.y != k(0.0f), center + radius * dir, s_p, s_err, s_n);
+      lp = select(sphere, s_p, lp);
+      lerr = select(sphere, s_err, lerr);
+      ln = select(sphere, s_n, ln);
+    }
+  }
 
   VF dist, cos_light;
   ok = hn::And(ok, light_point_seen(df, sp, lp, ln, two_sided != k(0.0f), ls.wi, dist, cos_light));
@@ -965,8 +980,8 @@ LightLanes sky_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, V
   return ls;
 }
 
-// LightSampler::sample for triangle lights sampled by area and the sky of
-// Sky, in the lanes of ok; those it gives no sample leave ok.
+// LightSampler::sample for triangle and sphere lights sampled by area and
+// the sky of Sky, in the lanes of ok; those it gives no sample leave ok.
 LightLanes area_or_sky_light(const Scene& sc, const Wave& w, std::size_t i0, const Streams& rng, const V3& sp,
                              const V3& wo, const V3& n, M& ok) {
   const DF df;
@@ -1121,10 +1136,6 @@ M disney_lanes(M m, const Scene& sc, VI shape) {
   return hn::And(m, shape_value(m, sc, shape, kLaneMaterial) == k(static_cast<float>(kLaneDisney)));
 }
 
-// Surfel::eval and Surfel::pdf towards wi for the lanes of ok (which lose
-// the lanes whose f is black): the Lambert lobe in the lanes (core/surfel.cpp,
-// bsdf/lambert-inl.h: only the local z of wo and wi matters), the lanes of
-// kShadeByCore by core, path by path.
 // The lanes of m whose hit shades in a frame of its own (ShapeField kFramed;
 // not core's: kShadeByCore), and that frame, as resolve() kept it.
 M framed_lanes(const Wave& w, std::size_t i0, M m, const Scene& sc, VI shape) {
@@ -1136,6 +1147,11 @@ void load_frame(const Wave& w, std::size_t i0, M framed, V3& fs, V3& ft, V3& fn)
   fn = select(framed, load3(w, kFnX, i0, framed), fn);
 }
 
+// Surfel::eval and Surfel::pdf towards wi for the lanes of ok (which lose
+// the lanes whose f is black): the Lambert and Disney lobes in the lanes
+// (core/surfel.cpp, bsdf/lambert-inl.h, disney-inl.h), in the geometric
+// normal's frame or a kFramed hit's own; the lanes of kShadeByCore by core,
+// path by path.
 void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V3& wo, const V3& n, const V3& wi, M& ok,
                V3& f, VF& pdf_bsdf) {
   const DF df;
@@ -1254,7 +1270,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     const Streams rng = streams(sc, w, i0, vertex);
     const V3 sp = load3(w, kPx, i0, alive);
     const V3 wo = -load3(w, kDx, i0, alive);
-    const V3 n = load3(w, kNx, i0, alive);  // the frame's normal is the surface's
+    const V3 n = load3(w, kNx, i0, alive);  // the geometric normal (eval_bsdf takes a kFramed hit's frame)
     const VI shape = load(w, kShape, i0, alive);
 
     // A delta light, in every strategy (LightSampler::sample_delta): f Le /

@@ -3,7 +3,7 @@
 // AVX-512, 8 with AVX2, 4 with SSE4, whichever core/simd/simd.h's dispatch
 // selected — for every scene (any camera, material, light, texture,
 // instance, alpha). The lanes do the camera, world-space hit points,
-// emission and its weight, triangle lights sampled by area, the environment
+// emission and its weight, triangle and sphere lights sampled by area, the environment
 // (one radiance or an image) and sun disks, delta lights,
 // untextured Lambert and Disney (VNDF sampling) in the geometric normal's
 // frame or the hit's own (vertex normals, tangents: Scene::framed), flat
@@ -46,13 +46,16 @@ struct Lights {
   const float* pmf = nullptr;       // LightSampler::pmf()
   const float* inv_area = nullptr;  // 1 / area, as LightSampler computes it
   // Per light, 16 floats (LightField): p0, p1, p2, front normal, emitted
-  // radiance, and 1 if it emits on both sides (else 0).
+  // radiance, and 1 if it emits on both sides (else 0); a sphere's centre
+  // in p0 and its radius and 1 if its normals point inwards in p1 (kLightRadius, kLightFlipped).
   const float* triangle = nullptr;
   // The same values by column when there are 1 to 16 lights (else null):
   // LightField f of light l at [16 f + l], then the cdf, pmf and 1 / area
   // rows (kLightCdf...). A lookup is then one permute of a register
   // instead of a gather from memory.
   const float* columns = nullptr;
+  // Per light, 1 for a sphere (else 0), when some light is one (else null).
+  const float* sphere = nullptr;
   // Under `light_sampler: bvh`: `bvh`; the grid points of LightChoice below
   // bvh_grid walk the tree (if any), the rest pick the sky's entries (Sky).
   bool bvh = false;
@@ -68,6 +71,7 @@ struct Lights {
 };
 enum LightField : int {
   kLightP0 = 0, kLightP1 = 3, kLightP2 = 6, kLightNormal = 9, kLightLe = 12, kLightTwoSided = 15,
+  kLightCenter = 0, kLightRadius = 3, kLightFlipped = 4,  // a sphere's (Lights::sphere)
   kLightCdf = 16, kLightPmf = 17, kLightInvArea = 18,  // rows of Lights::columns only
   kLightColumns = 19,
 };
@@ -148,15 +152,15 @@ struct Scene {
   // kLaneMaterial): else every lane shaded in the lanes is Lambert's or
   // Disney's.
   bool impulses = false;
-  // Some material the lanes shade is Disney's (flat, untextured, VNDF
+  // Some material the lanes shade is Disney's (untextured, VNDF
   // sampling): the lobes every Disney material of the scene is shaded with
   // (disney::Features: kDisneyLobes, with kClearcoat if the scene has a
   // clear coat, as core's ShadingPath says); else 0.
   unsigned disney = 0;
   const CompiledScene* compiled = nullptr;
-  // Lights beyond triangles sampled by area and the sky of Sky (sphere
-  // lights, light_sampling solid_angle, emitters placed by instances or
-  // textured): compiled->lights() samples them all
+  // Lights beyond triangles and spheres sampled by area and the sky of Sky
+  // (light_sampling solid_angle, emitters placed by instances or textured):
+  // compiled->lights() samples them all
   // and gives their densities, path by path; `sky`: escaped rays find an
   // environment or a sun disk (LightSampler::sky; in the lanes by `skies`
   // unless general_lights).
@@ -188,7 +192,7 @@ struct Scene {
   // materials the lanes shade that have them, kEnergyFloats floats each
   // (EnergyField), at ShapeField kEnergy; null if none.
   const float* energy = nullptr;
-  // Per shape, 48 floats (ShapeField): its material's albedo, emission and
+  // Per shape, 49 floats (ShapeField): its material's albedo, emission and
   // flags, its first light entry, and its geometry.
   const float* shape = nullptr;
   // The same by column when there are at most 16 shapes (else null): field
@@ -210,7 +214,7 @@ enum ShapeField : int {
   kRadius = 15,        // a sphere's radius
   kFlipped = 16,       // 1 if a sphere's normals point inwards
   kOneSided = 17,      // 1 if its material is one-sided (black from behind the geometric normal)
-  kGeneral = 18,       // 1 if it is shaded by core's Surfel (not flat untextured Lambert, Disney, mirror or glass)
+  kGeneral = 18,       // 1 if it is shaded by core's Surfel (not untextured Lambert or Disney, flat mirror or glass)
   kTexturedEmission = 19,  // 1 if its emission is textured (Surfel::emitted, path by path)
   kResolveByCore = 20,     // 1 if kGeneral and its Surfel needs CompiledScene::resolve (a shading frame of its
                            // own, textures); else resolve() makes its Frame(n) in the lanes
@@ -269,7 +273,8 @@ enum FloatArray : int {
   kHitT, kHitU, kHitV,
   kPx, kPy, kPz, kErrX, kErrY, kErrZ, kNx, kNy, kNz,
   // The shading frame (s, t, n) of a hit on a shape core's Surfel shades
-  // (ShapeField kGeneral), as CompiledScene::resolve made it.
+  // (ShapeField kGeneral) or with a frame of its own (kFramed), as
+  // CompiledScene::resolve (or the lanes, for a flat kGeneral shape) made it.
   kFsX, kFsY, kFsZ, kFtX, kFtY, kFtZ, kFnX, kFnY, kFnZ,
   // The shadow rays to trace, packed in path order for Embree (up to two a
   // path: room for 2 n), and what each brings if nothing blocks it.
@@ -287,7 +292,7 @@ enum UintArray : int {
 };
 enum ByteArray : int {
   kAlive, kFound, kPrevImpulse, kPrevBsdfTechnique,
-  kShadingNormal,  // Surfel::shading_normal of a hit on a kGeneral shape
+  kShadingNormal,  // Surfel::shading_normal of a hit on a kGeneral or kFramed shape
   kHasParams,      // its Surfel reads Wave::params (a textured material's)
   kShadeByCore,    // this bounce's hit is shaded by core's Surfel (a kGeneral shape's, or a normal not finite)
   kQOccluded,  // per packed shadow ray

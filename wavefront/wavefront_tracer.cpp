@@ -168,7 +168,7 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table, energy, sun_table,
-      sky_starts, sky_entries, env_row_cdf, env_column_cdf;
+      sky_starts, sky_entries, env_row_cdf, env_column_cdf, light_sphere;
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
   std::vector<std::string> general_materials, general;
@@ -191,10 +191,11 @@ struct WavefrontTracer::VectorStages {
     sc.strategy = settings.strategy;
     sc.rr_depth = settings.rr_depth;
     sc.max_vertex = settings.max_depth >= 0 ? settings.max_depth : kMaxVerticesUncapped;
-    // Flat untextured Lambert surfaces (shaded by lambert.h, not through the
-    // Disney closure), Disney surfaces (disney-inl.h; with one min_pdf),
-    // mirrors and dielectrics are shaded in the lanes; any other surface that scatters by core's Surfel, path
-    // by path (vector_stages.h).
+    // Untextured Lambert surfaces (shaded by lambert.h, not through the
+    // Disney closure) and Disney surfaces (disney-inl.h; with one min_pdf),
+    // in the geometric normal's frame or their own, and flat mirrors and
+    // dielectrics are shaded in the lanes; any other surface that scatters
+    // by core's Surfel, path by path (vector_stages.h).
     const Scene& scene = compiled.scene();
     const Material* diffuse = nullptr;
     const bool cosine = settings.strategy == Strategy::Cosine;  // every surface by scatter_cosine
@@ -230,7 +231,8 @@ struct WavefrontTracer::VectorStages {
       sc.camera_cone_spread = cone.spread;
       sc.texture_filter = static_cast<std::uint8_t>(settings.texture_filter);
     }
-    // The lanes sample triangle lights by area; the rest is core's (below).
+    // The lanes sample triangle and sphere lights by area, the sky and delta
+    // lights; the rest is core's (below).
     const LightSampler& lights = compiled.lights();
     // Delta lights: a second light sample and shadow ray per path, in the lanes.
     if (lights.has_delta_lights()) {
@@ -260,11 +262,6 @@ struct WavefrontTracer::VectorStages {
     if (const EnvironmentMap* map = scene.environment_map.get();
         map && std::size_t(map->width()) * std::size_t(map->height() + 1) * 3 >= (std::size_t{1} << 31))
       other_lights.push_back("an environment image of 2^29 texels or more");  // beyond the gathers' indices
-    for (std::uint32_t i = 0; i < scene.shapes.size(); ++i)
-      if (scene.shapes[i].kind == Shape::Kind::Sphere && lights.first_entry(i) >= 0) {
-        other_lights.push_back("sphere lights");
-        break;
-      }
     if (lights.light_sampling() != LightSampling::Area)
       other_lights.push_back(std::string("light_sampling ") + light_sampling_name(lights.light_sampling()));
     for (const Shape& shape : scene.shapes)
@@ -347,8 +344,11 @@ struct WavefrontTracer::VectorStages {
         const Shape& shape = scene.shapes[e.shape];
         const Material& m = scene.materials[shape.material];
         const Triangle& t = e.triangle;
-        for (const vec3& c : {t.p0, t.p1, t.p2, t.n, m.emission})
+        const bool sphere = shape.kind == Shape::Kind::Sphere;
+        const vec3 sphere_fields(shape.radius, shape.flip_normals ? 1.0f : 0.0f, 0.0f);
+        for (const vec3& c : {sphere ? shape.center : t.p0, sphere ? sphere_fields : t.p1, t.p2, t.n, m.emission})
           v->light_triangle.insert(v->light_triangle.end(), {c.x, c.y, c.z});
+        if (sphere) v->light_sphere.resize(i + 1, 0.0f), v->light_sphere[i] = 1.0f;
         v->light_triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
         v->inv_area.push_back(1.0f / e.area);
       }
@@ -365,6 +365,10 @@ struct WavefrontTracer::VectorStages {
       sc.lights = {n_lights, lights.cdf().data(), lights.pmf().data(), v->inv_area.data(), v->light_triangle.data(),
                    v->light_columns.empty() ? nullptr : v->light_columns.data()};
       sc.lights.bvh = lights.light_sampler() == LightSamplerKind::Bvh;
+      if (!v->light_sphere.empty()) {
+        v->light_sphere.resize(n_lights, 0.0f);
+        sc.lights.sphere = v->light_sphere.data();
+      }
       if (const LightBvh* bvh = lights.bvh(); bvh && !bvh->empty()) {
         // The light BVH as the stages walk it (core/simd/light_bvh-inl.h).
         v->bvh_nodes = bvh->node_table();
