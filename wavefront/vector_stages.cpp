@@ -989,6 +989,7 @@ LightLanes area_or_sky_light(const Scene& sc, const Wave& w, std::size_t i0, con
   const VI light = pick_light(sc, rng.u(Dim::LightChoice), sp, n, wo, ok, pmf);
   VF lu, lv;
   rng.u2(Dim::LightX, lu, lv);
+  if (sc.skies.first_entry >= sc.lights.count) return triangle_light(sc, w, i0, light, pmf, lu, lv, sp, n, ok);  // no sky
   const M sky = hn::And(ok, hn::RebindMask(DF(), hn::Not(light < hn::Set(DI(), static_cast<std::int32_t>(sc.skies.first_entry)))));
   M triangles = hn::AndNot(sky, ok);
   if (hn::AllFalse(df, sky)) {
@@ -1384,7 +1385,7 @@ void scatter(const Scene& sc, const Wave& w) {
         ok = hn::AndNot(hn::AndNot(drawn, dm), ok);
       });
     }
-    if (const M shading_normal = hn::And(framed, load_mask(w, kShadingNormal, i0, framed));
+    if (const M shading_normal = sc.framed ? hn::And(framed, load_mask(w, kShadingNormal, i0, framed)) : framed;
         !hn::AllFalse(df, shading_normal)) {
       // Surfel::scatter under a shading normal: wi on wo's geometric side.
       ok = hn::AndNot(hn::And(shading_normal, hn::Not(dot(wi, n) * dot(wo, n) > k(0.0f))), ok);
