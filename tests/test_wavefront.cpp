@@ -1,6 +1,7 @@
 // The wavefront tracer follows the reference's paths: same seed, same
 // samples, up to floating-point rounding of the sums.
 #include "core/compiled_scene.h"
+#include "core/environment_map.h"
 #include "core/film.h"
 #include "core/parallel.h"
 #include "core/render.h"
@@ -202,6 +203,22 @@ Scene cornell_with_sky_image() {
   return s;
 }
 
+// cornell_with_sky_image() whose map is patchy and turned: its lower half
+// black (rows of density 0: never drawn, escapes there see black at density
+// 0), every third texel of the upper half black (cells of width 0 inside the
+// rows' cdfs), turned 40 degrees about +y.
+Scene cornell_with_patchy_sky() {
+  Scene s = cornell_with_sky_image();
+  Image texels = s.environment_map->texels();
+  for (int y = 0; y < texels.height; ++y)
+    for (int x = 0; x < texels.width; ++x)
+      if (y >= texels.height / 2 || x % 3 == 0) texels.at(x, y) = Spectrum(0.0f);
+  const float c = std::cos(0.7f), sn = std::sin(0.7f);
+  const mat3 turn(vec3(c, 0.0f, -sn), vec3(0.0f, 1.0f, 0.0f), vec3(sn, 0.0f, c));
+  s.environment_map = std::make_shared<const EnvironmentMap>(std::move(texels), turn, "patchy");
+  return s;
+}
+
 Scene load_case(const SameSeedCase& c) {
   Scene s = c.scene.empty()          ? builtin_cornell_box()
             : c.scene == "every-light" ? cornell_with_every_light()
@@ -220,6 +237,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "sky"       ? cornell_with_sky()
             : c.scene == "smooth-plastic" ? cornell_with_smooth_plastic()
             : c.scene == "sky-image" ? cornell_with_sky_image()
+            : c.scene == "patchy-sky" ? cornell_with_patchy_sky()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
   s.film.width = std::min(s.film.width, 32);
   s.film.height = std::min(s.film.height, 24);
@@ -816,6 +834,9 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Light, Strategy::Mis})
     cases.push_back({"sky-image", st, 0.0f, 0, false, false, false, false, false, 0, true});
   cases.push_back({"sky-image", Strategy::Mis, 0.0f, -1, true, true, true, true, true, 0, false});
+  // A patchy, turned map: rows and cells of density 0 beside the sun disks.
+  for (Strategy st : {Strategy::Light, Strategy::Mis}) cases.push_back({"patchy-sky", st, 0.0f, 0});
+  cases.push_back({"patchy-sky", Strategy::LightBsdf, 0.0f, 0, false, false, false, false, true, 0, true});
   cases.push_back({"envmap", Strategy::Mis, 0.0f, 0, false, false, false, false, true, 0, true});
   cases.push_back({"envmap-sun-plane.json", Strategy::Mis, 0.0f, 0});
   // Strategy cosine: every surface scattered by core's Surfel::scatter_cosine (impulses by scatter).
