@@ -64,15 +64,15 @@ glm::ivec2 EnvironmentMap::texel_of(vec2 uv) const {
 
 namespace {
 // m v for a rotation m, as the lanes compute it: (m[0] v.x + m[1] v.y) + m[2] v.z, glm's order.
-vec3 rotate(const mat3& m, const vec3& v) {
+width1::F3 rotate(const mat3& m, const width1::F3& v) {
   using namespace width1;
-  return scalars(generic::to_world(lanes(m[0]), lanes(m[1]), lanes(m[2]), F{v.x}, F{v.y}, F{v.z}));
+  return generic::to_world(lanes(m[0]), lanes(m[1]), lanes(m[2]), v.x, v.y, v.z);
 }
 }  // namespace
 
 EnvironmentMap::Lookup EnvironmentMap::lookup(const vec3& dir) const {
   using namespace width1;
-  const vec3 local = rotate(to_local_, dir);
+  const vec3 local = scalars(rotate(to_local_, lanes(dir)));
   const glm::ivec2 t = texel_of(direction_to_uv(local));
   Lookup out;
   out.radiance = texels_.at(t.x, t.y);
@@ -94,7 +94,7 @@ std::optional<EnvironmentMap::Sample> EnvironmentMap::sample(vec2 u) const {
   const F3 local = generic::env_uv_to_direction(kScalar, F{s.p.x}, F{s.p.y}, sin_theta);
   if (!(s.pdf > 0.0f) || !(sin_theta.raw > 0.0f)) return std::nullopt;
   Sample out;
-  out.wi = scalars(generic::normalize(kScalar, lanes(rotate(to_world_, scalars(local)))));
+  out.wi = scalars(generic::normalize(kScalar, rotate(to_world_, local)));
   // The density and radiance of the texel drawn (as pbrt-v4's
   // ImageInfiniteLight does), not of a lookup of wi: a point drawn within
   // rounding of a texel's edge can map back into the neighbour, and next to

@@ -284,8 +284,7 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
   // The sun disks are the last entries, in order.
   if (!suns_.empty() && static_cast<std::int64_t>(i) >= suns_.front().entry) {
     const SunDisk* sun = &suns_[i - static_cast<std::size_t>(suns_.front().entry)];
-    // Uniform in the cone, by 1 - cos theta = u.x (1 - cos alpha): sin theta
-    // from that difference keeps the disk's size exact for a tiny sun.
+    // Uniform in the cone (core/simd/lights-inl.h's sun_direction).
     using namespace width1;
     const Frame& f = sun->frame;
     ls.wi = scalars(generic::sun_direction(kScalar, lanes(f.s), lanes(f.t), lanes(f.n), F{sun->one_minus_cos}, F{u.x},

@@ -71,16 +71,19 @@ Scene cornell_with_bulb() {
   return scene;
 }
 
+// m, named `name`, appended to the scene's materials: its index.
+std::uint32_t add_material(Scene& s, Material m, const char* name) {
+  m.name = name;
+  s.materials.push_back(std::move(m));
+  return static_cast<std::uint32_t>(s.materials.size() - 1);
+}
+
 // The Cornell box with every kind of material: the short box gold (Disney, metallic), the tall one glass,
 // the back wall a clear-coated velvet (Disney sheen and clearcoat) and the
 // red wall a mirror.
 Scene cornell_with_materials() {
   Scene s = builtin_cornell_box();
-  auto add = [&s](Material m, const char* name) {
-    m.name = name;
-    s.materials.push_back(std::move(m));
-    return static_cast<std::uint32_t>(s.materials.size() - 1);
-  };
+  const auto add = [&s](Material m, const char* name) { return add_material(s, std::move(m), name); };
   DisneyParams gold;
   gold.base_color = Spectrum(1.0f, 0.77f, 0.34f);
   gold.metallic = 1.0f;
@@ -121,10 +124,7 @@ Scene cornell_with_smooth_plastic() {
   plastic.anisotropic = 0.6f;
   plastic.sheen = 0.5f;
   plastic.clearcoat = 0.8f;
-  Material m = disney_material(plastic);
-  m.name = "plastic";
-  s.materials.push_back(std::move(m));
-  s.shapes.back().material = static_cast<std::uint32_t>(s.materials.size() - 1);
+  s.shapes.back().material = add_material(s, disney_material(plastic), "plastic");
   return s;
 }
 
@@ -139,10 +139,7 @@ Scene cornell_with_compensated_lacquer() {
   lacquer.anisotropic = 0.8f;
   lacquer.clearcoat = 1.0f;
   lacquer.energy_compensation = true;
-  Material m = disney_material(lacquer);
-  m.name = "lacquer";
-  s.materials.push_back(std::move(m));
-  s.shapes.at(2).material = static_cast<std::uint32_t>(s.materials.size() - 1);
+  s.shapes.at(2).material = add_material(s, disney_material(lacquer), "lacquer");
   return s;
 }
 
@@ -193,8 +190,8 @@ Scene cornell_with_sky() {
   return s;
 }
 
-// cornell_with_sky() whose environment is an image, turned (envmap-direct's
-// map): the texels drawn and looked up beside triangle lights and sun disks.
+// cornell_with_sky() whose environment is an image (envmap-direct's map, not
+// turned): the texels drawn and looked up beside triangle lights and sun disks.
 Scene cornell_with_sky_image() {
   Scene s = cornell_with_sky();
   s.environment.reset();

@@ -659,21 +659,18 @@ V3 rotate(const float* m, const V3& v) {
                   v.z);
 }
 
-// The texel (x, y) of an environment image in the lanes of m: its index in
-// the texels, and its cell's density in (u, v) (Distribution2D::pdf:
-// the row's pdf times the column's, each its cdf step times its count).
-struct EnvTexel {
-  VI index;
-  VF uv_pdf;
+// Cell `at` of a Distribution1D's cdf in the lanes of m: its ends, and its
+// density (Distribution1D::pdf: the step times the cells' count n).
+struct CdfCell {
+  VF lo, hi;
+  VF pdf(VF n) const { return (hi - lo) * n; }
 };
-EnvTexel env_texel_at(const Sky& s, M m, VF x, VF y) {
-  const VI xi = hn::ConvertTo(DI(), x), yi = hn::ConvertTo(DI(), y);
-  const VI width = hn::Set(DI(), static_cast<std::int32_t>(s.width));
-  const VI column = yi * (width + hn::Set(DI(), 1)) + xi;  // in the rows' column cdfs
-  const VF row_pdf = (gather(m, s.row_cdf, yi, 1, 1) - gather(m, s.row_cdf, yi, 1, 0)) * k(s.height);
-  const VF column_pdf = (gather(m, s.column_cdf, column, 1, 1) - gather(m, s.column_cdf, column, 1, 0)) * k(s.width);
-  return {yi * width + xi, row_pdf * column_pdf};
-}
+CdfCell cdf_cell(M m, const float* cdf, VI at) { return {gather(m, cdf, at, 1, 0), gather(m, cdf, at, 1, 1)}; }
+
+// An environment image's texel (x, y): its index among the texels, and
+// where row y's column cdf starts.
+VI texel_index(const Sky& s, VI x, VI y) { return y * hn::Set(DI(), static_cast<std::int32_t>(s.width)) + x; }
+VI column_cdf_row(const Sky& s, VI y) { return y * hn::Set(DI(), static_cast<std::int32_t>(s.width) + 1); }
 
 // EnvironmentMap::lookup in the lanes of m: the radiance of the texel dir
 // falls in, and the density in solid angle with which the map is sampled
@@ -683,9 +680,11 @@ void env_lookup(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) {
   const V3 local = rotate(s.to_local, dir);
   VF u, v;
   env_direction_to_uv(df, local, u, v);
-  const EnvTexel t = env_texel_at(s, m, env_texel(df, u, k(s.width)), env_texel(df, v, k(s.height)));
-  Le = gather3(m, s.image, t.index, 3, 0);
-  pdf = hn::IfThenElseZero(m, env_solid_angle_pdf(df, t.uv_pdf, hn::Sqrt(local.x * local.x + local.z * local.z)));
+  const VI x = hn::ConvertTo(DI(), env_texel(df, u, k(s.width))), y = hn::ConvertTo(DI(), env_texel(df, v, k(s.height)));
+  Le = gather3(m, s.image, texel_index(s, x, y), 3, 0);
+  // Distribution2D::pdf: the row's density times the column's.
+  const VF uv_pdf = cdf_cell(m, s.row_cdf, y).pdf(k(s.height)) * cdf_cell(m, s.column_cdf, column_cdf_row(s, y) + x).pdf(k(s.width));
+  pdf = hn::IfThenElseZero(m, env_solid_angle_pdf(df, uv_pdf, hn::Sqrt(local.x * local.x + local.z * local.z)));
 }
 
 // EnvironmentMap::sample in the lanes of ok (u = (ux, uy)): Distribution2D::
@@ -697,24 +696,24 @@ void env_sample(const Sky& s, VF ux, VF uy, M& ok, V3& wi, V3& Le, VF& pdf) {
   const auto row_cdf = [&](M valid, VF i) { return gather(valid, s.row_cdf, hn::ConvertTo(DI(), i), 1, 1); };
   const VF y = pick_cdf(df, ok, static_cast<std::size_t>(s.height), uy, row_cdf);
   const VI yi = hn::ConvertTo(DI(), y);
-  const VF row_lo = gather(ok, s.row_cdf, yi, 1, 0), row_hi = gather(ok, s.row_cdf, yi, 1, 1);
-  const VF row_pdf = (row_hi - row_lo) * k(s.height);
-  const VF py = piecewise_point(df, uy, row_lo, row_hi, y, k(s.height));
+  const CdfCell row_cell = cdf_cell(ok, s.row_cdf, yi);
+  const VF row_pdf = row_cell.pdf(k(s.height));
+  const VF py = piecewise_point(df, uy, row_cell.lo, row_cell.hi, y, k(s.height));
   ok = hn::And(ok, row_pdf > k(0.0f));
-  const VI row = yi * hn::Set(DI(), static_cast<std::int32_t>(s.width) + 1);
+  const VI row = column_cdf_row(s, yi);
   const auto column_cdf = [&](M valid, VF i) { return gather(valid, s.column_cdf, row + hn::ConvertTo(DI(), i), 1, 1); };
   const VF x = pick_cdf(df, ok, static_cast<std::size_t>(s.width), ux, column_cdf);
-  const VI at = row + hn::ConvertTo(DI(), x);
-  const VF column_lo = gather(ok, s.column_cdf, at, 1, 0), column_hi = gather(ok, s.column_cdf, at, 1, 1);
-  const VF px = piecewise_point(df, ux, column_lo, column_hi, x, k(s.width));
-  const VF uv_pdf = row_pdf * ((column_hi - column_lo) * k(s.width));
+  const VI xi = hn::ConvertTo(DI(), x);
+  const CdfCell column_cell = cdf_cell(ok, s.column_cdf, row + xi);
+  const VF px = piecewise_point(df, ux, column_cell.lo, column_cell.hi, x, k(s.width));
+  const VF uv_pdf = row_pdf * column_cell.pdf(k(s.width));
   VF sin_theta;
   const V3 local = env_uv_to_direction(df, px, py, sin_theta);
   ok = hn::And(ok, hn::And(uv_pdf > k(0.0f), sin_theta > k(0.0f)));
   wi = normalize(df, rotate(s.to_world, local));
   pdf = env_solid_angle_pdf(df, uv_pdf, sin_theta);
   ok = hn::AndNot(hn::IsInf(pdf), ok);
-  Le = gather3(ok, s.image, yi * hn::Set(DI(), static_cast<std::int32_t>(s.width)) + hn::ConvertTo(DI(), x), 3, 0);
+  Le = gather3(ok, s.image, texel_index(s, xi, yi), 3, 0);
 }
 
 // The sun disks' radiance and density along dir added to Le and pdf.
@@ -738,7 +737,7 @@ void sky_along(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) {
     pdf = k(s.pmf) * map_pdf;
   } else {
     Le = zero_unless(m, splat3(df, s.Le[0], s.Le[1], s.Le[2]));
-    pdf = hn::IfThenElseZero(m, k(s.pdf));
+    pdf = hn::IfThenElseZero(m, k(s.pmf * kInv4Pi));
   }
   add_suns(s, dir, Le, pdf);
 }
@@ -941,8 +940,9 @@ LightLanes sky_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, V
   ls.wi = ls.Le = zero3();
   ls.pdf = hn::Zero(df);
   M sun_lanes = hn::FirstN(df, 0);
+  // The environment's lanes (none where it is not sampled: its entry is -1).
   const M env = hn::And(ok, hn::RebindMask(DF(), light == hn::Set(DI(), static_cast<std::int32_t>(s.environment))));
-  const bool image = s.image && s.environment >= 0 && !hn::AllFalse(df, env);
+  const bool image = s.image && !hn::AllFalse(df, env);
   V3 image_Le;
   VF image_pdf;
   if (image) {
@@ -952,7 +952,7 @@ LightLanes sky_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, V
     image_pdf = k(s.pmf) * image_pdf;
     add_suns(s, ls.wi, image_Le, image_pdf);
     ok = hn::Or(hn::AndNot(env, ok), drawn);
-  } else if (s.environment >= 0 && !hn::AllFalse(df, env)) {
+  } else if (!hn::AllFalse(df, env)) {
     V3 wi;
     uniform_sphere(df, lu, lv, wi.x, wi.y, wi.z);
     ls.wi = select(env, wi, ls.wi);
@@ -1137,15 +1137,27 @@ M disney_lanes(M m, const Scene& sc, VI shape) {
   return hn::And(m, shape_value(m, sc, shape, kLaneMaterial) == k(static_cast<float>(kLaneDisney)));
 }
 
-// The lanes of m whose hit shades in a frame of its own (ShapeField kFramed;
-// not core's: kShadeByCore), and that frame, as resolve() kept it.
-M framed_lanes(const Wave& w, std::size_t i0, M m, const Scene& sc, VI shape) {
-  return hn::AndNot(load_mask(w, kShadeByCore, i0, m), shape_flag(m, sc, shape, kFramed));
+// The frame the lanes of m shade in: the geometric normal n's (Frame(n)),
+// or, for a hit that has one of its own (ShapeField kFramed; not core's:
+// kShadeByCore), that frame as resolve() kept it. Returns those lanes.
+M shading_frame(const Scene& sc, const Wave& w, std::size_t i0, M m, VI shape, const V3& n, V3& fs, V3& ft, V3& fn) {
+  frame(DF(), n, fs, ft);
+  fn = n;
+  if (!sc.framed) return hn::FirstN(DF(), 0);
+  const M framed = hn::AndNot(load_mask(w, kShadeByCore, i0, m), shape_flag(m, sc, shape, kFramed));
+  if (!hn::AllFalse(DF(), framed)) {
+    fs = select(framed, load3(w, kFsX, i0, framed), fs);
+    ft = select(framed, load3(w, kFtX, i0, framed), ft);
+    fn = select(framed, load3(w, kFnX, i0, framed), fn);
+  }
+  return framed;
 }
-void load_frame(const Wave& w, std::size_t i0, M framed, V3& fs, V3& ft, V3& fn) {
-  fs = select(framed, load3(w, kFsX, i0, framed), fs);
-  ft = select(framed, load3(w, kFtX, i0, framed), ft);
-  fn = select(framed, load3(w, kFnX, i0, framed), fn);
+// Surfel's rule under a shading normal (geometric_side_ok): the lanes of
+// `framed` whose hit has one and whose wo and wi lie on different geometric
+// sides (wo_z, wi_z: their dot products with the geometric normal).
+M across_geometric_sides(const Wave& w, std::size_t i0, M framed, VF wo_z, VF wi_z) {
+  if (hn::AllFalse(DF(), framed)) return framed;
+  return hn::And(load_mask(w, kShadingNormal, i0, framed), hn::Not(wi_z * wo_z > k(0.0f)));
 }
 
 // Surfel::eval and Surfel::pdf towards wi for the lanes of ok (which lose
@@ -1161,18 +1173,14 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   // (Surfel::eval); with wo in front, upper below is wi in front.
   if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), wo_z > k(0.0f)));
   // In the geometric normal's frame, or the hit's own (kFramed).
-  V3 fs, ft, fn = n, wo_local, wi_local;
-  frame(df, n, fs, ft);
-  if (sc.framed) {
-    if (const M framed = framed_lanes(w, i0, ok, sc, shape); !hn::AllFalse(df, framed)) {
-      load_frame(w, i0, framed, fs, ft, fn);
-      // Surfel::eval: a one-sided material's wi in front too (not implied by wo's side in a frame of its own), and
-      // under a shading normal wo and wi on one geometric side.
-      const VF wi_z = dot(wi, n);
-      if (sc.one_sided)
-        ok = hn::AndNot(hn::And(hn::And(framed, shape_flag(framed, sc, shape, kOneSided)), hn::Not(wi_z > k(0.0f))), ok);
-      ok = hn::AndNot(hn::And(load_mask(w, kShadingNormal, i0, framed), hn::Not(wi_z * wo_z > k(0.0f))), ok);
-    }
+  V3 fs, ft, fn, wo_local, wi_local;
+  if (const M framed = shading_frame(sc, w, i0, ok, shape, n, fs, ft, fn); !hn::AllFalse(df, framed)) {
+    // Surfel::eval: a one-sided material's wi in front too (not implied by wo's side in a frame of its own), and
+    // under a shading normal wo and wi on one geometric side.
+    const VF wi_z = dot(wi, n);
+    if (sc.one_sided)
+      ok = hn::AndNot(hn::And(hn::And(framed, shape_flag(framed, sc, shape, kOneSided)), hn::Not(wi_z > k(0.0f))), ok);
+    ok = hn::AndNot(across_geometric_sides(w, i0, framed, wo_z, wi_z), ok);
   }
   to_local_upper(df, fs, ft, fn, wo, wi, wo_local, wi_local);
   lambert_eval(df, shape_value3(ok, sc, shape, kAlbedo), wi_local.z, f, pdf_bsdf);
@@ -1349,14 +1357,9 @@ void scatter(const Scene& sc, const Wave& w) {
     const V3 n = load3(w, kNx, i0, ok);
     // Surfel::scatter: nothing from behind a one-sided material.
     if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), dot(wo, n) > k(0.0f)));
-    // The geometric normal's frame, or the hit's own (kFramed, as resolve() kept it).
-    V3 fs, ft, fn = n;
-    frame(df, n, fs, ft);
-    M framed = hn::FirstN(df, 0);
-    if (sc.framed) {
-      framed = framed_lanes(w, i0, ok, sc, shape);
-      if (!hn::AllFalse(df, framed)) load_frame(w, i0, framed, fs, ft, fn);
-    }
+    // The geometric normal's frame, or the hit's own (kFramed).
+    V3 fs, ft, fn;
+    const M framed = shading_frame(sc, w, i0, ok, shape, n, fs, ft, fn);
     const VF side = hn::IfThenElse(dot(wo, fn) < k(0.0f), k(-1.0f), k(1.0f));
     V3 wi = to_world(fs, ft, fn, local.x, local.y, local.z * side);
     V3 weight = shape_value3(ok, sc, shape, kAlbedo);
@@ -1385,11 +1388,8 @@ void scatter(const Scene& sc, const Wave& w) {
         ok = hn::AndNot(hn::AndNot(drawn, dm), ok);
       });
     }
-    if (const M shading_normal = sc.framed ? hn::And(framed, load_mask(w, kShadingNormal, i0, framed)) : framed;
-        !hn::AllFalse(df, shading_normal)) {
-      // Surfel::scatter under a shading normal: wi on wo's geometric side.
-      ok = hn::AndNot(hn::And(shading_normal, hn::Not(dot(wi, n) * dot(wo, n) > k(0.0f))), ok);
-    }
+    // Surfel::scatter under a shading normal: wi on wo's geometric side.
+    if (!hn::AllFalse(df, framed)) ok = hn::AndNot(across_geometric_sides(w, i0, framed, dot(wo, n), dot(wi, n)), ok);
     if (!hn::AllFalse(df, im)) {
       // Surfel::scatter_in_frame of a mirror (wo's side up, as the
       // reflection models take it) and of a dielectric (the frame as is).

@@ -39,7 +39,8 @@ enum class Strategy : std::uint8_t;  // core/scene.h
 namespace pathlab::vector_stages {
 
 // The area lights and the sky, as LightSampler::sample() picks and samples
-// them: entries [0, Sky::first_entry) are triangles, the rest the sky's.
+// them: entries [0, Sky::first_entry) are triangles and spheres, the rest
+// the sky's.
 struct Lights {
   std::size_t count = 0;
   const float* cdf = nullptr;       // LightSampler::cdf()
@@ -47,7 +48,8 @@ struct Lights {
   const float* inv_area = nullptr;  // 1 / area, as LightSampler computes it
   // Per light, 16 floats (LightField): p0, p1, p2, front normal, emitted
   // radiance, and 1 if it emits on both sides (else 0); a sphere's centre
-  // in p0 and its radius and 1 if its normals point inwards in p1 (kLightRadius, kLightFlipped).
+  // in p0's place, its radius and 1 if its normals point inwards (else 0)
+  // in p1.x and p1.y.
   const float* triangle = nullptr;
   // The same values by column when there are 1 to 16 lights (else null):
   // LightField f of light l at [16 f + l], then the cdf, pmf and 1 / area
@@ -71,7 +73,6 @@ struct Lights {
 };
 enum LightField : int {
   kLightP0 = 0, kLightP1 = 3, kLightP2 = 6, kLightNormal = 9, kLightLe = 12, kLightTwoSided = 15,
-  kLightCenter = 0, kLightRadius = 3, kLightFlipped = 4,  // a sphere's (Lights::sphere)
   kLightCdf = 16, kLightPmf = 17, kLightInvArea = 18,  // rows of Lights::columns only
   kLightColumns = 19,
 };
@@ -102,7 +103,6 @@ struct Sky {
   std::size_t first_entry = 0;   // the first of the sky's light entries (Lights)
   std::int64_t environment = -1; // the environment's entry, or -1 if it is not sampled
   float Le[3] = {};              // an environment of one radiance: it (0 without one)
-  float pdf = 0.0f;              // and its pick probability / 4 pi (0 if it is not sampled)
   float pmf = 0.0f;              // the environment's pick probability (0 if it is not sampled)
   // An environment image (else image is null; core/environment_map.h): its
   // texels (RGB, row-major), width and height (whole floats), the rotations

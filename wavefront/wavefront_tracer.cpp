@@ -255,9 +255,8 @@ struct WavefrontTracer::VectorStages {
       }
       sc.deltas = {lights.delta_lights().size(), lights.delta_cdf().data(), v->delta_table.data()};
     }
-    // The lanes sample triangle lights by area, an environment of one
-    // radiance and sun disks; any other light (or solid-angle sampling) is
-    // sampled by LightSampler::sample(), path by path.
+    // The lanes sample triangle and sphere lights by area and the sky; the
+    // rest (below) is sampled by LightSampler::sample(), path by path.
     std::vector<std::string> other_lights;
     if (const EnvironmentMap* map = scene.environment_map.get();
         map && std::size_t(map->width()) * std::size_t(map->height() + 1) * 3 >= (std::size_t{1} << 31))
@@ -293,7 +292,6 @@ struct WavefrontTracer::VectorStages {
       const Spectrum env_Le = scene.environment.value_or(Spectrum(0.0f));
       for (int c = 0; c < 3; ++c) sky.Le[c] = env_Le[c];
       sky.pmf = env >= 0 ? lights.pmf()[static_cast<std::size_t>(env)] : 0.0f;
-      sky.pdf = sky.pmf * kInv4Pi;  // LightSampler::sky's
       if (const EnvironmentMap* map = scene.environment_map.get()) {
         sky.image = &map->texels().pixels.front().x;
         sky.width = static_cast<float>(map->width());
@@ -338,6 +336,7 @@ struct WavefrontTracer::VectorStages {
         if (i >= sky.first_entry) {  // the sky's: no triangle
           v->light_triangle.insert(v->light_triangle.end(), 16, 0.0f);
           v->inv_area.push_back(0.0f);
+          v->light_sphere.push_back(0.0f);
           continue;
         }
         const LightSampler::Entry& e = lights.entries()[i];
@@ -348,7 +347,7 @@ struct WavefrontTracer::VectorStages {
         const vec3 sphere_fields(shape.radius, shape.flip_normals ? 1.0f : 0.0f, 0.0f);
         for (const vec3& c : {sphere ? shape.center : t.p0, sphere ? sphere_fields : t.p1, t.p2, t.n, m.emission})
           v->light_triangle.insert(v->light_triangle.end(), {c.x, c.y, c.z});
-        if (sphere) v->light_sphere.resize(i + 1, 0.0f), v->light_sphere[i] = 1.0f;
+        v->light_sphere.push_back(sphere ? 1.0f : 0.0f);
         v->light_triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
         v->inv_area.push_back(1.0f / e.area);
       }
@@ -365,10 +364,8 @@ struct WavefrontTracer::VectorStages {
       sc.lights = {n_lights, lights.cdf().data(), lights.pmf().data(), v->inv_area.data(), v->light_triangle.data(),
                    v->light_columns.empty() ? nullptr : v->light_columns.data()};
       sc.lights.bvh = lights.light_sampler() == LightSamplerKind::Bvh;
-      if (!v->light_sphere.empty()) {
-        v->light_sphere.resize(n_lights, 0.0f);
+      if (std::find(v->light_sphere.begin(), v->light_sphere.end(), 1.0f) != v->light_sphere.end())
         sc.lights.sphere = v->light_sphere.data();
-      }
       if (const LightBvh* bvh = lights.bvh(); bvh && !bvh->empty()) {
         // The light BVH as the stages walk it (core/simd/light_bvh-inl.h).
         v->bvh_nodes = bvh->node_table();
