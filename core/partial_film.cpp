@@ -1,6 +1,7 @@
 #include "core/partial_film.h"
 
 #include "core/error.h"
+#include "core/json_number.h"
 #include "core/render.h"
 #include "core/temp_files.h"
 
@@ -317,10 +318,20 @@ PartialFilm read_partial_film(const fs::path& path) {
   const json h = json::parse(text, nullptr, false);
   if (h.is_discarded() || !h.is_object()) r.fail("its header is not JSON (corrupted)");
 
+  // Every count as the integer type it is kept in: a corrupted header's
+  // 8.9e68 or -1 is refused here, not converted.
+  const auto count = [&r]<std::integral T>(const json& v, const char* name, T) -> T {
+    const std::optional<T> n = json_integer<T>(v);
+    if (!n) r.fail(std::string(name) + " is " + v.dump() + ", not an integer from 0 to " +
+                   std::to_string(std::numeric_limits<T>::max()));
+    return *n;
+  };
+  const auto u32 = [&](const json& v, const char* name) { return count(v, name, std::uint32_t{}); };
+  const auto u64 = [&](const json& v, const char* name) { return count(v, name, std::uint64_t{}); };
   try {
-    if (h.at("format_version").get<int>() != kFormatVersion)
+    if (json_integer<int>(h.at("format_version")) != kFormatVersion)
       r.fail("format version " + h.at("format_version").dump() + ", this pathlab reads " + std::to_string(kFormatVersion));
-    const int width = h.at("width").get<int>(), height = h.at("height").get<int>();
+    const std::uint32_t width = u32(h.at("width"), "its width"), height = u32(h.at("height"), "its height");
     if (width < 1 || height < 1 || width > 65536 || height > 65536) r.fail("its resolution is out of range");
     const std::string filter = h.at("filter").get<std::string>(), moments = h.at("moments").get<std::string>();
     if ((filter != "box" && filter != "bilinear") || (moments != "mean" && moments != "mean_and_variance"))
@@ -334,38 +345,40 @@ PartialFilm read_partial_film(const fs::path& path) {
       r.fail("truncated: a " + std::to_string(width) + "x" + std::to_string(height) + " film needs " +
              std::to_string(pixels * words_per_pixel * 8) + " bytes of arrays, the file has " +
              std::to_string(r.size() - r.position()) + " after its header, checksum included");
-    PartialFilm result{Film(width, height, filter == "box" ? FilterKind::Box : FilterKind::Bilinear,
+    PartialFilm result{Film(static_cast<int>(width), static_cast<int>(height), filter == "box" ? FilterKind::Box : FilterKind::Bilinear,
                             moments == "mean" ? FilmMoments::Mean : FilmMoments::MeanAndVariance),
                        {}};
     PartialFilmInfo& pf = result.info;
-    pf.passes = {h.at("passes").at(0).get<std::uint32_t>(), h.at("passes").at(1).get<std::uint32_t>()};
+    pf.passes = {u32(h.at("passes").at(0), "its first pass"), u32(h.at("passes").at(1), "its pass range's end")};
     if (pf.passes.end < pf.passes.begin) r.fail("its pass range ends before it begins");
-    pf.target_spp = h.at("target_spp").get<std::uint32_t>();
-    pf.processes = h.at("processes").get<std::uint32_t>();
-    pf.resumes = h.at("resumes").get<std::uint32_t>();
+    pf.target_spp = u32(h.at("target_spp"), "target_spp");
+    pf.processes = u32(h.at("processes"), "processes");
+    pf.resumes = u32(h.at("resumes"), "resumes");
     pf.fingerprint.digest = h.at("fingerprint").at("digest").get<std::string>();
     pf.fingerprint.lines = h.at("fingerprint").at("lines").get<std::vector<std::string>>();
     const json& st = h.at("stats");
     pf.stats.seconds = std::strtod(st.at("seconds").get<std::string>().c_str(), nullptr);
-    pf.stats.samples = st.at("samples").get<std::uint64_t>();
-    pf.stats.rays = st.at("rays").get<std::uint64_t>();
-    pf.stats.clamped_samples = st.at("clamped_samples").get<std::uint64_t>();
+    pf.stats.samples = u64(st.at("samples"), "stats.samples");
+    pf.stats.rays = u64(st.at("rays"), "stats.rays");
+    pf.stats.clamped_samples = u64(st.at("clamped_samples"), "stats.clamped_samples");
     pf.stats.energy_total = parse_sum(st.at("energy_total"), r, "energy_total");
     pf.stats.energy_clamped = parse_sum(st.at("energy_clamped"), r, "energy_clamped");
     std::vector<BadSample> kept;
     for (const json& b : h.at("bad_samples")) {
       const json& L = b.at("L");
-      kept.push_back({b.at("x").get<std::uint32_t>(), b.at("y").get<std::uint32_t>(), b.at("sample").get<std::uint32_t>(),
+      kept.push_back({u32(b.at("x"), "a bad sample's x"), u32(b.at("y"), "a bad sample's y"),
+                      u32(b.at("sample"), "a bad sample's number"),
                       Spectrum(std::strtof(L.at(0).get<std::string>().c_str(), nullptr),
                                std::strtof(L.at(1).get<std::string>().c_str(), nullptr),
                                std::strtof(L.at(2).get<std::string>().c_str(), nullptr))});
     }
-    result.film.restore_counts(h.at("bad_sample_count").get<std::uint64_t>(), h.at("film_rays").get<std::uint64_t>(),
+    result.film.restore_counts(u64(h.at("bad_sample_count"), "bad_sample_count"), u64(h.at("film_rays"), "film_rays"),
                                std::move(kept));
     const Film::Words words = result.film.words();
     const json& counts = h.at("words");
-    if (counts.at(0).get<std::uint64_t>() != words.pixels.size() ||
-        counts.at(1).get<std::uint64_t>() != words.moments.size() || counts.at(2).get<std::uint64_t>() != words.splat.size())
+    if (json_integer<std::uint64_t>(counts.at(0)) != words.pixels.size() ||
+        json_integer<std::uint64_t>(counts.at(1)) != words.moments.size() ||
+        json_integer<std::uint64_t>(counts.at(2)) != words.splat.size())
       r.fail("its header's array sizes do not match its resolution, filter and moments");
     for (const std::span<std::uint64_t> a : {words.pixels, words.moments, words.splat}) r.read(a.data(), a.size_bytes());
     const std::string computed = hex128(r.digest());

@@ -1,6 +1,7 @@
 #include "debugtools/path_recorder.h"
 
 #include "core/error.h"
+#include "core/json_number.h"
 #include "core/light_sampler.h"
 #include "core/render.h"
 
@@ -242,13 +243,15 @@ struct JsonEvents {
   float num(const nlohmann::json& e, const char* key) const {
     const nlohmann::json& v = field(e, key);
     if (v.is_null()) return std::numeric_limits<float>::infinity();
-    if (!v.is_number()) fail(std::string("\"") + key + "\" is not a number");
-    return v.get<float>();
+    const std::optional<float> f = json_float(v);
+    if (!f) fail(std::string("\"") + key + "\" is " + v.dump() + ", not a number a float holds");
+    return *f;
   }
   int integer(const nlohmann::json& e, const char* key) const {
     const nlohmann::json& v = field(e, key);
-    if (!v.is_number_integer()) fail(std::string("\"") + key + "\" is not an integer");
-    return v.get<int>();
+    const std::optional<int> i = json_integer<int>(v);
+    if (!i) fail(std::string("\"") + key + "\" is " + v.dump() + ", not an integer an int holds");
+    return *i;
   }
   bool flag(const nlohmann::json& e, const char* key) const {
     const nlohmann::json& v = field(e, key);
@@ -257,9 +260,10 @@ struct JsonEvents {
   }
   vec3 v3(const nlohmann::json& e, const char* key) const {
     const nlohmann::json& v = field(e, key);
-    if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
-      fail(std::string("\"") + key + "\" is not [x, y, z]");
-    return vec3(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
+    if (!v.is_array() || v.size() != 3) fail(std::string("\"") + key + "\" is not [x, y, z]");
+    const std::optional<float> x = json_float(v[0]), y = json_float(v[1]), z = json_float(v[2]);
+    if (!x || !y || !z) fail(std::string("\"") + key + "\" is " + v.dump() + ", not three numbers floats hold");
+    return vec3(*x, *y, *z);
   }
   // A ray {origin, dir, tmax (null: unbounded)}; absent (a trace by a build
   // older than the field) or null (a light sample with no shadow ray): a
@@ -280,12 +284,14 @@ struct JsonEvents {
     const std::string type = text(e, "type");
     if (type == "camera") {
       const nlohmann::json& f = field(e, "film");
-      if (!f.is_array() || f.size() != 2) fail("\"film\" is not [x, y]");
+      const std::optional<float> fx = f.is_array() && f.size() == 2 ? json_float(f[0]) : std::nullopt;
+      const std::optional<float> fy = f.is_array() && f.size() == 2 ? json_float(f[1]) : std::nullopt;
+      if (!fx || !fy) fail("\"film\" is not [x, y] (two numbers floats hold)");
       CameraEvent c;
       c.x = pixel_x;
       c.y = pixel_y;
       c.sample = sample;
-      c.film = vec2(f[0].get<float>(), f[1].get<float>());
+      c.film = vec2(*fx, *fy);
       c.origin = v3(e, "origin");
       c.dir = v3(e, "dir");
       return c;
@@ -303,7 +309,10 @@ struct JsonEvents {
       h.shape = static_cast<std::uint32_t>(integer(e, "shape"));
       h.prim = static_cast<std::uint32_t>(integer(e, "prim"));
       const nlohmann::json& inst = field(e, "instance");
-      h.instance = inst.is_null() ? kNoInstance : inst.get<std::uint32_t>();
+      const std::optional<std::uint32_t> instance =
+          inst.is_null() ? std::optional<std::uint32_t>(kNoInstance) : json_integer<std::uint32_t>(inst);
+      if (!instance) fail("\"instance\" is " + inst.dump() + ", not null or an instance's number");
+      h.instance = *instance;
       h.emitted = v3(e, "emitted");
       h.emission_weight = num(e, "emission_weight");
       h.added = v3(e, "added");
@@ -398,8 +407,9 @@ std::vector<PathEvent> path_events_from_json(const nlohmann::json& doc, const Sc
     throw InputError(what + ": not a `pathlab trace-pixel --json` document (format \"pathlab-trace\")");
   JsonEvents parse{scene, what};
   const auto header_int = [&](const nlohmann::json& v, const char* key) {
-    if (!v.is_number_unsigned()) throw InputError(what + ": \"" + key + "\" is not a non-negative integer");
-    return v.get<std::uint32_t>();
+    const std::optional<std::uint32_t> n = json_integer<std::uint32_t>(v);
+    if (!n) throw InputError(what + ": \"" + key + "\" is " + v.dump() + ", not an integer from 0 to 4294967295");
+    return *n;
   };
   if (doc.contains("pixel")) {
     const nlohmann::json& px = doc.at("pixel");

@@ -223,6 +223,19 @@ TEST_F(PartialFilmFile, DamagedFilesAreRefusedNamingTheFileAndTheProblem) {
   };
   std::string flipped = bytes;
   flipped[bytes.size() / 2] = static_cast<char>(flipped[bytes.size() / 2] ^ 0x10);
+  // The header's text edited, its length kept right: a number no field's
+  // integer holds (8.9e68 as the width, once undefined behaviour found by the
+  // fuzzer; -1 as the target) is refused before anything is made of it.
+  const auto with_header = [&](const std::string& from, const std::string& to) {
+    std::uint64_t n = 0;
+    std::memcpy(&n, bytes.data() + 8, 8);
+    std::string header = bytes.substr(16, n);
+    const std::size_t at = header.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) header.replace(at, from.size(), to);
+    const std::uint64_t m = header.size();
+    return bytes.substr(0, 8) + std::string(reinterpret_cast<const char*>(&m), 8) + header + bytes.substr(16 + n);
+  };
   std::string header_flipped = bytes;
   header_flipped[40] = static_cast<char>(header_flipped[40] ^ 0x01);
   const struct {
@@ -237,6 +250,11 @@ TEST_F(PartialFilmFile, DamagedFilesAreRefusedNamingTheFileAndTheProblem) {
       {write("foreign.pfilm", std::string("\x89PNG\r\n\x1a\n") + std::string(100, 'x')), "not a pathlab partial film"},
       {write("longer.pfilm", bytes + "x"), "after its checksum"},
       {dir_ / "missing.pfilm", "does not exist"},
+      {write("width.pfilm", with_header("\"width\": 5", "\"width\": 8.88889e+68")),
+       "its width is 8.88889e+68, not an integer from 0 to 4294967295"},
+      {write("target.pfilm", with_header("\"target_spp\": 16", "\"target_spp\": -1")),
+       "target_spp is -1, not an integer"},
+      {write("version.pfilm", with_header("\"format_version\": 1", "\"format_version\": 1.0")), "format version 1.0"},
   };
   for (const auto& c : cases) {
     const std::string message = error_reading(c.file);

@@ -1,6 +1,7 @@
 // first_divergence compares every field of every event kind (label "unit"):
 // for each field, two event lists that differ in exactly that field are
 // reported at that event, with that field named in the reason.
+#include "core/error.h"
 #include "debugtools/path_compare.h"
 #include "debugtools/path_recorder.h"
 
@@ -211,6 +212,43 @@ TEST(PathCompare, EveryFieldSurvivesTheTraceJson) {
   forget_rays(forgotten);
   EXPECT_EQ(std::get<LightEvent>(forgotten[2]).ray.tmax, Ray{}.tmax);
   EXPECT_EQ(std::get<ScatterEvent>(forgotten[3]).next.dir, Ray{}.dir);
+}
+
+// A trace from another build is input: numbers no float or integer of its
+// field holds (2^40 as a vertex, 1e300 as a position, -1 as the pixel) are
+// refused naming the event and the key, not converted (undefined behaviour
+// for 1e300 as a float, a silent wrap for -1).
+TEST(PathCompare, TraceNumbersOutOfTheirTypesRangeAreRefused) {
+  Scene scene;
+  PathRecorder recorder;
+  const nlohmann::json good =
+      path_to_json(TraceHeader{"test", "reference", 3, 4, 5, RenderSettings{}, 8, 8}, recorder, scene);
+  const auto refusal = [&](const nlohmann::json& doc) -> std::string {
+    try {
+      path_events_from_json(doc, scene, "their.json");
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  nlohmann::json doc = good;
+  doc["events"] = nlohmann::json::array({{{"type", "end"}, {"vertex", 1}, {"reason", "escaped"}}});
+  EXPECT_EQ(refusal(doc), "");
+  doc["events"][0]["vertex"] = std::uint64_t{1} << 40;
+  EXPECT_NE(refusal(doc).find("their.json: events[0]: \"vertex\" is 1099511627776, not an integer"),
+            std::string::npos) << refusal(doc);
+  doc["events"] = nlohmann::json::array(
+      {{{"type", "camera"}, {"film", {0.5, 1e300}}, {"origin", {0, 0, 0}}, {"dir", {0, 0, 1}}}});
+  EXPECT_NE(refusal(doc).find("events[0]: \"film\" is not [x, y]"), std::string::npos) << refusal(doc);
+  doc["events"][0]["film"] = {0.5, 0.5};
+  EXPECT_EQ(refusal(doc), "");
+  doc["events"][0]["dir"] = {0, -1e39, 1};
+  EXPECT_NE(refusal(doc).find("events[0]: \"dir\" is [0,-1e+39,1], not three numbers"), std::string::npos)
+      << refusal(doc);
+  doc = good;
+  doc["pixel"] = {-1, 4};
+  EXPECT_NE(refusal(doc).find("their.json: \"pixel\" is -1, not an integer from 0"), std::string::npos)
+      << refusal(doc);
 }
 
 // Within the tolerance every field agrees; a vertex or kind change is
