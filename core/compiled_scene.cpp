@@ -140,19 +140,18 @@ void CompiledScene::local_shading(const Shape& shape, const RayHit& hit, const m
   *ns_sum = s->n;
   if (shape.kind == Shape::Kind::Triangles && (shape.mesh.has_normals() || shape.mesh.has_uvs())) {
     const glm::uvec3 v = shape.mesh.triangles[hit.prim];
-    const float b0 = 1.0f - hit.uv.x - hit.uv.y;
     s->uv = shape.mesh.uv_at(hit.prim, hit.uv);
     if (shape.mesh.has_normals()) {
       const std::vector<vec3>& n = shape.mesh.normals;
       if (to_normal == nullptr) {
-        *ns_sum = b0 * n[v.x] + hit.uv.x * n[v.y] + hit.uv.y * n[v.z];
+        *ns_sum = blend_normals(hit.uv, n[v.x], n[v.y], n[v.z]);
       } else {
         // The vertex normals placed first, then blended, as a copy of the
         // mesh placed by transform_mesh would blend them: under a
         // non-uniform scale, blending first and placing the sum points
         // elsewhere.
         const auto placed = [&](std::uint32_t i) { return glm::normalize(*to_normal * n[i]); };
-        *ns_sum = b0 * placed(v.x) + hit.uv.x * placed(v.y) + hit.uv.y * placed(v.z);
+        *ns_sum = blend_normals(hit.uv, placed(v.x), placed(v.y), placed(v.z));
       }
     }
   }

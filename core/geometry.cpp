@@ -196,13 +196,15 @@ float sphere_crossing(const vec3& origin, const vec3& dir, float tnear, float tf
   return kNone;
 }
 
+// The generic shading_normal (core/simd/lanes-inl.h) at width 1.
 vec3 shading_normal(const vec3& ng, const vec3& sum) {
-  const float length = glm::length(sum);
-  if (!(length > 1e-20f) || !std::isfinite(length)) return ng;
-  vec3 ns = sum / length;
-  float c = glm::dot(ns, ng);
-  if (c < 0.0f) ns = -ns, c = -c;
-  return c > 1.0f - 1e-6f ? ng : ns;
+  using namespace width1;
+  return scalars(generic::shading_normal(kScalar, lanes(ng), lanes(sum)));
+}
+
+vec3 blend_normals(vec2 b, const vec3& n0, const vec3& n1, const vec3& n2) {
+  using namespace width1;
+  return scalars(generic::blend_normals(kScalar, F{b.x}, F{b.y}, lanes(n0), lanes(n1), lanes(n2)));
 }
 
 SurfacePoint sample_triangle(const Triangle& t, vec2 u) { return triangle_point(t, square_to_uniform_triangle(u)); }

@@ -109,6 +109,7 @@ std::size_t lanes() { return 1; }
 using pathlab::HWY_NAMESPACE::add_sun;
 using pathlab::HWY_NAMESPACE::area_light_pdf;
 using pathlab::HWY_NAMESPACE::area_light_pdf_at;
+using pathlab::HWY_NAMESPACE::blend_normals;
 using pathlab::HWY_NAMESPACE::bvh_field;
 using pathlab::HWY_NAMESPACE::bvh_importance;
 using pathlab::HWY_NAMESPACE::bvh_split;
@@ -141,6 +142,7 @@ using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::piecewise_point;
 using pathlab::HWY_NAMESPACE::select;
+using pathlab::HWY_NAMESPACE::shading_normal;
 using pathlab::HWY_NAMESPACE::spawn_origin;
 using pathlab::HWY_NAMESPACE::spawn_to;
 using pathlab::HWY_NAMESPACE::sphere_point;
@@ -543,6 +545,17 @@ void prefetch_hits(const Scene& sc, const Wave& w) {
       __builtin_prefetch(p);       // p0 ...
       __builtin_prefetch(p + 11);  // ... n: a triangle may straddle two lines
     }
+    if (!sc.vertex_normals) continue;
+    // And the vertex normals of those whose frame resolve() makes (kNormalsAt).
+    const VI at = shape_int(mesh, sc, shape, kNormalsAt);
+    const M framed = hn::And(mesh, fmask(hn::Not(at < hn::Zero(DI()))));
+    hn::Store(hn::IfThenElse(hn::RebindMask(DI(), framed), at + load(w, kPrim, i0, framed), hn::Set(DI(), -1)), DI(), tri);
+    for (std::size_t j = 0; j < lanes(); ++j) {
+      if (tri[j] < 0) continue;
+      const float* n = sc.vertex_normals + 9 * static_cast<std::size_t>(tri[j]);
+      __builtin_prefetch(n);
+      __builtin_prefetch(n + 8);
+    }
   }
 }
 
@@ -604,8 +617,31 @@ void resolve(const Scene& sc, const Wave& w) {
       }
     }
     store_mask(w, kShadeByCore, i0, found, general);
-    // A frame of its own (kFramed) comes from core's resolve_shading; the lanes shade in it.
-    if (sc.framed) by_core = hn::Or(by_core, shape_flag(hn::AndNot(general, found), sc, shape, kFramed));
+    // A frame of its own (kFramed), which the lanes shade in: of vertex
+    // normals (kNormalsAt) made here as CompiledScene::resolve_shading makes
+    // it (blend_normals, shading_normal, Frame), of tangents by it.
+    if (sc.framed) {
+      const M framed = shape_flag(hn::AndNot(hn::Or(general, by_core), found), sc, shape, kFramed);
+      const VI normals_at = shape_int(framed, sc, shape, kNormalsAt);
+      const M here = hn::And(framed, fmask(hn::Not(normals_at < hn::Zero(DI()))));
+      by_core = hn::Or(by_core, hn::AndNot(here, framed));
+      if (!hn::AllFalse(df, here)) {
+        const VI tri = normals_at + load(w, kPrim, i0, here);
+        const V3 sum = blend_normals(df, load(w, kHitU, i0, here), load(w, kHitV, i0, here),
+                                     gather3(here, sc.vertex_normals, tri, 9, 0),
+                                     gather3(here, sc.vertex_normals, tri, 9, 3),
+                                     gather3(here, sc.vertex_normals, tri, 9, 6));
+        const V3 ns = shading_normal(df, n, sum);
+        V3 fs, ft;
+        frame(df, ns, fs, ft);
+        store3(w, kFsX, i0, here, fs);
+        store3(w, kFtX, i0, here, ft);
+        store3(w, kFnX, i0, here, ns);
+        // Surfel::shading_normal: ns != n.
+        store_mask(w, kShadingNormal, i0, here, hn::Or(ns.x != n.x, hn::Or(ns.y != n.y, ns.z != n.z)));
+        store_mask(w, kHasParams, i0, here, hn::FirstN(df, 0));
+      }
+    }
     if (sc.textured) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kTexturedEmission));
     for_each_lane(by_core, i0, [&](std::size_t i, std::size_t) { general_resolve(sc, w, i); });
   }

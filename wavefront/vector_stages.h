@@ -146,7 +146,8 @@ struct Scene {
   // resolve() keeps its shading frame from compiled->resolve() (kFsX...).
   bool general = false;
   // Some shape the lanes shade has a shading frame of its own (ShapeField
-  // kFramed): its hits' frames come from core (resolve), the rest is the lanes'.
+  // kFramed): made in resolve() from its vertex normals (kNormalsAt), or by
+  // core (resolve_shading) for a mesh with tangents; the rest is the lanes'.
   bool framed = false;
   // Some shape the lanes shade is a mirror or a dielectric (ShapeField
   // kLaneMaterial): else every lane shaded in the lanes is Lambert's or
@@ -192,7 +193,7 @@ struct Scene {
   // materials the lanes shade that have them, kEnergyFloats floats each
   // (EnergyField), at ShapeField kEnergy; null if none.
   const float* energy = nullptr;
-  // Per shape, 49 floats (ShapeField): its material's albedo, emission and
+  // Per shape, 50 floats (ShapeField): its material's albedo, emission and
   // flags, its first light entry, and its geometry.
   const float* shape = nullptr;
   // The same by column when there are at most 16 shapes (else null): field
@@ -200,6 +201,10 @@ struct Scene {
   const float* shape_columns = nullptr;
   // Every triangle (CompiledScene::triangles(): 12 floats each, p0 p1 p2 n).
   const float* triangles = nullptr;
+  // The vertex normals of each triangle of the kFramed meshes whose frames
+  // the lanes make (ShapeField kNormalsAt): 9 floats a triangle, n0 n1 n2
+  // (its vertices' Mesh::normals); null if there are none.
+  const float* vertex_normals = nullptr;
 };
 enum ShapeField : int {
   kAlbedo = 0,         // 3 floats
@@ -237,8 +242,11 @@ enum ShapeField : int {
   kClearcoatLog2A2 = 46,
   kEnergy = 47,            // bits of an int32: its energy tables' first float in Scene::energy, -1 if none
   kFramed = 48,            // 1 if the lanes shade it in a frame of its own (vertex normals, tangents), which
-                           // CompiledScene::resolve_shading makes path by path (kFsX..., kShadingNormal)
-  kShapeFields = 49,
+                           // resolve() makes from kNormalsAt or CompiledScene::resolve_shading path by path
+                           // (kFsX..., kShadingNormal)
+  kNormalsAt = 49,         // bits of an int32: a kFramed mesh's triangle 0 in Scene::vertex_normals, whose
+                           // vertex normals make its frame in the lanes; -1 if core makes it (tangents)
+  kShapeFields = 50,
 };
 
 // A Disney material's EnergyTables in Scene::energy.

@@ -168,7 +168,7 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table, energy, sun_table,
-      sky_starts, sky_entries, env_row_cdf, env_column_cdf, light_sphere;
+      sky_starts, sky_entries, env_row_cdf, env_column_cdf, light_sphere, vertex_normals;
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
   std::vector<std::string> general_materials, general;
@@ -380,7 +380,8 @@ struct WavefrontTracer::VectorStages {
       }
     }
     // Per shape: its material's parameters and its geometry.
-    // Gathers index these tables with 32-bit float indices: 49 per shape, 12 per triangle, 16 per light.
+    // Gathers index these tables with 32-bit float indices: 50 per shape, 12 per triangle (9 of vertex
+    // normals), 16 per light.
     if (compiled.triangles().size() >= (std::size_t{1} << 27)) return no("more than 2^27 triangles");
     if (scene.shapes.size() >= (std::size_t{1} << 24)) return no("more than 2^24 shapes");
     // The light pick's indices are floats (pick_cdf, core/simd/lights-inl.h).
@@ -405,11 +406,27 @@ struct WavefrontTracer::VectorStages {
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
       f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
       sc.one_sided = sc.one_sided || m.one_sided;
-      // A mesh with vertex normals or tangents has a shading frame of its own, made by core
-      // (CompiledScene::resolve_shading) path by path; the lanes shade it under Lambert or Disney, core's Surfel
-      // a mirror or glass (their side rules under a shading normal).
-      if (m.scatters() && in_lanes(m) && shading_frame(sh)) v->general.push_back("the shading frame of " + sh.description);
+      // A mesh with vertex normals or tangents has a shading frame of its own; the lanes shade it under Lambert
+      // or Disney, core's Surfel a mirror or glass (their side rules under a shading normal). The lanes make
+      // the frame of vertex normals (kNormalsAt), core (CompiledScene::resolve_shading) one of tangents.
       const bool framed = m.scatters() && !cosine && in_lanes(m) && shading_frame(sh) && !m.is_pure_impulse();
+      const bool normals_in_lanes = framed && sh.mesh.tangents.empty();
+      if (m.scatters() && in_lanes(m) && shading_frame(sh) && !normals_in_lanes)
+        v->general.push_back("the shading frame of " + sh.description);
+      f[vs::kNormalsAt] = std::bit_cast<float>(std::int32_t{-1});
+      if (normals_in_lanes) {
+        if (v->vertex_normals.size() / 9 + sh.mesh.triangles.size() >= (std::size_t{1} << 27))
+          return no("more than 2^27 triangles with vertex normals");
+        f[vs::kNormalsAt] = std::bit_cast<float>(static_cast<std::int32_t>(v->vertex_normals.size() / 9));
+        const std::size_t at = v->vertex_normals.size();
+        v->vertex_normals.resize(at + 9 * sh.mesh.triangles.size());
+        float* out = v->vertex_normals.data() + at;
+        parallel_for(0, sh.mesh.triangles.size(), 4096, [&](std::size_t b, std::size_t e) {
+          for (std::size_t t = b; t < e; ++t)
+            for (int k = 0; k < 3; ++k)
+              for (int c = 0; c < 3; ++c) out[9 * t + 3 * k + c] = sh.mesh.normals[sh.mesh.triangles[t][k]][c];
+        });
+      }
       const bool general = m.scatters() && (cosine || !in_lanes(m) || (shading_frame(sh) && !framed));
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
       f[vs::kFramed] = framed ? 1.0f : 0.0f;
@@ -475,6 +492,7 @@ struct WavefrontTracer::VectorStages {
     }
     static_assert(sizeof(Triangle) == 12 * sizeof(float));
     sc.triangles = compiled.triangles().empty() ? nullptr : &compiled.triangles().data()->p0.x;
+    sc.vertex_normals = v->vertex_normals.empty() ? nullptr : v->vertex_normals.data();
     // The camera.
     const Camera& camera = compiled.camera();
     const Camera::Plane p = camera.plane();

@@ -127,6 +127,7 @@ inline V<float> Abs(V<float> a) { return {std::fabs(a.raw)}; }
 inline V<float> Neg(V<float> a) { return {-a.raw}; }
 inline V<float> CopySign(V<float> magnitude, V<float> sign) { return {std::copysign(magnitude.raw, sign.raw)}; }
 inline M IsInf(V<float> a) { return {std::isinf(a.raw)}; }
+inline M IsFinite(V<float> a) { return {std::isfinite(a.raw)}; }
 
 // c one float up for o > 0, down for o < 0 (lanes-inl.h's StepAway) by
 // core/ray.h's scalar primitives, whose branches are cheaper at width 1

@@ -327,6 +327,31 @@ HWY_INLINE void sphere_point(D d, const Vec3<V>& center, V radius, M flip, const
   n = select(flip, -dir, dir);
 }
 
+// A mesh's vertex normals n0, n1, n2 blended by the barycentrics
+// (b0, b1, b2) of a hit, b0 = (1 - b1) - b2 (CompiledScene::local_shading):
+// (b0 n0 + b1 n1) + b2 n2, not normalised.
+template <class D, class V = VecOf<D>>
+HWY_INLINE Vec3<V> blend_normals(D d, V b1, V b2, const Vec3<V>& n0, const Vec3<V>& n1, const Vec3<V>& n2) {
+  const V b0 = Set(d, 1.0f) - b1 - b2;
+  return (b0 * n0 + b1 * n1) + b2 * n2;
+}
+
+// shading_normal (core/geometry.cpp): `sum` (blended vertex normals, or a
+// normal map's tilt) normalised and turned to the geometric normal ng's
+// side; ng itself where the sum has no direction (length at most 1e-20 or
+// not finite) or is within ~0.08 degrees of ng, so that a flat mesh's
+// normals change no bit.
+template <class D, class V = VecOf<D>>
+HWY_INLINE Vec3<V> shading_normal(D d, const Vec3<V>& ng, const Vec3<V>& sum) {
+  const V length = Sqrt(dot(sum, sum));
+  const auto usable = And(length > Set(d, 1e-20f), IsFinite(length));
+  const Vec3<V> unit = sum / length;
+  const V c = dot(unit, ng);
+  const auto below = c < Zero(d);
+  const V cos = IfThenElse(below, Neg(c), c);
+  return select(Or(Not(usable), cos > Set(d, 1.0f - 1e-6f)), ng, select(below, -unit, unit));
+}
+
 // n turned to wo's side, 0 where wo is edge-on: the normal of a light
 // query (light_query, core/light_sampler.h) and of the light BVH's.
 template <class D, class V = VecOf<D>>
