@@ -4,6 +4,7 @@
 #include "core/geometry.h"
 #include "core/parallel.h"
 #include "core/scene_limits.h"
+#include "core/simd/width1.h"
 #include "core/tangents.h"
 
 #include <algorithm>
@@ -16,16 +17,25 @@ namespace {
 // growing as PBR 4th ed. 6.8.6 derives: the rounding of the three products
 // and three sums, plus the transformed input error.
 void transform_point(const mat4& m, vec3* p, vec3* p_error) {
-  constexpr float g3 = gamma_bound(3);
-  const vec3 in = *p, e = *p_error;
-  vec3 out, err;
-  for (int r = 0; r < 3; ++r) {
-    out[r] = m[0][r] * in.x + m[1][r] * in.y + m[2][r] * in.z + m[3][r];
-    err[r] = (g3 + 1.0f) * (std::abs(m[0][r]) * e.x + std::abs(m[1][r]) * e.y + std::abs(m[2][r]) * e.z) +
-             g3 * (std::abs(m[0][r] * in.x) + std::abs(m[1][r] * in.y) + std::abs(m[2][r] * in.z) + std::abs(m[3][r]));
-  }
-  *p = out;
-  *p_error = err;
+  using namespace width1;
+  F3 out = lanes(*p), err = lanes(*p_error);
+  generic::transform_point(kScalar, lanes(vec3(m[0])), lanes(vec3(m[1])), lanes(vec3(m[2])), lanes(vec3(m[3])), out, err);
+  *p = scalars(out);
+  *p_error = scalars(err);
+}
+
+// The point p under an affine placement, as mat4 * vec4(p, 1) (the generic
+// affine_point, which the wavefront's lanes run).
+vec3 affine_point(const mat4& m, const vec3& p) {
+  using namespace width1;
+  return scalars(generic::affine_point(lanes(vec3(m[0])), lanes(vec3(m[1])), lanes(vec3(m[2])), lanes(vec3(m[3])),
+                                       lanes(p)));
+}
+
+// glm::normalize(to_normal * n), by the generic place_normal.
+vec3 place_normal(const mat3& to_normal, const vec3& n) {
+  using namespace width1;
+  return scalars(generic::place_normal(kScalar, lanes(to_normal[0]), lanes(to_normal[1]), lanes(to_normal[2]), lanes(n)));
 }
 
 // The loaders check what a file says; a scene built in code gets the same
@@ -150,7 +160,7 @@ void CompiledScene::local_shading(const Shape& shape, const RayHit& hit, const m
         // mesh placed by transform_mesh would blend them: under a
         // non-uniform scale, blending first and placing the sum points
         // elsewhere.
-        const auto placed = [&](std::uint32_t i) { return glm::normalize(*to_normal * n[i]); };
+        const auto placed = [&](std::uint32_t i) { return place_normal(*to_normal, n[i]); };
         *ns_sum = blend_normals(hit.uv, placed(v.x), placed(v.y), placed(v.z));
       }
     }
@@ -168,11 +178,11 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s, const 
     // same along the world ray.
     const Placement& place = placements_[hit.instance];
     const vec3 p_world = ray.origin + hit.t * ray.dir;
-    resolve_local(shape, hit, vec3(place.to_local * vec4(p_world, 1.0f)), &place.to_normal, s, &ns_sum);
+    resolve_local(shape, hit, affine_point(place.to_local, p_world), &place.to_normal, s, &ns_sum);
     transform_point(place.to_world, &s->p, &s->p_error);
     // Normals by the inverse transpose keep pointing to the image of their
     // side, so the front stays the front under a mirroring placement too.
-    s->n = glm::normalize(place.to_normal * s->n);
+    s->n = place_normal(place.to_normal, s->n);
   }
   shading_frame(shape, hit, ns_sum, s);
   if (textures_ && s->material->reads_textures_at_hits()) read_textures(shape, ray, hit, cone, params, s);

@@ -113,14 +113,16 @@ class CompiledScene {
     __builtin_prefetch(&triangles_[t].n);
   }
   void prefetch(const RayHit& hit) const { prefetch(hit.shape, hit.prim); }
-
- private:
   // An instance's transforms, as resolve() applies them.
   struct Placement {
     mat4 to_world;
     mat4 to_local;     // its inverse
     mat3 to_normal;    // the inverse transpose of to_world's linear part
   };
+  // Per instance (Scene::instances), in order.
+  std::span<const Placement> placements() const { return placements_; }
+
+ private:
   // The point, front normal and texture coordinates of a hit on `shape`, in
   // the shape's own space (`p_approx` is the hit point there: spheres
   // reproject it), and the unnormalised interpolated shading normal - in

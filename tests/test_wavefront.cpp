@@ -895,7 +895,7 @@ TEST(Wavefront, VectorisedForEverySceneAtAVectorTarget) {
   // Materials the lanes do not shade are shaded by core's Surfel between them.
   EXPECT_EQ(vectorised(cornell, Strategy::Mis, true), any);  // --general-shading
   EXPECT_EQ(vectorised(cornell_with_materials(), Strategy::Mis), any);
-  // Shading frames of their own (vertex normals, tangents): made by core, shaded in the lanes.
+  // Shading frames of their own, shaded in the lanes: of vertex normals made there, of tangents by core.
   EXPECT_EQ(vectorised(cornell_with_tangents(), Strategy::Mis), any);
   EXPECT_EQ(vectorised(test::cornell_with_smooth_sphere(), Strategy::Mis), any);
   // Lights the lanes do not sample (solid-angle sampling) are sampled by core's LightSampler between them; the
@@ -933,7 +933,7 @@ TEST(Wavefront, VectorisedForEverySceneAtAVectorTarget) {
                        Strategy::Mis),
             any);  // an environment, Disney, glass
   EXPECT_EQ(vectorised(test::cornell_with_textures(), Strategy::Mis), any);  // textures read by core, path by path
-  EXPECT_EQ(vectorised(test::cornell_with_instances(), Strategy::Mis), any);  // hits placed by core's resolve
+  EXPECT_EQ(vectorised(test::cornell_with_instances(), Strategy::Mis), any);  // hits placed in the lanes
 }
 
 // times() counts every ray the render counts, by kind, and the time inside

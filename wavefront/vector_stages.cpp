@@ -107,6 +107,7 @@ std::size_t lanes() { return 1; }
 #else
 
 using pathlab::HWY_NAMESPACE::add_sun;
+using pathlab::HWY_NAMESPACE::affine_point;
 using pathlab::HWY_NAMESPACE::area_light_pdf;
 using pathlab::HWY_NAMESPACE::area_light_pdf_at;
 using pathlab::HWY_NAMESPACE::blend_normals;
@@ -140,6 +141,7 @@ using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::NoEnergy;
 using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::pick_cdf;
+using pathlab::HWY_NAMESPACE::place_normal;
 using pathlab::HWY_NAMESPACE::piecewise_point;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::shading_normal;
@@ -152,6 +154,7 @@ using pathlab::HWY_NAMESPACE::thin_lens;
 using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
+using pathlab::HWY_NAMESPACE::transform_point;
 using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::uniform_sphere;
 using pathlab::HWY_NAMESPACE::uniform_triangle;
@@ -568,6 +571,16 @@ void resolve(const Scene& sc, const Wave& w) {
     if (hn::AllFalse(df, found)) continue;
     const VI shape = load(w, kShape, i0, found);
     const M sphere = shape_flag(found, sc, shape, kIsSphere), mesh = hn::AndNot(sphere, found);
+    // A hit on an instance (kInstance not kNoInstance, all ones) was found
+    // in its group's own space: resolved there, then placed by the
+    // instance's transforms, as CompiledScene::resolve does.
+    M placed = hn::FirstN(df, 0);
+    VI instance = hn::Zero(DI());
+    if (sc.instanced) {
+      instance = load(w, kInstance, i0, found);
+      placed = hn::And(found, fmask(instance != hn::Set(DI(), -1)));
+    }
+    const auto placement = [&](M m, int field) { return gather3(m, sc.placements, instance, kPlacementFloats, field); };
     V3 p = zero3(), error = zero3(), n = zero3();
     if (!hn::AllFalse(df, mesh)) {
       // triangle_point (core/geometry.cpp) of the shape's triangle prim.
@@ -581,21 +594,36 @@ void resolve(const Scene& sc, const Wave& w) {
       // sphere_point (core/geometry.cpp) of origin + t dir.
       const VF t = load(w, kHitT, i0, sphere);
       const V3 o = load3(w, kOx, i0, sphere), d = load3(w, kDx, i0, sphere);
+      V3 at = o + t * d;
+      if (const M local = hn::And(sphere, placed); !hn::AllFalse(df, local))
+        at = select(local,
+                    affine_point(placement(local, kToLocal), placement(local, kToLocal + 3), placement(local, kToLocal + 6),
+                                 placement(local, kToLocal + 9), at),
+                    at);
       V3 sp, serr, sn;
       sphere_point(df, shape_value3(sphere, sc, shape, kCenter), shape_value(sphere, sc, shape, kRadius),
-                   shape_flag(sphere, sc, shape, kFlipped), o + t * d, sp, serr, sn);
+                   shape_flag(sphere, sc, shape, kFlipped), at, sp, serr, sn);
       p = select(sphere, sp, p);
       error = select(sphere, serr, error);
       n = select(sphere, sn, n);
     }
+    // The instances' hits placed: the point and its error bound by
+    // transform_point, the normals by the inverse transpose (place_normal).
+    V3 to_normal[3] = {zero3(), zero3(), zero3()};
+    if (!hn::AllFalse(df, placed)) {
+      V3 pp = p, pe = error;
+      transform_point(df, placement(placed, kToWorld), placement(placed, kToWorld + 3), placement(placed, kToWorld + 6),
+                      placement(placed, kToWorld + 9), pp, pe);
+      for (int c = 0; c < 3; ++c) to_normal[c] = placement(placed, kToNormal + 3 * c);
+      p = select(placed, pp, p);
+      error = select(placed, pe, error);
+      n = select(placed, place_normal(df, to_normal[0], to_normal[1], to_normal[2], n), n);
+    }
     store3(w, kPx, i0, found, p);
     store3(w, kErrX, i0, found, error);
     store3(w, kNx, i0, found, n);
-    // By core, path by path: a hit on an instance (found in the group's own
-    // space; kInstance is not kNoInstance, all ones), and the shading frame
-    // of a shape the lanes do not shade.
+    // By core, path by path: the hits whose Surfel core makes (below).
     M by_core = hn::FirstN(df, 0);
-    if (sc.instanced) by_core = hn::And(found, fmask(load(w, kInstance, i0, found) != hn::Set(DI(), -1)));
     // A normal that is not finite (a sliver's): resolve() marks its Surfel
     // shading_normal (NaN != NaN), and Surfel then absorbs the path. The
     // lanes leave such hits, like every kGeneral shape's, to core's Surfel.
@@ -627,10 +655,12 @@ void resolve(const Scene& sc, const Wave& w) {
       by_core = hn::Or(by_core, hn::AndNot(here, framed));
       if (!hn::AllFalse(df, here)) {
         const VI tri = normals_at + load(w, kPrim, i0, here);
-        const V3 sum = blend_normals(df, load(w, kHitU, i0, here), load(w, kHitV, i0, here),
-                                     gather3(here, sc.vertex_normals, tri, 9, 0),
-                                     gather3(here, sc.vertex_normals, tri, 9, 3),
-                                     gather3(here, sc.vertex_normals, tri, 9, 6));
+        V3 vn[3];
+        for (int k = 0; k < 3; ++k) vn[k] = gather3(here, sc.vertex_normals, tri, 9, 3 * k);
+        // On an instance, each placed first (CompiledScene::local_shading).
+        if (const M on = hn::And(here, placed); !hn::AllFalse(df, on))
+          for (V3& v : vn) v = select(on, place_normal(df, to_normal[0], to_normal[1], to_normal[2], v), v);
+        const V3 sum = blend_normals(df, load(w, kHitU, i0, here), load(w, kHitV, i0, here), vn[0], vn[1], vn[2]);
         const V3 ns = shading_normal(df, n, sum);
         V3 fs, ft;
         frame(df, ns, fs, ft);

@@ -169,7 +169,9 @@ struct Scene {
   bool sky = false;
   Sky skies;
   // The scene places shapes by instances: hits on them (kInstance set) are
-  // resolved by compiled->resolve(), path by path.
+  // resolved in their group's space and placed by `placements`, in the
+  // lanes as CompiledScene::resolve does (by it, path by path, where it
+  // resolves the hit anyway: textures, tangents).
   bool instanced = false;
   // Some material has alpha: every ray carries its alpha key (kAlphaKey,
   // kQAlphaKey) into Embree, whose filter decides (core/alpha.h).
@@ -205,6 +207,17 @@ struct Scene {
   // the lanes make (ShapeField kNormalsAt): 9 floats a triangle, n0 n1 n2
   // (its vertices' Mesh::normals); null if there are none.
   const float* vertex_normals = nullptr;
+  // Per instance, kPlacementFloats floats (PlacementField): its
+  // CompiledScene::Placement; null without instances.
+  const float* placements = nullptr;
+};
+// An instance's transforms (CompiledScene::Placement) by GLM's columns,
+// their first three rows.
+enum PlacementField : int {
+  kToWorld = 0,     // 4 columns of 3 floats: x, y, z, the translation
+  kToLocal = 12,    // its inverse, the same way
+  kToNormal = 24,   // 3 columns of 3 floats: the inverse transpose of to_world's linear part
+  kPlacementFloats = 33,
 };
 enum ShapeField : int {
   kAlbedo = 0,         // 3 floats

@@ -168,7 +168,7 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table, energy, sun_table,
-      sky_starts, sky_entries, env_row_cdf, env_column_cdf, light_sphere, vertex_normals;
+      sky_starts, sky_entries, env_row_cdf, env_column_cdf, light_sphere, vertex_normals, placements;
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
   std::vector<std::string> general_materials, general;
@@ -216,9 +216,19 @@ struct WavefrontTracer::VectorStages {
       diffuse = &m;
     }
     if (diffuse) sc.min_pdf = diffuse->shading.min_pdf;
-    // Hits on instances are placed by CompiledScene::resolve, path by path.
+    // Hits on instances are placed in the lanes by their instance's transforms (PlacementField).
     sc.instanced = !scene.instances.empty();
-    if (sc.instanced) v->general.push_back("the hit points on instances");
+    if (sc.instanced) {
+      if (compiled.placements().size() >= (std::size_t{1} << 26)) return no("more than 2^26 instances");
+      const auto column = [&](const auto& c) { v->placements.insert(v->placements.end(), {c.x, c.y, c.z}); };
+      for (const CompiledScene::Placement& pl : compiled.placements()) {
+        for (int c = 0; c < 4; ++c) column(pl.to_world[c]);
+        for (int c = 0; c < 4; ++c) column(pl.to_local[c]);
+        for (int c = 0; c < 3; ++c) column(pl.to_normal[c]);
+      }
+      static_assert(vs::kToLocal == 12 && vs::kToNormal == 24 && vs::kPlacementFloats == 33);
+      sc.placements = v->placements.data();
+    }
     // Alpha is decided inside Embree by the rays' keys, which the lanes make too.
     sc.alpha = compiled.has_alpha();
     // Textured materials and normal maps are shaded by core's Surfel (their

@@ -304,6 +304,36 @@ HWY_INLINE void triangle_point(D d, V b1, V b2, const Vec3<V>& p0, const Vec3<V>
   error = Set(d, gamma_bound(7)) * ((abs(a0) + abs(a1)) + abs(a2));
 }
 
+// An instance's placement (CompiledScene::resolve) is an affine map given by
+// the columns c0, c1, c2 (its linear part) and c3 (its translation) of a
+// GLM mat4, or a linear one by the columns of a mat3.
+//
+// The point p under it as GLM's mat4 * vec4(p, 1) rounds it:
+// (c0 x + c1 y) + (c2 z + c3 1).
+template <class V>
+HWY_INLINE Vec3<V> affine_point(const Vec3<V>& c0, const Vec3<V>& c1, const Vec3<V>& c2, const Vec3<V>& c3,
+                                const Vec3<V>& p) {
+  return (p.x * c0 + p.y * c1) + (p.z * c2 + c3);
+}
+// transform_point (core/compiled_scene.cpp): p placed, ((c0 x + c1 y) +
+// c2 z) + c3, and its error bound grown by the placement's rounding (PBR 4th
+// ed. 6.8.3): (gamma(3) + 1) (|c0| e.x + |c1| e.y + |c2| e.z) +
+// gamma(3) (|c0 x| + |c1 y| + |c2 z| + |c3|).
+template <class D, class V = VecOf<D>>
+HWY_INLINE void transform_point(D d, const Vec3<V>& c0, const Vec3<V>& c1, const Vec3<V>& c2, const Vec3<V>& c3,
+                                Vec3<V>& p, Vec3<V>& error) {
+  const Vec3<V> a0 = p.x * c0, a1 = p.y * c1, a2 = p.z * c2, e = error;
+  p = ((a0 + a1) + a2) + c3;
+  error = Set(d, gamma_bound(3) + 1.0f) * ((e.x * abs(c0) + e.y * abs(c1)) + e.z * abs(c2)) +
+          Set(d, gamma_bound(3)) * (((abs(a0) + abs(a1)) + abs(a2)) + abs(c3));
+}
+// A normal placed by the inverse transpose (columns c0, c1, c2) and made
+// unit again: glm::normalize(to_normal * n).
+template <class D, class V = VecOf<D>>
+HWY_INLINE Vec3<V> place_normal(D d, const Vec3<V>& c0, const Vec3<V>& c1, const Vec3<V>& c2, const Vec3<V>& n) {
+  return normalize(d, to_world(c0, c1, c2, n.x, n.y, n.z));
+}
+
 // square_to_uniform_triangle (core/sampling.cpp): barycentrics (b1, b2) =
 // (uy sqrt(ux), 1 - sqrt(ux)).
 template <class D, class V = VecOf<D>>
