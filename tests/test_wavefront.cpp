@@ -116,6 +116,24 @@ Scene cornell_with_framed_velvet() {
 // The Cornell box with a smooth UV sphere (vertex normals: a shading normal
 // at almost every hit) of an anisotropic clear-coated Disney plastic, shaded
 // in the lanes in the frame core interpolated (kFramed).
+// The Cornell box with a smooth glass sphere (vertex normals, 24 rings) and
+// a coarse smooth mirror sphere (8 rings: shading normals far from the
+// facets'), shaded in the lanes in the frames resolve() made there, with
+// Surfel's rules under a shading normal (the dielectric's wo on one side of
+// both normals; reflection on wo's geometric side, transmission across).
+Scene cornell_with_smooth_impulses() {
+  Scene s = test::cornell_with_smooth_sphere();
+  s.shapes.back().material = add_material(s, dielectric_material({}), "glass");
+  Shape ball;
+  ball.description = "coarse smooth mirror sphere";
+  ball.mesh = test::uv_sphere(vec3(0.35f, -0.6f, -0.25f), 0.35f, 8);
+  Material mirror = diffuse_material(Spectrum(0.9f, 0.85f, 0.8f));
+  mirror.type = MaterialType::Mirror;
+  ball.material = add_material(s, std::move(mirror), "mirror");
+  s.shapes.push_back(std::move(ball));
+  return s;
+}
+
 Scene cornell_with_smooth_plastic() {
   Scene s = test::cornell_with_smooth_sphere();
   DisneyParams plastic;
@@ -233,6 +251,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "bulb"      ? cornell_with_bulb()
             : c.scene == "sky"       ? cornell_with_sky()
             : c.scene == "smooth-plastic" ? cornell_with_smooth_plastic()
+            : c.scene == "smooth-impulses" ? cornell_with_smooth_impulses()
             : c.scene == "sky-image" ? cornell_with_sky_image()
             : c.scene == "patchy-sky" ? cornell_with_patchy_sky()
                                      : load_scene(std::filesystem::path(PATHLAB_SOURCE_DIR) / "analytic-scenes" / c.scene);
@@ -779,6 +798,10 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"smooth-plastic", st, 0.0f, 0});
   cases.push_back({"smooth-plastic", Strategy::Mis, 0.0f, -1, true, true, true, true, true, 0, true});
+  // Smooth glass and a smooth mirror: impulses in a frame of their own (vertex normals), in the lanes.
+  for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"smooth-impulses", st, 0.0f, 0});
+  cases.push_back({"smooth-impulses", Strategy::Mis, 0.0f, -1, true, true, true, true, true, 0, true});
   // Lights in the lanes beside the Cornell box's triangles: the sky (an environment image, a constant environment,
   // a sun disk) and sphere lights sampled by area (seen from outside: "bulb"; from inside: the rooms of
   // mirror-sphere-gray-room and white-sphere-emissive-room); under solid-angle sampling by core's LightSampler.

@@ -1454,8 +1454,9 @@ void scatter(const Scene& sc, const Wave& w) {
         ok = hn::AndNot(hn::AndNot(drawn, dm), ok);
       });
     }
-    // Surfel::scatter under a shading normal: wi on wo's geometric side.
-    if (!hn::AllFalse(df, framed)) ok = hn::AndNot(across_geometric_sides(w, i0, framed, dot(wo, n), dot(wi, n)), ok);
+    // Surfel::scatter under a shading normal: wi on wo's geometric side (the impulses' rule below).
+    if (const M lobes = hn::AndNot(im, framed); !hn::AllFalse(df, lobes))
+      ok = hn::AndNot(across_geometric_sides(w, i0, lobes, dot(wo, n), dot(wi, n)), ok);
     if (!hn::AllFalse(df, im)) {
       // Surfel::scatter_in_frame of a mirror (wo's side up, as the
       // reflection models take it) and of a dielectric (the frame as is).
@@ -1473,10 +1474,10 @@ void scatter(const Scene& sc, const Wave& w) {
         pdf = hn::IfThenElse(mirror, pdf_m, pdf);
         ok = hn::AndNot(hn::AndNot(mirrored, mirror), ok);
       }
+      M transmitted = hn::FirstN(df, 0);
       if (!hn::AllFalse(df, glass)) {
         V3 local_g, weight_g;
         VF pdf_g;
-        M transmitted;
         const M crossed = dielectric_sample(df, shape_value(glass, sc, shape, kIor),
                                             shape_value3(glass, sc, shape, kReflectance),
                                             shape_value3(glass, sc, shape, kTransmittance), u_lobe, wo_local, local_g,
@@ -1485,6 +1486,21 @@ void scatter(const Scene& sc, const Wave& w) {
         weight = select(glass, weight_g, weight);
         pdf = hn::IfThenElse(glass, pdf_g, pdf);
         ok = hn::AndNot(hn::AndNot(crossed, glass), ok);
+        transmitted = hn::And(glass, transmitted);
+      }
+      // Surfel::scatter under a shading normal (kFramed): a dielectric
+      // tells inside from outside by wo's side, which must be its side of
+      // both normals; wi on wo's geometric side, or across it if
+      // transmitted (geometric_side_ok).
+      if (const M fim = hn::And(load_mask(w, kShadingNormal, i0, hn::And(framed, im)), hn::And(framed, im));
+          !hn::AllFalse(df, fim)) {
+        const VF wo_z = dot(wo, n), wi_z = dot(wi, n);
+        const auto differ = [](M a, M b) { return hn::Or(hn::AndNot(a, b), hn::AndNot(b, a)); };
+        const M inside_out = hn::And(glass, differ(wo_z < k(0.0f), dot(wo, fn) < k(0.0f)));
+        const M across = hn::And(differ(wi_z < k(0.0f), wo_z < k(0.0f)),
+                                 hn::And(hn::Not(wi_z == k(0.0f)), hn::Not(wo_z == k(0.0f))));
+        const M sides_ok = hn::Or(hn::And(transmitted, across), hn::AndNot(transmitted, wi_z * wo_z > k(0.0f)));
+        ok = hn::AndNot(hn::And(fim, hn::Or(inside_out, hn::Not(sides_ok))), ok);
       }
       impulse = im;
     }

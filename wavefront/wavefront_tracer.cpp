@@ -416,10 +416,10 @@ struct WavefrontTracer::VectorStages {
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
       f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
       sc.one_sided = sc.one_sided || m.one_sided;
-      // A mesh with vertex normals or tangents has a shading frame of its own; the lanes shade it under Lambert
-      // or Disney, core's Surfel a mirror or glass (their side rules under a shading normal). The lanes make
-      // the frame of vertex normals (kNormalsAt), core (CompiledScene::resolve_shading) one of tangents.
-      const bool framed = m.scatters() && !cosine && in_lanes(m) && shading_frame(sh) && !m.is_pure_impulse();
+      // A mesh with vertex normals or tangents has a shading frame of its own, which the lanes shade in (with
+      // Surfel's rules under a shading normal). The lanes make the frame of vertex normals (kNormalsAt), core
+      // (CompiledScene::resolve_shading) one of tangents.
+      const bool framed = m.scatters() && !cosine && in_lanes(m) && shading_frame(sh);
       const bool normals_in_lanes = framed && sh.mesh.tangents.empty();
       if (m.scatters() && in_lanes(m) && shading_frame(sh) && !normals_in_lanes)
         v->general.push_back("the shading frame of " + sh.description);
