@@ -32,6 +32,7 @@
 #include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"
 #include "core/simd/sobol-inl.h"
+#include "core/material.h"
 #include "core/rng.h"
 #include "core/scene.h"
 #include "wavefront/vector_stages.h"
@@ -1149,6 +1150,55 @@ ClosureLanes<VF> closure_lanes(M m, const Scene& sc, VI shape) {
           f(kClearcoat),  f(kClearcoatAlpha), f(kClearcoatLogA2), f(kClearcoatLog2A2)};
 }
 
+// A textured material's hit (Scene::textured) carries its parameters in its
+// slot's SurfaceParams (Wave::params), which core's resolve evaluated from
+// its textures: the float at byte `offset` there, for the lanes of m.
+VF param(const Wave& w, std::size_t i0, M m, std::size_t offset) {
+  static_assert(sizeof(SurfaceParams) % sizeof(float) == 0 && alignof(SurfaceParams) >= alignof(float));
+  const VI slot = hn::Iota(DI(), static_cast<std::int32_t>(i0));
+  return gather(m, reinterpret_cast<const float*>(w.params), slot, static_cast<int>(sizeof(SurfaceParams) / sizeof(float)),
+                static_cast<int>(offset / sizeof(float)));
+}
+V3 param3(const Wave& w, std::size_t i0, M m, std::size_t offset) {
+  return {param(w, i0, m, offset), param(w, i0, m, offset + 4), param(w, i0, m, offset + 8)};
+}
+// The lanes of `framed` (a frame of their own: kFramed, not core's to
+// shade) whose Surfel reads its parameters from Wave::params.
+M textured_lanes(const Scene& sc, const Wave& w, std::size_t i0, M framed) {
+  if (!sc.textured || hn::AllFalse(DF(), framed)) return hn::FirstN(DF(), 0);
+  return load_mask(w, kHasParams, i0, framed);
+}
+// Surfel's MaterialView for the lanes of m: the Lambert albedo, and the
+// Disney closure, of each lane's shape, or of its slot's SurfaceParams in
+// the lanes of `textured`.
+V3 albedo_lanes(M m, const Scene& sc, const Wave& w, std::size_t i0, VI shape, M textured) {
+  const V3 albedo = shape_value3(m, sc, shape, kAlbedo);
+  if (hn::AllFalse(DF(), textured)) return albedo;
+  return select(textured, param3(w, i0, textured, offsetof(SurfaceParams, albedo)), albedo);
+}
+ClosureLanes<VF> closure_lanes(M m, const Scene& sc, const Wave& w, std::size_t i0, VI shape, M textured) {
+  ClosureLanes<VF> c = closure_lanes(m, sc, shape);
+  const M t = hn::And(m, textured);
+  if (hn::AllFalse(DF(), t)) return c;
+  constexpr std::size_t at = offsetof(SurfaceParams, closure);
+  using disney::Closure;
+  const auto one = [&](VF& v, std::size_t offset) { v = hn::IfThenElse(t, param(w, i0, t, at + offset), v); };
+  const auto three = [&](V3& v, std::size_t offset) { v = select(t, param3(w, i0, t, at + offset), v); };
+  three(c.diffuse, offsetof(Closure, diffuse));
+  one(c.roughness, offsetof(Closure, roughness));
+  one(c.subsurface, offsetof(Closure, subsurface));
+  three(c.sheen, offsetof(Closure, sheen));
+  one(c.specular, offsetof(Closure, specular));
+  three(c.spec0, offsetof(Closure, spec0));
+  one(c.ax, offsetof(Closure, ax));
+  one(c.ay, offsetof(Closure, ay));
+  one(c.clearcoat, offsetof(Closure, clearcoat));
+  one(c.clearcoat_alpha, offsetof(Closure, clearcoat_alpha));
+  one(c.clearcoat_log_a2, offsetof(Closure, clearcoat_log_a2));
+  one(c.clearcoat_log2_a2, offsetof(Closure, clearcoat_log2_a2));
+  return c;
+}
+
 // Energy compensation's layers for the lanes of `on` (disney-inl.h's
 // Energy), from their materials' tables in Scene::energy (`base`: each
 // lane's first float there).
@@ -1240,7 +1290,9 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), wo_z > k(0.0f)));
   // In the geometric normal's frame, or the hit's own (kFramed).
   V3 fs, ft, fn, wo_local, wi_local;
-  if (const M framed = shading_frame(sc, w, i0, ok, shape, n, fs, ft, fn); !hn::AllFalse(df, framed)) {
+  const M framed = shading_frame(sc, w, i0, ok, shape, n, fs, ft, fn);
+  const M textured = textured_lanes(sc, w, i0, framed);
+  if (!hn::AllFalse(df, framed)) {
     // Surfel::eval: a one-sided material's wi in front too (not implied by wo's side in a frame of its own), and
     // under a shading normal wo and wi on one geometric side.
     const VF wi_z = dot(wi, n);
@@ -1249,7 +1301,7 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
     ok = hn::AndNot(across_geometric_sides(w, i0, framed, wo_z, wi_z), ok);
   }
   to_local_upper(df, fs, ft, fn, wo, wi, wo_local, wi_local);
-  lambert_eval(df, shape_value3(ok, sc, shape, kAlbedo), wi_local.z, f, pdf_bsdf);
+  lambert_eval(df, albedo_lanes(ok, sc, w, i0, shape, textured), wi_local.z, f, pdf_bsdf);
   if (sc.impulses) {
     // A mirror's or a dielectric's f and pdf are 0 towards every direction (Surfel::eval, Surfel::pdf).
     const M lambert = shape_value(ok, sc, shape, kLaneMaterial) == k(static_cast<float>(kLaneLambert));
@@ -1258,7 +1310,7 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   }
   if (const M dm = disney_lanes(hn::AndNot(load_mask(w, kShadeByCore, i0, ok), ok), sc, shape); !hn::AllFalse(df, dm)) {
     // Surfel::eval and Surfel::pdf of a Disney material (disney::eval, disney::pdf).
-    const ClosureLanes<VF> c = closure_lanes(dm, sc, shape);
+    const ClosureLanes<VF> c = closure_lanes(dm, sc, w, i0, shape, textured);
     with_disney_model(dm, sc, shape, [&](auto lobes, const auto& energy) {
       constexpr unsigned F = decltype(lobes)::value;
       f = select(dm, disney_eval<F>(df, c, wo_local, wi_local, energy, {}), f);
@@ -1426,9 +1478,10 @@ void scatter(const Scene& sc, const Wave& w) {
     // The geometric normal's frame, or the hit's own (kFramed).
     V3 fs, ft, fn;
     const M framed = shading_frame(sc, w, i0, ok, shape, n, fs, ft, fn);
+    const M textured = textured_lanes(sc, w, i0, framed);
     const VF side = hn::IfThenElse(dot(wo, fn) < k(0.0f), k(-1.0f), k(1.0f));
     V3 wi = to_world(fs, ft, fn, local.x, local.y, local.z * side);
-    V3 weight = shape_value3(ok, sc, shape, kAlbedo);
+    V3 weight = albedo_lanes(ok, sc, w, i0, shape, textured);
     M impulse = hn::FirstN(df, 0);
     const M im = hn::And(impulses, ok), g = hn::And(general, ok), dm = hn::And(disneys, ok);
     // The lobe choice, drawn once for the impulses' lanes, the Disney lanes and core's.
@@ -1437,7 +1490,7 @@ void scatter(const Scene& sc, const Wave& w) {
       // Surfel::scatter_in_frame of a Disney material (wo's side up, as the
       // reflection models take it): a direction from the lobes' mixture,
       // weighted by f cos over the mixture's density there (scatter_closure).
-      const ClosureLanes<VF> c = closure_lanes(dm, sc, shape);
+      const ClosureLanes<VF> c = closure_lanes(dm, sc, w, i0, shape, textured);
       const V3 wo_local = to_local(fs, ft, fn, wo);
       const V3 wo_up{wo_local.x, wo_local.y, wo_local.z * side};
       with_disney_model(dm, sc, shape, [&](auto lobes, const auto& energy) {

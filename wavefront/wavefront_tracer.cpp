@@ -397,6 +397,7 @@ struct WavefrontTracer::VectorStages {
     // The light pick's indices are floats (pick_cdf, core/simd/lights-inl.h).
     if (sc.lights.count > kMaxExactFloatIndex || sc.deltas.count > kMaxExactFloatIndex) return no("more than 2^24 lights");
     std::vector<std::int32_t> energy_at;  // per material: its tables' offset in v->energy, -1 if not there yet
+    std::vector<std::string> textured_names;  // materials the lanes shade whose textures core reads at hits
     for (std::uint32_t i = 0; i < scene.shapes.size(); ++i) {
       const Shape& sh = scene.shapes[i];
       const Material& m = scene.materials[sh.material];
@@ -419,10 +420,18 @@ struct WavefrontTracer::VectorStages {
       // A mesh with vertex normals or tangents has a shading frame of its own, which the lanes shade in (with
       // Surfel's rules under a shading normal). The lanes make the frame of vertex normals (kNormalsAt), core
       // (CompiledScene::resolve_shading) one of tangents.
-      const bool framed = m.scatters() && !cosine && in_lanes(m) && shading_frame(sh);
-      const bool normals_in_lanes = framed && sh.mesh.tangents.empty();
-      if (m.scatters() && in_lanes(m) && shading_frame(sh) && !normals_in_lanes)
+      // A textured material's too: core's resolve reads its textures (and normal map) at the hit into the
+      // slot's SurfaceParams and frame, which the lanes shade with.
+      const bool reads_textures = m.reads_textures_at_hits();
+      const bool framed = m.scatters() && !cosine && in_lanes(m) && (shading_frame(sh) || reads_textures);
+      const bool normals_in_lanes = framed && sh.mesh.tangents.empty() && !reads_textures;
+      if (m.scatters() && in_lanes(m) && reads_textures) {
+        const std::string name = "'" + m.name + "'";
+        if (std::find(textured_names.begin(), textured_names.end(), name) == textured_names.end())
+          textured_names.push_back(name);
+      } else if (m.scatters() && in_lanes(m) && shading_frame(sh) && !normals_in_lanes) {
         v->general.push_back("the shading frame of " + sh.description);
+      }
       f[vs::kNormalsAt] = std::bit_cast<float>(std::int32_t{-1});
       if (normals_in_lanes) {
         if (v->vertex_normals.size() / 9 + sh.mesh.triangles.size() >= (std::size_t{1} << 27))
@@ -468,7 +477,8 @@ struct WavefrontTracer::VectorStages {
       f[vs::kClearcoatLogA2] = c.clearcoat_log_a2;
       f[vs::kClearcoatLog2A2] = c.clearcoat_log2_a2;
       f[vs::kEnergy] = std::bit_cast<float>(std::int32_t{-1});
-      if (m.type == MaterialType::Disney && c.energy.on && !general) {
+      // (A textured material's Surfel reads the closure core evaluated per hit, which has no tables.)
+      if (m.type == MaterialType::Disney && c.energy.on && !general && !m.is_textured()) {
         // Its energy tables, once per material.
         const std::size_t mi = static_cast<std::size_t>(&m - scene.materials.data());
         if (energy_at.size() <= mi) energy_at.resize(scene.materials.size(), -1);
@@ -484,6 +494,12 @@ struct WavefrontTracer::VectorStages {
       sc.general = sc.general || general;
       sc.impulses = sc.impulses || (m.scatters() && !general && m.is_pure_impulse());
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
+    }
+    if (!textured_names.empty()) {
+      std::string what = "the texture reads (and shading frames) at hits on ";
+      for (std::size_t i = 0; i < textured_names.size(); ++i)
+        what += (i == 0 ? "" : i + 1 == textured_names.size() ? " and " : ", ") + textured_names[i];
+      v->general.push_back(what);
     }
     static_assert(vs::kEnergyCoat == 3 * disney::kEnergyTableSize &&
                   vs::kEnergyDiffuseScale == vs::kEnergyCoat + disney::kEnergyTableSize &&
@@ -517,10 +533,13 @@ struct WavefrontTracer::VectorStages {
 
   // Whether the lanes shade m: Lambert, by lambert.h (every shading path but
   // General, which shades it through the Disney closure; core/surfel.cpp),
-  // a mirror (mirror.h) or a dielectric (dielectric.h); untextured.
+  // or Disney (VNDF), textured or not (core's resolve reads the textures and
+  // normal map into the hit's SurfaceParams and frame); an untextured mirror
+  // (mirror.h) or dielectric (dielectric.h).
   static bool in_lanes(const Material& m) {
+    if (m.is_pure_impulse()) return !m.is_textured() && !m.normal_map;
     const bool lambert = m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General;
-    return (lambert || m.is_pure_impulse() || disney_features(m) != 0) && !m.is_textured() && !m.normal_map;
+    return lambert || disney_features(m) != 0;
   }
   // The lobes the lanes shade a Disney material with (Scene::disney): those
   // of the scene's shading path, under VNDF sampling (cospow.h's lobes are
