@@ -109,9 +109,10 @@ Spectrum Surfel::emitted(const vec3& wo) const {
 // needs wi and wo on the same side of the geometric surface, a transmission
 // opposite sides. Without one the shading frame is the geometric frame and
 // the lobes' own hemisphere tests already say the same.
+// The generic geometric_side_ok (core/simd/lanes-inl.h) at width 1.
 bool geometric_side_ok(const vec3& n, const vec3& wi, const vec3& wo, bool transmission) {
-  const float a = glm::dot(wi, n), b = glm::dot(wo, n);
-  return transmission ? (a < 0.0f) != (b < 0.0f) && a != 0.0f && b != 0.0f : a * b > 0.0f;
+  using namespace width1;
+  return generic::geometric_side_ok(kScalar, lane1::M{transmission}, F{glm::dot(wi, n)}, F{glm::dot(wo, n)}).raw;
 }
 
 Spectrum Surfel::eval(const vec3& wi, const vec3& wo) const {

@@ -5,6 +5,7 @@
 #include "core/light_sampler.h"
 #include "core/render.h"
 
+#include <array>
 #include <cstdio>
 #include <sstream>
 
@@ -258,12 +259,25 @@ struct JsonEvents {
     if (!v.is_boolean()) fail(std::string("\"") + key + "\" is not true or false");
     return v.get<bool>();
   }
+  // v as N numbers floats hold: nothing if it is not an array of N or one of
+  // them is not such a number.
+  template <std::size_t N>
+  static std::optional<std::array<float, N>> floats(const nlohmann::json& v) {
+    if (!v.is_array() || v.size() != N) return std::nullopt;
+    std::array<float, N> out{};
+    for (std::size_t i = 0; i < N; ++i) {
+      const std::optional<float> f = json_float(v[i]);
+      if (!f) return std::nullopt;
+      out[i] = *f;
+    }
+    return out;
+  }
   vec3 v3(const nlohmann::json& e, const char* key) const {
     const nlohmann::json& v = field(e, key);
     if (!v.is_array() || v.size() != 3) fail(std::string("\"") + key + "\" is not [x, y, z]");
-    const std::optional<float> x = json_float(v[0]), y = json_float(v[1]), z = json_float(v[2]);
-    if (!x || !y || !z) fail(std::string("\"") + key + "\" is " + v.dump() + ", not three numbers floats hold");
-    return vec3(*x, *y, *z);
+    const std::optional<std::array<float, 3>> f = floats<3>(v);
+    if (!f) fail(std::string("\"") + key + "\" is " + v.dump() + ", not three numbers floats hold");
+    return vec3((*f)[0], (*f)[1], (*f)[2]);
   }
   // A ray {origin, dir, tmax (null: unbounded)}; absent (a trace by a build
   // older than the field) or null (a light sample with no shadow ray): a
@@ -284,14 +298,13 @@ struct JsonEvents {
     const std::string type = text(e, "type");
     if (type == "camera") {
       const nlohmann::json& f = field(e, "film");
-      const std::optional<float> fx = f.is_array() && f.size() == 2 ? json_float(f[0]) : std::nullopt;
-      const std::optional<float> fy = f.is_array() && f.size() == 2 ? json_float(f[1]) : std::nullopt;
-      if (!fx || !fy) fail("\"film\" is not [x, y] (two numbers floats hold)");
+      const std::optional<std::array<float, 2>> film = floats<2>(f);
+      if (!film) fail("\"film\" is not [x, y] (two numbers floats hold)");
       CameraEvent c;
       c.x = pixel_x;
       c.y = pixel_y;
       c.sample = sample;
-      c.film = vec2(*fx, *fy);
+      c.film = vec2((*film)[0], (*film)[1]);
       c.origin = v3(e, "origin");
       c.dir = v3(e, "dir");
       return c;

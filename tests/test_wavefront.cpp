@@ -113,9 +113,6 @@ Scene cornell_with_framed_velvet() {
   return s;
 }
 
-// The Cornell box with a smooth UV sphere (vertex normals: a shading normal
-// at almost every hit) of an anisotropic clear-coated Disney plastic, shaded
-// in the lanes in the frame core interpolated (kFramed).
 // The Cornell box with a smooth glass sphere (vertex normals, 24 rings) and
 // a coarse smooth mirror sphere (8 rings: shading normals far from the
 // facets'), shaded in the lanes in the frames resolve() made there, with
@@ -134,6 +131,9 @@ Scene cornell_with_smooth_impulses() {
   return s;
 }
 
+// The Cornell box with a smooth UV sphere (vertex normals: a shading normal
+// at almost every hit) of an anisotropic clear-coated Disney plastic, shaded
+// in the lanes in the frame resolve() interpolated (kFramed).
 Scene cornell_with_smooth_plastic() {
   Scene s = test::cornell_with_smooth_sphere();
   DisneyParams plastic;

@@ -132,6 +132,7 @@ using pathlab::HWY_NAMESPACE::env_texel;
 using pathlab::HWY_NAMESPACE::env_uv_to_direction;
 using pathlab::HWY_NAMESPACE::facing_normal;
 using pathlab::HWY_NAMESPACE::frame;
+using pathlab::HWY_NAMESPACE::geometric_side_ok;
 using pathlab::HWY_NAMESPACE::is_black;
 using pathlab::HWY_NAMESPACE::lambert_eval;
 using pathlab::HWY_NAMESPACE::lambert_sample;
@@ -140,6 +141,7 @@ using pathlab::HWY_NAMESPACE::mirror_sample;
 using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::NoEnergy;
+using pathlab::HWY_NAMESPACE::opposite_sides;
 using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::place_normal;
@@ -1269,11 +1271,12 @@ M shading_frame(const Scene& sc, const Wave& w, std::size_t i0, M m, VI shape, c
   return framed;
 }
 // Surfel's rule under a shading normal (geometric_side_ok): the lanes of
-// `framed` whose hit has one and whose wo and wi lie on different geometric
-// sides (wo_z, wi_z: their dot products with the geometric normal).
-M across_geometric_sides(const Wave& w, std::size_t i0, M framed, VF wo_z, VF wi_z) {
+// `framed` whose hit has one and whose wo and wi (wo_z, wi_z: their dot
+// products with the geometric normal) break it, a reflection or, in the
+// lanes of `transmitted`, a transmission.
+M across_geometric_sides(const Wave& w, std::size_t i0, M framed, M transmitted, VF wo_z, VF wi_z) {
   if (hn::AllFalse(DF(), framed)) return framed;
-  return hn::And(load_mask(w, kShadingNormal, i0, framed), hn::Not(wi_z * wo_z > k(0.0f)));
+  return hn::AndNot(geometric_side_ok(DF(), transmitted, wi_z, wo_z), load_mask(w, kShadingNormal, i0, framed));
 }
 
 // Surfel::eval and Surfel::pdf towards wi for the lanes of ok (which lose
@@ -1298,7 +1301,7 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
     const VF wi_z = dot(wi, n);
     if (sc.one_sided)
       ok = hn::AndNot(hn::And(hn::And(framed, shape_flag(framed, sc, shape, kOneSided)), hn::Not(wi_z > k(0.0f))), ok);
-    ok = hn::AndNot(across_geometric_sides(w, i0, framed, wo_z, wi_z), ok);
+    ok = hn::AndNot(across_geometric_sides(w, i0, framed, hn::FirstN(df, 0), wo_z, wi_z), ok);
   }
   to_local_upper(df, fs, ft, fn, wo, wi, wo_local, wi_local);
   lambert_eval(df, albedo_lanes(ok, sc, w, i0, shape, textured), wi_local.z, f, pdf_bsdf);
@@ -1509,7 +1512,7 @@ void scatter(const Scene& sc, const Wave& w) {
     }
     // Surfel::scatter under a shading normal: wi on wo's geometric side (the impulses' rule below).
     if (const M lobes = hn::AndNot(im, framed); !hn::AllFalse(df, lobes))
-      ok = hn::AndNot(across_geometric_sides(w, i0, lobes, dot(wo, n), dot(wi, n)), ok);
+      ok = hn::AndNot(across_geometric_sides(w, i0, lobes, hn::FirstN(df, 0), dot(wo, n), dot(wi, n)), ok);
     if (!hn::AllFalse(df, im)) {
       // Surfel::scatter_in_frame of a mirror (wo's side up, as the
       // reflection models take it) and of a dielectric (the frame as is).
@@ -1545,15 +1548,11 @@ void scatter(const Scene& sc, const Wave& w) {
       // tells inside from outside by wo's side, which must be its side of
       // both normals; wi on wo's geometric side, or across it if
       // transmitted (geometric_side_ok).
-      if (const M fim = hn::And(load_mask(w, kShadingNormal, i0, hn::And(framed, im)), hn::And(framed, im));
-          !hn::AllFalse(df, fim)) {
-        const VF wo_z = dot(wo, n), wi_z = dot(wi, n);
-        const auto differ = [](M a, M b) { return hn::Or(hn::AndNot(a, b), hn::AndNot(b, a)); };
-        const M inside_out = hn::And(glass, differ(wo_z < k(0.0f), dot(wo, fn) < k(0.0f)));
-        const M across = hn::And(differ(wi_z < k(0.0f), wo_z < k(0.0f)),
-                                 hn::And(hn::Not(wi_z == k(0.0f)), hn::Not(wo_z == k(0.0f))));
-        const M sides_ok = hn::Or(hn::And(transmitted, across), hn::AndNot(transmitted, wi_z * wo_z > k(0.0f)));
-        ok = hn::AndNot(hn::And(fim, hn::Or(inside_out, hn::Not(sides_ok))), ok);
+      if (const M fim = hn::And(framed, im); !hn::AllFalse(df, fim)) {
+        const VF wo_z = dot(wo, n);
+        const M glass_fim = hn::And(glass, fim);
+        const M inside_out = hn::And(load_mask(w, kShadingNormal, i0, glass_fim), opposite_sides(df, wo_z, dot(wo, fn)));
+        ok = hn::AndNot(hn::Or(inside_out, across_geometric_sides(w, i0, fim, transmitted, wo_z, dot(wi, n))), ok);
       }
       impulse = im;
     }

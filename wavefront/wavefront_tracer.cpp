@@ -423,13 +423,14 @@ struct WavefrontTracer::VectorStages {
       // A textured material's too: core's resolve reads its textures (and normal map) at the hit into the
       // slot's SurfaceParams and frame, which the lanes shade with.
       const bool reads_textures = m.reads_textures_at_hits();
-      const bool framed = m.scatters() && !cosine && in_lanes(m) && (shading_frame(sh) || reads_textures);
+      const bool shaded_in_lanes = m.scatters() && in_lanes(m);
+      const bool framed = shaded_in_lanes && !cosine && (shading_frame(sh) || reads_textures);
       const bool normals_in_lanes = framed && sh.mesh.tangents.empty() && !reads_textures;
-      if (m.scatters() && in_lanes(m) && reads_textures) {
+      if (shaded_in_lanes && reads_textures) {
         const std::string name = "'" + m.name + "'";
         if (std::find(textured_names.begin(), textured_names.end(), name) == textured_names.end())
           textured_names.push_back(name);
-      } else if (m.scatters() && in_lanes(m) && shading_frame(sh) && !normals_in_lanes) {
+      } else if (shaded_in_lanes && shading_frame(sh) && !normals_in_lanes) {
         v->general.push_back("the shading frame of " + sh.description);
       }
       f[vs::kNormalsAt] = std::bit_cast<float>(std::int32_t{-1});

@@ -233,6 +233,23 @@ HWY_INLINE void to_local_upper(D d, const Vec3<V>& s, const Vec3<V>& t, const Ve
   wi_local.z = IfThenElse(below, Neg(wi_local.z), wi_local.z);
 }
 
+// Whether a and b (two directions' dot products with one normal) have
+// opposite signs: (a < 0) != (b < 0).
+template <class D, class V = VecOf<D>>
+HWY_INLINE auto opposite_sides(D d, V a, V b) {
+  const auto below_a = a < Zero(d), below_b = b < Zero(d);
+  return Or(And(below_a, Not(below_b)), And(below_b, Not(below_a)));
+}
+// geometric_side_ok (core/surfel.cpp): under a shading normal, a reflection
+// needs wi and wo on one side of the geometric surface (wi_z wo_z > 0), a
+// transmission opposite sides, neither in it (wi_z, wo_z: their dot products
+// with the geometric normal).
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE M geometric_side_ok(D d, M transmission, V wi_z, V wo_z) {
+  const M across = And(opposite_sides(d, wi_z, wo_z), And(Not(wi_z == Zero(d)), Not(wo_z == Zero(d))));
+  return Or(And(transmission, across), And(Not(transmission), wi_z * wo_z > Zero(d)));
+}
+
 // Surfel::emitted: the emission Le towards wo, 0 behind a one-sided
 // emitter (n the geometric normal).
 template <class D, class M, class V = VecOf<D>>
@@ -317,7 +334,7 @@ HWY_INLINE Vec3<V> affine_point(const Vec3<V>& c0, const Vec3<V>& c1, const Vec3
 }
 // transform_point (core/compiled_scene.cpp): p placed, ((c0 x + c1 y) +
 // c2 z) + c3, and its error bound grown by the placement's rounding (PBR 4th
-// ed. 6.8.3): (gamma(3) + 1) (|c0| e.x + |c1| e.y + |c2| e.z) +
+// ed. 6.8.6): (gamma(3) + 1) (|c0| e.x + |c1| e.y + |c2| e.z) +
 // gamma(3) (|c0 x| + |c1 y| + |c2 z| + |c3|).
 template <class D, class V = VecOf<D>>
 HWY_INLINE void transform_point(D d, const Vec3<V>& c0, const Vec3<V>& c1, const Vec3<V>& c2, const Vec3<V>& c3,
