@@ -309,10 +309,12 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
       const dvec3 n = sample_sphere_cone_normal(view.cone, u);
       sp = sphere_point(shape, shape.center + shape.radius * vec3(n));
     } else {
-      const dvec3 o(ref), p0(e.triangle.p0), p1(e.triangle.p1), p2(e.triangle.p2);
-      const dvec3 dir = sample_spherical_triangle(glm::normalize(p0 - o), glm::normalize(p1 - o),
-                                                  glm::normalize(p2 - o), view.omega, u);
-      b = triangle_barycentrics_along(o, dir, p0, p1, p2);
+      using namespace width1;
+      D1 b1, b2;
+      generic::solid_angle_triangle_point(kScalarD, lanes(dvec3(ref)), lanes(dvec3(e.triangle.p0)),
+                                          lanes(dvec3(e.triangle.p1)), lanes(dvec3(e.triangle.p2)), D1{view.omega},
+                                          D1{double(u.x)}, D1{double(u.y)}, b1, b2);
+      b = vec2(static_cast<float>(b1.raw), static_cast<float>(b2.raw));
       sp = triangle_point(e.triangle, b);
     }
   } else if (shape.kind == Shape::Kind::Sphere) {
@@ -375,17 +377,21 @@ LightSampler::SolidAngleView LightSampler::solid_angle_view(const Entry& e, cons
   SolidAngleView view;
   if (light_sampling_ != LightSampling::SolidAngle) return view;
   const Shape& shape = scene_->shapes[e.shape];
-  const dvec3 o(ref);
+  // The rule and the densities as the wavefront's lanes compute them
+  // (core/simd/spherical-inl.h at width 1).
+  using namespace width1;
+  const D3 o = lanes(dvec3(ref));
   if (shape.kind == Shape::Kind::Sphere) {
-    const dvec3 to = dvec3(shape.center) - o;
-    const double r = shape.radius;
-    if (!(glm::dot(to, to) > kSphereConeMargin * r * r)) return view;  // inside (or on) the sphere: by area
-    view.cone = sphere_cone(o, dvec3(shape.center), r);
-    view.density = 1.0 / view.cone.solid_angle();
+    view.cone = sphere_cone(dvec3(ref), dvec3(shape.center), shape.radius);
+    if (!view.cone.outside) return view;  // inside (or on) the sphere: by area
+    view.density = generic::sphere_cone_density(kScalarD, D1{view.cone.one_minus_cos_max}).raw;
   } else {
-    view.omega = spherical_triangle_solid_angle(dvec3(e.triangle.p0) - o, dvec3(e.triangle.p1) - o,
-                                                dvec3(e.triangle.p2) - o);
-    if (!(view.omega >= kMinSphericalTriangle && view.omega <= kMaxSphericalTriangle)) return view;
+    D1 omega;
+    const bool sampled = generic::triangle_view(kScalarD, o, lanes(dvec3(e.triangle.p0)), lanes(dvec3(e.triangle.p1)),
+                                                lanes(dvec3(e.triangle.p2)), omega)
+                             .raw;
+    view.omega = omega.raw;
+    if (!sampled) return view;
     view.density = 1.0 / view.omega;
   }
   if (!std::isfinite(view.density)) view.density = 0.0;

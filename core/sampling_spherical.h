@@ -11,7 +11,9 @@
 // Everything is computed in double from the float inputs: the spherical
 // formulas subtract nearly equal angles for a small or distant emitter, and
 // double keeps them about 1e-10 accurate down to the smallest solid angle
-// the fallback rule (kMinSphericalTriangle) lets through. The pure functions
+// the fallback rule (kMinSphericalTriangle) lets through. The sines, cosines
+// and arctangents are pathlab's own (core/simd/spherical-inl.h), within a few
+// ulp of libm's and the same bits at every SIMD width. The pure functions
 // here take the shading point and the emitter and know nothing of scenes;
 // LightSampler decides, by the rule below, which of them to call.
 #pragma once
@@ -66,8 +68,13 @@ struct SphereCone {
   double r = 0.0;
   double sin2_max = 0.0;  // (r / d)^2
   double one_minus_cos_max = 0.0;  // 1 - cos theta_max = sin2 / (1 + cos), without cancellation
+  // ref lies outside the sphere by the rule's margin (kSphereConeMargin):
+  // else the sphere is sampled by area and the rest is meaningless.
+  bool outside = false;
   double solid_angle() const;      // 2 pi (1 - cos theta_max)
 };
+// The scalar functions here are core/simd/spherical-inl.h's generic code at
+// width 1 (the wavefront's lanes run the same source).
 SphereCone sphere_cone(const dvec3& ref, const dvec3& center, double radius);
 // A direction uniform in the cone (1 - cos theta = u.x (1 - cos theta_max),
 // phi = 2 pi u.y about `axis`), returned as the unit normal of the sphere at

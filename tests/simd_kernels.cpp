@@ -7,6 +7,7 @@
 #include "core/bsdf/disney-inl.h"
 #include "core/simd/lanes-inl.h"
 #include "core/simd/sampling-inl.h"
+#include "core/simd/spherical-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace pathlab::test::HWY_NAMESPACE {
@@ -112,6 +113,16 @@ void simd_atan2(const float* y, const float* x, float* out, std::size_t n) {
     hn::StoreU(warps::atan2_lanes(d, hn::LoadU(d, y + i), hn::LoadU(d, x + i)), d, out + i);
 }
 
+void simd_trig_d(const double* x, const double* y, double* sin, double* cos, double* atan2, std::size_t n) {
+  const hn::ScalableTag<double> d;
+  for (std::size_t i = 0; i < n; i += hn::Lanes(d)) {
+    hn::Vec<decltype(d)> s, c;
+    warps::sin_cos_d(d, hn::LoadU(d, x + i), s, c);
+    hn::StoreU(s, d, sin + i), hn::StoreU(c, d, cos + i);
+    hn::StoreU(warps::atan2_d(d, hn::LoadU(d, y + i), hn::LoadU(d, x + i)), d, atan2 + i);
+  }
+}
+
 }  // namespace pathlab::test::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -134,6 +145,10 @@ void simd_transcendentals(const float* u, const float* y, float* sin, float* cos
 HWY_EXPORT(simd_atan2);
 void simd_atan2(const float* y, const float* x, float* out, std::size_t n) {
   HWY_DYNAMIC_DISPATCH(simd_atan2)(y, x, out, n);
+}
+HWY_EXPORT(simd_trig_d);
+void simd_trig_d(const double* x, const double* y, double* sin, double* cos, double* atan2, std::size_t n) {
+  HWY_DYNAMIC_DISPATCH(simd_trig_d)(x, y, sin, cos, atan2, n);
 }
 HWY_EXPORT(simd_offset_ray_origin);
 void simd_offset_ray_origin(const float* p, const float* error, const float* normal, float* out, std::size_t n) {

@@ -34,5 +34,8 @@ void simd_disney(bool clearcoat, const float* in, float* out, std::size_t n);
 void simd_transcendentals(const float* u, const float* y, float* sin, float* cos, float* exp2, std::size_t n);
 // atan2_lanes(y[i], x[i]) (sampling-inl.h) into out; n a multiple of 16.
 void simd_atan2(const float* y, const float* x, float* out, std::size_t n);
+// sin_cos_d(x[i]) and atan2_d(y[i], x[i]) of core/simd/spherical-inl.h in
+// double lanes; n a multiple of 8.
+void simd_trig_d(const double* x, const double* y, double* sin, double* cos, double* atan2, std::size_t n);
 
 }  // namespace pathlab::test

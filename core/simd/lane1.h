@@ -55,6 +55,9 @@ template <typename T>
 inline V<T> Set(One<T>, T x) {
   return {x};
 }
+// Generic code written for float lanes (normalize's Set(d, 1.0f)) at a
+// double lane: the constant widened, as Highway's Set does.
+inline V<double> Set(One<double>, double x) { return {x}; }
 template <typename T>
 inline V<T> Zero(One<T>) {
   return {T(0)};
@@ -128,6 +131,16 @@ inline V<float> Neg(V<float> a) { return {-a.raw}; }
 inline V<float> CopySign(V<float> magnitude, V<float> sign) { return {std::copysign(magnitude.raw, sign.raw)}; }
 inline M IsInf(V<float> a) { return {std::isinf(a.raw)}; }
 inline M IsFinite(V<float> a) { return {std::isfinite(a.raw)}; }
+
+// The same for double lanes (core/simd/spherical-inl.h).
+inline V<double> Max(V<double> a, V<double> b) { return a.raw > b.raw ? a : b; }
+inline V<double> Min(V<double> a, V<double> b) { return a.raw < b.raw ? a : b; }
+inline V<double> Round(V<double> a) { return {std::nearbyint(a.raw)}; }
+inline V<double> Floor(V<double> a) { return {std::floor(a.raw)}; }
+inline V<double> Abs(V<double> a) { return {std::fabs(a.raw)}; }
+inline V<double> Neg(V<double> a) { return {-a.raw}; }
+inline V<double> CopySign(V<double> magnitude, V<double> sign) { return {std::copysign(magnitude.raw, sign.raw)}; }
+inline M IsFinite(V<double> a) { return {std::isfinite(a.raw)}; }
 
 // c one float up for o > 0, down for o < 0 (lanes-inl.h's StepAway) by
 // core/ray.h's scalar primitives, whose branches are cheaper at width 1

@@ -18,6 +18,7 @@
 #include "core/simd/lanes-inl.h"
 #include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"
+#include "core/simd/spherical-inl.h"
 
 namespace pathlab::width1 {
 
@@ -28,5 +29,12 @@ inline constexpr lane1::One<float> kScalar{};  // the descriptor: one plain floa
 
 inline F3 lanes(const vec3& v) { return {{v.x}, {v.y}, {v.z}}; }
 inline vec3 scalars(const F3& v) { return vec3(v.x.raw, v.y.raw, v.z.raw); }
+
+// One plain double (core/simd/spherical-inl.h).
+using D1 = lane1::V<double>;
+using D3 = generic::Vec3<D1>;
+inline constexpr lane1::One<double> kScalarD{};
+inline D3 lanes(const dvec3& v) { return {{v.x}, {v.y}, {v.z}}; }
+inline dvec3 scalars(const D3& v) { return dvec3(v.x.raw, v.y.raw, v.z.raw); }
 
 }  // namespace pathlab::width1
