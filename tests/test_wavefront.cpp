@@ -607,7 +607,7 @@ struct VectorCase {
   int spp = 0;             // 0: the scene's (an odd log2 of it gives zsobol's index a lone lowest bit)
   bool bvh = false;        // light_sampler bvh (the tree walked in double lanes, core/simd/light_bvh-inl.h)
   bool general_shading = false;  // every material through the Disney closure (--general-shading)
-  bool solid_angle = false;      // light_sampling solid_angle (LightSampler::sample, path by path)
+  bool solid_angle = false;      // light_sampling solid_angle (core/simd/spherical-inl.h in double lanes)
 };
 
 // Every diffuse material one-sided (black behind its geometric normal), and
@@ -814,6 +814,16 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Light, Strategy::Mis})
     cases.push_back({"", st, 0.0f, 0, false, false, false, false, false, 0, false, false, true});
   cases.push_back({"materials", Strategy::Mis, 0.0f, 0, false, false, false, false, false, 0, true, false, true});
+  // Solid-angle sampling in the lanes' double halves: spherical triangles (the box's lamp, cut into 16 and turned
+  // off the axes when crowded and tilted), a sphere's cone seen from outside ("bulb") and, from inside the emitting
+  // spheres of the rooms, the fallback to area; under power and the BVH, both samplers, every strategy that samples
+  // lights.
+  cases.push_back({"", Strategy::LightBsdf, 0.0f, 0, true, true, true, true, true, 0, true, false, true});
+  for (Strategy st : {Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"bulb", st, 0.0f, 0, false, false, false, false, false, 0, false, false, true});
+  cases.push_back({"bulb", Strategy::Mis, 0.0f, -1, true, true, true, false, true, 0, true, false, true});
+  for (const char* s : {"white-sphere-emissive-room.json", "mirror-sphere-gray-room.json"})
+    cases.push_back({s, Strategy::Mis, 0.0f, 0, false, false, false, false, false, 0, false, false, true});
   cases.push_back({"bulb", Strategy::Mis, 0.0f, 0, false, false, true, false, false, 0, true});
   // Disney surfaces shaded in the lanes in the geometric normal's frame beside one in its own (tangents); energy
   // compensation's tables gathered in the lanes (a coated sphere; the materials' box with an anisotropic,

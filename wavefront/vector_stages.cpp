@@ -32,6 +32,7 @@
 #include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"
 #include "core/simd/sobol-inl.h"
+#include "core/simd/spherical-inl.h"
 #include "core/material.h"
 #include "core/rng.h"
 #include "core/scene.h"
@@ -150,6 +151,10 @@ using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::shading_normal;
 using pathlab::HWY_NAMESPACE::spawn_origin;
 using pathlab::HWY_NAMESPACE::spawn_to;
+using pathlab::HWY_NAMESPACE::sample_sphere_cone_normal;
+using pathlab::HWY_NAMESPACE::solid_angle_triangle_point;
+using pathlab::HWY_NAMESPACE::sphere_cone;
+using pathlab::HWY_NAMESPACE::sphere_cone_density;
 using pathlab::HWY_NAMESPACE::sphere_point;
 using pathlab::HWY_NAMESPACE::sun_direction;
 using pathlab::HWY_NAMESPACE::splat3;
@@ -158,6 +163,7 @@ using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
 using pathlab::HWY_NAMESPACE::transform_point;
+using pathlab::HWY_NAMESPACE::triangle_view;
 using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::uniform_sphere;
 using pathlab::HWY_NAMESPACE::uniform_triangle;
@@ -680,8 +686,77 @@ void resolve(const Scene& sc, const Wave& w) {
   }
 }
 
-// LightSampler::pdf(prev.p, s) of triangle lights sampled by area, in the
-// lanes of lit (hits on emitters).
+// Under light_sampling solid_angle: LightSampler::solid_angle_view from ref
+// of the lights in the lanes of m (triangles p0 p1 p2; spheres, where
+// `sphere`: centre p0, radius p1.x), computed in the double halves of the
+// registers (core/simd/spherical-inl.h): `use` where the rule samples them
+// in solid angle, with that density (as a float, as sample() and pdf() take
+// it); and when u (lu, lv) is given, the point sample() draws there: a
+// triangle's barycentrics (b1, b2), a sphere's unit normal n (as floats).
+struct SolidAngleLanes {
+  M use;
+  VF density, b1, b2;
+  V3 n;
+};
+SolidAngleLanes solid_angle_lanes(M m, M sphere, const V3& ref, const V3& p0, const V3& p1, const V3& p2,
+                                  const VF* lu = nullptr, const VF* lv = nullptr) {
+  const DD dd;
+  VD use[2], density[2], b1[2], b2[2];
+  V3D n[2];
+  for (int h = 0; h < 2; ++h) {
+    use[h] = density[h] = b1[h] = b2[h] = hn::Zero(dd);
+    n[h] = {use[h], use[h], use[h]};
+    const MD in = half_mask(m, h);
+    if (hn::AllFalse(dd, in)) continue;
+    const MD spheres = hn::And(in, half_mask(sphere, h));
+    const MD triangles = hn::AndNot(spheres, in);
+    const V3D o = half_d(ref, h), q0 = half_d(p0, h), q1 = half_d(p1, h), q2 = half_d(p2, h);
+    MD sampled = hn::FirstN(dd, 0);
+    VD dens = hn::Zero(dd);
+    if (!hn::AllFalse(dd, triangles)) {
+      VD omega;
+      const MD t = hn::And(triangles, triangle_view(dd, o, q0, q1, q2, omega));
+      sampled = t;
+      dens = hn::IfThenElse(t, hn::Set(dd, 1.0) / omega, dens);
+      if (lu && !hn::AllFalse(dd, t)) {
+        VD tb1, tb2;
+        solid_angle_triangle_point(dd, o, q0, q1, q2, omega, half_d(*lu, h), half_d(*lv, h), tb1, tb2);
+        b1[h] = hn::IfThenElseZero(t, tb1);
+        b2[h] = hn::IfThenElseZero(t, tb2);
+      }
+    }
+    if (!hn::AllFalse(dd, spheres)) {
+      V3D axis;
+      VD dist, sin2_max, one_minus_cos_max;
+      const MD s = hn::And(spheres, sphere_cone(dd, o, q0, q1.x, axis, dist, sin2_max, one_minus_cos_max));
+      sampled = hn::Or(sampled, s);
+      dens = hn::IfThenElse(s, sphere_cone_density(dd, one_minus_cos_max), dens);
+      if (lu && !hn::AllFalse(dd, s))
+        n[h] = select(s, sample_sphere_cone_normal(dd, axis, dist, sin2_max, one_minus_cos_max, half_d(*lu, h),
+                                                   half_d(*lv, h)),
+                      n[h]);
+    }
+    sampled = hn::And(sampled, hn::IsFinite(dens));  // else density 0: by area
+    use[h] = hn::IfThenElseZero(sampled, hn::Set(dd, 1.0));
+    density[h] = hn::IfThenElseZero(sampled, dens);
+  }
+  SolidAngleLanes sa;
+  sa.use = hn::And(m, join_f(use[0], use[1]) != k(0.0f));
+  sa.density = join_f(density[0], density[1]);
+  sa.b1 = join_f(b1[0], b1[1]);
+  sa.b2 = join_f(b2[0], b2[1]);
+  sa.n = {join_f(n[0].x, n[1].x), join_f(n[0].y, n[1].y), join_f(n[0].z, n[1].z)};
+  return sa;
+}
+
+// The lanes of m whose light entry is a sphere (none if the scene has no sphere light).
+M sphere_lights(M m, const Lights& lights, VI entry) {
+  if (!lights.sphere) return hn::FirstN(DF(), 0);
+  return hn::And(m, gather(m, lights.sphere, entry, 1, 0) != k(0.0f));
+}
+
+// LightSampler::pdf(prev.p, s) of triangle and sphere lights, in the lanes
+// of lit (hits on emitters).
 VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI shape, const V3& n) {
   const DF df;
   const VI first = shape_int(lit, sc, shape, kFirstLight);
@@ -707,7 +782,18 @@ VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI 
     }
     pdf_zero = pmf == k(0.0f);  // a light the tree gives nothing from here: density 0
   }
-  const VF pdf = area_light_pdf_at(df, load3(w, kPrevX, i0, light), load3(w, kPx, i0, light), n, pmf, inv_area);
+  const V3 prev = load3(w, kPrevX, i0, light);
+  VF pdf = area_light_pdf_at(df, prev, load3(w, kPx, i0, light), n, pmf, inv_area);
+  if (sc.solid_angle && !hn::AllFalse(df, light)) {
+    // In the cone or spherical triangle the light subtends, where the rule
+    // says so; a light picked with probability 0 has density 0.
+    const SolidAngleLanes sa = solid_angle_lanes(light, sphere_lights(light, sc.lights, entry), prev,
+                                                 light_value3(light, sc.lights, entry, kLightP0),
+                                                 light_value3(light, sc.lights, entry, kLightP1),
+                                                 light_value3(light, sc.lights, entry, kLightP2));
+    pdf = hn::IfThenElse(sa.use, pmf * sa.density, pdf);
+    pdf_zero = hn::Or(pdf_zero, pmf == k(0.0f));
+  }
   return hn::IfThenZeroElse(pdf_zero, hn::IfThenElseZero(light, pdf));
 }
 
@@ -967,8 +1053,9 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI lig
   const VF two_sided = light_value(ok, sc.lights, light, kLightTwoSided);
   V3 lp, lerr;
   triangle_point(df, b1, b2, p0, p1, p2, lp, lerr);
+  const M spheres = sphere_lights(ok, sc.lights, light);
   if (sc.lights.sphere) {
-    if (const M sphere = hn::And(ok, gather(ok, sc.lights.sphere, light, 1, 0) != k(0.0f)); !hn::AllFalse(df, sphere)) {
+    if (const M sphere = spheres; !hn::AllFalse(df, sphere)) {
       // sample_sphere: a uniform direction from the centre, projected onto the sphere.
       V3 dir, s_p, s_err, s_n;
       uniform_sphere(df, lu, lv, dir.x, dir.y, dir.z);
@@ -980,11 +1067,33 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI lig
       ln = select(sphere, s_n, ln);
     }
   }
+  // Under solid_angle, where the rule says so: a triangle's point along a
+  // direction in the spherical triangle it subtends, a sphere's where a
+  // direction in its cone meets it (LightSampler::sample).
+  SolidAngleLanes sa;
+  if (sc.solid_angle) {
+    sa = solid_angle_lanes(ok, spheres, sp, p0, p1, p2, &lu, &lv);
+    if (const M tri = hn::AndNot(spheres, sa.use); !hn::AllFalse(df, tri)) {
+      V3 t_p, t_err;
+      triangle_point(df, sa.b1, sa.b2, p0, p1, p2, t_p, t_err);
+      lp = select(tri, t_p, lp);
+      lerr = select(tri, t_err, lerr);
+    }
+    if (const M cone = hn::And(spheres, sa.use); !hn::AllFalse(df, cone)) {
+      V3 s_p, s_err, s_n;
+      const VF radius = p1.x;
+      sphere_point(df, p0, radius, p1.y != k(0.0f), p0 + radius * sa.n, s_p, s_err, s_n);
+      lp = select(cone, s_p, lp);
+      lerr = select(cone, s_err, lerr);
+      ln = select(cone, s_n, ln);
+    }
+  }
 
   VF dist, cos_light;
   ok = hn::And(ok, light_point_seen(df, sp, lp, ln, two_sided != k(0.0f), ls.wi, dist, cos_light));
   const VF inv_area = light_value(ok, sc.lights, light, kLightInvArea);
   ls.pdf = area_light_pdf(df, pmf, inv_area, dist, cos_light);
+  if (sc.solid_angle) ls.pdf = hn::IfThenElse(sa.use, pmf * sa.density, ls.pdf);
   ok = hn::And(ok, usable_light_pdf(df, ls.pdf));  // not seen edge-on
 
   // Surfel::spawn_to(lp, lerr, ln).

@@ -159,8 +159,12 @@ struct Scene {
   // clear coat, as core's ShadingPath says); else 0.
   unsigned disney = 0;
   const CompiledScene* compiled = nullptr;
-  // Lights beyond triangles and spheres sampled by area and the sky of Sky
-  // (light_sampling solid_angle, emitters placed by instances or textured):
+  // light_sampling solid_angle: triangle and sphere lights are sampled in
+  // the spherical triangle or cone they subtend where the fallback rule
+  // says so (core/sampling_spherical.h), in the lanes' double halves.
+  bool solid_angle = false;
+  // Lights beyond triangles and spheres and the sky of Sky (emitters placed
+  // by instances or textured):
   // compiled->lights() samples them all
   // and gives their densities, path by path; `sky`: escaped rays find an
   // environment or a sun disk (LightSampler::sky; in the lanes by `skies`

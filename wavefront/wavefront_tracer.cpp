@@ -265,14 +265,14 @@ struct WavefrontTracer::VectorStages {
       }
       sc.deltas = {lights.delta_lights().size(), lights.delta_cdf().data(), v->delta_table.data()};
     }
-    // The lanes sample triangle and sphere lights by area and the sky; the
-    // rest (below) is sampled by LightSampler::sample(), path by path.
+    // The lanes sample triangle and sphere lights (by area or in solid angle)
+    // and the sky; the rest (below) is sampled by LightSampler::sample(), path
+    // by path.
     std::vector<std::string> other_lights;
     if (const EnvironmentMap* map = scene.environment_map.get();
         map && std::size_t(map->width()) * std::size_t(map->height() + 1) * 3 >= (std::size_t{1} << 31))
       other_lights.push_back("an environment image of 2^29 texels or more");  // beyond the gathers' indices
-    if (lights.light_sampling() != LightSampling::Area)
-      other_lights.push_back(std::string("light_sampling ") + light_sampling_name(lights.light_sampling()));
+    sc.solid_angle = lights.light_sampling() == LightSampling::SolidAngle;
     for (const Shape& shape : scene.shapes)
       if (shape.in_group && scene.materials[shape.material].emits()) {
         other_lights.push_back("emitters placed by instances");
