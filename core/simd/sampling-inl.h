@@ -40,6 +40,17 @@ HWY_INLINE void sin_cos_quarter(D d, V x, V& sin, V& cos) {
         Set(d, 1.0f);
 }
 
+// sin and cos of r + q pi/2 from s = sin r and c = cos r, where q1, q2 and q3
+// are the lanes in which q mod 4 is 1, 2 and 3: (c, s) turned by 0 (c, s),
+// 1 (-s, c), 2 (-c, -s) or 3 (s, -c) quarter turns.
+template <class M, class V>
+HWY_INLINE void quarter_turns(M q1, M q2, M q3, V s, V c, V& sin, V& cos) {
+  const auto swap = Or(q1, q3);
+  const V cs = IfThenElse(swap, s, c), sn = IfThenElse(swap, c, s);
+  cos = IfThenElse(Or(q1, q2), Neg(cs), cs);
+  sin = IfThenElse(Or(q2, q3), Neg(sn), sn);
+}
+
 // sin and cos of 2 pi u for u in [0, 1] (an azimuth from a uniform
 // number): u in quarter turns, 4u = q + f with q the nearest whole number
 // (exact: 4u and 4u - q are floats), sin_cos_quarter of f pi/2 in
@@ -52,12 +63,8 @@ HWY_INLINE void sin_cos_turn(D d, V u, V& sin, V& cos) {
   const V q = Round(t);
   V s, c;
   sin_cos_quarter(d, (t - q) * Set(d, 3.14159265358979323846f / 2.0f), s, c);
-  // q mod 4: 0 (c, s), 1 (-s, c), 2 (-c, -s), 3 (s, -c), 4 as 0.
-  const auto q1 = q == Set(d, 1.0f), q2 = q == Set(d, 2.0f), q3 = q == Set(d, 3.0f);
-  const auto swap = Or(q1, q3);
-  const V cs = IfThenElse(swap, s, c), sn = IfThenElse(swap, c, s);
-  cos = IfThenElse(Or(q1, q2), Neg(cs), cs);
-  sin = IfThenElse(Or(q2, q3), Neg(sn), sn);
+  // q mod 4 (4 as 0).
+  quarter_turns(q == Set(d, 1.0f), q == Set(d, 2.0f), q == Set(d, 3.0f), s, c, sin, cos);
 }
 
 // 2^y for y in [-126, 127]: y = n + f with n the nearest whole number and f
@@ -76,6 +83,27 @@ HWY_INLINE V exp2_lanes(D d, V y) {
   return (Set(d, 1.0f) + p) * Pow2I(d, n);
 }
 
+// atan2(y, x) in [-pi, pi] from atan_small(r), the arctangent of |r| <=
+// tan(pi/8) (+ rounding): r is the ratio t of the smaller |coordinate| to the
+// larger (in [0, 1]; 0 for (0, 0)), or above tan(pi/8) (t - 1) / (t + 1),
+// whose arctangent is pi/4 less; the angle is then turned to the octant and
+// quadrant of (x, y), with y's sign. The constants are the precision's
+// (float or double): tan(pi/8), pi/4, pi/2, pi.
+template <class D, class AtanSmall, class V = VecOf<D>>
+HWY_INLINE V atan2_octants(D d, V y, V x, V tan_pi_8, V pi_4, V pi_2, V pi, const AtanSmall& atan_small) {
+  const V ay = Abs(y), ax = Abs(x);
+  const auto steep = ay > ax;
+  const V num = IfThenElse(steep, ax, ay), den = IfThenElse(steep, ay, ax);
+  const V t = IfThenZeroElse(den == Zero(d), num / den);
+  const auto above = t > tan_pi_8;
+  const V one = Set(d, 1.0f);
+  const V p = atan_small(IfThenElse(above, (t - one) / (t + one), t));
+  V a = IfThenElse(above, p + pi_4, p);
+  a = IfThenElse(steep, pi_2 - a, a);
+  a = IfThenElse(x < Zero(d), pi - a, a);
+  return CopySign(a, y);
+}
+
 // atan2(y, x) in [-pi, pi]: Cephes' single-precision atanf polynomial
 // (|error| < 2 ulp on [0, tan(pi/8)]) of the ratio of the smaller |coordinate|
 // to the larger (in [0, 1]; above tan(pi/8) reduced about pi/4), then turned
@@ -84,22 +112,16 @@ HWY_INLINE V exp2_lanes(D d, V y) {
 // x included (libm: pi for x = -0).
 template <class D, class V = VecOf<D>>
 HWY_INLINE V atan2_lanes(D d, V y, V x) {
-  const V ay = Abs(y), ax = Abs(x);
-  const auto steep = ay > ax;
-  const V num = IfThenElse(steep, ax, ay), den = IfThenElse(steep, ay, ax);
-  const V t = IfThenZeroElse(den == Zero(d), num / den);
-  const auto above = t > Set(d, 0.4142135623730950f);
-  const V r = IfThenElse(above, (t - Set(d, 1.0f)) / (t + Set(d, 1.0f)), t);
-  const V z = r * r;
-  const V p = ((((Set(d, 8.05374449538e-2f) * z - Set(d, 1.38776856032e-1f)) * z + Set(d, 1.99777106478e-1f)) * z -
-               Set(d, 3.33329491539e-1f)) *
-              z) *
-                 r +
-             r;
-  V a = IfThenElse(above, p + Set(d, 0.78539816339744830962f), p);
-  a = IfThenElse(steep, Set(d, 1.57079632679489661923f) - a, a);
-  a = IfThenElse(x < Zero(d), Set(d, 3.14159265358979323846f) - a, a);
-  return CopySign(a, y);
+  return atan2_octants(d, y, x, Set(d, 0.4142135623730950f), Set(d, 0.78539816339744830962f),
+                       Set(d, 1.57079632679489661923f), Set(d, 3.14159265358979323846f), [&](V r) {
+                         const V z = r * r;
+                         return ((((Set(d, 8.05374449538e-2f) * z - Set(d, 1.38776856032e-1f)) * z +
+                                   Set(d, 1.99777106478e-1f)) * z -
+                                  Set(d, 3.33329491539e-1f)) *
+                                 z) *
+                                    r +
+                                r;
+                       });
 }
 
 // Distribution1D::sample's point in cell i of n whose cdf runs from lo to

@@ -29,9 +29,23 @@
 #include "core/sampling_spherical.h"
 #include "core/simd/lane1.h"
 #include "core/simd/lanes-inl.h"
+#include "core/simd/sampling-inl.h"
+
+#include <initializer_list>
 
 HWY_BEFORE_NAMESPACE();
 namespace pathlab::HWY_NAMESPACE {
+
+// A polynomial in z by Horner's rule, from the highest coefficient to the
+// constant: (...(c[0] z + c[1]) z + ...) z + c[n-1]. (Adding a negative
+// coefficient rounds as subtracting its magnitude.)
+template <class D, class V = VecOf<D>>
+HWY_INLINE V series(D d, V z, std::initializer_list<double> c) {
+  const double* k = c.begin();
+  V p = Set(d, *k);
+  for (++k; k != c.end(); ++k) p = p * z + Set(d, *k);
+  return p;
+}
 
 // sin and cos of x for |x| <= 5 pi / 2 (the angles here are within
 // [-pi, 2 pi]). x = q pi/2 + r with q the nearest whole number to x 2/pi and
@@ -44,73 +58,37 @@ namespace pathlab::HWY_NAMESPACE {
 template <class D, class V = VecOf<D>>
 HWY_INLINE void sin_cos_d(D d, V x, V& sin, V& cos) {
   const V q = Round(x * Set(d, 0.6366197723675814));  // 2 / pi
-  const V r = ((x - q * Set(d, 1.5707963267341256)) - q * Set(d, 6.077100506303966e-11)) - q * Set(d, 2.0222662487959506e-21);
+  const V r = ((x - q * Set(d, 1.5707963267341256)) - q * Set(d, 6.077100506303966e-11)) -
+              q * Set(d, 2.0222662487959506e-21);
   const V z = r * r;
-  // sin r = r + r z (-1/3! + z (1/5! + z (-1/7! + ...))), to 1/17!.
-  V s = Set(d, 1.0 / 355687428096000.0);  // 1/17!
-  s = s * z - Set(d, 1.0 / 1307674368000.0);
-  s = s * z + Set(d, 1.0 / 6227020800.0);
-  s = s * z - Set(d, 1.0 / 39916800.0);
-  s = s * z + Set(d, 1.0 / 362880.0);
-  s = s * z - Set(d, 1.0 / 5040.0);
-  s = s * z + Set(d, 1.0 / 120.0);
-  s = s * z - Set(d, 1.0 / 6.0);
-  const V sr = r + (r * z) * s;
+  // sin r = r + r z (-1/3! + z (1/5! + z (-1/7! + ...))), to 1/17!;
   // cos r = (1 - z/2) + z^2 (1/4! + z (-1/6! + ...)), to 1/18!.
-  V c = Set(d, -1.0 / 6402373705728000.0);  // -1/18!
-  c = c * z + Set(d, 1.0 / 20922789888000.0);
-  c = c * z - Set(d, 1.0 / 87178291200.0);
-  c = c * z + Set(d, 1.0 / 479001600.0);
-  c = c * z - Set(d, 1.0 / 3628800.0);
-  c = c * z + Set(d, 1.0 / 40320.0);
-  c = c * z - Set(d, 1.0 / 720.0);
-  c = c * z + Set(d, 1.0 / 24.0);
-  const V cr = (Set(d, 1.0) - Set(d, 0.5) * z) + (z * z) * c;
-  // q mod 4 (q - 4 floor(q / 4), exact for these small whole numbers):
-  // 0 (c, s), 1 (-s, c), 2 (-c, -s), 3 (s, -c).
+  const V sr = r + (r * z) * series(d, z, {1.0 / 355687428096000.0, -1.0 / 1307674368000.0, 1.0 / 6227020800.0,
+                                           -1.0 / 39916800.0, 1.0 / 362880.0, -1.0 / 5040.0, 1.0 / 120.0, -1.0 / 6.0});
+  const V cr = (Set(d, 1.0) - Set(d, 0.5) * z) +
+               (z * z) * series(d, z, {-1.0 / 6402373705728000.0, 1.0 / 20922789888000.0, -1.0 / 87178291200.0,
+                                       1.0 / 479001600.0, -1.0 / 3628800.0, 1.0 / 40320.0, -1.0 / 720.0, 1.0 / 24.0});
+  // q mod 4 (q - 4 floor(q / 4), exact for these small whole numbers).
   const V m = q - Set(d, 4.0) * Floor(q * Set(d, 0.25));
-  const auto q1 = m == Set(d, 1.0), q2 = m == Set(d, 2.0), q3 = m == Set(d, 3.0);
-  const auto swap = Or(q1, q3);
-  const V cs = IfThenElse(swap, sr, cr), sn = IfThenElse(swap, cr, sr);
-  cos = IfThenElse(Or(q1, q2), Neg(cs), cs);
-  sin = IfThenElse(Or(q2, q3), Neg(sn), sn);
+  quarter_turns(m == Set(d, 1.0), m == Set(d, 2.0), m == Set(d, 3.0), sr, cr, sin, cos);
 }
 
 // atan2(y, x) in [-pi, pi], as core/simd/sampling-inl.h's atan2_lanes in
-// double: t, the smaller |coordinate| over the larger, in [0, 1]; above
-// tan(pi/8) taken about pi/4 ((t - 1) / (t + 1), exact enough: t + 1 and
-// t - 1 round once each); then halved in angle, atan r = 2 atan(r / (1 +
-// sqrt(1 + r^2))), to |r| <= tan(pi/16) < 0.2; the series r - r^3/3 + ... to
-// r^25; turned to the octant and quadrant of (x, y), with y's sign. (0, 0)
-// gives 0 with y's sign (libm: pi for x = -0). A NaN gives NaN.
+// double (atan2_octants): the reduced r (|r| <= tan(pi/8)) halved in angle,
+// atan r = 2 atan(r / (1 + sqrt(1 + r^2))), to |h| <= tan(pi/16) < 0.2, then
+// the series h - h^3/3 + ... to h^25. (0, 0) gives 0 with y's sign (libm: pi
+// for x = -0). A NaN gives NaN.
 template <class D, class V = VecOf<D>>
 HWY_INLINE V atan2_d(D d, V y, V x) {
-  const V ay = Abs(y), ax = Abs(x);
-  const auto steep = ay > ax;
-  const V num = IfThenElse(steep, ax, ay), den = IfThenElse(steep, ay, ax);
-  const V t = IfThenZeroElse(den == Zero(d), num / den);
-  const auto above = t > Set(d, 0.41421356237309503);  // tan(pi/8)
-  const V r = IfThenElse(above, (t - Set(d, 1.0)) / (t + Set(d, 1.0)), t);
-  const V h = r / (Set(d, 1.0) + Sqrt(Set(d, 1.0) + r * r));
-  const V z = h * h;
-  V p = Set(d, 1.0 / 25.0);
-  p = p * z - Set(d, 1.0 / 23.0);
-  p = p * z + Set(d, 1.0 / 21.0);
-  p = p * z - Set(d, 1.0 / 19.0);
-  p = p * z + Set(d, 1.0 / 17.0);
-  p = p * z - Set(d, 1.0 / 15.0);
-  p = p * z + Set(d, 1.0 / 13.0);
-  p = p * z - Set(d, 1.0 / 11.0);
-  p = p * z + Set(d, 1.0 / 9.0);
-  p = p * z - Set(d, 1.0 / 7.0);
-  p = p * z + Set(d, 1.0 / 5.0);
-  p = p * z - Set(d, 1.0 / 3.0);
-  const V atan_h = h + (h * z) * p;
-  const V atan_r = Set(d, 2.0) * atan_h;
-  V a = IfThenElse(above, atan_r + Set(d, 0.7853981633974483), atan_r);  // pi/4
-  a = IfThenElse(steep, Set(d, 1.5707963267948966) - a, a);              // pi/2
-  a = IfThenElse(x < Zero(d), Set(d, 3.141592653589793) - a, a);         // pi
-  return CopySign(a, y);
+  return atan2_octants(d, y, x, Set(d, 0.41421356237309503), Set(d, 0.7853981633974483), Set(d, 1.5707963267948966),
+                       Set(d, 3.141592653589793), [&](V r) {
+                         const V h = r / (Set(d, 1.0) + Sqrt(Set(d, 1.0) + r * r));
+                         const V z = h * h;
+                         const V p = series(d, z, {1.0 / 25.0, -1.0 / 23.0, 1.0 / 21.0, -1.0 / 19.0, 1.0 / 17.0,
+                                                   -1.0 / 15.0, 1.0 / 13.0, -1.0 / 11.0, 1.0 / 9.0, -1.0 / 7.0,
+                                                   1.0 / 5.0, -1.0 / 3.0});
+                         return Set(d, 2.0) * (h + (h * z) * p);
+                       });
 }
 
 // spherical_triangle_solid_angle: Van Oosterom & Strackee's
