@@ -175,7 +175,7 @@ Scene cornell_with_tangents() {
 
 // cornell_with_instances() whose group's true sphere glows (an emitter no
 // light sample aims at: the loader takes emitters in groups only so), lit
-// also by delta lights and the sky: every light the stages leave to core.
+// also by delta lights and the sky: every kind of light at once.
 Scene cornell_with_every_light() {
   Scene s = test::cornell_with_instances();
   for (const DeltaLight& d : test::cornell_with_delta_lights().delta_lights) s.delta_lights.push_back(d);
@@ -841,7 +841,7 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"delta", st, 0.0f, 0});
   cases.push_back({"delta", Strategy::LightBsdf, 0.0f, -1, true, true, true, true, true, 0, true});
-  // Every kind of light core samples at once: delta lights, the sky, an emitter in a group, solid angle.
+  // Every kind of light at once: delta lights, the sky, an emitter in a group, solid angle.
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"every-light", st, 0.0f, 0});
   cases.push_back({"every-light", Strategy::Mis, 0.0f, 0, false, false, false, false, true, 0, false, false, true});

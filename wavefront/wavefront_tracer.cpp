@@ -273,11 +273,9 @@ struct WavefrontTracer::VectorStages {
         map && std::size_t(map->width()) * std::size_t(map->height() + 1) * 3 >= (std::size_t{1} << 31))
       other_lights.push_back("an environment image of 2^29 texels or more");  // beyond the gathers' indices
     sc.solid_angle = lights.light_sampling() == LightSampling::SolidAngle;
-    for (const Shape& shape : scene.shapes)
-      if (shape.in_group && scene.materials[shape.material].emits()) {
-        other_lights.push_back("emitters placed by instances");
-        break;
-      }
+    // Emitters placed by instances are no light entries (the loader takes them
+    // only as emitters no light sample aims at): found by rays alone, their
+    // density is 0 (triangle_light_pdf: no kFirstLight), as pdf() says.
     for (const Material& m : scene.materials)
       if (m.emission_textured) {
         other_lights.push_back("textured emitters");
