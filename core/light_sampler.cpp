@@ -342,15 +342,19 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
                                                                         PATHLAB_FAULT(LightPdfWithoutDistance))
                                                     .raw;
   if (!generic::usable_light_pdf(kScalar, F{ls.pdf}).raw) return std::nullopt;  // seen edge-on
-  if (!textured) {
-    ls.Le = m.emission;
-    return ls;
-  }
-  // The texture at the point's uv, as CompiledScene::resolve gives a hit there.
-  const vec2 uv = shape.kind == Shape::Kind::Sphere ? sphere_uv((ls.p - shape.center) / shape.radius)
-                                                    : shape.mesh.uv_at(e.prim, b);
-  ls.Le = emission_at(m, textures_, uv);
+  ls.Le = emission_at_point(i, b, ls.p);
   return ls;
+}
+
+Spectrum LightSampler::emission_at_point(std::size_t i, vec2 b, const vec3& p) const {
+  const Entry& e = entries_[i];
+  const Shape& shape = scene_->shapes[e.shape];
+  const Material& m = scene_->materials[shape.material];
+  if (!(textures_ && m.emission_textured)) return m.emission;
+  // The texture at the point's uv, as CompiledScene::resolve gives a hit there.
+  const vec2 uv = shape.kind == Shape::Kind::Sphere ? sphere_uv((p - shape.center) / shape.radius)
+                                                    : shape.mesh.uv_at(e.prim, b);
+  return emission_at(m, textures_, uv);
 }
 
 float LightSampler::pdf(const LightQuery& query, const Surfel& hit) const {

@@ -135,6 +135,12 @@ class LightSampler {
   // sample cannot contribute (back of a one-sided emitter, seen edge-on,
   // every light of the BVH unimportant there).
   std::optional<LightSample> sample(const LightQuery& ref, float u_choice, vec2 u) const;
+  // The radiance a light sample at point p of area-light entry i carries:
+  // its material's emission, or under an emission texture the texel at the
+  // point's uv (b: its barycentrics (b1, b2) on a triangle; a sphere's uv
+  // comes from p). sample() takes Le from here; the wavefront's lanes, which
+  // draw the point themselves, call it for textured emitters.
+  Spectrum emission_at_point(std::size_t i, vec2 b, const vec3& p) const;
   // Density with which sample() would produce the emitter point `hit`
   // (reached from `ref`), in solid angle; 0 if `hit` is not on a light.
   float pdf(const LightQuery& ref, const Surfel& hit) const;

@@ -833,10 +833,14 @@ std::vector<VectorCase> vector_cases() {
   cases.push_back({"compensated", Strategy::Mis, 0.0f, 0});
   cases.push_back({"compensated", Strategy::LightBsdf, 0.0f, 0, false, true, false, false, true});
   // Textures (albedo, Disney parameters, a normal map, a mirror's reflectance, an emitter's radiance), read by
-  // CompiledScene::resolve with each path's ray cone.
+  // CompiledScene::resolve with each path's ray cone (and at light samples by LightSampler::emission_at_point).
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"textured", st, 0.0f, 0});
   cases.push_back({"textured", Strategy::Mis, 0.0f, -1, true, true, false, true, true});
+  // The emitter's radiance texture read at light samples drawn in the lanes, by area or in solid angle.
+  for (Strategy st : {Strategy::Light, Strategy::LightBsdf})
+    cases.push_back({"textured", st, 0.0f, 0, false, false, false, false, false, 0, false, false, true});
+  cases.push_back({"textured", Strategy::Mis, 0.0f, 0, false, true, false, false, true, 0, true, false, true});
   // Delta lights (a point, a spot and a directional light): two shadow rays a path, interleaved in path order.
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"delta", st, 0.0f, 0});

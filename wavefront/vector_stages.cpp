@@ -80,6 +80,10 @@ float general_light_pdf(const Scene& scene, const Wave& wave, std::size_t i);
 // an instance or a material that reads textures), written to its arrays:
 // point, error bound, geometric normal, shading frame and flags.
 void general_resolve(const Scene& scene, const Wave& wave, std::size_t i);
+// LightSampler::emission_at_point: the radiance a light sample at p (on a
+// triangle at barycentrics b1, b2) of light entry `light` carries, for an
+// emitter whose emission is a texture.
+void general_light_emission(const Scene& scene, std::int32_t light, float b1, float b2, const float p[3], float Le[3]);
 // Surfel::emitted towards the path's wo, for a kTexturedEmission shape's hit.
 void general_emitted(const Scene& scene, const Wave& wave, std::size_t i, float Le[3]);
 // Under Scene::textured: the cone of the path in slot i after it scattered
@@ -1078,6 +1082,8 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI lig
       triangle_point(df, sa.b1, sa.b2, p0, p1, p2, t_p, t_err);
       lp = select(tri, t_p, lp);
       lerr = select(tri, t_err, lerr);
+      b1 = hn::IfThenElse(tri, sa.b1, b1);
+      b2 = hn::IfThenElse(tri, sa.b2, b2);
     }
     if (const M cone = hn::And(spheres, sa.use); !hn::AllFalse(df, cone)) {
       V3 s_p, s_err, s_n;
@@ -1095,6 +1101,25 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI lig
   ls.pdf = area_light_pdf(df, pmf, inv_area, dist, cos_light);
   if (sc.solid_angle) ls.pdf = hn::IfThenElse(sa.use, pmf * sa.density, ls.pdf);
   ok = hn::And(ok, usable_light_pdf(df, ls.pdf));  // not seen edge-on
+  if (sc.lights.textured) {
+    // An emission texture's texel at the point, read by core, path by path.
+    if (const M textured = hn::And(ok, gather(ok, sc.lights.textured, light, 1, 0) != k(0.0f));
+        !hn::AllFalse(df, textured)) {
+      HWY_ALIGN float at[5][kMaxLanes], radiance[3][kMaxLanes];
+      HWY_ALIGN std::int32_t entry[kMaxLanes];
+      hn::Store(b1, df, at[0]), hn::Store(b2, df, at[1]);
+      hn::Store(lp.x, df, at[2]), hn::Store(lp.y, df, at[3]), hn::Store(lp.z, df, at[4]);
+      hn::Store(light, DI(), entry);
+      hn::Store(ls.Le.x, df, radiance[0]), hn::Store(ls.Le.y, df, radiance[1]), hn::Store(ls.Le.z, df, radiance[2]);
+      for_each_lane(textured, i0, [&](std::size_t, std::size_t j) {
+        const float p[3] = {at[2][j], at[3][j], at[4][j]};
+        float e[3];
+        general_light_emission(sc, entry[j], at[0][j], at[1][j], p, e);
+        for (int c = 0; c < 3; ++c) radiance[c][j] = e[c];
+      });
+      ls.Le = load_lanes(radiance);
+    }
+  }
 
   // Surfel::spawn_to(lp, lerr, ln).
   V3 origin, dir;
@@ -1968,6 +1993,12 @@ bool general_light(const Scene& sc, const Wave& w, std::size_t i, float u_choice
   out->pdf = ls->pdf;
   out->ray[6] = r.tmax;
   return true;
+}
+
+void general_light_emission(const Scene& sc, std::int32_t light, float b1, float b2, const float p[3], float Le[3]) {
+  const Spectrum e =
+      sc.compiled->lights().emission_at_point(static_cast<std::size_t>(light), vec2(b1, b2), vec3(p[0], p[1], p[2]));
+  for (int c = 0; c < 3; ++c) Le[c] = e[c];
 }
 
 void general_sky(const Scene& sc, const Wave& w, std::size_t i, float Le[3], float* pdf) {

@@ -58,6 +58,10 @@ struct Lights {
   const float* columns = nullptr;
   // Per light, 1 for a sphere (else 0), when some light is one (else null).
   const float* sphere = nullptr;
+  // Per light, 1 where its emission is a texture (else 0), when some light's
+  // is (else null): a sample's radiance is read by core, path by path
+  // (LightSampler::emission_at_point), the rest is the lanes'.
+  const float* textured = nullptr;
   // Under `light_sampler: bvh`: `bvh`; the grid points of LightChoice below
   // bvh_grid walk the tree (if any), the rest pick the sky's entries (Sky).
   bool bvh = false;
@@ -163,8 +167,8 @@ struct Scene {
   // the spherical triangle or cone they subtend where the fallback rule
   // says so (core/sampling_spherical.h), in the lanes' double halves.
   bool solid_angle = false;
-  // Lights beyond triangles and spheres and the sky of Sky (emitters placed
-  // by instances or textured):
+  // Lights beyond triangles and spheres and the sky of Sky (an environment
+  // image too large for the gathers' indices):
   // compiled->lights() samples them all
   // and gives their densities, path by path; `sky`: escaped rays find an
   // environment or a sun disk (LightSampler::sky; in the lanes by `skies`

@@ -168,7 +168,8 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Scene scene;
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table, energy, sun_table,
-      sky_starts, sky_entries, env_row_cdf, env_column_cdf, light_sphere, vertex_normals, placements;
+      sky_starts, sky_entries, env_row_cdf, env_column_cdf, light_sphere, light_textured, vertex_normals,
+      placements;
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
   std::vector<std::string> general_materials, general;
@@ -276,11 +277,6 @@ struct WavefrontTracer::VectorStages {
     // Emitters placed by instances are no light entries (the loader takes them
     // only as emitters no light sample aims at): found by rays alone, their
     // density is 0 (triangle_light_pdf: no kFirstLight), as pdf() says.
-    for (const Material& m : scene.materials)
-      if (m.emission_textured) {
-        other_lights.push_back("textured emitters");
-        break;
-      }
     sc.sky = lights.samples_environment();
     sc.general_lights = !other_lights.empty();
     if (sc.general_lights) {
@@ -345,6 +341,7 @@ struct WavefrontTracer::VectorStages {
           v->light_triangle.insert(v->light_triangle.end(), 16, 0.0f);
           v->inv_area.push_back(0.0f);
           v->light_sphere.push_back(0.0f);
+          v->light_textured.push_back(0.0f);
           continue;
         }
         const LightSampler::Entry& e = lights.entries()[i];
@@ -356,6 +353,7 @@ struct WavefrontTracer::VectorStages {
         for (const vec3& c : {sphere ? shape.center : t.p0, sphere ? sphere_fields : t.p1, t.p2, t.n, m.emission})
           v->light_triangle.insert(v->light_triangle.end(), {c.x, c.y, c.z});
         v->light_sphere.push_back(sphere ? 1.0f : 0.0f);
+        v->light_textured.push_back(m.emission_textured ? 1.0f : 0.0f);
         v->light_triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
         v->inv_area.push_back(1.0f / e.area);
       }
@@ -374,6 +372,10 @@ struct WavefrontTracer::VectorStages {
       sc.lights.bvh = lights.light_sampler() == LightSamplerKind::Bvh;
       if (std::find(v->light_sphere.begin(), v->light_sphere.end(), 1.0f) != v->light_sphere.end())
         sc.lights.sphere = v->light_sphere.data();
+      if (std::find(v->light_textured.begin(), v->light_textured.end(), 1.0f) != v->light_textured.end()) {
+        sc.lights.textured = v->light_textured.data();
+        v->general.push_back("the emission textures' reads at light samples");
+      }
       if (const LightBvh* bvh = lights.bvh(); bvh && !bvh->empty()) {
         // The light BVH as the stages walk it (core/simd/light_bvh-inl.h).
         v->bvh_nodes = bvh->node_table();
