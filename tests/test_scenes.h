@@ -225,7 +225,9 @@ using pathlab::kAllStrategies;
 // roughness and metallic, a normal-mapped floor, a textured mirror, a
 // textured emissive light and a textured diffuse sphere. Its images live in
 // a folder that lasts as long as the test process.
-inline Scene cornell_with_textures() {
+// With textured_impulses, the mirror has a normal map too and the ball is
+// glass whose tints are textures, under a normal map.
+inline Scene cornell_with_textures(bool textured_impulses = false) {
   static const ScopedTempDir dir("textured-scenes");
   const std::filesystem::path& d = dir.path();
   if (!std::filesystem::exists(d / "noise.png")) {
@@ -268,7 +270,17 @@ inline Scene cornell_with_textures() {
     {"type": "sphere", "material": "ball", "center": [-0.4, -0.5, -0.2], "radius": 0.45},
     {"type": "rectangle", "material": "light", "transform": [{"scale": [0.25, 0.2, 1]}, {"rotate": {"axis": [1, 0, 0], "angle": 90}}, {"translate": [0, 0.998, 0]}]}
   ]})";
-  return parse_scene(text, d / "textured-cornell.json");
+  if (!textured_impulses) return parse_scene(text, d / "textured-cornell.json");
+  std::string impulses = text;
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    impulses.replace(impulses.find(from), from.size(), to);
+  };
+  replace(R"("offset": 0.2, "scale": 0.7}},)",
+          R"("offset": 0.2, "scale": 0.7}, "normal_map": {"texture": "normals.exr"}},)");
+  replace(R"("ball": {"type": "diffuse", "albedo": {"texture": "noise.png", "wrap": "clamp"}},)",
+          R"("ball": {"type": "dielectric", "ior": 1.4, "reflectance": {"texture": "noise.png", "offset": 0.5, "scale": 0.5},
+               "transmittance": {"texture": "data.png", "scale": 0.8, "offset": 0.2}, "normal_map": {"texture": "normals.exr"}},)");
+  return parse_scene(impulses, d / "textured-impulses-cornell.json");
 }
 
 }  // namespace pathlab::test

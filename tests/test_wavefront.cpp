@@ -247,6 +247,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "envmap"    ? envmap_scene()
             : c.scene == "alpha"     ? test::cornell_with_alpha()
             : c.scene == "textured"  ? test::cornell_with_textures()
+            : c.scene == "textured-impulses" ? test::cornell_with_textures(true)
             : c.scene == "many"      ? test::cornell_with_many_lights()
             : c.scene == "bulb"      ? cornell_with_bulb()
             : c.scene == "sky"       ? cornell_with_sky()
@@ -837,6 +838,11 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"textured", st, 0.0f, 0});
   cases.push_back({"textured", Strategy::Mis, 0.0f, -1, true, true, false, true, true});
+  // A normal-mapped mirror with a textured reflectance, and glass with textured tints under a normal map, shaded
+  // in the lanes from the frame and SurfaceParams core's resolve gives the hit.
+  for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"textured-impulses", st, 0.0f, 0});
+  cases.push_back({"textured-impulses", Strategy::Mis, 0.0f, -1, true, true, false, true, true, 0, true});
   // The emitter's radiance texture read at light samples drawn in the lanes, by area or in solid angle.
   for (Strategy st : {Strategy::Light, Strategy::LightBsdf})
     cases.push_back({"textured", st, 0.0f, 0, false, false, false, false, false, 0, false, false, true});

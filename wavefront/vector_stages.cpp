@@ -1668,10 +1668,17 @@ void scatter(const Scene& sc, const Wave& w) {
       if (!hn::AllFalse(df, glass)) {
         V3 local_g, weight_g;
         VF pdf_g;
-        const M crossed = dielectric_sample(df, shape_value(glass, sc, shape, kIor),
-                                            shape_value3(glass, sc, shape, kReflectance),
-                                            shape_value3(glass, sc, shape, kTransmittance), u_lobe, wo_local, local_g,
-                                            weight_g, pdf_g, transmitted);
+        // Its tints, from the slot's SurfaceParams where textures give them (kHasParams).
+        V3 reflectance = shape_value3(glass, sc, shape, kReflectance);
+        V3 transmittance = shape_value3(glass, sc, shape, kTransmittance);
+        if (const M tinted = hn::And(glass, textured); !hn::AllFalse(df, tinted)) {
+          constexpr std::size_t at = offsetof(SurfaceParams, glass);
+          reflectance = select(tinted, param3(w, i0, tinted, at + offsetof(DielectricParams, reflectance)), reflectance);
+          transmittance =
+              select(tinted, param3(w, i0, tinted, at + offsetof(DielectricParams, transmittance)), transmittance);
+        }
+        const M crossed = dielectric_sample(df, shape_value(glass, sc, shape, kIor), reflectance, transmittance, u_lobe,
+                                            wo_local, local_g, weight_g, pdf_g, transmitted);
         wi = select(glass, to_world(fs, ft, fn, local_g.x, local_g.y, local_g.z), wi);
         weight = select(glass, weight_g, weight);
         pdf = hn::IfThenElse(glass, pdf_g, pdf);

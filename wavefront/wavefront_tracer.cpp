@@ -534,11 +534,11 @@ struct WavefrontTracer::VectorStages {
 
   // Whether the lanes shade m: Lambert, by lambert.h (every shading path but
   // General, which shades it through the Disney closure; core/surfel.cpp),
-  // or Disney (VNDF), textured or not (core's resolve reads the textures and
-  // normal map into the hit's SurfaceParams and frame); an untextured mirror
-  // (mirror.h) or dielectric (dielectric.h).
+  // Disney (VNDF), a mirror (mirror.h) or a dielectric (dielectric.h),
+  // textured or not (core's resolve reads the textures and normal map into
+  // the hit's SurfaceParams and frame).
   static bool in_lanes(const Material& m) {
-    if (m.is_pure_impulse()) return !m.is_textured() && !m.normal_map;
+    if (m.is_pure_impulse()) return true;
     const bool lambert = m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General;
     return lambert || disney_features(m) != 0;
   }
