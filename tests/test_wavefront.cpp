@@ -418,10 +418,10 @@ TEST(Wavefront, EnvironmentMapSameBitsForOneAndTwoThreads) {
   expect_same_bits_for_one_and_two_threads(std::move(scene), true);
 }
 
-// Solid-angle light sampling: the wavefront runs its vectorised stages, the
-// light samples drawn by core's LightSampler path by path (asserted inside),
-// and both tracers give the same bits for one thread and two, and the
-// wavefront for any wave size, on the Cornell box (triangle lights).
+// Solid-angle light sampling: the wavefront runs its vectorised stages
+// (asserted inside; the light samples drawn in their double lanes), and both
+// tracers give the same bits for one thread and two, and the wavefront for
+// any wave size, on the Cornell box (triangle lights).
 TEST(Wavefront, SolidAngleLightSamplingSameBitsForOneAndTwoThreads) {
   Scene scene = test::small_cornell(16, 4, FilterKind::Box);
   scene.render.light_sampling = LightSampling::SolidAngle;
@@ -805,7 +805,7 @@ std::vector<VectorCase> vector_cases() {
   cases.push_back({"smooth-impulses", Strategy::Mis, 0.0f, -1, true, true, true, true, true, 0, true});
   // Lights in the lanes beside the Cornell box's triangles: the sky (an environment image, a constant environment,
   // a sun disk) and sphere lights sampled by area (seen from outside: "bulb"; from inside: the rooms of
-  // mirror-sphere-gray-room and white-sphere-emissive-room); under solid-angle sampling by core's LightSampler.
+  // mirror-sphere-gray-room and white-sphere-emissive-room).
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"envmap", st, 0.0f, 0});
   for (const char* s : {"sphere-in-environment.json", "sun-disk-plane.json", "glass-sphere-tinted.json",
@@ -910,6 +910,27 @@ INSTANTIATE_TEST_SUITE_P(Scenes, VectorStages, testing::ValuesIn(vector_cases())
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;
                          });
+
+// What the stages leave to core, path by path, as `pathlab render` names
+// it: no light sample under solid-angle sampling, nor with an emitter placed
+// by an instance beside delta lights and the sky; of a textured emitter's
+// light samples, only the texel.
+TEST(Wavefront, StagesNameWhatCoreDoesPathByPath) {
+  const auto describe = [](Scene scene) {
+    const RenderSettings settings = scene.render;
+    const CompiledScene compiled(std::move(scene));
+    return WavefrontTracer(compiled, settings).stages_description();
+  };
+  Scene solid_angle = builtin_cornell_box();
+  solid_angle.render.light_sampling = LightSampling::SolidAngle;
+  const std::string plain = describe(solid_angle);
+  EXPECT_EQ(plain.find("by core"), std::string::npos) << plain;
+  const std::string every = describe(cornell_with_every_light());
+  EXPECT_EQ(every.find("light samples"), std::string::npos) << every;
+  const std::string textured = describe(test::cornell_with_textures());
+  EXPECT_NE(textured.find("the emission textures' reads at light samples"), std::string::npos) << textured;
+  EXPECT_EQ(textured.find("the light samples ("), std::string::npos) << textured;
+}
 
 // Every kind of scene runs the vectorised stages at a vector SIMD target
 // (what the lanes do not do, core does path by path between them); the

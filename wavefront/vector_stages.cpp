@@ -1058,18 +1058,16 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI lig
   V3 lp, lerr;
   triangle_point(df, b1, b2, p0, p1, p2, lp, lerr);
   const M spheres = sphere_lights(ok, sc.lights, light);
-  if (sc.lights.sphere) {
-    if (const M sphere = spheres; !hn::AllFalse(df, sphere)) {
-      // sample_sphere: a uniform direction from the centre, projected onto the sphere.
-      V3 dir, s_p, s_err, s_n;
-      uniform_sphere(df, lu, lv, dir.x, dir.y, dir.z);
-      const V3 center = p0;
-      const VF radius = p1.x;
-      sphere_point(df, center, radius, p1.y != k(0.0f), center + radius * dir, s_p, s_err, s_n);
-      lp = select(sphere, s_p, lp);
-      lerr = select(sphere, s_err, lerr);
-      ln = select(sphere, s_n, ln);
-    }
+  if (!hn::AllFalse(df, spheres)) {
+    // sample_sphere: a uniform direction from the centre, projected onto the sphere.
+    V3 dir, s_p, s_err, s_n;
+    uniform_sphere(df, lu, lv, dir.x, dir.y, dir.z);
+    const V3 center = p0;
+    const VF radius = p1.x;
+    sphere_point(df, center, radius, p1.y != k(0.0f), center + radius * dir, s_p, s_err, s_n);
+    lp = select(spheres, s_p, lp);
+    lerr = select(spheres, s_err, lerr);
+    ln = select(spheres, s_n, ln);
   }
   // Under solid_angle, where the rule says so: a triangle's point along a
   // direction in the spherical triangle it subtends, a sphere's where a
