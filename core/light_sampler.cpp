@@ -390,13 +390,13 @@ LightSampler::SolidAngleView LightSampler::solid_angle_view(const Entry& e, cons
     if (!view.cone.outside) return view;  // inside (or on) the sphere: by area
     view.density = generic::sphere_cone_density(kScalarD, D1{view.cone.one_minus_cos_max}).raw;
   } else {
-    D1 omega;
+    D1 omega, density;
     const bool sampled = generic::triangle_view(kScalarD, o, lanes(dvec3(e.triangle.p0)), lanes(dvec3(e.triangle.p1)),
-                                                lanes(dvec3(e.triangle.p2)), omega)
+                                                lanes(dvec3(e.triangle.p2)), omega, density)
                              .raw;
     view.omega = omega.raw;
     if (!sampled) return view;
-    view.density = 1.0 / view.omega;
+    view.density = density.raw;
   }
   if (!std::isfinite(view.density)) view.density = 0.0;
   return view;

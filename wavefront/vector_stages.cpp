@@ -718,10 +718,10 @@ SolidAngleLanes solid_angle_lanes(M m, M sphere, const V3& ref, const V3& p0, co
     MD sampled = hn::FirstN(dd, 0);
     VD dens = hn::Zero(dd);
     if (!hn::AllFalse(dd, triangles)) {
-      VD omega;
-      const MD t = hn::And(triangles, triangle_view(dd, o, q0, q1, q2, omega));
+      VD omega, density_t;
+      const MD t = hn::And(triangles, triangle_view(dd, o, q0, q1, q2, omega, density_t));
       sampled = t;
-      dens = hn::IfThenElse(t, hn::Set(dd, 1.0) / omega, dens);
+      dens = hn::IfThenElse(t, density_t, dens);
       if (lu && !hn::AllFalse(dd, t)) {
         VD tb1, tb2;
         solid_angle_triangle_point(dd, o, q0, q1, q2, omega, half_d(*lu, h), half_d(*lv, h), tb1, tb2);

@@ -196,12 +196,13 @@ HWY_INLINE Vec3<V> sample_sphere_cone_normal(D d, const Vec3<V>& axis, V dist, V
 
 // LightSampler::solid_angle_view of a triangle (p0, p1, p2) seen from o:
 // its solid angle omega, and whether the fallback rule samples it in solid
-// angle (kMinSphericalTriangle <= omega <= kMaxSphericalTriangle; then its
-// density is 1 / omega, finite).
+// angle (kMinSphericalTriangle <= omega <= kMaxSphericalTriangle), with
+// that density, 1 / omega (finite there).
 template <class D, class V = VecOf<D>>
 HWY_INLINE auto triangle_view(D d, const Vec3<V>& o, const Vec3<V>& p0, const Vec3<V>& p1, const Vec3<V>& p2,
-                              V& omega) {
+                              V& omega, V& density) {
   omega = spherical_triangle_solid_angle(d, p0 - o, p1 - o, p2 - o);
+  density = Set(d, 1.0) / omega;
   return And(omega >= Set(d, kMinSphericalTriangle), omega <= Set(d, kMaxSphericalTriangle));
 }
 
