@@ -61,7 +61,7 @@ void simd_offset_ray_origin(const float* p, const float* error, const float* nor
   for (; i < n; ++i) offset_lanes(one, p + 3 * i, error + 3 * i, normal + 3 * i, out + 3 * i);
 }
 
-template <unsigned F>
+template <unsigned F, class Lobes>
 void disney_lanes(const float* in, float* out, std::size_t n) {
   using D = hn::ScalableTag<float>;
   using V = hn::Vec<D>;
@@ -75,13 +75,13 @@ void disney_lanes(const float* in, float* out, std::size_t n) {
                                    at(14), at(15), at(16), at(17)};
     const warps::Vec3<V> wo = at3(18), wi = at3(21);
     const warps::NoEnergy energy;
-    const warps::VndfLobes lobes;
+    const Lobes lobes;
     const auto put = [&](int k, V v) { hn::StoreU(v, d, out + k * n + i); };
     const warps::Vec3<V> f = warps::disney_eval<F>(d, c, wo, wi, energy, {});
     put(0, f.x), put(1, f.y), put(2, f.z);
     put(3, warps::disney_pdf<F>(d, c, wo, wi, lobes, energy, {}));
     V p[3];
-    warps::disney_lobe_probabilities<F>(d, c, wo.z, false, energy, p);
+    warps::disney_lobe_probabilities<F>(d, c, wo.z, Lobes::kKeepsCosine, energy, p);
     put(4, p[0]), put(5, p[1]), put(6, p[2]);
     warps::Vec3<V> s;
     V family;
@@ -92,9 +92,24 @@ void disney_lanes(const float* in, float* out, std::size_t n) {
   }
 }
 
-void simd_disney(bool clearcoat, const float* in, float* out, std::size_t n) {
-  if (clearcoat) disney_lanes<3u>(in, out, n);
-  else disney_lanes<1u>(in, out, n);
+void simd_disney(bool clearcoat, bool cospow, const float* in, float* out, std::size_t n) {
+  if (cospow) {
+    if (clearcoat) disney_lanes<3u, warps::CospowLobes>(in, out, n);
+    else disney_lanes<1u, warps::CospowLobes>(in, out, n);
+  } else {
+    if (clearcoat) disney_lanes<3u, warps::VndfLobes>(in, out, n);
+    else disney_lanes<1u, warps::VndfLobes>(in, out, n);
+  }
+}
+
+void simd_log_exp(const float* in, float* out, std::size_t n) {
+  const hn::ScalableTag<float> d;
+  for (std::size_t i = 0; i < n; i += hn::Lanes(d)) {
+    hn::StoreU(warps::log_lanes(d, hn::LoadU(d, in + i)), d, out + i);
+    hn::StoreU(warps::log1p_lanes(d, hn::LoadU(d, in + n + i)), d, out + n + i);
+    hn::StoreU(warps::exp_lanes(d, hn::LoadU(d, in + 2 * n + i)), d, out + 2 * n + i);
+    hn::StoreU(warps::expm1_lanes(d, hn::LoadU(d, in + 3 * n + i)), d, out + 3 * n + i);
+  }
 }
 
 void simd_transcendentals(const float* u, const float* y, float* sin, float* cos, float* exp2, std::size_t n) {
@@ -135,9 +150,11 @@ void simd_warps(const float* ux, const float* uy, float* x, float* y, float* z, 
   HWY_DYNAMIC_DISPATCH(simd_warps)(ux, uy, x, y, z, s, c, n);
 }
 HWY_EXPORT(simd_disney);
-void simd_disney(bool clearcoat, const float* in, float* out, std::size_t n) {
-  HWY_DYNAMIC_DISPATCH(simd_disney)(clearcoat, in, out, n);
+void simd_disney(bool clearcoat, bool cospow, const float* in, float* out, std::size_t n) {
+  HWY_DYNAMIC_DISPATCH(simd_disney)(clearcoat, cospow, in, out, n);
 }
+HWY_EXPORT(simd_log_exp);
+void simd_log_exp(const float* in, float* out, std::size_t n) { HWY_DYNAMIC_DISPATCH(simd_log_exp)(in, out, n); }
 HWY_EXPORT(simd_transcendentals);
 void simd_transcendentals(const float* u, const float* y, float* sin, float* cos, float* exp2, std::size_t n) {
   HWY_DYNAMIC_DISPATCH(simd_transcendentals)(u, y, sin, cos, exp2, n);

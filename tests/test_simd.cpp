@@ -254,6 +254,78 @@ TEST(SimdTranscendentals, CloseToLibmAndTheSameBitsOnEveryTarget) {
   }
 }
 
+// log_lanes, log1p_lanes, exp_lanes and expm1_lanes (core/simd/sampling-inl.h),
+// the cosine-power lobe's (core/bsdf/cospow-inl.h) in both tracers: within
+// a few ulp of libm's double functions, relative to the result, over their
+// whole domains (every binade of log's, the ends of each reduction and
+// series, arguments from 1e-30 to the overflow), and the same bits on every
+// target and at width 1.
+TEST(SimdTranscendentals, LogAndExpCloseToLibmAndTheSameBitsOnEveryTarget) {
+  const SimdChoice restore;
+  std::mt19937 g(20261205);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  constexpr std::size_t n = 1u << 16;
+  std::vector<float> in[4];  // log, log1p, exp, expm1
+  const auto around = [](std::vector<float>& v, float x) {
+    for (float y : {x, std::nextafter(x, -HUGE_VALF), std::nextafter(x, HUGE_VALF), -x, std::nextafter(-x, -HUGE_VALF),
+                    std::nextafter(-x, HUGE_VALF)})
+      v.push_back(y);
+  };
+  for (float x : {1.0f, 2.0f, 0.5f, 1.41421354f, 0.70710677f, FLT_MIN, FLT_MAX, 0x1p-24f, 3.0f, 1e-30f, 1e30f})
+    for (float y : {x, std::nextafter(x, 0.0f), std::nextafter(x, HUGE_VALF)})
+      if (std::isnormal(y)) in[0].push_back(y);
+  for (float x : {0.0f, 1e-30f, 1e-8f, 0.29289323f, 0.41421354f, 0.5f, 0.99f}) around(in[1], x);
+  in[1].insert(in[1].end(), {std::nextafter(-1.0f, 0.0f), 1.0f, 1e30f, 3.0e38f});
+  for (float x : {0.0f, 1e-30f, 1e-8f, 0.34657359f, 0.5f, 1.0f, 20.0f, 87.6f, 88.0f}) around(in[2], x), around(in[3], x);
+  for (auto* v : {&in[2], &in[3]}) v->insert(v->end(), {-100.0f, -1e30f, -HUGE_VALF});
+  while (in[0].size() < n) in[0].push_back(std::ldexp(1.0f + uniform(g), static_cast<int>(253.0f * uniform(g)) - 126));
+  while (in[1].size() < n / 2) in[1].push_back(2.0f * uniform(g) - 1.0f);
+  while (in[1].size() < n) in[1].push_back(std::ldexp(uniform(g), static_cast<int>(60.0f * uniform(g)) - 30));
+  for (auto* v : {&in[2], &in[3]}) {
+    while (v->size() < n / 2) v->push_back(2.0f * uniform(g) - 1.0f);
+    while (v->size() < n) v->push_back(176.0f * uniform(g) - 88.0f);
+  }
+  std::vector<float> all(4 * n), want(4 * n);
+  for (int k = 0; k < 4; ++k) std::copy(in[k].begin(), in[k].end(), all.begin() + k * n);
+  double worst[4] = {};
+  const char* names[4] = {"log_lanes", "log1p_lanes", "exp_lanes", "expm1_lanes"};
+  for (std::size_t i = 0; i < n; ++i) {
+    const width1::F x[4] = {{all[i]}, {all[n + i]}, {all[2 * n + i]}, {all[3 * n + i]}};
+    const float got[4] = {width1::generic::log_lanes(width1::kScalar, x[0]).raw,
+                          width1::generic::log1p_lanes(width1::kScalar, x[1]).raw,
+                          width1::generic::exp_lanes(width1::kScalar, x[2]).raw,
+                          width1::generic::expm1_lanes(width1::kScalar, x[3]).raw};
+    const double exact[4] = {std::log(double(x[0].raw)), std::log1p(double(x[1].raw)), std::exp(double(x[2].raw)),
+                             std::expm1(double(x[3].raw))};
+    for (int k = 0; k < 4; ++k) {
+      want[k * n + i] = got[k];
+      if (k >= 2 && x[k].raw < -87.6f) {  // below the smallest normal float: 0 (expm1: -1)
+        EXPECT_EQ(got[k], k == 2 ? 0.0f : -1.0f) << names[k] << "(" << x[k].raw << ")";
+        continue;
+      }
+      // In units of 2^-24 of the result (of the smallest normal float at least).
+      const double ulps = std::abs(double(got[k]) - exact[k]) / std::max(std::abs(exact[k]), double(FLT_MIN)) * 0x1p24;
+      if (!std::isnan(worst[k]) && !(ulps <= worst[k])) worst[k] = ulps;  // a NaN sticks
+    }
+  }
+  EXPECT_EQ(want[0], 0.0f) << "log 1";
+  EXPECT_EQ(want[n], 0.0f) << "log1p 0";
+  EXPECT_EQ(want[2 * n], 1.0f) << "exp 0";
+  EXPECT_EQ(want[3 * n], 0.0f) << "expm1 0";
+  for (int k = 0; k < 4; ++k) {
+    RecordProperty(names[k], std::to_string(worst[k]));
+    EXPECT_LT(worst[k], 4.5) << names[k] << " against libm's double function, in units of 2^-24 of the result";
+  }
+  for (SimdTarget t : supported_simd_targets()) {
+    select_simd_target(t);
+    std::vector<float> got(4 * n);
+    test::simd_log_exp(all.data(), got.data(), n);
+    for (int k = 0; k < 4; ++k)
+      EXPECT_EQ(std::memcmp(got.data() + k * n, want.data() + k * n, n * sizeof(float)), 0)
+          << simd_target_name(t) << ": " << names[k] << " differs from the width-1 code's";
+  }
+}
+
 // atan2_lanes (core/simd/sampling-inl.h), the environment image's azimuth
 // and polar angle in both tracers: within 3e-7 of libm's double atan2 on
 // every octant, the axes, signed zeros, ratios from 1e-30 to 1e30 and random
@@ -421,7 +493,10 @@ TEST(SimdDisney, EveryTargetComputesTheBitsOfCoresDisneyModel) {
       for (int k = 0; k < 3; ++k) put(18 + k, i, wo[k]), put(21 + k, i, wi[k]), put(24 + k, i, u[k]);
     }
   }
+  for (const bool cospow : {false, true})
   for (const bool clearcoat : {true, false}) {
+    const BsdfSampling sampling = cospow ? BsdfSampling::Cospow : BsdfSampling::Vndf;
+    const std::string model = std::string(clearcoat ? " (clearcoat" : " (no clearcoat") + (cospow ? ", cospow)" : ", vndf)");
     // The width-1 code: what both tracers' scalar paths call.
     std::vector<float> want(test::kDisneyKernelOutputs * n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -430,13 +505,13 @@ TEST(SimdDisney, EveryTargetComputesTheBitsOfCoresDisneyModel) {
       const unsigned features = clearcoat ? disney::kDisneyLobes | disney::kClearcoat : disney::kDisneyLobes;
       const Spectrum f = clearcoat ? disney::eval<disney::kDisneyLobes | disney::kClearcoat>(c, wo, wi)
                                    : disney::eval<disney::kDisneyLobes>(c, wo, wi);
-      const float pdf = clearcoat ? disney::pdf<disney::kDisneyLobes | disney::kClearcoat>(c, wo, wi, BsdfSampling::Vndf)
-                                  : disney::pdf<disney::kDisneyLobes>(c, wo, wi, BsdfSampling::Vndf);
-      const disney::LobeProbabilities p = disney::lobe_probabilities(c, wo, features, BsdfSampling::Vndf);
+      const float pdf = clearcoat ? disney::pdf<disney::kDisneyLobes | disney::kClearcoat>(c, wo, wi, sampling)
+                                  : disney::pdf<disney::kDisneyLobes>(c, wo, wi, sampling);
+      const disney::LobeProbabilities p = disney::lobe_probabilities(c, wo, features, sampling);
       const float u_lobe = in[24 * n + i];
       const vec2 u(in[25 * n + i], in[26 * n + i]);
-      const auto s = clearcoat ? disney::sample<disney::kDisneyLobes | disney::kClearcoat>(c, wo, u_lobe, u, BsdfSampling::Vndf)
-                               : disney::sample<disney::kDisneyLobes>(c, wo, u_lobe, u, BsdfSampling::Vndf);
+      const auto s = clearcoat ? disney::sample<disney::kDisneyLobes | disney::kClearcoat>(c, wo, u_lobe, u, sampling)
+                               : disney::sample<disney::kDisneyLobes>(c, wo, u_lobe, u, sampling);
       const float family = !s                                   ? -1.0f
                            : s->lobe == Lobe::Specular          ? 1.0f
                            : s->lobe == Lobe::Clearcoat         ? 2.0f
@@ -451,7 +526,7 @@ TEST(SimdDisney, EveryTargetComputesTheBitsOfCoresDisneyModel) {
       if (t == SimdTarget::Scalar) continue;  // Highway's one-lane target: the kernels' tails elsewhere, not here
       select_simd_target(t);
       std::vector<float> got(test::kDisneyKernelOutputs * n, std::numeric_limits<float>::quiet_NaN());
-      test::simd_disney(clearcoat, in.data(), got.data(), n);
+      test::simd_disney(clearcoat, cospow, in.data(), got.data(), n);
       std::size_t differ = 0;
       for (std::size_t i = 0; i < n; ++i) {
         const bool drawn = want[10 * n + i] != 0.0f;
@@ -460,11 +535,11 @@ TEST(SimdDisney, EveryTargetComputesTheBitsOfCoresDisneyModel) {
           const float a = got[k * n + i], b = want[k * n + i];
           const bool same = std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b) || (std::isnan(a) && std::isnan(b));
           if (!same && differ++ < 5)
-            ADD_FAILURE() << simd_target_name(t) << (clearcoat ? " (clearcoat)" : "") << ": " << names[k] << " of input " << i
+            ADD_FAILURE() << simd_target_name(t) << model << ": " << names[k] << " of input " << i
                           << " is " << a << ", the width-1 code gives " << b;
         }
       }
-      EXPECT_EQ(differ, 0u) << simd_target_name(t) << (clearcoat ? " (clearcoat)" : "") << ": values differing, of "
+      EXPECT_EQ(differ, 0u) << simd_target_name(t) << model << ": values differing, of "
                             << 12 * n;
     }
   }

@@ -609,6 +609,7 @@ struct VectorCase {
   bool bvh = false;        // light_sampler bvh (the tree walked in double lanes, core/simd/light_bvh-inl.h)
   bool general_shading = false;  // every material through the Disney closure (--general-shading)
   bool solid_angle = false;      // light_sampling solid_angle (core/simd/spherical-inl.h in double lanes)
+  bool cospow = false;           // bsdf_sampling cospow (Disney's glossy lobes by core/bsdf/cospow-inl.h)
 };
 
 // Every diffuse material one-sided (black behind its geometric normal), and
@@ -696,6 +697,7 @@ TEST_P(VectorStages, GiveTheScalarStagesBits) {
   if (c.bvh) scene.render.light_sampler = LightSamplerKind::Bvh;
   scene.render.force_general_shading = c.general_shading;
   if (c.solid_angle) scene.render.light_sampling = LightSampling::SolidAngle;
+  if (c.cospow) scene.render.bsdf_sampling = BsdfSampling::Cospow;
   if (c.thin_lens) {
     scene.camera.aperture_radius = 0.1f;
     scene.camera.focus_distance = 3.0f;
@@ -847,6 +849,17 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Light, Strategy::LightBsdf})
     cases.push_back({"textured", st, 0.0f, 0, false, false, false, false, false, 0, false, false, true});
   cases.push_back({"textured", Strategy::Mis, 0.0f, 0, false, true, false, false, true, 0, true, false, true});
+  // Disney's glossy lobes sampled by cosine-power lobes (bsdf_sampling cospow): flat, under a shading normal,
+  // energy-compensated and textured; off the axes, under zsobol and the BVH.
+  const auto cospow = [&](VectorCase c) {
+    c.cospow = true;
+    cases.push_back(c);
+  };
+  for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf}) cospow({"materials", st, 0.0f, 0});
+  cospow({"materials", Strategy::Mis, 0.2f, 0, false, true, false, false, true, 0, true});
+  cospow({"smooth-plastic", Strategy::Mis, 0.0f, 0});
+  cospow({"compensated", Strategy::Mis, 0.0f, 0});
+  cospow({"textured", Strategy::LightBsdf, 0.0f, 0});
   // Delta lights (a point, a spot and a directional light): two shadow rays a path, interleaved in path order.
   for (Strategy st : {Strategy::Bsdf, Strategy::Light, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"delta", st, 0.0f, 0});
@@ -905,7 +918,8 @@ INSTANTIATE_TEST_SUITE_P(Scenes, VectorStages, testing::ValuesIn(vector_cases())
                                            (p.param.spp > 0 ? "_spp" + std::to_string(p.param.spp) : "") +
                                            (p.param.bvh ? "_bvh" : "") +
                                            (p.param.general_shading ? "_general_shading" : "") +
-                                           (p.param.solid_angle ? "_solid_angle" : "");
+                                           (p.param.solid_angle ? "_solid_angle" : "") +
+                                           (p.param.cospow ? "_cospow" : "");
                            for (char& ch : s)
                              if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
                            return s;

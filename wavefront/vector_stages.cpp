@@ -172,6 +172,7 @@ using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::uniform_sphere;
 using pathlab::HWY_NAMESPACE::uniform_triangle;
 using pathlab::HWY_NAMESPACE::usable_light_pdf;
+using pathlab::HWY_NAMESPACE::CospowLobes;
 using pathlab::HWY_NAMESPACE::VndfLobes;
 using pathlab::HWY_NAMESPACE::zero_unless;
 using pathlab::HWY_NAMESPACE::zsobol_top24;
@@ -1361,17 +1362,22 @@ struct LaneEnergy {
   }
 };
 
-// fn(std::integral_constant<unsigned, F>, energy) for the Disney lanes of m:
-// F the lobes of the scene (Scene::disney), so that the lanes shade with the
-// lobes core's ShadingPath compiles in; energy a LaneEnergy if some of the
-// lanes' materials have energy tables, else NoEnergy (nothing of it
-// compiled into the call).
+// fn(std::integral_constant<unsigned, F>, energy, sampler) for the Disney
+// lanes of m: F the lobes of the scene (Scene::disney), so that the lanes
+// shade with the lobes core's ShadingPath compiles in; energy a LaneEnergy
+// if some of the lanes' materials have energy tables, else NoEnergy
+// (nothing of it compiled into the call); sampler the glossy lobes'
+// (Scene::disney_cospow: CospowLobes, else VndfLobes).
 template <class Fn>
 void with_disney_model(M m, const Scene& sc, VI shape, Fn&& fn) {
   constexpr unsigned kLobes = 1u, kCoat = 2u;  // disney::Features
+  const auto with_sampler = [&](auto lobes, const auto& energy) {
+    if (sc.disney_cospow) fn(lobes, energy, CospowLobes{});
+    else fn(lobes, energy, VndfLobes{});
+  };
   const auto with_lobes = [&](const auto& energy) {
-    if (sc.disney == (kLobes | kCoat)) fn(std::integral_constant<unsigned, kLobes | kCoat>{}, energy);
-    else fn(std::integral_constant<unsigned, kLobes>{}, energy);
+    if (sc.disney == (kLobes | kCoat)) with_sampler(std::integral_constant<unsigned, kLobes | kCoat>{}, energy);
+    else with_sampler(std::integral_constant<unsigned, kLobes>{}, energy);
   };
   if (sc.energy) {
     const VI base = shape_int(m, sc, shape, kEnergy);
@@ -1446,10 +1452,10 @@ void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V
   if (const M dm = disney_lanes(hn::AndNot(load_mask(w, kShadeByCore, i0, ok), ok), sc, shape); !hn::AllFalse(df, dm)) {
     // Surfel::eval and Surfel::pdf of a Disney material (disney::eval, disney::pdf).
     const ClosureLanes<VF> c = closure_lanes(dm, sc, w, i0, shape, textured);
-    with_disney_model(dm, sc, shape, [&](auto lobes, const auto& energy) {
+    with_disney_model(dm, sc, shape, [&](auto lobes, const auto& energy, const auto& sampler) {
       constexpr unsigned F = decltype(lobes)::value;
       f = select(dm, disney_eval<F>(df, c, wo_local, wi_local, energy, {}), f);
-      pdf_bsdf = hn::IfThenElse(dm, disney_pdf<F>(df, c, wo_local, wi_local, VndfLobes{}, energy, {}), pdf_bsdf);
+      pdf_bsdf = hn::IfThenElse(dm, disney_pdf<F>(df, c, wo_local, wi_local, sampler, energy, {}), pdf_bsdf);
     });
   }
   if (const M general = load_mask(w, kShadeByCore, i0, ok); !hn::AllFalse(df, general)) {
@@ -1628,12 +1634,12 @@ void scatter(const Scene& sc, const Wave& w) {
       const ClosureLanes<VF> c = closure_lanes(dm, sc, w, i0, shape, textured);
       const V3 wo_local = to_local(fs, ft, fn, wo);
       const V3 wo_up{wo_local.x, wo_local.y, wo_local.z * side};
-      with_disney_model(dm, sc, shape, [&](auto lobes, const auto& energy) {
+      with_disney_model(dm, sc, shape, [&](auto lobes, const auto& energy, const auto& sampler) {
         constexpr unsigned F = decltype(lobes)::value;
         V3 local_d;
         VF family;
-        M drawn = disney_sample<F>(df, c, wo_up, u_lobe, du, dv, VndfLobes{}, energy, local_d, family);
-        const VF pdf_d = disney_pdf<F>(df, c, wo_up, local_d, VndfLobes{}, energy, {});
+        M drawn = disney_sample<F>(df, c, wo_up, u_lobe, du, dv, sampler, energy, local_d, family);
+        const VF pdf_d = disney_pdf<F>(df, c, wo_up, local_d, sampler, energy, {});
         drawn = hn::And(drawn, hn::And(pdf_d > k(0.0f), hn::Not(pdf_d < k(sc.min_pdf))));
         const V3 f = disney_eval<F>(df, c, wo_up, local_d, energy, {});
         wi = select(dm, to_world(fs, ft, fn, local_d.x, local_d.y, local_d.z * side), wi);

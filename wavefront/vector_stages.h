@@ -2,15 +2,17 @@
 // (structure of arrays), a block of them per SIMD register — 16 with
 // AVX-512, 8 with AVX2, 4 with SSE4, whichever core/simd/simd.h's dispatch
 // selected — for every scene (any camera, material, light, texture,
-// instance, alpha). The lanes do the camera, world-space hit points,
-// emission and its weight, triangle and sphere lights sampled by area, the environment
-// (one radiance or an image) and sun disks, delta lights,
-// untextured Lambert and Disney (VNDF sampling) in the geometric normal's
-// frame or the hit's own (vertex normals, tangents: Scene::framed), flat
-// mirror and dielectric shading, roulette and compaction; everything else
-// (other materials, the frames of vertex normals, textures, instances,
-// other lights) is core's, called one path at a time between the lanes'
-// steps (Scene::general, framed, general_lights, instanced, textured).
+// instance, alpha). The lanes do the camera, world-space hit points (on
+// instances too), alpha, emission and its weight, every light (triangles and
+// spheres sampled by area or solid angle, the environment, sun disks, delta
+// lights, the points of textured emitters), Lambert, Disney (either sampling
+// of its glossy lobes), mirror and dielectric shading, textured or not, in
+// the geometric normal's frame or the hit's own (vertex normals: Scene::
+// framed), roulette and compaction. Core does, one path at a time between
+// the lanes' steps: texture and normal-map reads (OpenImageIO's) at hits and
+// at textured emitters' light samples, frames from tangents, the general
+// shading path's materials, the strategy `cosine`, and environment images of
+// 2^29 texels or more (Scene::general, textured, general_lights).
 // `--simd scalar` runs the scalar stages of wavefront_tracer.cpp.
 //
 // Written once (vector_stages.cpp, over Google Highway, compiled for every
@@ -157,11 +159,14 @@ struct Scene {
   // kLaneMaterial): else every lane shaded in the lanes is Lambert's or
   // Disney's.
   bool impulses = false;
-  // Some material the lanes shade is Disney's (untextured, VNDF
-  // sampling): the lobes every Disney material of the scene is shaded with
+  // Some material the lanes shade is Disney's: the lobes every Disney material of the scene is shaded with
   // (disney::Features: kDisneyLobes, with kClearcoat if the scene has a
   // clear coat, as core's ShadingPath says); else 0.
   unsigned disney = 0;
+  // The Disney materials' glossy lobes are sampled by cosine-power lobes
+  // (`bsdf_sampling: cospow`, disney-inl.h's CospowLobes), else by their
+  // visible normals (VndfLobes).
+  bool disney_cospow = false;
   const CompiledScene* compiled = nullptr;
   // light_sampling solid_angle: triangle and sphere lights are sampled in
   // the spherical triangle or cone they subtend where the fallback rule

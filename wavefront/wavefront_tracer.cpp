@@ -208,9 +208,13 @@ struct WavefrontTracer::VectorStages {
         continue;
       }
       if (const unsigned lobes = disney_features(m); lobes != 0) {
-        // The lobes are the scene's ShadingPath's, the same for every material (configure_shading).
+        // The lobes are the scene's ShadingPath's, the same for every material (configure_shading), and so is
+        // the glossy lobes' sampling (the render's bsdf_sampling).
+        const bool cospow = m.shading.sampling == BsdfSampling::Cospow;
         if (sc.disney != 0 && sc.disney != lobes) return no("Disney materials shaded with different lobes");
+        if (sc.disney != 0 && sc.disney_cospow != cospow) return no("Disney materials sampled in different ways");
         sc.disney = lobes;
+        sc.disney_cospow = cospow;
       }
       if (m.type != MaterialType::Diffuse && m.type != MaterialType::Disney) continue;
       if (diffuse && m.shading.min_pdf != diffuse->shading.min_pdf) return no("materials with different min_pdf");
@@ -534,7 +538,7 @@ struct WavefrontTracer::VectorStages {
 
   // Whether the lanes shade m: Lambert, by lambert.h (every shading path but
   // General, which shades it through the Disney closure; core/surfel.cpp),
-  // Disney (VNDF), a mirror (mirror.h) or a dielectric (dielectric.h),
+  // Disney (either sampling of its glossy lobes), a mirror (mirror.h) or a dielectric (dielectric.h),
   // textured or not (core's resolve reads the textures and normal map into
   // the hit's SurfaceParams and frame).
   static bool in_lanes(const Material& m) {
@@ -543,10 +547,10 @@ struct WavefrontTracer::VectorStages {
     return lambert || disney_features(m) != 0;
   }
   // The lobes the lanes shade a Disney material with (Scene::disney): those
-  // of the scene's shading path, under VNDF sampling (cospow.h's lobes are
-  // core's alone); 0 if not in lanes.
+  // of the scene's shading path, under either sampling of the glossy lobes;
+  // 0 if not in lanes.
   static unsigned disney_features(const Material& m) {
-    if (m.type != MaterialType::Disney || m.shading.sampling != BsdfSampling::Vndf) return 0;
+    if (m.type != MaterialType::Disney) return 0;
     switch (m.shading.path) {
       case ShadingPath::Disney: return disney::kDisneyLobes;
       case ShadingPath::DisneyClearcoat: return disney::kDisneyLobes | disney::kClearcoat;

@@ -9,8 +9,8 @@
 //  - F, the lobes compiled in (disney::Features: "model only what a scene
 //    requires");
 //  - the glossy lobes' sampler: `Lobes` with specular_pdf/_sample and
-//    clearcoat_pdf/_sample; VndfLobes below (exact visible normals, the
-//    default) is generic, disney.cpp's Cospow lobes are core's only;
+//    clearcoat_pdf/_sample: VndfLobes below (exact visible normals, the
+//    default) or CospowLobes (cosine-power lobes, cospow-inl.h);
 //  - energy compensation (core/bsdf/energy.h): `Energy` (below) with the
 //    layers' transmittances, from each lane's tables; NoEnergy for none;
 //  - DisneyFaults: the test-only planted bugs core's fault build passes
@@ -26,6 +26,7 @@
 
 #include <hwy/highway.h>
 
+#include "core/bsdf/cospow-inl.h"
 #include "core/bsdf/energy.h"
 #include "core/bsdf/microfacet-inl.h"
 #include "core/math.h"
@@ -158,6 +159,40 @@ struct VndfLobes {
     const auto ok = wi.z > Zero(d);
     wi = normalize(d, wi);
     return ok;
+  }
+};
+
+// The glossy lobes' densities and samplers by cosine-power lobes about wo's
+// mirror direction (BsdfSampling::Cospow, cospow-inl.h), of exponent
+// 2 / alpha^2 - 2: the specular lobe's alpha is sqrt(ax ay), the clear
+// coat's its own. A sample is normalised; `ok` false where it falls below
+// the surface.
+struct CospowLobes {
+  // Whether the mixture keeps the cosine lobe whatever the material (disney.h: cospow's tails need it).
+  static constexpr bool kKeepsCosine = true;
+  template <class D, class V = VecOf<D>>
+  HWY_INLINE V specular_pdf(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, const Vec3<V>& wi,
+                            const disney::DisneyFaults&) const {
+    return cospow_pdf(d, mirror(wo), cospow_exponent(d, Sqrt(c.ax * c.ay)), wi);
+  }
+  template <class D, class V = VecOf<D>>
+  HWY_INLINE V clearcoat_pdf(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, const Vec3<V>& wi) const {
+    return cospow_pdf(d, mirror(wo), cospow_exponent(d, c.clearcoat_alpha), wi);
+  }
+  template <class D, class V = VecOf<D>>
+  HWY_INLINE auto specular_sample(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, V ux, V uy, Vec3<V>& wi) const {
+    wi = cospow_sample(d, mirror(wo), cospow_exponent(d, Sqrt(c.ax * c.ay)), ux, uy);
+    return wi.z > Zero(d);
+  }
+  template <class D, class V = VecOf<D>>
+  HWY_INLINE auto clearcoat_sample(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, V ux, V uy, Vec3<V>& wi) const {
+    wi = cospow_sample(d, mirror(wo), cospow_exponent(d, c.clearcoat_alpha), ux, uy);
+    return wi.z > Zero(d);
+  }
+  // wo mirrored about the normal (0, 0, 1).
+  template <class V>
+  static HWY_INLINE Vec3<V> mirror(const Vec3<V>& wo) {
+    return {Neg(wo.x), Neg(wo.y), wo.z};
   }
 };
 

@@ -7,7 +7,13 @@
 #include "core/sampling.h"
 #include "core/simd/width1.h"
 
-namespace pathlab::disney {
+namespace pathlab {
+
+float cospow::exponent_from_alpha(float alpha) {
+  return width1::generic::cospow_exponent(width1::kScalar, width1::F{alpha}).raw;
+}
+
+namespace disney {
 
 namespace {
 
@@ -38,47 +44,15 @@ DisneyFaults faults() {
           PATHLAB_FAULT(CoatNotCoupled)};
 }
 
-float specular_alpha(const Closure& c) { return std::sqrt(c.ax * c.ay); }
-
-// The glossy lobes by cosine-power lobes about the mirror direction
-// (BsdfSampling::Cospow, cospow.h): core's only, at width 1, beside
-// disney-inl.h's VndfLobes.
-struct CospowLobes {
-  static constexpr bool kKeepsCosine = true;  // disney.h: the cosine lobe bounds f cos / pdf
-  const Closure& closure;
-  F specular_pdf(lane1::One<float>, const ClosureLanes<F>&, const F3& wo, const F3& wi, const DisneyFaults&) const {
-    return pdf(specular_alpha(closure), wo, wi);
-  }
-  F clearcoat_pdf(lane1::One<float>, const ClosureLanes<F>&, const F3& wo, const F3& wi) const {
-    return pdf(closure.clearcoat_alpha, wo, wi);
-  }
-  lane1::M specular_sample(lane1::One<float>, const ClosureLanes<F>&, const F3& wo, F ux, F uy, F3& wi) const {
-    return sample(specular_alpha(closure), wo, ux, uy, wi);
-  }
-  lane1::M clearcoat_sample(lane1::One<float>, const ClosureLanes<F>&, const F3& wo, F ux, F uy, F3& wi) const {
-    return sample(closure.clearcoat_alpha, wo, ux, uy, wi);
-  }
-  // The lobe of exponent 2 / alpha^2 - 2 about wo's mirror direction.
-  static F pdf(float alpha, const F3& wo, const F3& wi) {
-    return F{cospow::pdf(microfacet::reflect(scalars(wo), vec3(0, 0, 1)), cospow::exponent_from_alpha(alpha), scalars(wi))};
-  }
-  static lane1::M sample(float alpha, const F3& wo, F ux, F uy, F3& wi) {
-    const vec3 w = cospow::sample(microfacet::reflect(scalars(wo), vec3(0, 0, 1)), cospow::exponent_from_alpha(alpha),
-                                  vec2(ux.raw, uy.raw));
-    wi = lanes(glm::normalize(w));
-    return {w.z > 0.0f};
-  }
-};
-
 // The mixture under the closure's sampling: fn(lobes).
 template <class Fn>
-auto with_lobes(const Closure& c, BsdfSampling sampling, Fn&& fn) {
-  if (sampling == BsdfSampling::Cospow) return fn(CospowLobes{c});
+auto with_lobes(BsdfSampling sampling, Fn&& fn) {
+  if (sampling == BsdfSampling::Cospow) return fn(generic::CospowLobes{});
   return fn(generic::VndfLobes{});
 }
 
 std::optional<vec3> family_sample(const Closure& c, SampledLobe lobe, const vec3& wo, vec2 u, BsdfSampling sampling) {
-  return with_lobes(c, sampling, [&](const auto& lobes) -> std::optional<vec3> {
+  return with_lobes(sampling, [&](const auto& lobes) -> std::optional<vec3> {
     F3 wi;
     const ClosureLanes<F> cl = lanes_of(c);
     const lane1::M ok = lobe == SampledLobe::Specular ? lobes.specular_sample(kScalar, cl, lanes(wo), F{u.x}, F{u.y}, wi)
@@ -118,7 +92,7 @@ template <unsigned Fs> Spectrum eval(const Closure& c, const vec3& wo, const vec
 }
 
 template <unsigned Fs> float pdf(const Closure& c, const vec3& wo, const vec3& wi, BsdfSampling sampling) {
-  return with_lobes(c, sampling, [&](const auto& lobes) {
+  return with_lobes(sampling, [&](const auto& lobes) {
     return generic::disney_pdf<Fs>(kScalar, lanes_of(c), lanes(wo), lanes(wi), lobes, TableEnergy{c.energy},
                                    faults())
         .raw;
@@ -127,7 +101,7 @@ template <unsigned Fs> float pdf(const Closure& c, const vec3& wo, const vec3& w
 
 template <unsigned Fs>
 std::optional<DirectionSample> sample(const Closure& c, const vec3& wo, float u_lobe, vec2 u, BsdfSampling sampling) {
-  return with_lobes(c, sampling, [&](const auto& lobes) -> std::optional<DirectionSample> {
+  return with_lobes(sampling, [&](const auto& lobes) -> std::optional<DirectionSample> {
     F3 wi;
     F family;
     if (!generic::disney_sample<Fs>(kScalar, lanes_of(c), lanes(wo), F{u_lobe}, F{u.x}, F{u.y}, lobes,
@@ -174,7 +148,7 @@ Spectrum lobe_eval(const Closure& c, SampledLobe lobe, const vec3& wo, const vec
 
 float lobe_pdf(const Closure& c, SampledLobe lobe, const vec3& wo, const vec3& wi, BsdfSampling sampling) {
   if (!above(wo, wi)) return 0.0f;
-  return with_lobes(c, sampling, [&](const auto& lobes) {
+  return with_lobes(sampling, [&](const auto& lobes) {
     const ClosureLanes<F> cl = lanes_of(c);
     switch (lobe) {
       case SampledLobe::Diffuse: return cosine_hemisphere_pdf(wi);
@@ -200,4 +174,5 @@ std::optional<vec3> lobe_sample(const Closure& c, SampledLobe lobe, const vec3& 
   return std::nullopt;
 }
 
-}  // namespace pathlab::disney
+}  // namespace disney
+}  // namespace pathlab

@@ -160,5 +160,14 @@ inline V<float> NextFloat(One<float>, V<float> v) {
 // 2^n for a whole n in [-126, 127] (lanes-inl.h's Pow2I; exact both ways).
 inline V<float> Pow2I(One<float>, V<float> n) { return {std::ldexp(1.0f, static_cast<int>(n.raw))}; }
 
+// x = m 2^e, m in [1, 2), for a positive normal x (lanes-inl.h's
+// SplitExponent; exact both ways).
+inline V<float> SplitExponent(One<float>, V<float> x, V<float>& e) {
+  int n = 0;
+  const float m = std::frexp(x.raw, &n);  // in [1/2, 1)
+  e.raw = static_cast<float>(n - 1);
+  return {m * 2.0f};
+}
+
 }  // namespace lane1
 }  // namespace pathlab

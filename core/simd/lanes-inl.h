@@ -138,6 +138,17 @@ HWY_INLINE V Pow2I(D d, V n) {
   return BitCast(d, hn::ShiftLeft<23>(hn::ConvertTo(di, n) + Set(di, 127)));
 }
 
+// x = m 2^e with m in [1, 2) and e whole, for a positive normal float x
+// (0, subnormals, infinities and NaN are outside: callers keep them out);
+// returns m, e in `e`. Both exact. A primitive: lane1 has its own (frexp).
+template <class D, class V = VecOf<D>>
+HWY_INLINE V SplitExponent(D d, V x, V& e) {
+  const hn::RebindToSigned<D> di;
+  const auto bits = BitCast(di, x);
+  e = hn::ConvertTo(d, hn::ShiftRight<23>(bits) - Set(di, 127));
+  return BitCast(d, hn::Or(hn::And(bits, Set(di, 0x007fffff)), Set(di, 0x3f800000)));
+}
+
 // fn(dd, a, b) computed in double lanes (dd a descriptor of doubles) for two
 // vec3s of float lanes, the result rounded to float once: for the few steps
 // that need double's precision (microfacet-inl.h's half_vector). A

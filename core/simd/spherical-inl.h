@@ -31,21 +31,8 @@
 #include "core/simd/lanes-inl.h"
 #include "core/simd/sampling-inl.h"
 
-#include <initializer_list>
-
 HWY_BEFORE_NAMESPACE();
 namespace pathlab::HWY_NAMESPACE {
-
-// A polynomial in z by Horner's rule, from the highest coefficient to the
-// constant: (...(c[0] z + c[1]) z + ...) z + c[n-1]. (Adding a negative
-// coefficient rounds as subtracting its magnitude.)
-template <class D, class V = VecOf<D>>
-HWY_INLINE V series(D d, V z, std::initializer_list<double> c) {
-  const double* k = c.begin();
-  V p = Set(d, *k);
-  for (++k; k != c.end(); ++k) p = p * z + Set(d, *k);
-  return p;
-}
 
 // sin and cos of x for |x| <= 5 pi / 2 (the angles here are within
 // [-pi, 2 pi]). x = q pi/2 + r with q the nearest whole number to x 2/pi and
