@@ -14,12 +14,9 @@
 namespace pathlab {
 
 // A strong 64-bit bijective mixer (the splitmix64 finaliser, Steele et al.
-// 2014). Every output bit depends on every input bit.
-constexpr std::uint64_t mix64(std::uint64_t z) {
-  z = (z ^ (z >> 30)) * sobol::kMixMul0;
-  z = (z ^ (z >> 27)) * sobol::kMixMul1;
-  return z ^ (z >> 31);
-}
+// 2014; core/sobol.h's, which the zsobol sampler's parts use too). Every
+// output bit depends on every input bit.
+constexpr std::uint64_t mix64(std::uint64_t z) { return sobol::mix(z); }
 
 // Top 24 bits of a hash as a float in [0, 1): every value is exactly
 // representable, and 1 - 2^-24 is the largest, so u < 1 always holds.

@@ -27,8 +27,7 @@ inline constexpr std::uint32_t kScrambleEven0 = 0x6b43a9b6u;  // scramble: the x
 inline constexpr std::uint32_t kScrambleEven1 = 0x9e3779b8u;
 inline constexpr std::uint64_t kSlotStep = 0xd1b54a32d192ed03ull;  // SampleStream: a slot's point hash
 
-// splitmix64's finaliser (as mix64 in core/rng.h, kept here so this header
-// stands alone).
+// splitmix64's finaliser (core/rng.h's mix64 is this one).
 constexpr std::uint64_t mix(std::uint64_t z) {
   z = (z ^ (z >> 30)) * kMixMul0;
   z = (z ^ (z >> 27)) * kMixMul1;
