@@ -21,6 +21,7 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pathlab {
@@ -493,10 +494,10 @@ TEST(SimdDisney, EveryTargetComputesTheBitsOfCoresDisneyModel) {
       for (int k = 0; k < 3; ++k) put(18 + k, i, wo[k]), put(21 + k, i, wi[k]), put(24 + k, i, u[k]);
     }
   }
-  for (const bool cospow : {false, true})
-  for (const bool clearcoat : {true, false}) {
+  for (const auto& [clearcoat, cospow] : {std::pair{true, false}, {false, false}, {true, true}, {false, true}}) {
     const BsdfSampling sampling = cospow ? BsdfSampling::Cospow : BsdfSampling::Vndf;
-    const std::string model = std::string(clearcoat ? " (clearcoat" : " (no clearcoat") + (cospow ? ", cospow)" : ", vndf)");
+    const std::string model =
+        std::string(clearcoat ? " (clearcoat" : " (no clearcoat") + (cospow ? ", cospow)" : ", vndf)");
     // The width-1 code: what both tracers' scalar paths call.
     std::vector<float> want(test::kDisneyKernelOutputs * n);
     for (std::size_t i = 0; i < n; ++i) {

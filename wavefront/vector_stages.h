@@ -159,9 +159,10 @@ struct Scene {
   // kLaneMaterial): else every lane shaded in the lanes is Lambert's or
   // Disney's.
   bool impulses = false;
-  // Some material the lanes shade is Disney's: the lobes every Disney material of the scene is shaded with
-  // (disney::Features: kDisneyLobes, with kClearcoat if the scene has a
-  // clear coat, as core's ShadingPath says); else 0.
+  // Some material the lanes shade is Disney's: the lobes every Disney
+  // material of the scene is shaded with (disney::Features: kDisneyLobes,
+  // with kClearcoat if the scene has a clear coat, as core's ShadingPath
+  // says); else 0.
   unsigned disney = 0;
   // The Disney materials' glossy lobes are sampled by cosine-power lobes
   // (`bsdf_sampling: cospow`, disney-inl.h's CospowLobes), else by their

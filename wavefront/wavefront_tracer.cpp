@@ -538,9 +538,9 @@ struct WavefrontTracer::VectorStages {
 
   // Whether the lanes shade m: Lambert, by lambert.h (every shading path but
   // General, which shades it through the Disney closure; core/surfel.cpp),
-  // Disney (either sampling of its glossy lobes), a mirror (mirror.h) or a dielectric (dielectric.h),
-  // textured or not (core's resolve reads the textures and normal map into
-  // the hit's SurfaceParams and frame).
+  // Disney (either sampling of its glossy lobes), a mirror (mirror.h) or a
+  // dielectric (dielectric.h), textured or not (core's resolve reads the
+  // textures and normal map into the hit's SurfaceParams and frame).
   static bool in_lanes(const Material& m) {
     if (m.is_pure_impulse()) return true;
     const bool lambert = m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General;

@@ -173,26 +173,29 @@ struct CospowLobes {
   template <class D, class V = VecOf<D>>
   HWY_INLINE V specular_pdf(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, const Vec3<V>& wi,
                             const disney::DisneyFaults&) const {
-    return cospow_pdf(d, mirror(wo), cospow_exponent(d, Sqrt(c.ax * c.ay)), wi);
+    return pdf(d, Sqrt(c.ax * c.ay), wo, wi);
   }
   template <class D, class V = VecOf<D>>
   HWY_INLINE V clearcoat_pdf(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, const Vec3<V>& wi) const {
-    return cospow_pdf(d, mirror(wo), cospow_exponent(d, c.clearcoat_alpha), wi);
+    return pdf(d, c.clearcoat_alpha, wo, wi);
   }
   template <class D, class V = VecOf<D>>
   HWY_INLINE auto specular_sample(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, V ux, V uy, Vec3<V>& wi) const {
-    wi = cospow_sample(d, mirror(wo), cospow_exponent(d, Sqrt(c.ax * c.ay)), ux, uy);
-    return wi.z > Zero(d);
+    return sample(d, Sqrt(c.ax * c.ay), wo, ux, uy, wi);
   }
   template <class D, class V = VecOf<D>>
   HWY_INLINE auto clearcoat_sample(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, V ux, V uy, Vec3<V>& wi) const {
-    wi = cospow_sample(d, mirror(wo), cospow_exponent(d, c.clearcoat_alpha), ux, uy);
-    return wi.z > Zero(d);
+    return sample(d, c.clearcoat_alpha, wo, ux, uy, wi);
   }
-  // wo mirrored about the normal (0, 0, 1).
-  template <class V>
-  static HWY_INLINE Vec3<V> mirror(const Vec3<V>& wo) {
-    return {Neg(wo.x), Neg(wo.y), wo.z};
+  // The lobe of roughness alpha about wo mirrored about the normal (0, 0, 1).
+  template <class D, class V = VecOf<D>>
+  static HWY_INLINE V pdf(D d, V alpha, const Vec3<V>& wo, const Vec3<V>& wi) {
+    return cospow_pdf(d, Vec3<V>{Neg(wo.x), Neg(wo.y), wo.z}, cospow_exponent(d, alpha), wi);
+  }
+  template <class D, class V = VecOf<D>>
+  static HWY_INLINE auto sample(D d, V alpha, const Vec3<V>& wo, V ux, V uy, Vec3<V>& wi) {
+    wi = cospow_sample(d, Vec3<V>{Neg(wo.x), Neg(wo.y), wo.z}, cospow_exponent(d, alpha), ux, uy);
+    return wi.z > Zero(d);
   }
 };
 

@@ -190,32 +190,36 @@ HWY_INLINE V log1p_lanes(D d, V x) {
   return IfThenElse(near, small, far);
 }
 
+// e^x - 1 for |x| <= ln 2 / 2 (plus rounding) by its Taylor series,
+// x + x^2 (1/2 + x/6 + ... + x^7/9!); the first term left out is below
+// 2e-11 of the result. exp_lanes's e^r is 1 plus this.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V expm1_small(D d, V x) {
+  return x + (x * x) * series(d, x, {1.0 / 362880.0, 1.0 / 40320.0, 1.0 / 5040.0, 1.0 / 720.0, 1.0 / 120.0,
+                                     1.0 / 24.0, 1.0 / 6.0, 0.5});
+}
+
 // e^x for x in [-88, 88]; 0 below -87.6, where e^x is below the smallest
 // normal float. x = k ln 2 + r with k the nearest whole number to x / ln 2
 // and r = (x - k kLn2Hi) - k kLn2Lo (Cody and Waite; |r| <= ln 2 / 2 plus
-// rounding), e^r = 1 + r + r^2 (1/2 + r/6 + ... + r^7/9!) (the first term
-// left out below 8e-11), times 2^k exactly (Pow2I).
+// rounding), e^r = 1 + expm1_small(r), times 2^k exactly (Pow2I).
 template <class D, class V = VecOf<D>>
 HWY_INLINE V exp_lanes(D d, V x) {
   const auto underflow = x < Set(d, -87.6f);
   const V xc = IfThenElse(underflow, Zero(d), x);
   const V k = Round(xc * Set(d, 1.44269502f));  // 1 / ln 2
   const V r = (xc - k * Set(d, kLn2Hi)) - k * Set(d, kLn2Lo);
-  const V er = Set(d, 1.0f) + (r + (r * r) * series(d, r, {1.0 / 362880.0, 1.0 / 40320.0, 1.0 / 5040.0, 1.0 / 720.0,
-                                                             1.0 / 120.0, 1.0 / 24.0, 1.0 / 6.0, 0.5}));
+  const V er = Set(d, 1.0f) + expm1_small(d, r);
   return IfThenZeroElse(underflow, er * Pow2I(d, k));
 }
 
 // e^x - 1 for x <= 88, keeping its relative accuracy near 0: for |x| <=
-// ln 2 / 2 the series x + x^2 (1/2 + x/6 + ... + x^7/9!) (the first term
-// left out below 2e-11 of the result); elsewhere exp_lanes(x) - 1, exact by
-// Sterbenz's lemma down to x = -ln 2 and a small part of the result beyond.
+// ln 2 / 2 expm1_small(x); elsewhere exp_lanes(x) - 1, exact by Sterbenz's
+// lemma down to x = -ln 2 and a small part of the result beyond.
 template <class D, class V = VecOf<D>>
 HWY_INLINE V expm1_lanes(D d, V x) {
   const auto near = Abs(x) <= Set(d, 0.34657359f);
-  const V small = x + (x * x) * series(d, x, {1.0 / 362880.0, 1.0 / 40320.0, 1.0 / 5040.0, 1.0 / 720.0, 1.0 / 120.0,
-                                               1.0 / 24.0, 1.0 / 6.0, 0.5});
-  return IfThenElse(near, small, exp_lanes(d, x) - Set(d, 1.0f));
+  return IfThenElse(near, expm1_small(d, x), exp_lanes(d, x) - Set(d, 1.0f));
 }
 
 // Distribution1D::sample's point in cell i of n whose cdf runs from lo to
