@@ -143,7 +143,7 @@ struct VndfLobes {
     // when wo itself grazes): below wo.h = 1e-20 report 0, a set of measure
     // zero, instead of an infinity (D <= 2.3e4, so the quotient stays below
     // 6e23 above the cut).
-    const V value = (gtr1_D(d, h.z, c.clearcoat_alpha, c.clearcoat_log_a2) * h.z) / (Set(d, 4.0f) * wo_h);
+    const V value = (gtr1_D(d, h, c.clearcoat_alpha, c.clearcoat_log_a2) * h.z) / (Set(d, 4.0f) * wo_h);
     return IfThenElseZero(wo_h > Set(d, 1e-20f), value);
   }
   template <class D, class V = VecOf<D>>
@@ -345,7 +345,7 @@ HWY_INLINE V clearcoat_family(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, 
                               V FH) {
   const V a = Set(d, disney::kClearcoatGAlpha);
   const V Fr = Set(d, 0.04f) + Set(d, 0.96f) * FH;
-  return ((((c.clearcoat * Fr) * gtr1_D(d, h.z, c.clearcoat_alpha, c.clearcoat_log_a2)) * gtr1_g(d, wo.z, a)) *
+  return ((((c.clearcoat * Fr) * gtr1_D(d, h, c.clearcoat_alpha, c.clearcoat_log_a2)) * gtr1_g(d, wo.z, a)) *
           gtr1_g(d, wi.z, a)) *
          wi.z;
 }

@@ -18,7 +18,8 @@ inline float alpha_from_gloss(float gloss) { return 0.1f + (0.001f - 0.1f) * glo
 inline float log_alpha2(float a) { return std::log(a * a); }
 inline float log2_alpha2(float a) { return std::log2(a * a); }
 
-// D at cos_h (the closed-form tests read it; the model calls microfacet-inl.h).
-float D(float cos_h, float a);
+// D at the unit half vector h (local frame; the closed-form tests read it,
+// the model calls microfacet-inl.h).
+float D(const vec3& h, float a);
 
 }  // namespace pathlab::gtr1

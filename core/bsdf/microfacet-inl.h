@@ -120,17 +120,27 @@ HWY_INLINE Vec3<V> ggx_sample_visible(D d, V ax, V ay, const Vec3<V>& wo, V ux, 
   return normalize(d, Vec3<V>{ax * nh.x, ay * nh.y, Max(nh.z, zero)});
 }
 
-// GTR1's D at cos_h, with log_a2 = ln(a^2): 0 at or below the horizon.
+// GTR1's D for a half vector of cosine cos_h and squared sine sin2_h (both
+// given: see below), with log_a2 = ln(a^2): 0 at or below the horizon.
 template <class D, class V = VecOf<D>>
-HWY_INLINE V gtr1_D(D d, V cos_h, V a, V log_a2) {
+HWY_INLINE V gtr1_D(D d, V cos_h, V sin2_h, V a, V log_a2) {
   const V one = Set(d, 1.0f);
   const V a2 = a * a;  // a in [0.001, 0.1] (gloss in [0, 1]): a2 < 1, ln(a2) < 0
-  // 1 + (a2 - 1) cos^2 written as a2 cos^2 + (1 - cos)(1 + cos): at the
-  // peak (cos -> 1) the published form cancels 1 against 1 - a2 and keeps
-  // only the float rounding of a2 - 1 (6e-8, 6 % of a2 = 1e-6 at gloss 1:
-  // D was 1.3 % low there). 1 - cos is exact near 1.
-  const V denom = (a2 * cos_h) * cos_h + (one - cos_h) * (one + cos_h);
+  // 1 + (a2 - 1) cos^2 written as a2 cos^2 + sin^2: at the peak (cos -> 1)
+  // the published form cancels 1 against 1 - a2 and keeps only the float
+  // rounding of a2 - 1 (6e-8, 6 % of a2 = 1e-6 at gloss 1: D was 1.3 %
+  // low there). sin^2 is taken from the half vector's x and y, not as
+  // (1 - cos)(1 + cos): floats below 1 are 6e-8 apart, so that form moves
+  // in steps of 1.2e-7, 12 % of a2 at gloss 1, and D was a staircase
+  // across the peak (its quadrature then missed 4e-4 of the lobe).
+  const V denom = (a2 * cos_h) * cos_h + sin2_h;
   return IfThenZeroElse(cos_h <= Zero(d), (a2 - one) / ((Set(d, kPi) * log_a2) * denom));
+}
+
+// ... at the half vector h (unit, local frame).
+template <class D, class V = VecOf<D>>
+HWY_INLINE V gtr1_D(D d, const Vec3<V>& h, V a, V log_a2) {
+  return gtr1_D(d, h.z, h.x * h.x + h.y * h.y, a, log_a2);
 }
 
 // Burley's smithG_GGX(c, a) / (2 c): 1 / (c + sqrt(a^2 + c^2 - a^2 c^2)),
@@ -149,10 +159,14 @@ HWY_INLINE Vec3<V> gtr1_sample(D d, V ux, V uy, V a, V log2_a2) {
   const V a2 = a * a;
   // cos^2 = (1 - a2^(1-u)) / (1 - a2), in [0, 1]; clamp the rounding
   // (std::clamp's order: below 0, then above 1; a NaN stays).
-  const V q = (one - exp2_lanes(d, (one - ux) * log2_a2)) / (one - a2);
+  // sin^2 = (a2^(1-u) - a2) / (1 - a2), its own quotient rather than
+  // 1 - cos^2, which near the peak moves in steps of 6e-8 (6 % of a2 at
+  // gloss 1): the half vectors came out on rings.
+  const V e = exp2_lanes(d, (one - ux) * log2_a2);
+  const V q = (one - e) / (one - a2);
   const V cos2 = IfThenElse(q < zero, zero, IfThenElse(one < q, one, q));
   const V cos_h = Sqrt(cos2);
-  const V sin_h = Sqrt(Max(one - cos2, zero));
+  const V sin_h = Sqrt(Max((e - a2) / (one - a2), zero));
   V sin_phi, cos_phi;
   sin_cos_turn(d, uy, sin_phi, cos_phi);
   return {sin_h * cos_phi, sin_h * sin_phi, cos_h};

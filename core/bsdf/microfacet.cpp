@@ -22,9 +22,9 @@ vec3 reflect(const vec3& wo, const vec3& h) {
 
 namespace gtr1 {
 
-float D(float cos_h, float a) {
+float D(const vec3& h, float a) {
   using namespace width1;
-  return generic::gtr1_D(kScalar, F{cos_h}, F{a}, F{log_alpha2(a)}).raw;
+  return generic::gtr1_D(kScalar, lanes(h), F{a}, F{log_alpha2(a)}).raw;
 }
 
 }  // namespace gtr1
