@@ -6,6 +6,12 @@
 
 #include <algorithm>
 #include <thread>
+#ifdef PATHLAB_TSAN
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <vector>
+#endif
 
 namespace pathlab {
 
@@ -36,6 +42,36 @@ void parallel_for_impl(std::size_t begin, std::size_t end, std::size_t grain, Ra
     for (std::size_t c = 0; c < chunks; ++c) fn(body, begin + c * grain, std::min(end, begin + (c + 1) * grain));
     return;
   }
+#ifdef PATHLAB_TSAN
+  // Under ThreadSanitizer (tools/run-tsan.sh) the chunks run on threads of
+  // their own, not on TBB's workers. Debian's libtbb is not instrumented:
+  // TSan cannot see its scheduler hand a range from one thread to another
+  // and reports hundreds of races in TBB's templates per render, and every
+  // worker's stack has libtbb in it, so suppressing those hides every race
+  // in pathlab's own code as well (it hid one planted in the wavefront's
+  // loop). pthread_create and join are what TSan understands. The same
+  // chunks, taken in any order, as with TBB; the first exception a chunk
+  // throws is rethrown here, as tbb::parallel_for does.
+  const std::size_t threads = std::min<std::size_t>(chunks, static_cast<std::size_t>(max_threads()));
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  const auto work = [&] {
+    try {
+      for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
+        fn(body, begin + c * grain, std::min(end, begin + (c + 1) * grain));
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+      next = chunks;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+#else
   // simple_partitioner with grain 1 over chunk indices: exactly our chunks.
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, chunks, 1),
@@ -44,6 +80,7 @@ void parallel_for_impl(std::size_t begin, std::size_t end, std::size_t grain, Ra
           fn(body, begin + c * grain, std::min(end, begin + (c + 1) * grain));
       },
       tbb::simple_partitioner());
+#endif
 }
 
 }  // namespace detail

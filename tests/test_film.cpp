@@ -11,10 +11,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 namespace pathlab {
 namespace {
@@ -166,6 +168,23 @@ TEST(Film, SameBitsForOneAndTwoThreads) {
     ASSERT_EQ(a.pixels.size(), b.pixels.size());
     EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(vec3)), 0);
   }
+}
+
+// tools/run-tsan.sh's proof that its ThreadSanitizer run can fail: with
+// PATHLAB_TSAN_PLANTED_RACE=1 the chunks of a parallel_for on two threads
+// add to one plain counter, and the run must report a data race. Skipped
+// otherwise (in every ordinary run).
+TEST(Parallel, PlantedRaceForThreadSanitizer) {
+  if (std::getenv("PATHLAB_TSAN_PLANTED_RACE") == nullptr) GTEST_SKIP() << "only for tools/run-tsan.sh";
+  const ThreadLimit two(2);
+  long counter = 0;
+  parallel_for(0, 64, 1, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      counter = counter + 1;
+      std::this_thread::yield();
+    }
+  });
+  EXPECT_GT(counter, 0);
 }
 
 // The user-facing promise: `pathlab render --threads 1` and `--threads 2`
