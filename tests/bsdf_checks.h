@@ -142,10 +142,10 @@ inline Chi2Result chi2_test(const Target& t, std::uint64_t seed, long n, double 
   }
   const auto density = [&](double z, double phi) { return t.pdf(quadrature::dir_of(z, phi)); };
   // Every cell's quadrature error lands in the lost cell's expectation,
-  // 1 - total: each cell is integrated to a hundredth of a sample (or 1e-4
-  // of its mass; that rule leaves ~3e-6 of a peaked lobe, 5 samples of
-  // 1.6M, which the pooling below absorbs). At 2e-6 a cell, 2.5e-5 of a
-  // cospow lobe went missing and the lost cell expected 40 samples of none.
+  // 1 - total, so each cell is integrated to a hundredth of a sample. (At a
+  // fixed 2e-6 a cell, before the quadrature checked both splits, 2.5e-5 of
+  // a cospow lobe seen head-on went uncounted: at 16x the samples the lost
+  // cell expected 40 of 1.6M and saw none.)
   const double cell_tol = 0.01 / static_cast<double>(n);
   double total = 0.0;
   for (int iz = 0; iz < nz; ++iz)
