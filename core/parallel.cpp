@@ -37,9 +37,10 @@ void parallel_for_impl(std::size_t begin, std::size_t end, std::size_t grain, Ra
   if (begin >= end) return;
   grain = std::max<std::size_t>(grain, 1);
   const std::size_t chunks = (end - begin + grain - 1) / grain;
+  const auto chunk = [&](std::size_t c) { fn(body, begin + c * grain, std::min(end, begin + (c + 1) * grain)); };
   if (chunks == 1 || max_threads() == 1) {
     // Same chunks in the same order as the parallel path, on this thread.
-    for (std::size_t c = 0; c < chunks; ++c) fn(body, begin + c * grain, std::min(end, begin + (c + 1) * grain));
+    for (std::size_t c = 0; c < chunks; ++c) chunk(c);
     return;
   }
 #ifdef PATHLAB_TSAN
@@ -58,8 +59,7 @@ void parallel_for_impl(std::size_t begin, std::size_t end, std::size_t grain, Ra
   std::mutex failure_mutex;
   const auto work = [&] {
     try {
-      for (std::size_t c; (c = next.fetch_add(1)) < chunks;)
-        fn(body, begin + c * grain, std::min(end, begin + (c + 1) * grain));
+      for (std::size_t c; (c = next.fetch_add(1)) < chunks;) chunk(c);
     } catch (...) {
       const std::lock_guard<std::mutex> lock(failure_mutex);
       if (!failure) failure = std::current_exception();
@@ -76,8 +76,7 @@ void parallel_for_impl(std::size_t begin, std::size_t end, std::size_t grain, Ra
   tbb::parallel_for(
       tbb::blocked_range<std::size_t>(0, chunks, 1),
       [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t c = r.begin(); c < r.end(); ++c)
-          fn(body, begin + c * grain, std::min(end, begin + (c + 1) * grain));
+        for (std::size_t c = r.begin(); c < r.end(); ++c) chunk(c);
       },
       tbb::simple_partitioner());
 #endif

@@ -51,7 +51,9 @@ template <typename F> value_of<F> gauss2x2(const F& f, double z0, double z1, dou
 // Binary refinement. Far from every peak the cell splits along whichever
 // side is longer as an angle (near the pole a cell's phi side is short
 // however wide it is in phi; a z side is split at its mid-angle, not its
-// mid-z, so that cells shrink there too) until the estimate settles.
+// mid-z, so that cells shrink there too) until the estimate settles:
+// both its halvings, along theta and along phi, agree with the whole (the
+// leaf then returns their extrapolation; see below).
 // Around each peak the mesh is graded, anisotropically: measured in units
 // of the peak's widths along theta and phi, a cell is trusted only once it
 // is smaller than a quarter of its distance to the peak (and of one width).
