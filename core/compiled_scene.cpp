@@ -239,17 +239,21 @@ void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayH
       const mat3 l(placements_[hit.instance].to_world);
       e1 = l * e1, e2 = l * e2;
     }
-    float uv_area = 0.5f;  // barycentrics
+    vec2 a(0.0f), b(0.0f);
     if (shape.mesh.has_uvs()) {
       const glm::uvec3 v = shape.mesh.triangles[hit.prim];
-      const vec2 a = shape.mesh.uvs[v.y] - shape.mesh.uvs[v.x], b = shape.mesh.uvs[v.z] - shape.mesh.uvs[v.x];
-      uv_area = 0.5f * std::abs(a.x * b.y - a.y * b.x);
+      a = shape.mesh.uvs[v.y] - shape.mesh.uvs[v.x], b = shape.mesh.uvs[v.z] - shape.mesh.uvs[v.x];
     }
-    const float area = 0.5f * glm::length(glm::cross(e1, e2));
-    uv_per_area = area > 0.0f ? uv_area / area : 0.0f;
+    using namespace width1;
+    uv_per_area = generic::triangle_uv_per_area(kScalar, lanes(e1), lanes(e2), lane1::M{shape.mesh.has_uvs()}, F{a.x},
+                                                F{a.y}, F{b.x}, F{b.y})
+                      .raw;
   }
-  const float width = uv_footprint(cone.width_at(glm::length(s->p - ray.origin)), glm::dot(ray.dir, s->n), uv_per_area);
-  const TextureFootprint at{s->uv, std::isfinite(width) ? width : 0.0f};
+  using namespace width1;
+  const float width = generic::footprint_width(kScalar, F{cone.width}, F{cone.spread}, F{glm::length(s->p - ray.origin)},
+                                               F{glm::dot(ray.dir, s->n)}, F{uv_per_area})
+                          .raw;
+  const TextureFootprint at{s->uv, width};
   if (m.normal_map) {
     // Tangent space as glTF has it: x along the tangent (dP/du), y along the
     // bitangent (dP/dv, "+y up"), z the shading normal; n = 2 c - 1, x and y

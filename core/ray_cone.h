@@ -63,11 +63,9 @@ inline RayCone scattered_cone(const RayCone& in, float t, bool impulse, float pd
   return out;
 }
 
-// The footprint's width in texture space at a hit: the cone's width `w`
-// there, projected onto the surface (`cos_theta` between ray and normal)
-// and scaled by sqrt(uv area / world area).
-inline float uv_footprint(float w, float cos_theta, float uv_per_world_area) {
-  return w / std::max(std::abs(cos_theta), 1e-4f) * std::sqrt(uv_per_world_area);
-}
+// The footprint's width in texture space at a hit (the cone's width there,
+// projected onto the surface and scaled by sqrt(uv area / world area)) is
+// footprint_width in core/simd/lanes-inl.h: CompiledScene::read_textures
+// and the wavefront's lanes compute it by that one source.
 
 }  // namespace pathlab

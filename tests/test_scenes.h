@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 #include <random>
 #include <string>
 #include <vector>
@@ -227,7 +229,8 @@ using pathlab::kAllStrategies;
 // a folder that lasts as long as the test process.
 // With textured_impulses, the mirror has a normal map too and the ball is
 // glass whose tints are textures, under a normal map.
-inline Scene cornell_with_textures(bool textured_impulses = false) {
+// The folder of the textured scenes' images (written once per test process).
+inline const std::filesystem::path& textured_scene_dir() {
   static const ScopedTempDir dir("textured-scenes");
   const std::filesystem::path& d = dir.path();
   if (!std::filesystem::exists(d / "noise.png")) {
@@ -246,6 +249,11 @@ inline Scene cornell_with_textures(bool textured_impulses = false) {
     write_image(d / "normals.exr", 32, 32, 3, normals);
     write_image(d / "light.exr", 8, 8, 3, light);
   }
+  return d;
+}
+
+inline Scene cornell_with_textures(bool textured_impulses = false) {
+  const std::filesystem::path& d = textured_scene_dir();
   const std::string text = R"({"pathlab_scene": 1,
   "camera": {"position": [0, 0, 3.75], "look_at": [0, 0, 0], "fov_y": 40},
   "film": {"resolution": [32, 32]},
@@ -281,6 +289,55 @@ inline Scene cornell_with_textures(bool textured_impulses = false) {
           R"("ball": {"type": "dielectric", "ior": 1.4, "reflectance": {"texture": "noise.png", "offset": 0.5, "scale": 0.5},
                "transmittance": {"texture": "data.png", "scale": 0.8, "offset": 0.2}, "normal_map": {"texture": "normals.exr"}},)");
   return parse_scene(impulses, d / "textured-impulses-cornell.json");
+}
+
+// Textured meshes of every kind whose hits the wavefront's lanes resolve
+// themselves (ShapeField kTexturedHits: no tangents, no normal map), core
+// reading only the texels: a tent without texture coordinates (the
+// barycentrics are), a smooth octahedron with vertex normals and its own
+// coordinates in world space, and the same octahedron in a group placed
+// by instance_placements() (turned, mirrored with a non-uniform scale,
+// sheared), in Lambert and Disney materials under a textured light.
+inline Scene cornell_with_textured_meshes() {
+  const std::filesystem::path& d = textured_scene_dir();
+  if (!std::filesystem::exists(d / "gem.obj")) {
+    std::ofstream tent(d / "tent.obj");
+    tent << "v -0.9 -1 0.2\nv -0.1 -1 0.2\nv -0.5 -0.2 -0.3\nv -0.5 -1 -0.8\nf 1 2 3\nf 2 4 3\nf 4 1 3\n";
+    std::ofstream gem(d / "gem.obj");
+    gem << "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n";
+    gem << "vn 0.9 0.3 0.3\nvn -0.9 0.3 -0.3\nvn 0.3 0.9 0.3\nvn -0.3 -0.9 0.3\nvn 0.3 0.3 0.9\nvn -0.3 0.3 -0.9\n";
+    gem << "vt 0.1 0.2\nvt 0.9 0.1\nvt 0.5 0.95\nvt 0.4 0.05\nvt 0.7 0.6\nvt 0.2 0.7\n";
+    for (const char* f : {"1 3 5", "3 2 5", "2 4 5", "4 1 5", "3 1 6", "2 3 6", "4 2 6", "1 4 6"}) {
+      int a, b, c;
+      std::sscanf(f, "%d %d %d", &a, &b, &c);
+      gem << "f " << a << "/" << a << "/" << a << " " << b << "/" << b << "/" << b << " " << c << "/" << c << "/" << c << "\n";
+    }
+  }
+  const std::string text = R"({"pathlab_scene": 1,
+  "camera": {"position": [0, 0, 3.75], "look_at": [0, 0, 0], "fov_y": 40},
+  "film": {"resolution": [32, 32]},
+  "render": {"spp": 4, "max_depth": 6, "rr_depth": 3},
+  "materials": {
+    "walls": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": 0.9, "wrap": "mirror"}},
+    "red": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": [0.8, 0.1, 0.1], "wrap": "clamp"}},
+    "disney": {"type": "disney", "base_color": {"texture": "noise.png"}, "roughness": {"texture": "data.png", "channel": 1},
+               "metallic": {"texture": "data.png", "channel": 2}, "sheen": {"texture": "data.png", "channel": 0}},
+    "light": {"type": "emissive", "radiance": {"texture": "light.exr", "scale": [17, 12, 4], "colorspace": "linear"}}
+  },
+  "shapes": [
+    {"type": "rectangle", "material": "walls", "transform": [{"rotate": {"axis": [1, 0, 0], "angle": -90}}, {"translate": [0, -1, 0]}]},
+    {"type": "rectangle", "material": "walls", "transform": [{"scale": 1.0}, {"translate": [0, 0, -1]}]},
+    {"type": "rectangle", "material": "red", "transform": [{"rotate": {"axis": [0, 1, 0], "angle": 90}}, {"translate": [-1, 0, 0]}]},
+    {"type": "mesh", "file": "tent.obj", "material": "disney"},
+    {"type": "mesh", "file": "gem.obj", "material": "red", "transform": [{"scale": 0.3}, {"translate": [0.5, 0.4, 0.0]}]},
+    {"type": "rectangle", "material": "light", "transform": [{"scale": [0.25, 0.2, 1]}, {"rotate": {"axis": [1, 0, 0], "angle": 90}}, {"translate": [0, 0.998, 0]}]}
+  ],
+  "groups": {"gems": [{"type": "mesh", "file": "gem.obj", "material": "disney"}]},
+  "instances": [
+    {"group": "gems", "transform": [{"scale": 0.22}, {"rotate": {"axis": [0.3, 1, 0.2], "angle": 34}}, {"translate": [-0.45, -0.7, 0.35]}]},
+    {"group": "gems", "transform": [{"scale": [-0.3, 0.18, 0.24]}, {"translate": [0.45, -0.55, -0.25]}]}
+  ]})";
+  return parse_scene(text, d / "textured-meshes-cornell.json");
 }
 
 }  // namespace pathlab::test

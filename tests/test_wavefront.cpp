@@ -27,7 +27,8 @@ namespace pathlab {
 namespace {
 
 struct SameSeedCase {
-  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" / "alpha" / "textured" (test_scenes.h),
+  // "" = the built-in Cornell box, "smooth" / "instanced" / "delta" / "alpha" / "textured" /
+  // "textured-meshes" (test_scenes.h),
   // "envmap" / "bulb" (below), else a file in analytic-scenes/
   std::string scene;
   Strategy strategy;
@@ -248,6 +249,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "alpha"     ? test::cornell_with_alpha()
             : c.scene == "textured"  ? test::cornell_with_textures()
             : c.scene == "textured-impulses" ? test::cornell_with_textures(true)
+            : c.scene == "textured-meshes" ? test::cornell_with_textured_meshes()
             : c.scene == "many"      ? test::cornell_with_many_lights()
             : c.scene == "bulb"      ? cornell_with_bulb()
             : c.scene == "sky"       ? cornell_with_sky()
@@ -328,6 +330,7 @@ std::vector<SameSeedCase> same_seed_cases() {
   scenes.push_back("envmap");     // an environment image over a diffuse sphere and a metal ground (above)
   scenes.push_back("alpha");      // the instanced Cornell box with partial coverage (test_scenes.h)
   scenes.push_back("textured");   // the Cornell box reading textures everywhere (test_scenes.h)
+  scenes.push_back("textured-meshes");  // textured meshes without uvs, smooth, on instances (test_scenes.h)
   scenes.push_back("bulb");       // the Cornell box with a sphere light seen from outside (above)
   scenes.push_back("sky");        // the Cornell box under an environment and two sun disks (above)
   scenes.push_back("sky-image");  // the same under an environment image (above)
@@ -845,6 +848,11 @@ std::vector<VectorCase> vector_cases() {
   for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"textured-impulses", st, 0.0f, 0});
   cases.push_back({"textured-impulses", Strategy::Mis, 0.0f, -1, true, true, false, true, true, 0, true});
+  // Textured meshes whose hits the lanes resolve, core reading only the texels (kTexturedHits): without texture
+  // coordinates, with vertex normals, on instances (turned, mirrored, sheared); Lambert and Disney.
+  for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"textured-meshes", st, 0.0f, 0});
+  cases.push_back({"textured-meshes", Strategy::Mis, 0.0f, -1, true, true, false, true, true, 0, true});
   // The emitter's radiance texture read at light samples drawn in the lanes, by area or in solid angle.
   for (Strategy st : {Strategy::Light, Strategy::LightBsdf})
     cases.push_back({"textured", st, 0.0f, 0, false, false, false, false, false, 0, false, false, true});

@@ -80,6 +80,10 @@ float general_light_pdf(const Scene& scene, const Wave& wave, std::size_t i);
 // an instance or a material that reads textures), written to its arrays:
 // point, error bound, geometric normal, shading frame and flags.
 void general_resolve(const Scene& scene, const Wave& wave, std::size_t i);
+// The texels a kTexturedHits hit in slot i reads (evaluate_textured, core/
+// material.h: OpenImageIO's lookups at the footprint kTexU, kTexV,
+// kTexWidth) into the slot's SurfaceParams.
+void general_texels(const Scene& scene, const Wave& wave, std::size_t i);
 // LightSampler::emission_at_point: the radiance a light sample at p (on a
 // triangle at barycentrics b1, b2) of light entry `light` carries, for an
 // emitter whose emission is a texture.
@@ -136,6 +140,7 @@ using pathlab::HWY_NAMESPACE::env_solid_angle_pdf;
 using pathlab::HWY_NAMESPACE::env_texel;
 using pathlab::HWY_NAMESPACE::env_uv_to_direction;
 using pathlab::HWY_NAMESPACE::facing_normal;
+using pathlab::HWY_NAMESPACE::footprint_width;
 using pathlab::HWY_NAMESPACE::frame;
 using pathlab::HWY_NAMESPACE::geometric_side_ok;
 using pathlab::HWY_NAMESPACE::is_black;
@@ -167,6 +172,7 @@ using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
 using pathlab::HWY_NAMESPACE::transform_point;
+using pathlab::HWY_NAMESPACE::triangle_uv_per_area;
 using pathlab::HWY_NAMESPACE::triangle_view;
 using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::uniform_sphere;
@@ -666,7 +672,10 @@ void resolve(const Scene& sc, const Wave& w) {
       const M framed = shape_flag(hn::AndNot(hn::Or(general, by_core), found), sc, shape, kFramed);
       const VI normals_at = shape_int(framed, sc, shape, kNormalsAt);
       const M here = hn::And(framed, fmask(hn::Not(normals_at < hn::Zero(DI()))));
-      by_core = hn::Or(by_core, hn::AndNot(here, framed));
+      // A textured mesh's hit (kTexturedHits) is the lanes' too, its frame Frame(n) where it has no vertex
+      // normals; then its texture lookups' footprint (below).
+      const M textured = sc.textured_hits ? shape_flag(framed, sc, shape, kTexturedHits) : hn::FirstN(df, 0);
+      by_core = hn::Or(by_core, hn::AndNot(hn::Or(here, textured), framed));
       if (!hn::AllFalse(df, here)) {
         const VI tri = normals_at + load(w, kPrim, i0, here);
         V3 vn[3];
@@ -684,6 +693,52 @@ void resolve(const Scene& sc, const Wave& w) {
         // Surfel::shading_normal: ns != n.
         store_mask(w, kShadingNormal, i0, here, hn::Or(ns.x != n.x, hn::Or(ns.y != n.y, ns.z != n.z)));
         store_mask(w, kHasParams, i0, here, hn::FirstN(df, 0));
+      }
+      if (!hn::AllFalse(df, textured)) {
+        // CompiledScene::shading_frame's Frame(n) where no vertex normals made one.
+        if (const M flat = hn::AndNot(here, textured); !hn::AllFalse(df, flat)) {
+          V3 fs, ft;
+          frame(df, n, fs, ft);
+          store3(w, kFsX, i0, flat, fs);
+          store3(w, kFtX, i0, flat, ft);
+          store3(w, kFnX, i0, flat, n);
+          store_mask(w, kShadingNormal, i0, flat, hn::FirstN(df, 0));
+        }
+        // CompiledScene::read_textures' footprint: the texture coordinates (Mesh::uv_at: the vertices' blended
+        // by the barycentrics, as blend_normals blends normals; or the barycentrics) and the width of the ray
+        // cone there in uv (footprint_width), from the triangle's edges (placed by its instance) and uv edges.
+        const VI tri = shape_int(textured, sc, shape, kFirstTriangle) + load(w, kPrim, i0, textured);
+        const V3 p0 = gather3(textured, sc.triangles, tri, 12, 0);
+        V3 e1 = gather3(textured, sc.triangles, tri, 12, 3) - p0, e2 = gather3(textured, sc.triangles, tri, 12, 6) - p0;
+        if (const M on = hn::And(textured, placed); !hn::AllFalse(df, on)) {
+          const V3 c0 = placement(on, kToWorld), c1 = placement(on, kToWorld + 3), c2 = placement(on, kToWorld + 6);
+          e1 = select(on, to_world(c0, c1, c2, e1.x, e1.y, e1.z), e1);
+          e2 = select(on, to_world(c0, c1, c2, e2.x, e2.y, e2.z), e2);
+        }
+        const VF b1 = load(w, kHitU, i0, textured), b2 = load(w, kHitV, i0, textured);
+        V3 uv{b1, b2, hn::Zero(df)}, a = zero3(), b = zero3();
+        const VI uvs_at = shape_int(textured, sc, shape, kUvsAt);
+        const M has_uvs = hn::And(textured, fmask(hn::Not(uvs_at < hn::Zero(DI()))));
+        if (!hn::AllFalse(df, has_uvs)) {
+          const VI at = uvs_at + load(w, kPrim, i0, has_uvs);
+          V3 t[3];
+          for (int k = 0; k < 3; ++k)
+            t[k] = V3{gather(has_uvs, sc.triangle_uvs, at, 6, 2 * k), gather(has_uvs, sc.triangle_uvs, at, 6, 2 * k + 1),
+                      hn::Zero(df)};
+          uv = select(has_uvs, blend_normals(df, b1, b2, t[0], t[1], t[2]), uv);
+          a = t[1] - t[0];
+          b = t[2] - t[0];
+        }
+        const VF uv_per_area = triangle_uv_per_area(df, e1, e2, has_uvs, a.x, a.y, b.x, b.y);
+        const V3 o = load3(w, kOx, i0, textured), d = load3(w, kDx, i0, textured);
+        const VF width = footprint_width(df, load(w, kConeWidth, i0, textured), load(w, kConeSpread, i0, textured),
+                                         hn::Sqrt(dot(p - o, p - o)), dot(d, n), uv_per_area);
+        store(w, kTexU, i0, textured, uv.x);
+        store(w, kTexV, i0, textured, uv.y);
+        store(w, kTexWidth, i0, textured, width);
+        store_mask(w, kHasParams, i0, textured, textured);
+        // The texels: OpenImageIO's lookups, by core, path by path, into the slot's SurfaceParams.
+        for_each_lane(textured, i0, [&](std::size_t i, std::size_t) { general_texels(sc, w, i); });
       }
     }
     if (sc.textured) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kTexturedEmission));
@@ -1933,6 +1988,13 @@ void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {
     for (int c = 0; c < 3; ++c) w.f[arrays[a] + c][i] = (*fields[a])[c];
   w.b[kShadingNormal][i] = s.shading_normal ? 1 : 0;
   w.b[kHasParams][i] = s.params != nullptr ? 1 : 0;
+}
+
+void general_texels(const Scene& sc, const Wave& w, std::size_t i) {
+  const pathlab::Scene& scene = sc.compiled->scene();
+  const Material& m = scene.materials[scene.shapes[w.u[kShape][i]].material];
+  evaluate_textured(m, *sc.compiled->textures(),
+                    TextureFootprint{vec2(w.f[kTexU][i], w.f[kTexV][i]), w.f[kTexWidth][i]}, &w.params[i]);
 }
 
 void general_cone(const Scene& sc, const Wave& w, std::size_t i, bool impulse, float pdf) {

@@ -209,7 +209,7 @@ struct Scene {
   // materials the lanes shade that have them, kEnergyFloats floats each
   // (EnergyField), at ShapeField kEnergy; null if none.
   const float* energy = nullptr;
-  // Per shape, 50 floats (ShapeField): its material's albedo, emission and
+  // Per shape, kShapeFields floats (ShapeField): its material's albedo, emission and
   // flags, its first light entry, and its geometry.
   const float* shape = nullptr;
   // The same by column when there are at most 16 shapes (else null): field
@@ -221,6 +221,12 @@ struct Scene {
   // the lanes make (ShapeField kNormalsAt): 9 floats a triangle, n0 n1 n2
   // (its vertices' Mesh::normals); null if there are none.
   const float* vertex_normals = nullptr;
+  // The texture coordinates of each triangle of the kTexturedHits meshes
+  // (ShapeField kUvsAt): 6 floats a triangle, uv0 uv1 uv2 (Mesh::uvs); null
+  // if there are none.
+  const float* triangle_uvs = nullptr;
+  // Some shape is kTexturedHits.
+  bool textured_hits = false;
   // Per instance, kPlacementFloats floats (PlacementField): its
   // CompiledScene::Placement; null without instances.
   const float* placements = nullptr;
@@ -272,8 +278,14 @@ enum ShapeField : int {
                            // resolve() makes from kNormalsAt or CompiledScene::resolve_shading path by path
                            // (kFsX..., kShadingNormal)
   kNormalsAt = 49,         // bits of an int32: a kFramed mesh's triangle 0 in Scene::vertex_normals, whose
-                           // vertex normals make its frame in the lanes; -1 if core makes it (tangents)
-  kShapeFields = 50,
+                           // vertex normals make its frame in the lanes; -1 if core makes it (tangents) or
+                           // it has none (a kTexturedHits mesh: Frame(n))
+  kTexturedHits = 50,      // 1 if its material reads textures at hits and the lanes resolve the hit (a kFramed
+                           // mesh without tangents or a normal map): they make its frame and the lookups'
+                           // footprint, core reads the texels into the slot's SurfaceParams, path by path
+  kUvsAt = 51,             // bits of an int32: a kTexturedHits mesh's triangle 0 in Scene::triangle_uvs; -1 if
+                           // the mesh has no texture coordinates (its barycentrics are)
+  kShapeFields = 52,
 };
 
 // A Disney material's EnergyTables in Scene::energy.
@@ -304,6 +316,7 @@ enum FloatArray : int {
   kPrevNx, kPrevNy, kPrevNz,            // PreviousVertex::ref.n (the light BVH's query)
   kFilmX, kFilmY,
   kConeWidth, kConeSpread,              // the ray's cone (Scene::textured)
+  kTexU, kTexV, kTexWidth,              // a kTexturedHits hit's texture footprint (TextureFootprint)
   // This bounce only: the hit and the Surfel made of it.
   kHitT, kHitU, kHitV,
   kPx, kPy, kPz, kErrX, kErrY, kErrZ, kNx, kNy, kNz,

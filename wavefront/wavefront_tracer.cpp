@@ -169,6 +169,7 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table, energy, sun_table,
       sky_starts, sky_entries, env_row_cdf, env_column_cdf, light_sphere, light_textured, vertex_normals,
+      triangle_uvs,
       placements;
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
@@ -394,14 +395,15 @@ struct WavefrontTracer::VectorStages {
       }
     }
     // Per shape: its material's parameters and its geometry.
-    // Gathers index these tables with 32-bit float indices: 50 per shape, 12 per triangle (9 of vertex
+    // Gathers index these tables with 32-bit float indices: kShapeFields per shape, 12 per triangle (9 of vertex
     // normals), 16 per light.
     if (compiled.triangles().size() >= (std::size_t{1} << 27)) return no("more than 2^27 triangles");
     if (scene.shapes.size() >= (std::size_t{1} << 24)) return no("more than 2^24 shapes");
     // The light pick's indices are floats (pick_cdf, core/simd/lights-inl.h).
     if (sc.lights.count > kMaxExactFloatIndex || sc.deltas.count > kMaxExactFloatIndex) return no("more than 2^24 lights");
     std::vector<std::int32_t> energy_at;  // per material: its tables' offset in v->energy, -1 if not there yet
-    std::vector<std::string> textured_names;  // materials the lanes shade whose textures core reads at hits
+    std::vector<std::string> textured_names;  // materials the lanes shade whose hits core resolves (textures)
+    std::vector<std::string> texel_names;     // materials whose texels alone core reads at hits
     for (std::uint32_t i = 0; i < scene.shapes.size(); ++i) {
       const Shape& sh = scene.shapes[i];
       const Material& m = scene.materials[sh.material];
@@ -429,8 +431,16 @@ struct WavefrontTracer::VectorStages {
       const bool reads_textures = m.reads_textures_at_hits();
       const bool shaded_in_lanes = m.scatters() && in_lanes(m);
       const bool framed = shaded_in_lanes && !cosine && (shading_frame(sh) || reads_textures);
-      const bool normals_in_lanes = framed && sh.mesh.tangents.empty() && !reads_textures;
-      if (shaded_in_lanes && reads_textures) {
+      // A textured mesh without tangents or a normal map (and no emission texture, whose hits core resolves):
+      // the lanes resolve its hits, frame and footprint included, and core reads only the texels.
+      const bool textured_hits = framed && reads_textures && sh.kind == Shape::Kind::Triangles &&
+                                 sh.mesh.tangents.empty() && !m.normal_map && !m.emission_textured;
+      const bool normals_in_lanes =
+          framed && sh.mesh.tangents.empty() && (!reads_textures || textured_hits) && sh.mesh.has_normals();
+      if (textured_hits) {
+        const std::string name = "'" + m.name + "'";
+        if (std::find(texel_names.begin(), texel_names.end(), name) == texel_names.end()) texel_names.push_back(name);
+      } else if (shaded_in_lanes && reads_textures) {
         const std::string name = "'" + m.name + "'";
         if (std::find(textured_names.begin(), textured_names.end(), name) == textured_names.end())
           textured_names.push_back(name);
@@ -454,6 +464,22 @@ struct WavefrontTracer::VectorStages {
       const bool general = m.scatters() && (cosine || !in_lanes(m) || (shading_frame(sh) && !framed));
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
       f[vs::kFramed] = framed ? 1.0f : 0.0f;
+      f[vs::kTexturedHits] = textured_hits ? 1.0f : 0.0f;
+      sc.textured_hits = sc.textured_hits || textured_hits;
+      f[vs::kUvsAt] = std::bit_cast<float>(std::int32_t{-1});
+      if (textured_hits && sh.mesh.has_uvs()) {
+        if (v->triangle_uvs.size() / 6 + sh.mesh.triangles.size() >= (std::size_t{1} << 27))
+          return no("more than 2^27 textured triangles");
+        f[vs::kUvsAt] = std::bit_cast<float>(static_cast<std::int32_t>(v->triangle_uvs.size() / 6));
+        const std::size_t at = v->triangle_uvs.size();
+        v->triangle_uvs.resize(at + 6 * sh.mesh.triangles.size());
+        float* out = v->triangle_uvs.data() + at;
+        parallel_for(0, sh.mesh.triangles.size(), 4096, [&](std::size_t b, std::size_t e) {
+          for (std::size_t t = b; t < e; ++t)
+            for (int k = 0; k < 3; ++k)
+              for (int c = 0; c < 2; ++c) out[6 * t + 2 * k + c] = sh.mesh.uvs[sh.mesh.triangles[t][k]][c];
+        });
+      }
       sc.framed = sc.framed || framed;
       f[vs::kTexturedEmission] = m.emission_textured ? 1.0f : 0.0f;
       f[vs::kResolveByCore] = general && (shading_frame(sh) || m.reads_textures_at_hits()) ? 1.0f : 0.0f;
@@ -506,6 +532,12 @@ struct WavefrontTracer::VectorStages {
         what += (i == 0 ? "" : i + 1 == textured_names.size() ? " and " : ", ") + textured_names[i];
       v->general.push_back(what);
     }
+    if (!texel_names.empty()) {
+      std::string what = "the texels at hits on ";
+      for (std::size_t i = 0; i < texel_names.size(); ++i)
+        what += (i == 0 ? "" : i + 1 == texel_names.size() ? " and " : ", ") + texel_names[i];
+      v->general.push_back(what + " (OpenImageIO's lookups)");
+    }
     static_assert(vs::kEnergyCoat == 3 * disney::kEnergyTableSize &&
                   vs::kEnergyDiffuseScale == vs::kEnergyCoat + disney::kEnergyTableSize &&
                   vs::kEnergyFloats == vs::kEnergyDiffuseScale + 3);
@@ -524,6 +556,7 @@ struct WavefrontTracer::VectorStages {
     static_assert(sizeof(Triangle) == 12 * sizeof(float));
     sc.triangles = compiled.triangles().empty() ? nullptr : &compiled.triangles().data()->p0.x;
     sc.vertex_normals = v->vertex_normals.empty() ? nullptr : v->vertex_normals.data();
+    sc.triangle_uvs = v->triangle_uvs.empty() ? nullptr : v->triangle_uvs.data();
     // The camera.
     const Camera& camera = compiled.camera();
     const Camera::Plane p = camera.plane();

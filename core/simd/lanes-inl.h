@@ -394,6 +394,32 @@ HWY_INLINE Vec3<V> blend_normals(D d, V b1, V b2, const Vec3<V>& n0, const Vec3<
   return (b0 * n0 + b1 * n1) + b2 * n2;
 }
 
+// A texture lookup's footprint (CompiledScene::read_textures; ray cones,
+// core/ray_cone.h). Of a triangle with world edges e1 and e2 (placed by its
+// instance) and texture-coordinate edges a and b (uv1 - uv0, uv2 - uv0; the
+// barycentrics' where the mesh has none, `uvs` false: uv area 1/2): the uv
+// area per world area, 0 for a degenerate triangle.
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE V triangle_uv_per_area(D d, const Vec3<V>& e1, const Vec3<V>& e2, M uvs, V ax, V ay, V bx, V by) {
+  const V half = Set(d, 0.5f);
+  const V uv_area = IfThenElse(uvs, half * Abs(ax * by - ay * bx), half);
+  const Vec3<V> c = cross(e1, e2);
+  const V area = half * Sqrt(dot(c, c));
+  const auto usable = area > Zero(d);
+  return IfThenElse(usable, uv_area / IfThenElse(usable, area, Set(d, 1.0f)), Zero(d));
+}
+// The footprint's width in texture space: the ray cone's width at the hit
+// (`width` at the ray's origin plus `spread` per unit of `distance`: RayCone::
+// width_at), projected onto the surface (cos_theta between the ray and the
+// geometric normal, at least 1e-4 in magnitude) and scaled by
+// sqrt(uv_per_area); 0 (the finest level) where that is not finite.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V footprint_width(D d, V width, V spread, V distance, V cos_theta, V uv_per_area) {
+  const V w = width + spread * distance;
+  const V fw = w / Max(Set(d, 1e-4f), Abs(cos_theta)) * Sqrt(uv_per_area);
+  return IfThenElse(IsFinite(fw), fw, Zero(d));
+}
+
 // shading_normal (core/geometry.cpp): `sum` (blended vertex normals, or a
 // normal map's tilt) normalised and turned to the geometric normal ng's
 // side; ng itself where the sum has no direction (length at most 1e-20 or
