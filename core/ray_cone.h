@@ -52,16 +52,10 @@ inline float pixel_spread_angle(float fov_y_degrees, int height) {
 }
 
 // The cone leaving a hit at distance `t` along `in` after a scatter (none
-// with the point filter).
-inline RayCone scattered_cone(const RayCone& in, float t, bool impulse, float pdf, TextureFilter filter) {
-  if (filter == TextureFilter::Point) return {};
-  RayCone out{in.width_at(t), in.spread};
-  if (!impulse) {
-    const float lobe = pdf > 0.0f ? 2.0f * std::sqrt(1.0f / (kPi * pdf)) : kPi;
-    out.spread = std::max(in.spread, std::min(lobe, kPi));
-  }
-  return out;
-}
+// with the point filter): the width there, and the spread of the sampled
+// lobe where it is wider (not after an impulse). Generic code
+// (core/simd/lanes-inl.h scattered_cone) that the wavefront's lanes call too.
+RayCone scattered_cone(const RayCone& in, float t, bool impulse, float pdf, TextureFilter filter);
 
 // The footprint's width in texture space at a hit (the cone's width there,
 // projected onto the surface and scaled by sqrt(uv area / world area)) is

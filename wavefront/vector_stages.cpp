@@ -90,9 +90,6 @@ void general_texels(const Scene& scene, const Wave& wave, std::size_t i);
 void general_light_emission(const Scene& scene, std::int32_t light, float b1, float b2, const float p[3], float Le[3]);
 // Surfel::emitted towards the path's wo, for a kTexturedEmission shape's hit.
 void general_emitted(const Scene& scene, const Wave& wave, std::size_t i, float Le[3]);
-// Under Scene::textured: the cone of the path in slot i after it scattered
-// (scattered_cone of its ray's, to its hit), before the next ray replaces it.
-void general_cone(const Scene& scene, const Wave& wave, std::size_t i, bool impulse, float pdf);
 }  // namespace pathlab::vector_stages
 #endif
 
@@ -161,6 +158,7 @@ using pathlab::HWY_NAMESPACE::shading_normal;
 using pathlab::HWY_NAMESPACE::spawn_origin;
 using pathlab::HWY_NAMESPACE::spawn_to;
 using pathlab::HWY_NAMESPACE::sample_sphere_cone_normal;
+using pathlab::HWY_NAMESPACE::scattered_cone;
 using pathlab::HWY_NAMESPACE::solid_angle_triangle_point;
 using pathlab::HWY_NAMESPACE::sphere_cone;
 using pathlab::HWY_NAMESPACE::sphere_cone_density;
@@ -1804,12 +1802,15 @@ void scatter(const Scene& sc, const Wave& w) {
     store_mask(w, kPrevBsdfTechnique, i0, ok, bsdf_technique);
 
     if (sc.textured && !hn::AllFalse(df, ok)) {
-      // The ray cone after the scatter, path by path (core/ray_cone.h).
-      HWY_ALIGN float density[kMaxLanes];
-      HWY_ALIGN std::int32_t impulse_at[kMaxLanes];
-      hn::Store(pdf, df, density);
-      hn::Store(hn::VecFromMask(DI(), hn::RebindMask(DI(), impulse)), DI(), impulse_at);
-      for_each_lane(ok, i0, [&](std::size_t i, std::size_t j) { general_cone(sc, w, i, impulse_at[j] != 0, density[j]); });
+      // The ray cone after the scatter (scattered_cone, core/ray_cone.h; none under the point filter).
+      VF width = hn::Zero(df), spread = hn::Zero(df);
+      if (static_cast<TextureFilter>(sc.texture_filter) != TextureFilter::Point) {
+        const V3 o = load3(w, kOx, i0, ok);
+        scattered_cone(df, load(w, kConeWidth, i0, ok), load(w, kConeSpread, i0, ok), hn::Sqrt(dot(sp - o, sp - o)),
+                       impulse, pdf, width, spread);
+      }
+      store(w, kConeWidth, i0, ok, width);
+      store(w, kConeSpread, i0, ok, spread);
     }
 
     // Surfel::spawn(wi).
@@ -1995,13 +1996,6 @@ void general_texels(const Scene& sc, const Wave& w, std::size_t i) {
   const Material& m = scene.materials[scene.shapes[w.u[kShape][i]].material];
   evaluate_textured(m, *sc.compiled->textures(),
                     TextureFootprint{vec2(w.f[kTexU][i], w.f[kTexV][i]), w.f[kTexWidth][i]}, &w.params[i]);
-}
-
-void general_cone(const Scene& sc, const Wave& w, std::size_t i, bool impulse, float pdf) {
-  const RayCone cone = scattered_cone(RayCone{w.f[kConeWidth][i], w.f[kConeSpread][i]}, glm::length(at(w, kPx, i) - at(w, kOx, i)),
-                                      impulse, pdf, static_cast<TextureFilter>(sc.texture_filter));
-  w.f[kConeWidth][i] = cone.width;
-  w.f[kConeSpread][i] = cone.spread;
 }
 
 // The Surfel of a hit on a kGeneral shape, from what general_resolve (or,

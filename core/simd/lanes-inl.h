@@ -394,6 +394,21 @@ HWY_INLINE Vec3<V> blend_normals(D d, V b1, V b2, const Vec3<V>& n0, const Vec3<
   return (b0 * n0 + b1 * n1) + b2 * n2;
 }
 
+// scattered_cone (core/ray_cone.h): the ray cone (width at its origin,
+// spread) leaving a hit at distance t after a scatter of density `pdf`: its
+// width there, and the spread of the lobe, 2 sqrt(1 / (pi pdf)) capped at
+// pi (pi where pdf is not positive), where that is wider and the scatter is
+// not an impulse. (The point filter's zero cone is the caller's.)
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE void scattered_cone(D d, V width, V spread, V t, M impulse, V pdf, V& out_width, V& out_spread) {
+  out_width = width + spread * t;
+  const V pi = Set(d, kPi);
+  const auto positive = pdf > Zero(d);
+  const V lobe =
+      IfThenElse(positive, Set(d, 2.0f) * Sqrt(Set(d, 1.0f) / (pi * IfThenElse(positive, pdf, Set(d, 1.0f)))), pi);
+  out_spread = IfThenElse(impulse, spread, Max(Min(pi, lobe), spread));
+}
+
 // A texture lookup's footprint (CompiledScene::read_textures; ray cones,
 // core/ray_cone.h). Of a triangle with world edges e1 and e2 (placed by its
 // instance) and texture-coordinate edges a and b (uv1 - uv0, uv2 - uv0; the
