@@ -252,14 +252,17 @@ inline const std::filesystem::path& textured_scene_dir() {
   return d;
 }
 
-inline Scene cornell_with_textures(bool textured_impulses = false) {
-  const std::filesystem::path& d = textured_scene_dir();
-  const std::string text = R"({"pathlab_scene": 1,
+// The textured scenes' camera, film, render settings and textured walls.
+inline constexpr const char* kTexturedCornellHead = R"({"pathlab_scene": 1,
   "camera": {"position": [0, 0, 3.75], "look_at": [0, 0, 0], "fov_y": 40},
   "film": {"resolution": [32, 32]},
   "render": {"spp": 4, "max_depth": 6, "rr_depth": 3},
   "materials": {
-    "walls": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": 0.9, "wrap": "mirror"}},
+    "walls": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": 0.9, "wrap": "mirror"}},)";
+
+inline Scene cornell_with_textures(bool textured_impulses = false) {
+  const std::filesystem::path& d = textured_scene_dir();
+  const std::string text = std::string(kTexturedCornellHead) + R"(
     "floor": {"type": "diffuse", "albedo": [0.7, 0.7, 0.6], "normal_map": {"texture": "normals.exr", "scale": 0.8}},
     "red": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": [0.8, 0.1, 0.1]}},
     "disney": {"type": "disney", "base_color": {"texture": "noise.png"}, "roughness": {"texture": "data.png", "channel": 1},
@@ -313,12 +316,7 @@ inline Scene cornell_with_textured_meshes() {
       gem << "f " << a << "/" << a << "/" << a << " " << b << "/" << b << "/" << b << " " << c << "/" << c << "/" << c << "\n";
     }
   }
-  const std::string text = R"({"pathlab_scene": 1,
-  "camera": {"position": [0, 0, 3.75], "look_at": [0, 0, 0], "fov_y": 40},
-  "film": {"resolution": [32, 32]},
-  "render": {"spp": 4, "max_depth": 6, "rr_depth": 3},
-  "materials": {
-    "walls": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": 0.9, "wrap": "mirror"}},
+  const std::string text = std::string(kTexturedCornellHead) + R"(
     "red": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": [0.8, 0.1, 0.1], "wrap": "clamp"}},
     "disney": {"type": "disney", "base_color": {"texture": "noise.png"}, "roughness": {"texture": "data.png", "channel": 1},
                "metallic": {"texture": "data.png", "channel": 2}, "sheen": {"texture": "data.png", "channel": 0}},

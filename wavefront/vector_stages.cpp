@@ -640,6 +640,15 @@ void resolve(const Scene& sc, const Wave& w) {
     store3(w, kPx, i0, found, p);
     store3(w, kErrX, i0, found, error);
     store3(w, kNx, i0, found, n);
+    // resolve's Frame(n) (the geometric normal's) for the lanes of m, no shading normal.
+    const auto store_normal_frame = [&](M m) {
+      V3 fs, ft;
+      frame(df, n, fs, ft);
+      store3(w, kFsX, i0, m, fs);
+      store3(w, kFtX, i0, m, ft);
+      store3(w, kFnX, i0, m, n);
+      store_mask(w, kShadingNormal, i0, m, hn::FirstN(df, 0));
+    };
     // By core, path by path: the hits whose Surfel core makes (below).
     M by_core = hn::FirstN(df, 0);
     // A normal that is not finite (a sliver's): resolve() marks its Surfel
@@ -653,12 +662,7 @@ void resolve(const Scene& sc, const Wave& w) {
       by_core = hn::Or(by_core, shape_flag(general, sc, shape, kResolveByCore));
       // The others shade in the geometric normal's Frame (resolve's Frame(n)), made here.
       if (const M plain = hn::AndNot(by_core, general); !hn::AllFalse(df, plain)) {
-        V3 fs, ft;
-        frame(df, n, fs, ft);
-        store3(w, kFsX, i0, plain, fs);
-        store3(w, kFtX, i0, plain, ft);
-        store3(w, kFnX, i0, plain, n);
-        store_mask(w, kShadingNormal, i0, plain, hn::FirstN(df, 0));
+        store_normal_frame(plain);
         store_mask(w, kHasParams, i0, plain, hn::FirstN(df, 0));
       }
     }
@@ -694,14 +698,7 @@ void resolve(const Scene& sc, const Wave& w) {
       }
       if (!hn::AllFalse(df, textured)) {
         // CompiledScene::shading_frame's Frame(n) where no vertex normals made one.
-        if (const M flat = hn::AndNot(here, textured); !hn::AllFalse(df, flat)) {
-          V3 fs, ft;
-          frame(df, n, fs, ft);
-          store3(w, kFsX, i0, flat, fs);
-          store3(w, kFtX, i0, flat, ft);
-          store3(w, kFnX, i0, flat, n);
-          store_mask(w, kShadingNormal, i0, flat, hn::FirstN(df, 0));
-        }
+        if (const M flat = hn::AndNot(here, textured); !hn::AllFalse(df, flat)) store_normal_frame(flat);
         // CompiledScene::read_textures' footprint: the texture coordinates (Mesh::uv_at: the vertices' blended
         // by the barycentrics, as blend_normals blends normals; or the barycentrics) and the width of the ray
         // cone there in uv (footprint_width), from the triangle's edges (placed by its instance) and uv edges.
