@@ -3,6 +3,7 @@
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/material.h"
+#include "core/simd/width1.h"
 
 #include <cmath>
 
@@ -70,20 +71,19 @@ void add_needed_tangents(Scene* scene) {
 Frame mesh_tangent_frame(const TriangleMesh& mesh, std::uint32_t tri, vec2 b, const mat3& to_world,
                          const vec3& n_mesh, const vec3& ns) {
   const glm::uvec3 v = mesh.triangles[tri];
-  const float b0 = 1.0f - b.x - b.y;
-  const vec4 sum = b0 * mesh.tangents[v.x] + b.x * mesh.tangents[v.y] + b.y * mesh.tangents[v.z];
-  const vec3 placed = to_world * vec3(sum);
-  // Gram-Schmidt against the shading normal: the interpolated tangent is
-  // not perpendicular to it in general (curved meshes, interpolated normals).
-  const vec3 s = placed - glm::dot(placed, ns) * ns;
-  const float length = glm::length(s);
-  if (!(length > 1e-4f * glm::length(placed)) || !std::isfinite(length)) return Frame(ns);
-  // The bitangent w * cross(n, t) keeps its direction in the surface if the
-  // normal turns (ns opposite n_mesh) or a mirror reverses cross().
-  float w = sum.w < 0.0f ? -1.0f : 1.0f;
-  if (glm::determinant(to_world) < 0.0f) w = -w;
-  if (glm::dot(ns, n_mesh) < 0.0f) w = -w;
-  return Frame(ns, s / length, w);
+  const vec4 sum = (1.0f - b.x - b.y) * mesh.tangents[v.x] + b.x * mesh.tangents[v.y] + b.y * mesh.tangents[v.z];
+  // The generic steps (core/simd/lanes-inl.h tangent_frame), which the
+  // wavefront's lanes take too: placed, made perpendicular to ns, its
+  // handedness turned by a mirroring placement and a normal that turned.
+  using namespace width1;
+  F3 fs, ft;
+  generic::tangent_frame(kScalar, lanes(vec3(sum)), F{sum.w}, lanes(to_world[0]), lanes(to_world[1]), lanes(to_world[2]),
+                         lane1::M{glm::determinant(to_world) < 0.0f}, lanes(n_mesh), lanes(ns), fs, ft);
+  Frame f;
+  f.s = scalars(fs);
+  f.t = scalars(ft);
+  f.n = ns;
+  return f;
 }
 
 }  // namespace pathlab

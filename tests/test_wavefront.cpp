@@ -174,6 +174,25 @@ Scene cornell_with_tangents() {
   return s;
 }
 
+// cornell_with_instances() with tangents: on the group's smooth UV sphere
+// (not perpendicular to its normals, the handedness changing between
+// vertices), placed turned, mirrored and sheared; and on the tall box in
+// world space, turned inside out (flip_normals: its own normal is the other
+// side's). The tangent frames the lanes make (kTangentsAt).
+Scene cornell_with_instanced_tangents() {
+  Scene s = test::cornell_with_instances();
+  Shape& ball = s.shapes[s.groups[0].shapes[0]];
+  ball.mesh.tangents.resize(ball.mesh.positions.size());
+  for (std::size_t i = 0; i < ball.mesh.positions.size(); ++i) {
+    const vec3& p = ball.mesh.positions[i];
+    ball.mesh.tangents[i] = glm::vec4(-p.z, 0.3f, p.x + 0.1f, i % 3 == 0 ? -1.0f : 1.0f);
+  }
+  Shape& box = s.shapes[6];  // the tall box
+  box.mesh.tangents.assign(box.mesh.positions.size(), glm::vec4(0.6f, 0.8f, 0.0f, -1.0f));
+  box.flip_normals = true;
+  return s;
+}
+
 // cornell_with_instances() whose group's true sphere glows (an emitter no
 // light sample aims at: the loader takes emitters in groups only so), lit
 // also by delta lights and the sky: every kind of light at once.
@@ -242,6 +261,7 @@ Scene load_case(const SameSeedCase& c) {
             : c.scene == "framed-velvet" ? cornell_with_framed_velvet()
             : c.scene == "compensated" ? cornell_with_compensated_lacquer()
             : c.scene == "tangents"  ? cornell_with_tangents()
+            : c.scene == "tangents-instanced" ? cornell_with_instanced_tangents()
             : c.scene == "smooth"    ? test::cornell_with_smooth_sphere()
             : c.scene == "instanced" ? test::cornell_with_instances()
             : c.scene == "delta"     ? test::cornell_with_delta_lights()
@@ -801,6 +821,11 @@ std::vector<VectorCase> vector_cases() {
   cases.push_back({"smooth", Strategy::Mis, 0.0f, 0, false, true, false, true});
   cases.push_back({"smooth", Strategy::LightBsdf, 0.0f, -1, false, false, true, false, true});
   cases.push_back({"tangents", Strategy::Mis, 0.0f, 0});
+  // Tangent frames made in the lanes: on instances (turned, mirrored, sheared) about vertex normals, and on a
+  // flat mesh turned inside out.
+  for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf})
+    cases.push_back({"tangents-instanced", st, 0.0f, 0});
+  cases.push_back({"tangents-instanced", Strategy::Mis, 0.0f, -1, true, true, false, true, true, 0, true});
   for (Strategy st : {Strategy::Bsdf, Strategy::Mis, Strategy::LightBsdf})
     cases.push_back({"smooth-plastic", st, 0.0f, 0});
   cases.push_back({"smooth-plastic", Strategy::Mis, 0.0f, -1, true, true, true, true, true, 0, true});

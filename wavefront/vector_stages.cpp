@@ -165,6 +165,7 @@ using pathlab::HWY_NAMESPACE::sphere_cone_density;
 using pathlab::HWY_NAMESPACE::sphere_point;
 using pathlab::HWY_NAMESPACE::sun_direction;
 using pathlab::HWY_NAMESPACE::splat3;
+using pathlab::HWY_NAMESPACE::tangent_frame;
 using pathlab::HWY_NAMESPACE::thin_lens;
 using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
@@ -672,23 +673,64 @@ void resolve(const Scene& sc, const Wave& w) {
     // it (blend_normals, shading_normal, Frame), of tangents by it.
     if (sc.framed) {
       const M framed = shape_flag(hn::AndNot(hn::Or(general, by_core), found), sc, shape, kFramed);
+      // The frames the lanes make (CompiledScene::shading_frame): of vertex normals (kNormalsAt), of tangents
+      // (kTangentsAt) about those or the geometric normal, and Frame(n) for a flat textured mesh (kTexturedHits;
+      // its texture lookups' footprint below). The rest (normal maps) core's.
       const VI normals_at = shape_int(framed, sc, shape, kNormalsAt);
-      const M here = hn::And(framed, fmask(hn::Not(normals_at < hn::Zero(DI()))));
-      // A textured mesh's hit (kTexturedHits) is the lanes' too, its frame Frame(n) where it has no vertex
-      // normals; then its texture lookups' footprint (below).
+      const M smooth = hn::And(framed, fmask(hn::Not(normals_at < hn::Zero(DI()))));
+      M tangents = hn::FirstN(df, 0);
+      VI tangents_at = hn::Zero(DI());
+      if (sc.vertex_tangents) {
+        tangents_at = shape_int(framed, sc, shape, kTangentsAt);
+        tangents = hn::And(framed, fmask(hn::Not(tangents_at < hn::Zero(DI()))));
+      }
+      const M here = hn::Or(smooth, tangents);
       const M textured = sc.textured_hits ? shape_flag(framed, sc, shape, kTexturedHits) : hn::FirstN(df, 0);
       by_core = hn::Or(by_core, hn::AndNot(hn::Or(here, textured), framed));
       if (!hn::AllFalse(df, here)) {
-        const VI tri = normals_at + load(w, kPrim, i0, here);
-        V3 vn[3];
-        for (int k = 0; k < 3; ++k) vn[k] = gather3(here, sc.vertex_normals, tri, 9, 3 * k);
-        // On an instance, each placed first (CompiledScene::local_shading).
-        if (const M on = hn::And(here, placed); !hn::AllFalse(df, on))
-          for (V3& v : vn) v = select(on, place_normal(df, to_normal[0], to_normal[1], to_normal[2], v), v);
-        const V3 sum = blend_normals(df, load(w, kHitU, i0, here), load(w, kHitV, i0, here), vn[0], vn[1], vn[2]);
-        const V3 ns = shading_normal(df, n, sum);
+        const VF b1 = load(w, kHitU, i0, here), b2 = load(w, kHitV, i0, here);
+        // The shading normal of the vertex normals (CompiledScene::local_shading's sum, each placed first on an
+        // instance; shading_normal), else the geometric normal.
+        V3 sum = n, ns = n;
+        if (!hn::AllFalse(df, smooth)) {
+          const VI tri = normals_at + load(w, kPrim, i0, smooth);
+          V3 vn[3];
+          for (int k = 0; k < 3; ++k) vn[k] = gather3(smooth, sc.vertex_normals, tri, 9, 3 * k);
+          if (const M on = hn::And(smooth, placed); !hn::AllFalse(df, on))
+            for (V3& v : vn) v = select(on, place_normal(df, to_normal[0], to_normal[1], to_normal[2], v), v);
+          sum = select(smooth, blend_normals(df, b1, b2, vn[0], vn[1], vn[2]), n);
+          ns = select(smooth, shading_normal(df, n, sum), n);
+        }
         V3 fs, ft;
         frame(df, ns, fs, ft);
+        if (!hn::AllFalse(df, tangents)) {
+          // mesh_tangent_frame: the tangents blended, placed (by the identity in world space, as core), made
+          // perpendicular to ns, about the mesh's own normal (the vertex normals' sum, or the geometric normal
+          // before flip_normals).
+          const VI tri = tangents_at + load(w, kPrim, i0, tangents);
+          V3 t[3];
+          VF tw[3];
+          for (int k = 0; k < 3; ++k) {
+            t[k] = gather3(tangents, sc.vertex_tangents, tri, 12, 4 * k);
+            tw[k] = gather(tangents, sc.vertex_tangents, tri, 12, 4 * k + 3);
+          }
+          const V3 tsum = blend_normals(df, b1, b2, t[0], t[1], t[2]);
+          const VF b0 = k(1.0f) - b1 - b2;
+          const VF wsum = (b0 * tw[0] + b1 * tw[1]) + b2 * tw[2];
+          V3 c0 = splat3(df, 1.0f, 0.0f, 0.0f), c1 = splat3(df, 0.0f, 1.0f, 0.0f), c2 = splat3(df, 0.0f, 0.0f, 1.0f);
+          M mirrors = hn::FirstN(df, 0);
+          if (const M on = hn::And(tangents, placed); !hn::AllFalse(df, on)) {
+            c0 = select(on, placement(on, kToWorld), c0);
+            c1 = select(on, placement(on, kToWorld + 3), c1);
+            c2 = select(on, placement(on, kToWorld + 6), c2);
+            mirrors = hn::And(on, gather(on, sc.placements, instance, kPlacementFloats, kMirrors) > k(0.0f));
+          }
+          const V3 n_mesh = select(smooth, sum, select(shape_flag(tangents, sc, shape, kFlipped), -n, n));
+          V3 tfs, tft;
+          tangent_frame(df, tsum, wsum, c0, c1, c2, mirrors, n_mesh, ns, tfs, tft);
+          fs = select(tangents, tfs, fs);
+          ft = select(tangents, tft, ft);
+        }
         store3(w, kFsX, i0, here, fs);
         store3(w, kFtX, i0, here, ft);
         store3(w, kFnX, i0, here, ns);

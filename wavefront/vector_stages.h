@@ -152,8 +152,9 @@ struct Scene {
   // resolve() keeps its shading frame from compiled->resolve() (kFsX...).
   bool general = false;
   // Some shape the lanes shade has a shading frame of its own (ShapeField
-  // kFramed): made in resolve() from its vertex normals (kNormalsAt), or by
-  // core (resolve_shading) for a mesh with tangents; the rest is the lanes'.
+  // kFramed): made in resolve() from its vertex normals (kNormalsAt) and
+  // tangents (kTangentsAt), or by core (CompiledScene::resolve) for a mesh
+  // with a normal map; the rest is the lanes'.
   bool framed = false;
   // Some shape the lanes shade is a mirror or a dielectric (ShapeField
   // kLaneMaterial): else every lane shaded in the lanes is Lambert's or
@@ -225,6 +226,10 @@ struct Scene {
   // (ShapeField kUvsAt): 6 floats a triangle, uv0 uv1 uv2 (Mesh::uvs); null
   // if there are none.
   const float* triangle_uvs = nullptr;
+  // The tangents (xyz and handedness w) of each triangle of the meshes with
+  // ShapeField kTangentsAt: 12 floats a triangle, t0 t1 t2 (Mesh::tangents);
+  // null if there are none.
+  const float* vertex_tangents = nullptr;
   // Some shape is kTexturedHits.
   bool textured_hits = false;
   // Per instance, kPlacementFloats floats (PlacementField): its
@@ -237,7 +242,8 @@ enum PlacementField : int {
   kToWorld = 0,     // 4 columns of 3 floats: x, y, z, the translation
   kToLocal = 12,    // its inverse, the same way
   kToNormal = 24,   // 3 columns of 3 floats: the inverse transpose of to_world's linear part
-  kPlacementFloats = 33,
+  kMirrors = 33,    // 1 if to_world's linear part has a negative determinant, else 0
+  kPlacementFloats = 34,
 };
 enum ShapeField : int {
   kAlbedo = 0,         // 3 floats
@@ -274,18 +280,22 @@ enum ShapeField : int {
   kClearcoatLogA2 = 45,
   kClearcoatLog2A2 = 46,
   kEnergy = 47,            // bits of an int32: its energy tables' first float in Scene::energy, -1 if none
-  kFramed = 48,            // 1 if the lanes shade it in a frame of its own (vertex normals, tangents), which
-                           // resolve() makes from kNormalsAt or CompiledScene::resolve_shading path by path
+  kFramed = 48,            // 1 if the lanes shade it in a frame of its own (vertex normals, tangents,
+                           // textures), which resolve() makes (kNormalsAt, kTangentsAt; Frame(n) for a flat
+                           // kTexturedHits mesh) or CompiledScene::resolve path by path (a normal map)
                            // (kFsX..., kShadingNormal)
   kNormalsAt = 49,         // bits of an int32: a kFramed mesh's triangle 0 in Scene::vertex_normals, whose
-                           // vertex normals make its frame in the lanes; -1 if core makes it (tangents) or
-                           // it has none (a kTexturedHits mesh: Frame(n))
+                           // vertex normals make its frame in the lanes; -1 if it has none or core makes
+                           // its frame (a normal map)
   kTexturedHits = 50,      // 1 if its material reads textures at hits and the lanes resolve the hit (a kFramed
-                           // mesh without tangents or a normal map): they make its frame and the lookups'
-                           // footprint, core reads the texels into the slot's SurfaceParams, path by path
+                           // mesh without a normal map): they make its frame and the lookups' footprint,
+                           // core reads the texels into the slot's SurfaceParams, path by path
   kUvsAt = 51,             // bits of an int32: a kTexturedHits mesh's triangle 0 in Scene::triangle_uvs; -1 if
                            // the mesh has no texture coordinates (its barycentrics are)
-  kShapeFields = 52,
+  kTangentsAt = 52,        // bits of an int32: a kFramed mesh's triangle 0 in Scene::vertex_tangents, whose
+                           // tangents make its frame in the lanes (about its vertex normals' or geometric
+                           // normal); -1 if it has none or core makes its frame (a normal map)
+  kShapeFields = 53,
 };
 
 // A Disney material's EnergyTables in Scene::energy.

@@ -169,8 +169,7 @@ struct WavefrontTracer::VectorStages {
   vector_stages::Camera camera;
   std::vector<float> inv_area, light_triangle, shape, light_columns, shape_columns, delta_table, energy, sun_table,
       sky_starts, sky_entries, env_row_cdf, env_column_cdf, light_sphere, light_textured, vertex_normals,
-      triangle_uvs,
-      placements;
+      triangle_uvs, vertex_tangents, placements;
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
   std::vector<std::string> general_materials, general;
@@ -231,8 +230,10 @@ struct WavefrontTracer::VectorStages {
         for (int c = 0; c < 4; ++c) column(pl.to_world[c]);
         for (int c = 0; c < 4; ++c) column(pl.to_local[c]);
         for (int c = 0; c < 3; ++c) column(pl.to_normal[c]);
+        // Whether it mirrors (mesh_tangent_frame's handedness), decided as core decides it.
+        v->placements.push_back(glm::determinant(mat3(pl.to_world)) < 0.0f ? 1.0f : 0.0f);
       }
-      static_assert(vs::kToLocal == 12 && vs::kToNormal == 24 && vs::kPlacementFloats == 33);
+      static_assert(vs::kToLocal == 12 && vs::kToNormal == 24 && vs::kMirrors == 33 && vs::kPlacementFloats == 34);
       sc.placements = v->placements.data();
     }
     // Alpha is decided inside Embree by the rays' keys, which the lanes make too.
@@ -431,12 +432,14 @@ struct WavefrontTracer::VectorStages {
       const bool reads_textures = m.reads_textures_at_hits();
       const bool shaded_in_lanes = m.scatters() && in_lanes(m);
       const bool framed = shaded_in_lanes && !cosine && (shading_frame(sh) || reads_textures);
-      // A textured mesh without tangents or a normal map (and no emission texture, whose hits core resolves):
-      // the lanes resolve its hits, frame and footprint included, and core reads only the texels.
-      const bool textured_hits = framed && reads_textures && sh.kind == Shape::Kind::Triangles &&
-                                 sh.mesh.tangents.empty() && !m.normal_map && !m.emission_textured;
-      const bool normals_in_lanes =
-          framed && sh.mesh.tangents.empty() && (!reads_textures || textured_hits) && sh.mesh.has_normals();
+      // A textured mesh without a normal map (and no emission texture, whose hits core resolves): the lanes
+      // resolve its hits, frame and footprint included, and core reads only the texels.
+      const bool textured_hits = framed && reads_textures && sh.kind == Shape::Kind::Triangles && !m.normal_map &&
+                                 !m.emission_textured;
+      // The frame the lanes make: of vertex normals, of tangents (about those normals, or the geometric one).
+      const bool frame_in_lanes = framed && !m.normal_map && (!reads_textures || textured_hits);
+      const bool normals_in_lanes = frame_in_lanes && sh.mesh.has_normals();
+      const bool tangents_in_lanes = frame_in_lanes && !sh.mesh.tangents.empty();
       if (textured_hits) {
         const std::string name = "'" + m.name + "'";
         if (std::find(texel_names.begin(), texel_names.end(), name) == texel_names.end()) texel_names.push_back(name);
@@ -444,7 +447,7 @@ struct WavefrontTracer::VectorStages {
         const std::string name = "'" + m.name + "'";
         if (std::find(textured_names.begin(), textured_names.end(), name) == textured_names.end())
           textured_names.push_back(name);
-      } else if (shaded_in_lanes && shading_frame(sh) && !normals_in_lanes) {
+      } else if (shaded_in_lanes && shading_frame(sh) && !frame_in_lanes) {
         v->general.push_back("the shading frame of " + sh.description);
       }
       f[vs::kNormalsAt] = std::bit_cast<float>(std::int32_t{-1});
@@ -459,6 +462,20 @@ struct WavefrontTracer::VectorStages {
           for (std::size_t t = b; t < e; ++t)
             for (int k = 0; k < 3; ++k)
               for (int c = 0; c < 3; ++c) out[9 * t + 3 * k + c] = sh.mesh.normals[sh.mesh.triangles[t][k]][c];
+        });
+      }
+      f[vs::kTangentsAt] = std::bit_cast<float>(std::int32_t{-1});
+      if (tangents_in_lanes) {
+        if (v->vertex_tangents.size() / 12 + sh.mesh.triangles.size() >= (std::size_t{1} << 27))
+          return no("more than 2^27 triangles with tangents");
+        f[vs::kTangentsAt] = std::bit_cast<float>(static_cast<std::int32_t>(v->vertex_tangents.size() / 12));
+        const std::size_t at = v->vertex_tangents.size();
+        v->vertex_tangents.resize(at + 12 * sh.mesh.triangles.size());
+        float* out = v->vertex_tangents.data() + at;
+        parallel_for(0, sh.mesh.triangles.size(), 4096, [&](std::size_t b, std::size_t e) {
+          for (std::size_t t = b; t < e; ++t)
+            for (int k = 0; k < 3; ++k)
+              for (int c = 0; c < 4; ++c) out[12 * t + 4 * k + c] = sh.mesh.tangents[sh.mesh.triangles[t][k]][c];
         });
       }
       const bool general = m.scatters() && (cosine || !in_lanes(m) || (shading_frame(sh) && !framed));
@@ -557,6 +574,7 @@ struct WavefrontTracer::VectorStages {
     sc.triangles = compiled.triangles().empty() ? nullptr : &compiled.triangles().data()->p0.x;
     sc.vertex_normals = v->vertex_normals.empty() ? nullptr : v->vertex_normals.data();
     sc.triangle_uvs = v->triangle_uvs.empty() ? nullptr : v->triangle_uvs.data();
+    sc.vertex_tangents = v->vertex_tangents.empty() ? nullptr : v->vertex_tangents.data();
     // The camera.
     const Camera& camera = compiled.camera();
     const Camera::Plane p = camera.plane();

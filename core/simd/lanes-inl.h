@@ -409,6 +409,34 @@ HWY_INLINE void scattered_cone(D d, V width, V spread, V t, M impulse, V pdf, V&
   out_spread = IfThenElse(impulse, spread, Max(Min(pi, lobe), spread));
 }
 
+// mesh_tangent_frame (core/tangents.cpp): the shading frame of a mesh with
+// tangents at a hit. `sum` is the vertices' tangents (xyz; handedness w)
+// blended by the barycentrics (blend_normals' order), placed by the linear
+// part c0 c1 c2 of the instance's placement (the identity's columns in world
+// space: core multiplies by mat3(1) too); `mirrors` where that placement's
+// determinant is negative. The placed tangent is made perpendicular to the
+// shading normal ns (Gram-Schmidt) and is the frame's s, with t = w' n x s,
+// w' the handedness turned where the placement mirrors and where ns faces
+// away from the mesh's own normal n_mesh; Frame(ns) where the tangent has
+// (almost) no part perpendicular to ns or is not finite.
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE void tangent_frame(D d, const Vec3<V>& sum, V w, const Vec3<V>& c0, const Vec3<V>& c1, const Vec3<V>& c2,
+                              M mirrors, const Vec3<V>& n_mesh, const Vec3<V>& ns, Vec3<V>& fs, Vec3<V>& ft) {
+  const Vec3<V> placed = to_world(c0, c1, c2, sum.x, sum.y, sum.z);
+  const Vec3<V> s = placed - dot(placed, ns) * ns;
+  const V length = Sqrt(dot(s, s));
+  const auto usable = And(length > Set(d, 1e-4f) * Sqrt(dot(placed, placed)), IsFinite(length));
+  const V one = Set(d, 1.0f);
+  V handed = IfThenElse(w < Zero(d), Neg(one), one);
+  handed = IfThenElse(mirrors, Neg(handed), handed);
+  handed = IfThenElse(dot(ns, n_mesh) < Zero(d), Neg(handed), handed);
+  const Vec3<V> tangent = s / IfThenElse(usable, length, one);
+  Vec3<V> ds, dt;
+  frame(d, ns, ds, dt);
+  fs = select(usable, tangent, ds);
+  ft = select(usable, handed * cross(ns, tangent), dt);
+}
+
 // A texture lookup's footprint (CompiledScene::read_textures; ray cones,
 // core/ray_cone.h). Of a triangle with world edges e1 and e2 (placed by its
 // instance) and texture-coordinate edges a and b (uv1 - uv0, uv2 - uv0; the
