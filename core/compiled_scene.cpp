@@ -256,26 +256,16 @@ void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayH
   const TextureFootprint at{s->uv, width};
   if (m.normal_map) {
     // Tangent space as glTF has it: x along the tangent (dP/du), y along the
-    // bitangent (dP/dv, "+y up"), z the shading normal; n = 2 c - 1, x and y
-    // times the map's scale.
+    // bitangent (dP/dv, "+y up"), z the shading normal (generic code, which
+    // the wavefront's lanes run too: lanes-inl.h normal_map_frame).
     const vec3 c = vec3(textures_->color(m.normal_map->texture, at));
-    vec3 nt = 2.0f * c - 1.0f;
-    nt.x *= m.normal_map->scale;
-    nt.y *= m.normal_map->scale;
-    const Frame& f = s->frame;
-    const vec3 sum = nt.x * f.s + nt.y * f.t + nt.z * f.n;
-    // The shading-normal policy applies to the tilted normal: turned to the
-    // geometric side, and a tilt below ~0.08 degrees leaves the frame as it
-    // was (a flat map changes no bit).
-    const float length = glm::length(sum);
-    if (length > 1e-20f && std::isfinite(length) && glm::dot(sum / length, f.n) < 1.0f - 1e-6f) {
-      const vec3 ns = shading_normal(s->n, sum);
-      // Keep s along the tangent: Gram-Schmidt against the new normal.
-      const vec3 t = f.s - glm::dot(f.s, ns) * ns;
-      const float tl = glm::length(t);
-      const float handed = glm::dot(glm::cross(f.n, f.s), f.t) < 0.0f ? -1.0f : 1.0f;
-      s->frame = tl > 1e-4f ? Frame(ns, t / tl, handed) : Frame(ns);
-      s->shading_normal = ns != s->n;
+    using namespace width1;
+    F3 fs = lanes(s->frame.s), ft = lanes(s->frame.t), fn = lanes(s->frame.n);
+    if (generic::normal_map_frame(kScalar, lanes(c), F{m.normal_map->scale}, lanes(s->n), fs, ft, fn).raw) {
+      s->frame.s = scalars(fs);
+      s->frame.t = scalars(ft);
+      s->frame.n = scalars(fn);
+      s->shading_normal = s->frame.n != s->n;
     }
   }
   if (m.is_textured() && params != nullptr) {

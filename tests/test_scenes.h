@@ -295,12 +295,14 @@ inline Scene cornell_with_textures(bool textured_impulses = false) {
 }
 
 // Textured meshes of every kind whose hits the wavefront's lanes resolve
-// themselves (ShapeField kTexturedHits: no tangents, no normal map), core
-// reading only the texels: a tent without texture coordinates (the
+// themselves (ShapeField kTexturedHits), core reading only the texels: a tent without texture coordinates (the
 // barycentrics are), a smooth octahedron with vertex normals and its own
 // coordinates in world space, and the same octahedron in a group placed
 // by instance_placements() (turned, mirrored with a non-uniform scale,
-// sheared), in Lambert and Disney materials under a textured light.
+// sheared), in Lambert and Disney materials under a textured light and an
+// environment (so that paths a shading normal sends below a surface still
+// carry light); normal maps on the floor (a flat rectangle), the red wall
+// and the world-space octahedron (vertex normals).
 inline Scene cornell_with_textured_meshes() {
   const std::filesystem::path& d = textured_scene_dir();
   if (!std::filesystem::exists(d / "gem.obj")) {
@@ -317,19 +319,22 @@ inline Scene cornell_with_textured_meshes() {
     }
   }
   const std::string text = std::string(kTexturedCornellHead) + R"(
-    "red": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": [0.8, 0.1, 0.1], "wrap": "clamp"}},
+    "red": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": [0.8, 0.1, 0.1], "wrap": "clamp"},
+            "normal_map": {"texture": "normals.exr", "scale": 1.3}},
     "disney": {"type": "disney", "base_color": {"texture": "noise.png"}, "roughness": {"texture": "data.png", "channel": 1},
                "metallic": {"texture": "data.png", "channel": 2}, "sheen": {"texture": "data.png", "channel": 0}},
+    "bumps": {"type": "diffuse", "albedo": [0.6, 0.6, 0.5], "normal_map": {"texture": "normals.exr", "scale": 0.9}},
     "light": {"type": "emissive", "radiance": {"texture": "light.exr", "scale": [17, 12, 4], "colorspace": "linear"}}
   },
   "shapes": [
-    {"type": "rectangle", "material": "walls", "transform": [{"rotate": {"axis": [1, 0, 0], "angle": -90}}, {"translate": [0, -1, 0]}]},
+    {"type": "rectangle", "material": "bumps", "transform": [{"rotate": {"axis": [1, 0, 0], "angle": -90}}, {"translate": [0, -1, 0]}]},
     {"type": "rectangle", "material": "walls", "transform": [{"scale": 1.0}, {"translate": [0, 0, -1]}]},
     {"type": "rectangle", "material": "red", "transform": [{"rotate": {"axis": [0, 1, 0], "angle": 90}}, {"translate": [-1, 0, 0]}]},
     {"type": "mesh", "file": "tent.obj", "material": "disney"},
     {"type": "mesh", "file": "gem.obj", "material": "red", "transform": [{"scale": 0.3}, {"translate": [0.5, 0.4, 0.0]}]},
     {"type": "rectangle", "material": "light", "transform": [{"scale": [0.25, 0.2, 1]}, {"rotate": {"axis": [1, 0, 0], "angle": 90}}, {"translate": [0, 0.998, 0]}]}
   ],
+  "lights": [{"type": "environment", "radiance": [0.3, 0.35, 0.4]}],
   "groups": {"gems": [{"type": "mesh", "file": "gem.obj", "material": "disney"}]},
   "instances": [
     {"group": "gems", "transform": [{"scale": 0.22}, {"rotate": {"axis": [0.3, 1, 0.2], "angle": 34}}, {"translate": [-0.45, -0.7, 0.35]}]},

@@ -149,6 +149,7 @@ using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::NoEnergy;
 using pathlab::HWY_NAMESPACE::opposite_sides;
+using pathlab::HWY_NAMESPACE::normal_map_frame;
 using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::place_normal;
@@ -773,9 +774,20 @@ void resolve(const Scene& sc, const Wave& w) {
         store(w, kTexU, i0, textured, uv.x);
         store(w, kTexV, i0, textured, uv.y);
         store(w, kTexWidth, i0, textured, width);
-        store_mask(w, kHasParams, i0, textured, textured);
-        // The texels: OpenImageIO's lookups, by core, path by path, into the slot's SurfaceParams.
+        store_mask(w, kHasParams, i0, textured, shape_flag(textured, sc, shape, kTexturedParams));
+        // The texels: OpenImageIO's lookups, by core, path by path, into the slot's SurfaceParams and kMapR...
         for_each_lane(textured, i0, [&](std::size_t i, std::size_t) { general_texels(sc, w, i); });
+        // A normal map tilts the frame (CompiledScene::read_textures: normal_map_frame).
+        if (const M mapped = shape_flag(textured, sc, shape, kNormalMapped); !hn::AllFalse(df, mapped)) {
+          V3 fs = load3(w, kFsX, i0, mapped), ft = load3(w, kFtX, i0, mapped), fn = load3(w, kFnX, i0, mapped);
+          const M tilted = hn::And(mapped, normal_map_frame(df, load3(w, kMapR, i0, mapped),
+                                                            shape_value(mapped, sc, shape, kNormalMapScale), n, fs,
+                                                            ft, fn));
+          store3(w, kFsX, i0, tilted, fs);
+          store3(w, kFtX, i0, tilted, ft);
+          store3(w, kFnX, i0, tilted, fn);
+          store_mask(w, kShadingNormal, i0, tilted, hn::Or(fn.x != n.x, hn::Or(fn.y != n.y, fn.z != n.z)));
+        }
       }
     }
     if (sc.textured) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kTexturedEmission));
@@ -2033,8 +2045,12 @@ void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {
 void general_texels(const Scene& sc, const Wave& w, std::size_t i) {
   const pathlab::Scene& scene = sc.compiled->scene();
   const Material& m = scene.materials[scene.shapes[w.u[kShape][i]].material];
-  evaluate_textured(m, *sc.compiled->textures(),
-                    TextureFootprint{vec2(w.f[kTexU][i], w.f[kTexV][i]), w.f[kTexWidth][i]}, &w.params[i]);
+  const TextureFootprint at{vec2(w.f[kTexU][i], w.f[kTexV][i]), w.f[kTexWidth][i]};
+  if (m.normal_map) {
+    const Spectrum c = sc.compiled->textures()->color(m.normal_map->texture, at);
+    for (int k = 0; k < 3; ++k) w.f[kMapR + k][i] = c[k];
+  }
+  if (m.is_textured()) evaluate_textured(m, *sc.compiled->textures(), at, &w.params[i]);
 }
 
 // The Surfel of a hit on a kGeneral shape, from what general_resolve (or,

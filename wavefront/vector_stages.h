@@ -153,8 +153,9 @@ struct Scene {
   bool general = false;
   // Some shape the lanes shade has a shading frame of its own (ShapeField
   // kFramed): made in resolve() from its vertex normals (kNormalsAt) and
-  // tangents (kTangentsAt), or by core (CompiledScene::resolve) for a mesh
-  // with a normal map; the rest is the lanes'.
+  // tangents (kTangentsAt), tilted by a normal map, or by core
+  // (CompiledScene::resolve) for a textured sphere or emitter; the rest is
+  // the lanes'.
   bool framed = false;
   // Some shape the lanes shade is a mirror or a dielectric (ShapeField
   // kLaneMaterial): else every lane shaded in the lanes is Lambert's or
@@ -282,20 +283,27 @@ enum ShapeField : int {
   kEnergy = 47,            // bits of an int32: its energy tables' first float in Scene::energy, -1 if none
   kFramed = 48,            // 1 if the lanes shade it in a frame of its own (vertex normals, tangents,
                            // textures), which resolve() makes (kNormalsAt, kTangentsAt; Frame(n) for a flat
-                           // kTexturedHits mesh) or CompiledScene::resolve path by path (a normal map)
+                           // kTexturedHits mesh; tilted by a normal map) or CompiledScene::resolve path by
+                           // path (textured spheres and emitters)
                            // (kFsX..., kShadingNormal)
   kNormalsAt = 49,         // bits of an int32: a kFramed mesh's triangle 0 in Scene::vertex_normals, whose
                            // vertex normals make its frame in the lanes; -1 if it has none or core makes
-                           // its frame (a normal map)
+                           // its frame (a textured emitter)
   kTexturedHits = 50,      // 1 if its material reads textures at hits and the lanes resolve the hit (a kFramed
-                           // mesh without a normal map): they make its frame and the lookups' footprint,
-                           // core reads the texels into the slot's SurfaceParams, path by path
+                           // mesh without an emission texture): they make its frame and the lookups'
+                           // footprint, core reads the texels into the slot's SurfaceParams (and the normal
+                           // map's into kMapR...), path by path
   kUvsAt = 51,             // bits of an int32: a kTexturedHits mesh's triangle 0 in Scene::triangle_uvs; -1 if
                            // the mesh has no texture coordinates (its barycentrics are)
   kTangentsAt = 52,        // bits of an int32: a kFramed mesh's triangle 0 in Scene::vertex_tangents, whose
                            // tangents make its frame in the lanes (about its vertex normals' or geometric
-                           // normal); -1 if it has none or core makes its frame (a normal map)
-  kShapeFields = 53,
+                           // normal); -1 if it has none or core makes its frame (a textured emitter)
+  kNormalMapped = 53,      // 1 if a kTexturedHits mesh's material has a normal map, which tilts its frame in
+                           // the lanes (normal_map_frame) from the texel core reads (kMapR...)
+  kNormalMapScale = 54,    // its NormalMap::scale
+  kTexturedParams = 55,    // 1 if a kTexturedHits mesh's material has textured parameters (kHasParams), 0 if
+                           // it reads only a normal map
+  kShapeFields = 56,
 };
 
 // A Disney material's EnergyTables in Scene::energy.
@@ -327,6 +335,7 @@ enum FloatArray : int {
   kFilmX, kFilmY,
   kConeWidth, kConeSpread,              // the ray's cone (Scene::textured)
   kTexU, kTexV, kTexWidth,              // a kTexturedHits hit's texture footprint (TextureFootprint)
+  kMapR, kMapG, kMapB,                  // and its normal map's texel (kNormalMapped)
   // This bounce only: the hit and the Surfel made of it.
   kHitT, kHitU, kHitV,
   kPx, kPy, kPz, kErrX, kErrY, kErrZ, kNx, kNy, kNz,

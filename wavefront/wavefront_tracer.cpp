@@ -432,12 +432,11 @@ struct WavefrontTracer::VectorStages {
       const bool reads_textures = m.reads_textures_at_hits();
       const bool shaded_in_lanes = m.scatters() && in_lanes(m);
       const bool framed = shaded_in_lanes && !cosine && (shading_frame(sh) || reads_textures);
-      // A textured mesh without a normal map (and no emission texture, whose hits core resolves): the lanes
-      // resolve its hits, frame and footprint included, and core reads only the texels.
-      const bool textured_hits = framed && reads_textures && sh.kind == Shape::Kind::Triangles && !m.normal_map &&
-                                 !m.emission_textured;
+      // A textured mesh (but an emitter's, whose hits core resolves): the lanes resolve its hits, frame, normal
+      // map's tilt and footprint included, and core reads only the texels.
+      const bool textured_hits = framed && reads_textures && sh.kind == Shape::Kind::Triangles && !m.emission_textured;
       // The frame the lanes make: of vertex normals, of tangents (about those normals, or the geometric one).
-      const bool frame_in_lanes = framed && !m.normal_map && (!reads_textures || textured_hits);
+      const bool frame_in_lanes = framed && (!reads_textures || textured_hits);
       const bool normals_in_lanes = frame_in_lanes && sh.mesh.has_normals();
       const bool tangents_in_lanes = frame_in_lanes && !sh.mesh.tangents.empty();
       if (textured_hits) {
@@ -482,6 +481,9 @@ struct WavefrontTracer::VectorStages {
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
       f[vs::kFramed] = framed ? 1.0f : 0.0f;
       f[vs::kTexturedHits] = textured_hits ? 1.0f : 0.0f;
+      f[vs::kNormalMapped] = textured_hits && m.normal_map ? 1.0f : 0.0f;
+      f[vs::kTexturedParams] = textured_hits && m.is_textured() ? 1.0f : 0.0f;
+      f[vs::kNormalMapScale] = m.normal_map ? m.normal_map->scale : 0.0f;
       sc.textured_hits = sc.textured_hits || textured_hits;
       f[vs::kUvsAt] = std::bit_cast<float>(std::int32_t{-1});
       if (textured_hits && sh.mesh.has_uvs()) {

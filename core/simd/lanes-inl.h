@@ -437,6 +437,38 @@ HWY_INLINE void tangent_frame(D d, const Vec3<V>& sum, V w, const Vec3<V>& c0, c
   ft = select(usable, handed * cross(ns, tangent), dt);
 }
 
+// A normal map's tilt of the shading frame (fs, ft, fn) at a hit with
+// geometric normal ng (CompiledScene::read_textures): the map's texel c
+// read as glTF's tangent-space normal (2 c - 1, x and y times `scale`),
+// taken to the frame, through the shading-normal policy (shading_normal),
+// with s kept along the old s (Gram-Schmidt; Frame(ns) where it is (almost)
+// along ns) and t = h ns x s, h the old frame's handedness. The frame is
+// kept where the tilted normal has no direction or is within ~0.08 degrees
+// of fn (so a flat map changes no bit). Returns where it tilted.
+template <class D, class V = VecOf<D>>
+HWY_INLINE auto normal_map_frame(D d, const Vec3<V>& c, V scale, const Vec3<V>& ng, Vec3<V>& fs, Vec3<V>& ft,
+                                 Vec3<V>& fn) {
+  const V one = Set(d, 1.0f), two = Set(d, 2.0f);
+  const V x = (two * c.x - one) * scale, y = (two * c.y - one) * scale, z = two * c.z - one;
+  const Vec3<V> sum = to_world(fs, ft, fn, x, y, z);
+  const V length = Sqrt(dot(sum, sum));
+  const auto tilt =
+      And(And(length > Set(d, 1e-20f), IsFinite(length)), dot(sum / length, fn) < Set(d, 1.0f - 1e-6f));
+  const Vec3<V> ns = shading_normal(d, ng, sum);
+  const Vec3<V> t = fs - dot(fs, ns) * ns;
+  const V tl = Sqrt(dot(t, t));
+  const V handed = IfThenElse(dot(cross(fn, fs), ft) < Zero(d), Neg(one), one);
+  const auto along = tl > Set(d, 1e-4f);
+  const Vec3<V> ts = t / IfThenElse(along, tl, one);
+  Vec3<V> ds, dt;
+  frame(d, ns, ds, dt);
+  const Vec3<V> new_s = select(along, ts, ds), new_t = select(along, handed * cross(ns, ts), dt);
+  fs = select(tilt, new_s, fs);
+  ft = select(tilt, new_t, ft);
+  fn = select(tilt, ns, fn);
+  return tilt;
+}
+
 // A texture lookup's footprint (CompiledScene::read_textures; ray cones,
 // core/ray_cone.h). Of a triangle with world edges e1 and e2 (placed by its
 // instance) and texture-coordinate edges a and b (uv1 - uv0, uv2 - uv0; the
