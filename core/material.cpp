@@ -163,7 +163,7 @@ void evaluate_textured(const Material& m, const Textures& textures, const Textur
   // Only the code that reads it pays for it: a Lambert material's closure is
   // read by the general shading path alone (the closure holds the energy
   // tables, some 500 bytes, so building it per hit is not free).
-  if (m.type == MaterialType::Disney) out->closure = disney::make_closure(p);
+  if (m.type == MaterialType::Disney) disney::set_closure(p, &out->closure);
   else if (m.shading.path == ShadingPath::General) out->closure = disney::lambert_closure(out->albedo);
 }
 

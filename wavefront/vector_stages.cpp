@@ -1389,18 +1389,6 @@ ClosureLanes<VF> closure_lanes(M m, const Scene& sc, VI shape) {
           f(kClearcoat),  f(kClearcoatAlpha), f(kClearcoatLogA2), f(kClearcoatLog2A2)};
 }
 
-// A textured material's hit (Scene::textured) carries its parameters in its
-// slot's SurfaceParams (Wave::params), which core's resolve evaluated from
-// its textures: the float at byte `offset` there, for the lanes of m.
-VF param(const Wave& w, std::size_t i0, M m, std::size_t offset) {
-  static_assert(sizeof(SurfaceParams) % sizeof(float) == 0 && alignof(SurfaceParams) >= alignof(float));
-  const VI slot = hn::Iota(DI(), static_cast<std::int32_t>(i0));
-  return gather(m, reinterpret_cast<const float*>(w.params), slot, static_cast<int>(sizeof(SurfaceParams) / sizeof(float)),
-                static_cast<int>(offset / sizeof(float)));
-}
-V3 param3(const Wave& w, std::size_t i0, M m, std::size_t offset) {
-  return {param(w, i0, m, offset), param(w, i0, m, offset + 4), param(w, i0, m, offset + 8)};
-}
 // The lanes of `framed` (a frame of their own: kFramed, not core's to
 // shade) whose Surfel reads its parameters from Wave::params.
 M textured_lanes(const Scene& sc, const Wave& w, std::size_t i0, M framed) {
@@ -1413,28 +1401,26 @@ M textured_lanes(const Scene& sc, const Wave& w, std::size_t i0, M framed) {
 V3 albedo_lanes(M m, const Scene& sc, const Wave& w, std::size_t i0, VI shape, M textured) {
   const V3 albedo = shape_value3(m, sc, shape, kAlbedo);
   if (hn::AllFalse(DF(), textured)) return albedo;
-  return select(textured, param3(w, i0, textured, offsetof(SurfaceParams, albedo)), albedo);
+  return select(textured, load3(w, kPrmAlbedo, i0, textured), albedo);
 }
 ClosureLanes<VF> closure_lanes(M m, const Scene& sc, const Wave& w, std::size_t i0, VI shape, M textured) {
   ClosureLanes<VF> c = closure_lanes(m, sc, shape);
   const M t = hn::And(m, textured);
   if (hn::AllFalse(DF(), t)) return c;
-  constexpr std::size_t at = offsetof(SurfaceParams, closure);
-  using disney::Closure;
-  const auto one = [&](VF& v, std::size_t offset) { v = hn::IfThenElse(t, param(w, i0, t, at + offset), v); };
-  const auto three = [&](V3& v, std::size_t offset) { v = select(t, param3(w, i0, t, at + offset), v); };
-  three(c.diffuse, offsetof(Closure, diffuse));
-  one(c.roughness, offsetof(Closure, roughness));
-  one(c.subsurface, offsetof(Closure, subsurface));
-  three(c.sheen, offsetof(Closure, sheen));
-  one(c.specular, offsetof(Closure, specular));
-  three(c.spec0, offsetof(Closure, spec0));
-  one(c.ax, offsetof(Closure, ax));
-  one(c.ay, offsetof(Closure, ay));
-  one(c.clearcoat, offsetof(Closure, clearcoat));
-  one(c.clearcoat_alpha, offsetof(Closure, clearcoat_alpha));
-  one(c.clearcoat_log_a2, offsetof(Closure, clearcoat_log_a2));
-  one(c.clearcoat_log2_a2, offsetof(Closure, clearcoat_log2_a2));
+  const auto one = [&](VF& v, FloatArray a) { v = hn::IfThenElse(t, load(w, a, i0, t), v); };
+  const auto three = [&](V3& v, FloatArray a) { v = select(t, load3(w, a, i0, t), v); };
+  three(c.diffuse, kPrmDiffuse);
+  one(c.roughness, kPrmRoughness);
+  one(c.subsurface, kPrmSubsurface);
+  three(c.sheen, kPrmSheen);
+  one(c.specular, kPrmSpecular);
+  three(c.spec0, kPrmSpec0);
+  one(c.ax, kPrmAx);
+  one(c.ay, kPrmAy);
+  one(c.clearcoat, kPrmClearcoat);
+  one(c.clearcoat_alpha, kPrmClearcoatAlpha);
+  one(c.clearcoat_log_a2, kPrmClearcoatLogA2);
+  one(c.clearcoat_log2_a2, kPrmClearcoatLog2A2);
   return c;
 }
 
@@ -1780,10 +1766,8 @@ void scatter(const Scene& sc, const Wave& w) {
         V3 reflectance = shape_value3(glass, sc, shape, kReflectance);
         V3 transmittance = shape_value3(glass, sc, shape, kTransmittance);
         if (const M tinted = hn::And(glass, textured); !hn::AllFalse(df, tinted)) {
-          constexpr std::size_t at = offsetof(SurfaceParams, glass);
-          reflectance = select(tinted, param3(w, i0, tinted, at + offsetof(DielectricParams, reflectance)), reflectance);
-          transmittance =
-              select(tinted, param3(w, i0, tinted, at + offsetof(DielectricParams, transmittance)), transmittance);
+          reflectance = select(tinted, load3(w, kPrmReflectance, i0, tinted), reflectance);
+          transmittance = select(tinted, load3(w, kPrmTransmittance, i0, tinted), transmittance);
         }
         const M crossed = dielectric_sample(df, shape_value(glass, sc, shape, kIor), reflectance, transmittance, u_lobe,
                                             wo_local, local_g, weight_g, pdf_g, transmitted);
@@ -2009,6 +1993,31 @@ static Surfel shading_point(const Wave& w, std::size_t i) {
   return s;
 }
 
+// The slot's SurfaceParams into the arrays the lanes read (kPrmAlbedo...).
+static void store_params(const Wave& w, std::size_t i) {
+  const SurfaceParams& p = w.params[i];
+  const disney::Closure& c = p.closure;
+  const auto three = [&](FloatArray a, const Spectrum& v) {
+    for (int k = 0; k < 3; ++k) w.f[a + k][i] = v[k];
+  };
+  three(kPrmAlbedo, p.albedo);
+  three(kPrmReflectance, p.glass.reflectance);
+  three(kPrmTransmittance, p.glass.transmittance);
+  three(kPrmDiffuse, c.diffuse);
+  three(kPrmSheen, c.sheen);
+  three(kPrmSpec0, c.spec0);
+  const std::pair<FloatArray, float> ones[] = {{kPrmRoughness, c.roughness},
+                                               {kPrmSubsurface, c.subsurface},
+                                               {kPrmSpecular, c.specular},
+                                               {kPrmAx, c.ax},
+                                               {kPrmAy, c.ay},
+                                               {kPrmClearcoat, c.clearcoat},
+                                               {kPrmClearcoatAlpha, c.clearcoat_alpha},
+                                               {kPrmClearcoatLogA2, c.clearcoat_log_a2},
+                                               {kPrmClearcoatLog2A2, c.clearcoat_log2_a2}};
+  for (const auto& [a, v] : ones) w.f[a][i] = v;
+}
+
 void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {
   RayHit hit;
   hit.t = w.f[kHitT][i];
@@ -2040,6 +2049,7 @@ void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {
     for (int c = 0; c < 3; ++c) w.f[arrays[a] + c][i] = (*fields[a])[c];
   w.b[kShadingNormal][i] = s.shading_normal ? 1 : 0;
   w.b[kHasParams][i] = s.params != nullptr ? 1 : 0;
+  if (s.params != nullptr) store_params(w, i);
 }
 
 void general_texels(const Scene& sc, const Wave& w, std::size_t i) {
@@ -2050,7 +2060,10 @@ void general_texels(const Scene& sc, const Wave& w, std::size_t i) {
     const Spectrum c = sc.compiled->textures()->color(m.normal_map->texture, at);
     for (int k = 0; k < 3; ++k) w.f[kMapR + k][i] = c[k];
   }
-  if (m.is_textured()) evaluate_textured(m, *sc.compiled->textures(), at, &w.params[i]);
+  if (m.is_textured()) {
+    evaluate_textured(m, *sc.compiled->textures(), at, &w.params[i]);
+    store_params(w, i);
+  }
 }
 
 // The Surfel of a hit on a kGeneral shape, from what general_resolve (or,

@@ -336,6 +336,15 @@ enum FloatArray : int {
   kConeWidth, kConeSpread,              // the ray's cone (Scene::textured)
   kTexU, kTexV, kTexWidth,              // a kTexturedHits hit's texture footprint (TextureFootprint)
   kMapR, kMapG, kMapB,                  // and its normal map's texel (kNormalMapped)
+  // A hit's textured parameters where kHasParams says so, as the lanes read
+  // them (Wave::params' SurfaceParams, copied by core where it evaluated
+  // them): the albedo, the dielectric's tints, the Disney closure's lobes.
+  kPrmAlbedo, kPrmAlbedoG, kPrmAlbedoB,
+  kPrmReflectance, kPrmReflectanceG, kPrmReflectanceB,
+  kPrmTransmittance, kPrmTransmittanceG, kPrmTransmittanceB,
+  kPrmDiffuse, kPrmDiffuseG, kPrmDiffuseB, kPrmRoughness, kPrmSubsurface,
+  kPrmSheen, kPrmSheenG, kPrmSheenB, kPrmSpecular, kPrmSpec0, kPrmSpec0G, kPrmSpec0B,
+  kPrmAx, kPrmAy, kPrmClearcoat, kPrmClearcoatAlpha, kPrmClearcoatLogA2, kPrmClearcoatLog2A2,
   // This bounce only: the hit and the Surfel made of it.
   kHitT, kHitU, kHitV,
   kPx, kPy, kPz, kErrX, kErrY, kErrZ, kNx, kNy, kNz,

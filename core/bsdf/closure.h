@@ -48,24 +48,34 @@ struct Closure {
   EnergyTables energy{};    // on: the lobes are coupled (energy.h)
 };
 
-inline Closure make_closure(const DisneyParams& p) {
-  Closure c;
+// The closure of a Disney material's parameters into *c, every field but
+// the energy tables, which it turns off: what make_closure computes, for a
+// textured material's hit (evaluate_textured), which has no tables (refused
+// at load) and builds its closure in place rather than copying the tables.
+inline void set_closure(const DisneyParams& p, Closure* c) {
   const float lum = luminance(p.base_color);
   const Spectrum tint = lum > 0.0f ? p.base_color / lum : Spectrum(1.0f);
   const float dielectric = 1.0f - p.metallic;
-  c.diffuse = dielectric * p.base_color;
-  c.roughness = p.roughness;
-  c.subsurface = p.subsurface;
-  c.sheen = dielectric * p.sheen * glm::mix(Spectrum(1.0f), tint, p.sheen_tint);
-  c.specular = 1.0f;
-  c.spec0 = glm::mix(p.specular * 0.08f * glm::mix(Spectrum(1.0f), tint, p.specular_tint), p.base_color, p.metallic);
+  c->lambert = Spectrum(0.0f);
+  c->diffuse = dielectric * p.base_color;
+  c->roughness = p.roughness;
+  c->subsurface = p.subsurface;
+  c->sheen = dielectric * p.sheen * glm::mix(Spectrum(1.0f), tint, p.sheen_tint);
+  c->specular = 1.0f;
+  c->spec0 = glm::mix(p.specular * 0.08f * glm::mix(Spectrum(1.0f), tint, p.specular_tint), p.base_color, p.metallic);
   const vec2 a = microfacet::alpha_from(p.roughness, p.anisotropic);
-  c.ax = a.x;
-  c.ay = a.y;
-  c.clearcoat = 0.25f * p.clearcoat;
-  c.clearcoat_alpha = gtr1::alpha_from_gloss(p.clearcoat_gloss);
-  c.clearcoat_log_a2 = gtr1::log_alpha2(c.clearcoat_alpha);
-  c.clearcoat_log2_a2 = gtr1::log2_alpha2(c.clearcoat_alpha);
+  c->ax = a.x;
+  c->ay = a.y;
+  c->clearcoat = 0.25f * p.clearcoat;
+  c->clearcoat_alpha = gtr1::alpha_from_gloss(p.clearcoat_gloss);
+  c->clearcoat_log_a2 = gtr1::log_alpha2(c->clearcoat_alpha);
+  c->clearcoat_log2_a2 = gtr1::log2_alpha2(c->clearcoat_alpha);
+  c->energy.on = false;
+}
+
+inline Closure make_closure(const DisneyParams& p) {
+  Closure c;
+  set_closure(p, &c);
   if (p.energy_compensation) c.energy = make_energy_tables(c);
   return c;
 }
