@@ -669,9 +669,8 @@ void resolve(const Scene& sc, const Wave& w) {
       }
     }
     store_mask(w, kShadeByCore, i0, found, general);
-    // A frame of its own (kFramed), which the lanes shade in: of vertex
-    // normals (kNormalsAt) made here as CompiledScene::resolve_shading makes
-    // it (blend_normals, shading_normal, Frame), of tangents by it.
+    // A frame of its own (kFramed), which the lanes shade in, made here as
+    // CompiledScene::resolve makes it (below).
     if (sc.framed) {
       const M framed = shape_flag(hn::AndNot(hn::Or(general, by_core), found), sc, shape, kFramed);
       // The frames the lanes make (CompiledScene::shading_frame): of vertex normals (kNormalsAt), of tangents

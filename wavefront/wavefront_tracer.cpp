@@ -449,57 +449,39 @@ struct WavefrontTracer::VectorStages {
       } else if (shaded_in_lanes && shading_frame(sh) && !frame_in_lanes) {
         v->general.push_back("the shading frame of " + sh.description);
       }
-      f[vs::kNormalsAt] = std::bit_cast<float>(std::int32_t{-1});
-      if (normals_in_lanes) {
-        if (v->vertex_normals.size() / 9 + sh.mesh.triangles.size() >= (std::size_t{1} << 27))
-          return no("more than 2^27 triangles with vertex normals");
-        f[vs::kNormalsAt] = std::bit_cast<float>(static_cast<std::int32_t>(v->vertex_normals.size() / 9));
-        const std::size_t at = v->vertex_normals.size();
-        v->vertex_normals.resize(at + 9 * sh.mesh.triangles.size());
-        float* out = v->vertex_normals.data() + at;
+      // Each triangle's three vertices' attribute (n floats each) appended to `table`, the shape's `field`
+      // holding its triangle 0's index there (-1 without); false beyond the gathers' 2^27 triangles.
+      const auto per_triangle = [&](std::vector<float>& table, const auto& attribute, int n, vs::ShapeField field) {
+        const std::size_t stride = 3 * static_cast<std::size_t>(n);
+        if (table.size() / stride + sh.mesh.triangles.size() >= (std::size_t{1} << 27)) return false;
+        f[field] = std::bit_cast<float>(static_cast<std::int32_t>(table.size() / stride));
+        const std::size_t at = table.size();
+        table.resize(at + stride * sh.mesh.triangles.size());
+        float* out = table.data() + at;
         parallel_for(0, sh.mesh.triangles.size(), 4096, [&](std::size_t b, std::size_t e) {
           for (std::size_t t = b; t < e; ++t)
             for (int k = 0; k < 3; ++k)
-              for (int c = 0; c < 3; ++c) out[9 * t + 3 * k + c] = sh.mesh.normals[sh.mesh.triangles[t][k]][c];
+              for (int c = 0; c < n; ++c) out[stride * t + n * k + c] = attribute[sh.mesh.triangles[t][k]][c];
         });
-      }
-      f[vs::kTangentsAt] = std::bit_cast<float>(std::int32_t{-1});
-      if (tangents_in_lanes) {
-        if (v->vertex_tangents.size() / 12 + sh.mesh.triangles.size() >= (std::size_t{1} << 27))
-          return no("more than 2^27 triangles with tangents");
-        f[vs::kTangentsAt] = std::bit_cast<float>(static_cast<std::int32_t>(v->vertex_tangents.size() / 12));
-        const std::size_t at = v->vertex_tangents.size();
-        v->vertex_tangents.resize(at + 12 * sh.mesh.triangles.size());
-        float* out = v->vertex_tangents.data() + at;
-        parallel_for(0, sh.mesh.triangles.size(), 4096, [&](std::size_t b, std::size_t e) {
-          for (std::size_t t = b; t < e; ++t)
-            for (int k = 0; k < 3; ++k)
-              for (int c = 0; c < 4; ++c) out[12 * t + 4 * k + c] = sh.mesh.tangents[sh.mesh.triangles[t][k]][c];
-        });
-      }
+        return true;
+      };
+      for (vs::ShapeField field : {vs::kNormalsAt, vs::kTangentsAt, vs::kUvsAt})
+        f[field] = std::bit_cast<float>(std::int32_t{-1});
+      if (normals_in_lanes && !per_triangle(v->vertex_normals, sh.mesh.normals, 3, vs::kNormalsAt))
+        return no("more than 2^27 triangles with vertex normals");
+      if (tangents_in_lanes && !per_triangle(v->vertex_tangents, sh.mesh.tangents, 4, vs::kTangentsAt))
+        return no("more than 2^27 triangles with tangents");
+      if (textured_hits && sh.mesh.has_uvs() && !per_triangle(v->triangle_uvs, sh.mesh.uvs, 2, vs::kUvsAt))
+        return no("more than 2^27 textured triangles");
       const bool general = m.scatters() && (cosine || !in_lanes(m) || (shading_frame(sh) && !framed));
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
       f[vs::kFramed] = framed ? 1.0f : 0.0f;
+      sc.framed = sc.framed || framed;
       f[vs::kTexturedHits] = textured_hits ? 1.0f : 0.0f;
       f[vs::kNormalMapped] = textured_hits && m.normal_map ? 1.0f : 0.0f;
       f[vs::kTexturedParams] = textured_hits && m.is_textured() ? 1.0f : 0.0f;
       f[vs::kNormalMapScale] = m.normal_map ? m.normal_map->scale : 0.0f;
       sc.textured_hits = sc.textured_hits || textured_hits;
-      f[vs::kUvsAt] = std::bit_cast<float>(std::int32_t{-1});
-      if (textured_hits && sh.mesh.has_uvs()) {
-        if (v->triangle_uvs.size() / 6 + sh.mesh.triangles.size() >= (std::size_t{1} << 27))
-          return no("more than 2^27 textured triangles");
-        f[vs::kUvsAt] = std::bit_cast<float>(static_cast<std::int32_t>(v->triangle_uvs.size() / 6));
-        const std::size_t at = v->triangle_uvs.size();
-        v->triangle_uvs.resize(at + 6 * sh.mesh.triangles.size());
-        float* out = v->triangle_uvs.data() + at;
-        parallel_for(0, sh.mesh.triangles.size(), 4096, [&](std::size_t b, std::size_t e) {
-          for (std::size_t t = b; t < e; ++t)
-            for (int k = 0; k < 3; ++k)
-              for (int c = 0; c < 2; ++c) out[6 * t + 2 * k + c] = sh.mesh.uvs[sh.mesh.triangles[t][k]][c];
-        });
-      }
-      sc.framed = sc.framed || framed;
       f[vs::kTexturedEmission] = m.emission_textured ? 1.0f : 0.0f;
       f[vs::kResolveByCore] = general && (shading_frame(sh) || m.reads_textures_at_hits()) ? 1.0f : 0.0f;
       f[vs::kLaneMaterial] = m.type == MaterialType::Mirror       ? static_cast<float>(vs::kLaneMirror)
