@@ -7,12 +7,14 @@
 // spheres sampled by area or solid angle, the environment, sun disks, delta
 // lights, the points of textured emitters), Lambert, Disney (either sampling
 // of its glossy lobes), mirror and dielectric shading, textured or not, in
-// the geometric normal's frame or the hit's own (vertex normals: Scene::
-// framed), roulette and compaction. Core does, one path at a time between
-// the lanes' steps: texture and normal-map reads (OpenImageIO's) at hits and
-// at textured emitters' light samples, frames from tangents, the general
-// shading path's materials, the strategy `cosine`, and environment images of
-// 2^29 texels or more (Scene::general, textured, general_lights).
+// the geometric normal's frame or the hit's own (vertex normals, tangents,
+// a normal map's tilt: Scene::framed), textured meshes' texture coordinates
+// and footprints, the ray cones, roulette and compaction. Core does, one
+// path at a time between the lanes' steps: the texel reads (OpenImageIO's)
+// at hits and at textured emitters' light samples, whole hits on textured
+// spheres and emitters, the general shading path's materials, the strategy
+// `cosine`, and environment images of 2^29 texels or more (Scene::general,
+// textured, general_lights).
 // `--simd scalar` runs the scalar stages of wavefront_tracer.cpp.
 //
 // Written once (vector_stages.cpp, over Google Highway, compiled for every
