@@ -218,6 +218,7 @@ void CompiledScene::shading_frame(const Shape& shape, const RayHit& hit, const v
 
 void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayHit& hit, const RayCone& cone,
                                   SurfaceParams* params, Surfel* s) const {
+  using namespace width1;  // the generic steps at width 1 (core/simd/lanes-inl.h)
   const Material& m = *s->material;
   // Texture coordinates and the uv-to-world area ratio that turns the cone's
   // width into a footprint in uv (core/ray_cone.h).
@@ -244,12 +245,10 @@ void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayH
       const glm::uvec3 v = shape.mesh.triangles[hit.prim];
       a = shape.mesh.uvs[v.y] - shape.mesh.uvs[v.x], b = shape.mesh.uvs[v.z] - shape.mesh.uvs[v.x];
     }
-    using namespace width1;
     uv_per_area = generic::triangle_uv_per_area(kScalar, lanes(e1), lanes(e2), lane1::M{shape.mesh.has_uvs()}, F{a.x},
                                                 F{a.y}, F{b.x}, F{b.y})
                       .raw;
   }
-  using namespace width1;
   const float width = generic::footprint_width(kScalar, F{cone.width}, F{cone.spread}, F{glm::length(s->p - ray.origin)},
                                                F{glm::dot(ray.dir, s->n)}, F{uv_per_area})
                           .raw;
@@ -259,7 +258,6 @@ void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayH
     // bitangent (dP/dv, "+y up"), z the shading normal (generic code, which
     // the wavefront's lanes run too: lanes-inl.h normal_map_frame).
     const vec3 c = vec3(textures_->color(m.normal_map->texture, at));
-    using namespace width1;
     F3 fs = lanes(s->frame.s), ft = lanes(s->frame.t), fn = lanes(s->frame.n);
     if (generic::normal_map_frame(kScalar, lanes(c), F{m.normal_map->scale}, lanes(s->n), fs, ft, fn).raw) {
       s->frame.s = scalars(fs);

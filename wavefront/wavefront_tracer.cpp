@@ -132,6 +132,17 @@ struct WavefrontTracer::Wave {
 };
 
 namespace {
+
+// "a", "a and b", "a, b and c": names listed in a stage description.
+std::string list_names(const std::vector<std::string>& names) {
+  std::string l;
+  for (std::size_t i = 0; i < names.size(); ++i) l += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+  return l;
+}
+// `name` appended to `names` unless it is there already.
+void add_name(std::vector<std::string>& names, const std::string& name) {
+  if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+}
 std::uint64_t clock_ns() {
   return static_cast<std::uint64_t>(
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count());
@@ -440,12 +451,9 @@ struct WavefrontTracer::VectorStages {
       const bool normals_in_lanes = frame_in_lanes && sh.mesh.has_normals();
       const bool tangents_in_lanes = frame_in_lanes && !sh.mesh.tangents.empty();
       if (textured_hits) {
-        const std::string name = "'" + m.name + "'";
-        if (std::find(texel_names.begin(), texel_names.end(), name) == texel_names.end()) texel_names.push_back(name);
+        add_name(texel_names, "'" + m.name + "'");
       } else if (shaded_in_lanes && reads_textures) {
-        const std::string name = "'" + m.name + "'";
-        if (std::find(textured_names.begin(), textured_names.end(), name) == textured_names.end())
-          textured_names.push_back(name);
+        add_name(textured_names, "'" + m.name + "'");
       } else if (shaded_in_lanes && shading_frame(sh) && !frame_in_lanes) {
         v->general.push_back("the shading frame of " + sh.description);
       }
@@ -527,18 +535,10 @@ struct WavefrontTracer::VectorStages {
       sc.impulses = sc.impulses || (m.scatters() && !general && m.is_pure_impulse());
       v->shape.insert(v->shape.end(), std::begin(f), std::end(f));
     }
-    if (!textured_names.empty()) {
-      std::string what = "the texture reads (and shading frames) at hits on ";
-      for (std::size_t i = 0; i < textured_names.size(); ++i)
-        what += (i == 0 ? "" : i + 1 == textured_names.size() ? " and " : ", ") + textured_names[i];
-      v->general.push_back(what);
-    }
-    if (!texel_names.empty()) {
-      std::string what = "the texels at hits on ";
-      for (std::size_t i = 0; i < texel_names.size(); ++i)
-        what += (i == 0 ? "" : i + 1 == texel_names.size() ? " and " : ", ") + texel_names[i];
-      v->general.push_back(what + " (OpenImageIO's lookups)");
-    }
+    if (!textured_names.empty())
+      v->general.push_back("the texture reads (and shading frames) at hits on " + list_names(textured_names));
+    if (!texel_names.empty())
+      v->general.push_back("the texels at hits on " + list_names(texel_names) + " (OpenImageIO's lookups)");
     static_assert(vs::kEnergyCoat == 3 * disney::kEnergyTableSize &&
                   vs::kEnergyDiffuseScale == vs::kEnergyCoat + disney::kEnergyTableSize &&
                   vs::kEnergyFloats == vs::kEnergyDiffuseScale + 3);
@@ -672,15 +672,10 @@ std::string WavefrontTracer::stages_description() const {
   if (!vector_) return "scalar stages (" + scalar_reason_ + ")";
   std::string d = std::string("every stage vectorised (") + simd_target_name(active_simd_target()) + ", " +
                   std::to_string(vector_stages::lanes()) + " paths at a time, paths as structure of arrays)";
-  auto list = [](const std::vector<std::string>& items) {
-    std::string l;
-    for (std::size_t i = 0; i < items.size(); ++i) l += (i == 0 ? "" : i + 1 == items.size() ? " and " : ", ") + items[i];
-    return l;
-  };
   std::vector<std::string> general = vector_->general;
   if (!vector_->general_materials.empty())
     general.insert(general.begin(), std::string(vector_->general_materials.size() > 1 ? "materials " : "material ") +
-                                        list(vector_->general_materials));
+                                        list_names(vector_->general_materials));
   for (std::size_t i = 0; i < general.size(); ++i) d += (i == 0 ? "; by core, one path at a time: " : "; ") + general[i];
   return d;
 }
