@@ -457,9 +457,10 @@ std::size_t count_rejected(std::span<const Ray> rays) {
   for (const Ray& r : rays) n += embree_accepts(r) ? 0 : 1;
   return n;
 }
-std::size_t count_rejected(const RayArrays& rays, std::size_t n) {
-  std::size_t bad = 0;
-  for (std::size_t i = 0; i < n; ++i) bad += embree_accepts(ray_at(rays, i)) ? 0 : 1;
+std::size_t count_rejected(const RayArrays& r, std::size_t n) {
+  std::uint32_t bad = 0;  // n < 2^32 (Embree's stream size is an unsigned)
+  for (std::size_t i = 0; i < n; ++i)
+    bad += embree_accepts(vec3(r.ox[i], r.oy[i], r.oz[i]), vec3(r.dx[i], r.dy[i], r.dz[i]), r.tmax[i]) ? 0u : 1u;
   return bad;
 }
 
@@ -595,27 +596,27 @@ void fill_packet(Packet& p, const RayArrays& rays, std::size_t b, std::size_t n)
 
 // The per-ray inputs of a pointer-SoA stream that the arrays do not hold:
 // tnear 0, time 0, every mask bit, flags 0, id 0 unless the arrays hold
-// alpha keys; and tfar to be written.
+// alpha keys; and room for what Embree writes that the caller does not
+// keep: an occlusion query's tfar, a hit's geometric normal, its instance
+// where the caller keeps none.
 struct StreamScratch {
-  std::vector<float> zeros, tfar, ng, u, v;
-  std::vector<unsigned> mask, zero_ids, geom, prim, inst;
-  // This thread's scratch, with room for n rays and tfar set from `rays`.
-  static StreamScratch& for_rays(const RayArrays& rays, std::size_t n) {
+  std::vector<float> zeros, tfar, ng;
+  std::vector<unsigned> mask, zero_ids, inst;
+  // This thread's scratch, with room for n rays.
+  static StreamScratch& for_rays(std::size_t n) {
     thread_local StreamScratch s;
     if (s.zeros.size() < n) {
       s.zeros.assign(n, 0.0f), s.mask.assign(n, 0xffffffffu), s.zero_ids.assign(n, 0u);
-      s.tfar.resize(n), s.ng.resize(n), s.u.resize(n), s.v.resize(n), s.geom.resize(n), s.prim.resize(n),
-          s.inst.resize(n);
+      s.tfar.resize(n), s.ng.resize(n), s.inst.resize(n);
     }
-    std::memcpy(s.tfar.data(), rays.tmax, n * sizeof(float));
     return s;
   }
-  // Embree's pointer-SoA ray is not const, but it writes only tfar (kept
-  // here) and, for intersections, the hit arrays.
-  RTCRayNp ray(const RayArrays& r) {
+  // Embree's pointer-SoA ray is not const, but it writes only tfar, which
+  // `tfar` receives.
+  RTCRayNp ray(const RayArrays& r, float* tfar_out) {
     return RTCRayNp{const_cast<float*>(r.ox), const_cast<float*>(r.oy), const_cast<float*>(r.oz), zeros.data(),
                     const_cast<float*>(r.dx), const_cast<float*>(r.dy), const_cast<float*>(r.dz), zeros.data(),
-                    tfar.data(), mask.data(),
+                    tfar_out, mask.data(),
                     r.alpha_key ? const_cast<unsigned*>(r.alpha_key) : zero_ids.data(), zero_ids.data()};
   }
 };
@@ -668,13 +669,26 @@ void EmbreeAccel::intersect_arrays(const RayArrays& rays_in, std::size_t n, cons
       });
       return;
     case RayBatchMode::Stream: {
-      StreamScratch& s = StreamScratch::for_rays(rays, n);
-      std::fill_n(s.geom.begin(), n, RTC_INVALID_GEOMETRY_ID);
-      std::fill_n(s.inst.begin(), n, RTC_INVALID_GEOMETRY_ID);
-      const RTCRayHitNp rh{s.ray(rays), RTCHitNp{s.ng.data(), s.ng.data(), s.ng.data(), s.u.data(), s.v.data(),
-                                                 s.prim.data(), s.geom.data(), {s.inst.data()}}};
+      // Embree writes the hits straight into the caller's arrays: tfar (the
+      // distance; tmax where it finds nothing), u, v, primID, geomID (the
+      // shape, renumbered below for instances) and instID; on a miss only
+      // tfar is read back, so geomID and instID start as "none".
+      StreamScratch& s = StreamScratch::for_rays(n);
+      std::uint32_t* const inst = hits.instance ? hits.instance : s.inst.data();
+      std::memcpy(hits.t, rays.tmax, n * sizeof(float));
+      std::fill_n(hits.shape, n, RTC_INVALID_GEOMETRY_ID);
+      std::fill_n(inst, n, RTC_INVALID_GEOMETRY_ID);
+      const RTCRayHitNp rh{s.ray(rays, hits.t), RTCHitNp{s.ng.data(), s.ng.data(), s.ng.data(), hits.u, hits.v,
+                                                         hits.prim, hits.shape, {inst}}};
       rtcIntersectNp(impl_->scene, &context, &rh, static_cast<unsigned>(n));
-      for (std::size_t i = 0; i < n; ++i) record(i, s.tfar[i], s.geom[i], s.prim[i], s.u[i], s.v[i], s.inst[i]);
+      for (std::size_t i = 0; i < n; ++i) hits.found[i] = hits.shape[i] != RTC_INVALID_GEOMETRY_ID;
+      // kNoInstance is RTC_INVALID_GEOMETRY_ID: a scene without instances
+      // needs no renumbering.
+      if (!impl_->instance_group.empty())
+        for (std::size_t i = 0; i < n; ++i) {
+          hits.shape[i] = impl_->shape_of(hits.shape[i], inst[i]);
+          inst[i] = impl_->instance_of(inst[i]);
+        }
       return;
     }
   }
@@ -710,8 +724,9 @@ void EmbreeAccel::occluded_arrays(const RayArrays& rays, std::size_t n, std::uin
       });
       return;
     case RayBatchMode::Stream: {
-      StreamScratch& s = StreamScratch::for_rays(rays, n);
-      const RTCRayNp r = s.ray(rays);
+      StreamScratch& s = StreamScratch::for_rays(n);
+      std::memcpy(s.tfar.data(), rays.tmax, n * sizeof(float));
+      const RTCRayNp r = s.ray(rays, s.tfar.data());
       rtcOccludedNp(impl_->scene, &context, &r, static_cast<unsigned>(n));
       for (std::size_t i = 0; i < n; ++i) occluded[i] = s.tfar[i] < 0.0f;
       return;

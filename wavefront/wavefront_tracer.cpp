@@ -559,6 +559,9 @@ struct WavefrontTracer::VectorStages {
     sc.vertex_normals = v->vertex_normals.empty() ? nullptr : v->vertex_normals.data();
     sc.triangle_uvs = v->triangle_uvs.empty() ? nullptr : v->triangle_uvs.data();
     sc.vertex_tangents = v->vertex_tangents.empty() ? nullptr : v->vertex_tangents.data();
+    sc.prefetch = sizeof(float) * (12 * compiled.triangles().size() + v->vertex_normals.size() +
+                                   v->triangle_uvs.size() + v->vertex_tangents.size()) >
+                  vs::Scene::kPrefetchBytes;
     // The camera.
     const Camera& camera = compiled.camera();
     const Camera::Plane p = camera.plane();
@@ -1017,7 +1020,7 @@ void WavefrontTracer::run_wave_vector(Lanes& lanes, std::span<FilmSample> out, s
     scene_.intersect_arrays(rays, n, hits, camera_rays ? modes_.camera : modes_.bounce, camera_rays);
     clock.batch(camera_rays ? kCameraQueries : kBounceQueries, t, n);
     t_stage = clock_ns();
-    vs::prefetch_hits(sc, w);  // overlap the hits' cache misses (as intersect() does)
+    if (sc.prefetch) vs::prefetch_hits(sc, w);  // overlap the hits' cache misses (as intersect() does)
     vs::resolve(sc, w);
     clock.stage(WavefrontStage::Resolve, &t_stage);
     vs::add_emission(sc, w);
