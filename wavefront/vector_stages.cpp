@@ -1382,10 +1382,15 @@ LightLanes other_light(const Scene& sc, const Wave& w, std::size_t i0, const Str
 
 // Each lane's shape's Disney closure (ShapeField kDiffuse...; no Lambert lobe).
 ClosureLanes<VF> closure_lanes(M m, const Scene& sc, VI shape) {
-  const auto f = [&](ShapeField field) { return shape_value(m, sc, shape, field); };
-  return {zero3(),        shape_value3(m, sc, shape, kDiffuse), f(kRoughness), f(kSubsurface),
-          shape_value3(m, sc, shape, kSheen), f(kSpecular), shape_value3(m, sc, shape, kSpec0), f(kAx), f(kAy),
-          f(kClearcoat),  f(kClearcoatAlpha), f(kClearcoatLogA2), f(kClearcoatLog2A2)};
+  ClosureLanes<VF> c;
+  c.lambert = zero3();
+  for_each_closure_field(c, [&](auto& v, ShapeField field, FloatArray) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, VF>)
+      v = shape_value(m, sc, shape, field);
+    else
+      v = shape_value3(m, sc, shape, field);
+  });
+  return c;
 }
 
 // The lanes of `framed` (a frame of their own: kFramed, not core's to
@@ -1406,20 +1411,12 @@ ClosureLanes<VF> closure_lanes(M m, const Scene& sc, const Wave& w, std::size_t 
   ClosureLanes<VF> c = closure_lanes(m, sc, shape);
   const M t = hn::And(m, textured);
   if (hn::AllFalse(DF(), t)) return c;
-  const auto one = [&](VF& v, FloatArray a) { v = hn::IfThenElse(t, load(w, a, i0, t), v); };
-  const auto three = [&](V3& v, FloatArray a) { v = select(t, load3(w, a, i0, t), v); };
-  three(c.diffuse, kPrmDiffuse);
-  one(c.roughness, kPrmRoughness);
-  one(c.subsurface, kPrmSubsurface);
-  three(c.sheen, kPrmSheen);
-  one(c.specular, kPrmSpecular);
-  three(c.spec0, kPrmSpec0);
-  one(c.ax, kPrmAx);
-  one(c.ay, kPrmAy);
-  one(c.clearcoat, kPrmClearcoat);
-  one(c.clearcoat_alpha, kPrmClearcoatAlpha);
-  one(c.clearcoat_log_a2, kPrmClearcoatLogA2);
-  one(c.clearcoat_log2_a2, kPrmClearcoatLog2A2);
+  for_each_closure_field(c, [&](auto& v, ShapeField, FloatArray a) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, VF>)
+      v = hn::IfThenElse(t, load(w, a, i0, t), v);
+    else
+      v = select(t, load3(w, a, i0, t), v);
+  });
   return c;
 }
 
@@ -2002,19 +1999,12 @@ static void store_params(const Wave& w, std::size_t i) {
   three(kPrmAlbedo, p.albedo);
   three(kPrmReflectance, p.glass.reflectance);
   three(kPrmTransmittance, p.glass.transmittance);
-  three(kPrmDiffuse, c.diffuse);
-  three(kPrmSheen, c.sheen);
-  three(kPrmSpec0, c.spec0);
-  const std::pair<FloatArray, float> ones[] = {{kPrmRoughness, c.roughness},
-                                               {kPrmSubsurface, c.subsurface},
-                                               {kPrmSpecular, c.specular},
-                                               {kPrmAx, c.ax},
-                                               {kPrmAy, c.ay},
-                                               {kPrmClearcoat, c.clearcoat},
-                                               {kPrmClearcoatAlpha, c.clearcoat_alpha},
-                                               {kPrmClearcoatLogA2, c.clearcoat_log_a2},
-                                               {kPrmClearcoatLog2A2, c.clearcoat_log2_a2}};
-  for (const auto& [a, v] : ones) w.f[a][i] = v;
+  for_each_closure_field(c, [&](const auto& v, ShapeField, FloatArray a) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(v)>, float>)
+      w.f[a][i] = v;
+    else
+      three(a, v);
+  });
 }
 
 void general_resolve(const Scene& sc, const Wave& w, std::size_t i) {

@@ -365,6 +365,30 @@ enum FloatArray : int {
   kQOx, kQOy, kQOz, kQDx, kQDy, kQDz, kQTmax, kQUnR, kQUnG, kQUnB,
   kFloatArrays
 };
+// The Disney closure's fields that the lanes read, in one list: each one's
+// ShapeField (an untextured material's value, in the shape table) and
+// FloatArray (a textured hit's, kPrm...). Calls f(field, shape_field,
+// float_array) for each field of c, a disney::Closure or the lanes'
+// ClosureLanes (core/bsdf/disney-inl.h); a field is a float or a
+// Spectrum there, a vector or a Vec3 of them here. A field added to the
+// closure is added here, and the tracer fills the table, the lanes read it
+// and core's textured parameters reach the lanes by this list alone.
+template <class Closure, class F>
+void for_each_closure_field(Closure& c, F&& f) {
+  f(c.diffuse, kDiffuse, kPrmDiffuse);
+  f(c.roughness, kRoughness, kPrmRoughness);
+  f(c.subsurface, kSubsurface, kPrmSubsurface);
+  f(c.sheen, kSheen, kPrmSheen);
+  f(c.specular, kSpecular, kPrmSpecular);
+  f(c.spec0, kSpec0, kPrmSpec0);
+  f(c.ax, kAx, kPrmAx);
+  f(c.ay, kAy, kPrmAy);
+  f(c.clearcoat, kClearcoat, kPrmClearcoat);
+  f(c.clearcoat_alpha, kClearcoatAlpha, kPrmClearcoatAlpha);
+  f(c.clearcoat_log_a2, kClearcoatLogA2, kPrmClearcoatLogA2);
+  f(c.clearcoat_log2_a2, kClearcoatLog2A2, kPrmClearcoatLog2A2);
+}
+
 enum UintArray : int {
   kOutIndex, kRays, kVertex, kPixelX, kPixelY,
   kShape, kPrim,  // the hit's

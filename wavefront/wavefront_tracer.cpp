@@ -502,20 +502,12 @@ struct WavefrontTracer::VectorStages {
         f[vs::kTransmittance + c] = m.glass.transmittance[c];
       }
       const disney::Closure& c = m.closure;
-      for (int k = 0; k < 3; ++k) {
-        f[vs::kDiffuse + k] = c.diffuse[k];
-        f[vs::kSheen + k] = c.sheen[k];
-        f[vs::kSpec0 + k] = c.spec0[k];
-      }
-      f[vs::kRoughness] = c.roughness;
-      f[vs::kSubsurface] = c.subsurface;
-      f[vs::kSpecular] = c.specular;
-      f[vs::kAx] = c.ax;
-      f[vs::kAy] = c.ay;
-      f[vs::kClearcoat] = c.clearcoat;
-      f[vs::kClearcoatAlpha] = c.clearcoat_alpha;
-      f[vs::kClearcoatLogA2] = c.clearcoat_log_a2;
-      f[vs::kClearcoatLog2A2] = c.clearcoat_log2_a2;
+      vs::for_each_closure_field(c, [&f](const auto& value, vs::ShapeField field, vs::FloatArray) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(value)>, float>)
+          f[field] = value;
+        else
+          for (int k = 0; k < 3; ++k) f[field + k] = value[k];
+      });
       f[vs::kEnergy] = std::bit_cast<float>(std::int32_t{-1});
       // (A textured material's Surfel reads the closure core evaluated per hit, which has no tables.)
       if (m.type == MaterialType::Disney && c.energy.on && !general && !m.is_textured()) {
