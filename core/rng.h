@@ -116,8 +116,10 @@ class SampleStream {
     if (index_bits_ != kHash) {
       const SobolSlot s = sobol_slot(x);
       if (s.entity < kSobolSlotsPerVertex && s.axis == 0 && sobol_slot(y).entity == s.entity) {
-        const Point p = zsobol_point(bounce * kSobolSlotsPerVertex + s.entity);
-        return {p.value(0), p.value(1)};
+        std::uint32_t second = 0;
+        const std::uint32_t first =
+            sobol::zsobol_top24(index_, sobol_key_, index_bits_, bounce * kSobolSlotsPerVertex + s.entity, 0, &second);
+        return {sobol::top24_to_float(first), sobol::top24_to_float(second)};
       }
     }
     return {get(bounce, x), get(bounce, y)};
@@ -125,24 +127,13 @@ class SampleStream {
 
   // Point `slot` of the zsobol sequence in Sobol' dimension `axis`, as get()
   // draws it (public for the tests of its parts).
-  constexpr float zsobol(std::uint32_t slot, int axis) const { return zsobol_point(slot).value(axis); }
+  constexpr float zsobol(std::uint32_t slot, int axis) const {
+    return sobol::top24_to_float(sobol::zsobol_top24(index_, sobol_key_, index_bits_, slot, axis, nullptr));
+  }
 
  private:
   friend class SamplerSetup;
   static constexpr std::uint32_t kHash = 0xffffffffu;
-  // One slot's permuted Sobol' index and its scrambling key: both axes of
-  // the slot's 2D point come from it.
-  struct Point {
-    std::uint64_t index, h;
-    constexpr float value(int axis) const {
-      return sobol::to_float(
-          sobol::scramble(sobol::sample(index, axis), mix64(h + 1 + static_cast<std::uint64_t>(axis))));
-    }
-  };
-  constexpr Point zsobol_point(std::uint32_t slot) const {
-    const std::uint64_t h = mix64(sobol_key_ ^ (static_cast<std::uint64_t>(slot) * sobol::kSlotStep));
-    return {sobol::permute_digits(index_, index_bits_, h), h};
-  }
   std::uint64_t key_;
   std::uint64_t index_ = 0;       // zsobol: morton(x, y) << log2_spp | sample mod 2^log2_spp
   std::uint64_t sobol_key_ = 0;   // zsobol: a hash of the seed and the sample's replicate

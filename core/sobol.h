@@ -10,6 +10,10 @@
 // first binary digit after the point.
 #pragma once
 
+#include "core/simd/lane1.h"
+
+#include <hwy/base.h>  // HWY_INLINE, for core/simd/sobol-generic.h
+
 #include <array>
 #include <cstdint>
 
@@ -27,21 +31,6 @@ inline constexpr std::uint32_t kScrambleEven0 = 0x6b43a9b6u;  // scramble: the x
 inline constexpr std::uint32_t kScrambleEven1 = 0x9e3779b8u;
 inline constexpr std::uint64_t kSlotStep = 0xd1b54a32d192ed03ull;  // SampleStream: a slot's point hash
 
-// splitmix64's finaliser (core/rng.h's mix64 is this one).
-constexpr std::uint64_t mix(std::uint64_t z) {
-  z = (z ^ (z >> 30)) * kMixMul0;
-  z = (z ^ (z >> 27)) * kMixMul1;
-  return z ^ (z >> 31);
-}
-
-constexpr std::uint32_t reverse_bits(std::uint32_t v) {
-  v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
-  v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
-  v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
-  v = ((v >> 8) & 0x00ff00ffu) | ((v & 0x00ff00ffu) << 8);
-  return (v >> 16) | (v << 16);
-}
-
 // Point `index` of Sobol's sequence in dimension 0 or 1, unscrambled, from
 // its generator matrix (column j the image of index bit j; index bits from 32
 // on only reach digits past the 32nd, which a 32-bit value drops).
@@ -58,12 +47,7 @@ constexpr std::uint32_t reverse_bits(std::uint32_t v) {
 // Butterfly b (shift 2^b) updates the positions i whose bit b is clear.
 inline constexpr std::array<std::uint32_t, 5> kSupersetMasks = {0x55555555u, 0x33333333u, 0x0f0f0f0fu, 0x00ff00ffu,
                                                                 0x0000ffffu};
-constexpr std::uint32_t sample(std::uint64_t index, int dim) {
-  auto f = static_cast<std::uint32_t>(index);
-  if (dim == 0) return reverse_bits(f);
-  for (unsigned b = 0; b < 5; ++b) f ^= (f >> (1u << b)) & kSupersetMasks[b];
-  return reverse_bits(f);
-}
+constexpr std::uint32_t sample(std::uint64_t index, int dim);
 
 // A nested scrambling of v seeded by `seed`: digit k of the result is digit
 // k of v flipped or not by a function of `seed` and v's digits before k, so
@@ -76,23 +60,7 @@ constexpr std::uint32_t sample(std::uint64_t index, int dim) {
 // this is a chain of our own: two rounds of add, odd multiply, xor-multiply,
 // with four 32-bit keys drawn from the seed). The first add's key is
 // independent of the rest, so each value is scrambled to a uniform one.
-constexpr std::uint32_t scramble(std::uint32_t v, std::uint64_t seed) {
-  const std::uint64_t more = mix(seed ^ kScrambleSalt);
-  const auto k0 = static_cast<std::uint32_t>(seed), k1 = static_cast<std::uint32_t>(seed >> 32);
-  const auto k2 = static_cast<std::uint32_t>(more), k3 = static_cast<std::uint32_t>(more >> 32);
-  v = reverse_bits(v);
-  v += k0;
-  v *= k1 | 1u;
-  v ^= v * kScrambleEven0;
-  v += k2;
-  v *= k3 | 1u;
-  v ^= v * kScrambleEven1;
-  return reverse_bits(v);
-}
-
-// The 32-bit fixed-point value as a float in [0, 1): its top 24 bits, as
-// to_unit_float (core/rng.h) takes the hash's.
-constexpr float to_float(std::uint32_t v) { return static_cast<float>(v >> 8) * 0x1p-24f; }
+constexpr std::uint32_t scramble(std::uint32_t v, std::uint64_t seed);
 
 // x in the even bits, y in the odd bits: pixels close on the screen get
 // close indices, and each aligned 2^k x 2^k block of pixels is an aligned
@@ -132,22 +100,74 @@ inline constexpr std::array<std::uint8_t, 24> kPermutations4 = [] {
 // that share all bits from k up, k even, or k odd when `bits` is odd) maps
 // onto an aligned run of the same length, so the points of a run of a
 // (0, 2)-sequence stay a (0, k, 2)-net.
-constexpr std::uint64_t permute_digits(std::uint64_t index, unsigned bits, std::uint64_t seed) {
-  const unsigned lone = bits & 1u;
-  std::uint64_t out = index & ~((bits >= 64 ? 0ull : (1ull << bits)) - 1ull);
-  for (unsigned p = bits - 2; p + 2 > lone && p < 64; p -= 2) {  // digit in bits [p, p + 1]
-    const std::uint64_t higher = index >> (p + 2);
-    const auto digit = static_cast<unsigned>((index >> p) & 3u);
-    const std::uint64_t h = mix((seed + (static_cast<std::uint64_t>(p) + 1) * kDigitStep) ^ higher);
-    const unsigned perm = kPermutations4[static_cast<std::size_t>((h >> 32) % 24)];
-    out |= static_cast<std::uint64_t>((perm >> (2 * digit)) & 3u) << p;
-    if (p < 2) break;
-  }
-  if (lone) {
-    const std::uint64_t h = mix(seed ^ kLoneBitSalt ^ (index >> 1));
-    out |= (index ^ (h >> 63)) & 1u;
-  }
+constexpr std::uint64_t permute_digits(std::uint64_t index, unsigned bits, std::uint64_t seed);
+
+// kPermutations4 packed eight to a 64-bit word (entry i in byte i % 8 of
+// word i / 8), as permute_digits reads it.
+inline constexpr std::array<std::uint64_t, 3> kPermutations4Packed = [] {
+  std::array<std::uint64_t, 3> out{};
+  for (std::size_t i = 0; i < 24; ++i) out[i / 8] |= std::uint64_t{kPermutations4[i]} << (8 * (i % 8));
   return out;
+}();
+
+}  // namespace pathlab::sobol
+
+namespace pathlab::lane1 {
+// core/simd/lanes-inl.h's permutation_image at width 1: the image of
+// `digit` under permutation (h >> 32) % 24 of the four, by indexing the
+// table (the lanes read it packed, by selects; the same entry).
+constexpr U64 permutation_image(One<std::uint64_t>, U64 h, U64 digit) {
+  return {(std::uint64_t{sobol::kPermutations4[(h.raw >> 32) % 24]} >> (2 * digit.raw)) & 3u};
 }
+}  // namespace pathlab::lane1
+
+namespace pathlab::sobol {
+
+// The bodies, written once for every width (core/simd/sobol-generic.h),
+// here over lane1's one plain uint64; the wavefront's lanes compile the
+// same text over Highway's vectors (core/simd/sobol-inl.h).
+namespace width1 {
+#include "core/simd/sobol-generic.h"
+}  // namespace width1
+
+namespace detail {
+inline constexpr lane1::One<std::uint64_t> kLane{};
+constexpr lane1::U64 lane(std::uint64_t v) { return {v}; }
+}  // namespace detail
+
+// splitmix64's finaliser (core/rng.h's mix64 is this one).
+constexpr std::uint64_t mix(std::uint64_t z) { return width1::mix64(detail::kLane, detail::lane(z)).raw; }
+
+constexpr std::uint32_t reverse_bits(std::uint32_t v) {
+  return static_cast<std::uint32_t>(width1::reverse_bits32(detail::kLane, detail::lane(v)).raw);
+}
+
+constexpr std::uint32_t sample(std::uint64_t index, int dim) {
+  return static_cast<std::uint32_t>(width1::sobol_sample(detail::kLane, detail::lane(index), dim).raw);
+}
+
+constexpr std::uint32_t scramble(std::uint32_t v, std::uint64_t seed) {
+  return static_cast<std::uint32_t>(width1::scramble(detail::kLane, detail::lane(v), detail::lane(seed)).raw);
+}
+
+constexpr std::uint64_t permute_digits(std::uint64_t index, unsigned bits, std::uint64_t seed) {
+  return width1::permute_digits(detail::kLane, detail::lane(index), bits, detail::lane(seed)).raw;
+}
+
+// The top 24 bits of point `slot` of a zsobol stream (index, key, bits: its
+// SamplerSetup::zsobol_index, zsobol_key, zsobol_bits) in Sobol' dimension
+// `axis`, scrambled; with `second` not null, dimension 1's too (one permuted
+// index for the pair). SampleStream::get draws it, the lanes the same.
+constexpr std::uint32_t zsobol_top24(std::uint64_t index, std::uint64_t key, unsigned bits, std::uint32_t slot,
+                                     int axis, std::uint32_t* second) {
+  lane1::U64 other{};
+  const lane1::U64 top = width1::zsobol_top24(detail::kLane, detail::lane(index), detail::lane(key), bits,
+                                              detail::lane(slot), axis, second ? &other : nullptr);
+  if (second) *second = static_cast<std::uint32_t>(other.raw);
+  return static_cast<std::uint32_t>(top.raw);
+}
+// A 32-bit fixed-point value's top 24 bits (zsobol_top24's) as a float in
+// [0, 1), as to_unit_float (core/rng.h) takes the hash's.
+constexpr float top24_to_float(std::uint32_t top) { return static_cast<float>(top) * 0x1p-24f; }
 
 }  // namespace pathlab::sobol

@@ -23,6 +23,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 namespace pathlab {
 
@@ -51,24 +52,25 @@ struct M {
   bool raw;
 };
 
+// x converted to the lane's type, as Highway's Set does (Set(d64, 3)).
 template <typename T>
-inline V<T> Set(One<T>, T x) {
+constexpr V<T> Set(One<T>, std::type_identity_t<T> x) {
   return {x};
 }
 // Generic code written for float lanes (normalize's Set(d, 1.0f)) at a
 // double lane: the constant widened, as Highway's Set does.
 inline V<double> Set(One<double>, double x) { return {x}; }
 template <typename T>
-inline V<T> Zero(One<T>) {
+constexpr V<T> Zero(One<T>) {
   return {T(0)};
 }
 
 template <typename T>
-inline V<T> operator+(V<T> a, V<T> b) {
+constexpr V<T> operator+(V<T> a, V<T> b) {
   return {static_cast<T>(a.raw + b.raw)};
 }
 template <typename T>
-inline V<T> operator-(V<T> a, V<T> b) {
+constexpr V<T> operator-(V<T> a, V<T> b) {
   return {static_cast<T>(a.raw - b.raw)};
 }
 template <typename T>
@@ -92,7 +94,7 @@ inline M operator>=(V<T> a, V<T> b) {
   return {a.raw >= b.raw};
 }
 template <typename T>
-inline M operator<(V<T> a, V<T> b) {
+constexpr M operator<(V<T> a, V<T> b) {
   return {a.raw < b.raw};
 }
 template <typename T>
@@ -101,7 +103,7 @@ inline M operator<=(V<T> a, V<T> b) {
 }
 
 template <typename T>
-inline V<T> IfThenElse(M m, V<T> yes, V<T> no) {
+constexpr V<T> IfThenElse(M m, V<T> yes, V<T> no) {
   return m.raw ? yes : no;
 }
 template <typename T>
@@ -168,6 +170,28 @@ inline V<float> SplitExponent(One<float>, V<float> x, V<float>& e) {
   e.raw = static_cast<float>(n - 1);
   return {m * 2.0f};
 }
+
+// 64-bit integer lanes (core/simd/sobol-generic.h: the samplers' hashes),
+// modulo 2^64 as Highway's are.
+using U64 = V<std::uint64_t>;
+constexpr U64 And(U64 a, U64 b) { return {a.raw & b.raw}; }
+constexpr U64 Or(U64 a, U64 b) { return {a.raw | b.raw}; }
+constexpr U64 Xor(U64 a, U64 b) { return {a.raw ^ b.raw}; }
+template <int kBits>
+constexpr U64 ShiftRight(U64 a) {
+  return {a.raw >> kBits};
+}
+template <int kBits>
+constexpr U64 ShiftLeft(U64 a) {
+  return {a.raw << kBits};
+}
+constexpr U64 ShiftRightSame(U64 a, int bits) { return {a.raw >> bits}; }
+constexpr U64 ShiftLeftSame(U64 a, int bits) { return {a.raw << bits}; }
+// The two products core/simd/lanes-inl.h builds for Highway's lanes: the
+// 64-bit product of the low 32 bits of a and b, and z * c modulo 2^64.
+constexpr U64 mul_wide32(One<std::uint64_t>, U64 a, U64 b) { return {(a.raw & 0xffffffffu) * (b.raw & 0xffffffffu)}; }
+constexpr U64 mul64(One<std::uint64_t>, U64 z, std::uint64_t c) { return {z.raw * c}; }
+// (The third, permutation_image, is in core/sobol.h, beside its table.)
 
 }  // namespace lane1
 }  // namespace pathlab
