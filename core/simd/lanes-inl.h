@@ -409,6 +409,20 @@ HWY_INLINE void scattered_cone(D d, V width, V spread, V t, M impulse, V pdf, V&
   out_spread = IfThenElse(impulse, spread, Max(Min(pi, lobe), spread));
 }
 
+// The shading frame about the unit normal ns whose s lies along `perp`
+// (perpendicular to ns, of length `length`) where `usable`, with
+// t = handed ns x s; Frame(ns) elsewhere. The tail of tangent_frame and
+// normal_map_frame, which differ in what they call usable.
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE void frame_along(D d, const Vec3<V>& ns, const Vec3<V>& perp, V length, M usable, V handed, Vec3<V>& fs,
+                            Vec3<V>& ft) {
+  const Vec3<V> s = perp / IfThenElse(usable, length, Set(d, 1.0f));
+  Vec3<V> ds, dt;
+  frame(d, ns, ds, dt);
+  fs = select(usable, s, ds);
+  ft = select(usable, handed * cross(ns, s), dt);
+}
+
 // mesh_tangent_frame (core/tangents.cpp): the shading frame of a mesh with
 // tangents at a hit. `sum` is the vertices' tangents (xyz; handedness w)
 // blended by the barycentrics (blend_normals' order), placed by the linear
@@ -430,11 +444,7 @@ HWY_INLINE void tangent_frame(D d, const Vec3<V>& sum, V w, const Vec3<V>& c0, c
   V handed = IfThenElse(w < Zero(d), Neg(one), one);
   handed = IfThenElse(mirrors, Neg(handed), handed);
   handed = IfThenElse(dot(ns, n_mesh) < Zero(d), Neg(handed), handed);
-  const Vec3<V> tangent = s / IfThenElse(usable, length, one);
-  Vec3<V> ds, dt;
-  frame(d, ns, ds, dt);
-  fs = select(usable, tangent, ds);
-  ft = select(usable, handed * cross(ns, tangent), dt);
+  frame_along(d, ns, s, length, usable, handed, fs, ft);
 }
 
 // A normal map's tilt of the shading frame (fs, ft, fn) at a hit with
@@ -458,11 +468,8 @@ HWY_INLINE auto normal_map_frame(D d, const Vec3<V>& c, V scale, const Vec3<V>& 
   const Vec3<V> t = fs - dot(fs, ns) * ns;
   const V tl = Sqrt(dot(t, t));
   const V handed = IfThenElse(dot(cross(fn, fs), ft) < Zero(d), Neg(one), one);
-  const auto along = tl > Set(d, 1e-4f);
-  const Vec3<V> ts = t / IfThenElse(along, tl, one);
-  Vec3<V> ds, dt;
-  frame(d, ns, ds, dt);
-  const Vec3<V> new_s = select(along, ts, ds), new_t = select(along, handed * cross(ns, ts), dt);
+  Vec3<V> new_s, new_t;
+  frame_along(d, ns, t, tl, tl > Set(d, 1e-4f), handed, new_s, new_t);
   fs = select(tilt, new_s, fs);
   ft = select(tilt, new_t, ft);
   fn = select(tilt, ns, fn);
