@@ -19,11 +19,13 @@ namespace pathlab {
 // this; the scene loader keeps every position within kMaxSceneCoordinate
 // (core/geometry.h), so only a ray already poisoned by NaN can.
 inline constexpr float kEmbreeLargest = 1.844e18f;
-// Written with & rather than &&: no branch per component, so that a loop
-// over arrays of rays (EmbreeAccel's check of a whole batch) vectorises.
+// Written with & on 0/1 integers rather than &&: no branch per component,
+// so that a loop over arrays of rays (EmbreeAccel's check of a whole batch)
+// vectorises.
 inline bool embree_accepts(const vec3& origin, const vec3& dir, float tmax) {
-  const auto ok = [](float v) { return std::abs(v) <= kEmbreeLargest; };
-  return ok(origin.x) & ok(origin.y) & ok(origin.z) & ok(dir.x) & ok(dir.y) & ok(dir.z) & !std::isnan(tmax);
+  const auto ok = [](float v) { return static_cast<unsigned>(std::abs(v) <= kEmbreeLargest); };
+  return (ok(origin.x) & ok(origin.y) & ok(origin.z) & ok(dir.x) & ok(dir.y) & ok(dir.z) &
+          static_cast<unsigned>(!std::isnan(tmax))) != 0u;
 }
 inline bool embree_accepts(const Ray& ray) { return embree_accepts(ray.origin, ray.dir, ray.tmax); }
 
