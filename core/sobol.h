@@ -103,7 +103,8 @@ inline constexpr std::array<std::uint8_t, 24> kPermutations4 = [] {
 constexpr std::uint64_t permute_digits(std::uint64_t index, unsigned bits, std::uint64_t seed);
 
 // kPermutations4 packed eight to a 64-bit word (entry i in byte i % 8 of
-// word i / 8), as permute_digits reads it.
+// word i / 8), as the lanes' permute_digits reads it (permutation_image,
+// core/simd/lanes-inl.h).
 inline constexpr std::array<std::uint64_t, 3> kPermutations4Packed = [] {
   std::array<std::uint64_t, 3> out{};
   for (std::size_t i = 0; i < 24; ++i) out[i / 8] |= std::uint64_t{kPermutations4[i]} << (8 * (i % 8));
