@@ -41,9 +41,9 @@ inline constexpr std::uint64_t kSlotStep = 0xd1b54a32d192ed03ull;  // SampleStre
 // subset of the bits of j (Lucas). So digit i + 1 of the point is the parity
 // of the index's set bits j that contain i, a sum over supersets which five
 // butterflies compute for every i at once (f[i] ^= f[i + 2^b] where bit b of
-// i is clear), before the reversal into digit order. core/simd/sobol-inl.h
-// computes the same in lanes; tests/test_sobol.cpp checks it against the
-// binomials.
+// i is clear), before the reversal into digit order. The body is
+// core/simd/sobol-generic.h's sobol_sample, which the lanes run too;
+// tests/test_sobol.cpp checks it against the binomials.
 // Butterfly b (shift 2^b) updates the positions i whose bit b is clear.
 inline constexpr std::array<std::uint32_t, 5> kSupersetMasks = {0x55555555u, 0x33333333u, 0x0f0f0f0fu, 0x00ff00ffu,
                                                                 0x0000ffffu};
@@ -138,10 +138,6 @@ constexpr lane1::U64 lane(std::uint64_t v) { return {v}; }
 
 // splitmix64's finaliser (core/rng.h's mix64 is this one).
 constexpr std::uint64_t mix(std::uint64_t z) { return width1::mix64(detail::kLane, detail::lane(z)).raw; }
-
-constexpr std::uint32_t reverse_bits(std::uint32_t v) {
-  return static_cast<std::uint32_t>(width1::reverse_bits32(detail::kLane, detail::lane(v)).raw);
-}
 
 constexpr std::uint32_t sample(std::uint64_t index, int dim) {
   return static_cast<std::uint32_t>(width1::sobol_sample(detail::kLane, detail::lane(index), dim).raw);

@@ -61,7 +61,7 @@ constexpr V<T> Set(One<T>, std::type_identity_t<T> x) {
 // double lane: the constant widened, as Highway's Set does.
 inline V<double> Set(One<double>, double x) { return {x}; }
 template <typename T>
-constexpr V<T> Zero(One<T>) {
+inline V<T> Zero(One<T>) {
   return {T(0)};
 }
 
@@ -94,7 +94,7 @@ inline M operator>=(V<T> a, V<T> b) {
   return {a.raw >= b.raw};
 }
 template <typename T>
-constexpr M operator<(V<T> a, V<T> b) {
+inline M operator<(V<T> a, V<T> b) {
   return {a.raw < b.raw};
 }
 template <typename T>
@@ -103,7 +103,7 @@ inline M operator<=(V<T> a, V<T> b) {
 }
 
 template <typename T>
-constexpr V<T> IfThenElse(M m, V<T> yes, V<T> no) {
+inline V<T> IfThenElse(M m, V<T> yes, V<T> no) {
   return m.raw ? yes : no;
 }
 template <typename T>

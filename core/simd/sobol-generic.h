@@ -15,7 +15,8 @@
 // Set, And, Or, Xor, ShiftRight<k>, ShiftLeft<k>, ShiftRightSame,
 // ShiftLeftSame, +, -, and three primitives whose best form differs by
 // width: the products mul_wide32 and mul64, and permutation_image (Highway's
-// in core/simd/lanes-inl.h, lane1's in core/simd/lane1.h, each pair held to
+// in core/simd/lanes-inl.h; lane1's products in core/simd/lane1.h and its
+// permutation_image in core/sobol.h, beside the table; each pair held to
 // one result: integer arithmetic, exact both ways).
 
 // sobol::mix (core/rng.h's mix64): the splitmix64 finaliser.
@@ -50,7 +51,7 @@ constexpr HWY_INLINE V64 permute_digits(D64 d64, V64 index, unsigned bits, V64 s
   return out;
 }
 
-// sobol::reverse_bits of the low 32 bits of each lane (the high 32 are 0).
+// The low 32 bits of each lane (the high 32 are 0) in reverse order.
 template <class D64, class V64 = VecOf<D64>>
 constexpr HWY_INLINE V64 reverse_bits32(D64 d64, V64 v) {
   const auto swap = [d64](V64 x, int shift, std::uint64_t mask) {
