@@ -226,13 +226,11 @@ void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayH
   if (shape.kind == Shape::Kind::Sphere) {
     // pbrt's (phi, theta) parametrisation about the z axis, in the shape's
     // own space: u = phi / 2 pi, v = 1 - theta / pi (v = 1 at +z).
-    const vec3 p_local = hit.instance == kNoInstance ? s->p : vec3(placements_[hit.instance].to_local * vec4(s->p, 1.0f));
+    const vec3 p_local = hit.instance == kNoInstance ? s->p : affine_point(placements_[hit.instance].to_local, s->p);
     const vec3 d = (p_local - shape.center) / shape.radius;
-    s->uv = sphere_uv(d);
-    const float theta = (1.0f - s->uv.y) * kPi;
-    // dA = r^2 sin(theta) dtheta dphi = 2 pi^2 r^2 sin(theta) du dv.
-    const float sin_theta = std::max(std::sin(theta), 1e-4f);
-    uv_per_area = 1.0f / (2.0f * kPi * kPi * shape.radius * shape.radius * sin_theta);
+    float sin_theta;
+    s->uv = sphere_uv(d, &sin_theta);
+    uv_per_area = generic::sphere_uv_per_area(kScalar, F{shape.radius}, F{sin_theta}).raw;
   } else {
     const Triangle& t = triangles_[first_triangle_[hit.shape] + hit.prim];
     vec3 e1 = t.p1 - t.p0, e2 = t.p2 - t.p0;

@@ -1,6 +1,7 @@
 #include "core/texture.h"
 
 #include "core/error.h"
+#include "core/simd/width1.h"
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -13,6 +14,14 @@
 #include <unistd.h>
 
 namespace pathlab {
+
+vec2 sphere_uv(const vec3& d, float* sin_theta) {
+  using namespace width1;
+  F u, v, s;
+  generic::sphere_uv(kScalar, lanes(d), u, v, s);
+  if (sin_theta != nullptr) *sin_theta = s.raw;
+  return vec2(u.raw, v.raw);
+}
 
 const char* texture_wrap_name(TextureWrap wrap) {
   switch (wrap) {

@@ -97,13 +97,10 @@ struct TextureFootprint {
 
 // A sphere's texture coordinates at the unit direction `d` from its centre
 // (in its own space): pbrt's (phi, theta) about the z axis, u = phi / 2 pi
-// in [0, 1), v = 1 - theta / pi (1 at +z).
-inline vec2 sphere_uv(const vec3& d) {
-  float phi = std::atan2(d.y, d.x);
-  if (phi < 0.0f) phi += 2.0f * kPi;
-  const float theta = std::acos(std::clamp(d.z, -1.0f, 1.0f));
-  return vec2(phi / (2.0f * kPi), 1.0f - theta / kPi);
-}
+// in [0, 1), v = 1 - theta / pi (1 at +z); and sin theta, if asked (the
+// generic sphere_uv of core/simd/environment-inl.h, which the wavefront's
+// lanes run too).
+vec2 sphere_uv(const vec3& d, float* sin_theta = nullptr);
 
 class Textures {
  public:

@@ -294,15 +294,16 @@ inline Scene cornell_with_textures(bool textured_impulses = false) {
   return parse_scene(impulses, d / "textured-impulses-cornell.json");
 }
 
-// Textured meshes of every kind whose hits the wavefront's lanes resolve
+// Textured shapes of every kind whose hits the wavefront's lanes resolve
 // themselves (ShapeField kTexturedHits), core reading only the texels: a tent without texture coordinates (the
 // barycentrics are), a smooth octahedron with vertex normals and its own
-// coordinates in world space, and the same octahedron in a group placed
-// by instance_placements() (turned, mirrored with a non-uniform scale,
-// sheared), in Lambert and Disney materials under a textured light and an
+// coordinates in world space, and the same octahedron and a normal-mapped
+// sphere in a group placed twice (turned; mirrored with a non-uniform
+// scale), in Lambert and Disney materials under a textured light and an
 // environment (so that paths a shading normal sends below a surface still
 // carry light); normal maps on the floor (a flat rectangle), the red wall
-// and the world-space octahedron (vertex normals).
+// and the world-space octahedron (vertex normals); and a glowing sphere
+// that scatters and emits, both by textures.
 inline Scene cornell_with_textured_meshes() {
   const std::filesystem::path& d = textured_scene_dir();
   if (!std::filesystem::exists(d / "gem.obj")) {
@@ -324,6 +325,8 @@ inline Scene cornell_with_textured_meshes() {
     "disney": {"type": "disney", "base_color": {"texture": "noise.png"}, "roughness": {"texture": "data.png", "channel": 1},
                "metallic": {"texture": "data.png", "channel": 2}, "sheen": {"texture": "data.png", "channel": 0}},
     "bumps": {"type": "diffuse", "albedo": [0.6, 0.6, 0.5], "normal_map": {"texture": "normals.exr", "scale": 0.9}},
+    "glow": {"type": "diffuse", "albedo": {"texture": "noise.png", "scale": 0.6},
+             "emission": {"texture": "light.exr", "scale": [1.5, 0.8, 0.3], "colorspace": "linear"}},
     "light": {"type": "emissive", "radiance": {"texture": "light.exr", "scale": [17, 12, 4], "colorspace": "linear"}}
   },
   "shapes": [
@@ -332,10 +335,12 @@ inline Scene cornell_with_textured_meshes() {
     {"type": "rectangle", "material": "red", "transform": [{"rotate": {"axis": [0, 1, 0], "angle": 90}}, {"translate": [-1, 0, 0]}]},
     {"type": "mesh", "file": "tent.obj", "material": "disney"},
     {"type": "mesh", "file": "gem.obj", "material": "red", "transform": [{"scale": 0.3}, {"translate": [0.5, 0.4, 0.0]}]},
+    {"type": "sphere", "material": "glow", "center": [0.55, -0.75, 0.45], "radius": 0.2},
     {"type": "rectangle", "material": "light", "transform": [{"scale": [0.25, 0.2, 1]}, {"rotate": {"axis": [1, 0, 0], "angle": 90}}, {"translate": [0, 0.998, 0]}]}
   ],
   "lights": [{"type": "environment", "radiance": [0.3, 0.35, 0.4]}],
-  "groups": {"gems": [{"type": "mesh", "file": "gem.obj", "material": "disney"}]},
+  "groups": {"gems": [{"type": "mesh", "file": "gem.obj", "material": "disney"},
+                      {"type": "sphere", "material": "red", "center": [0, 2.2, 0], "radius": 0.9}]},
   "instances": [
     {"group": "gems", "transform": [{"scale": 0.22}, {"rotate": {"axis": [0.3, 1, 0.2], "angle": 34}}, {"translate": [-0.45, -0.7, 0.35]}]},
     {"group": "gems", "transform": [{"scale": [-0.3, 0.18, 0.24]}, {"translate": [0.45, -0.55, -0.25]}]}

@@ -22,6 +22,7 @@
 #include <cstring>
 #include <random>
 #include <sstream>
+#include <tuple>
 
 namespace pathlab {
 namespace {
@@ -197,6 +198,63 @@ TEST(RayCone, CameraSpreadIsOnePixelsAngle) {
     EXPECT_EQ(p.width, 0.0f);
     EXPECT_EQ(p.spread, 0.0f);
   }
+}
+
+// A sphere's texture coordinates (pbrt's phi and theta about z) against
+// closed forms: the axes and the quarter turns exactly, u in [0, 1) across
+// the seam (just below the +x axis it is just below 1, never 1 itself), v
+// by theta near the poles, where acos(z) would round (z = 1 - 1e-8 is 1 in
+// float, theta 1e-4 is not 0), and on random directions within a few ulp of
+// libm's double atan2; sin theta too (the footprint's).
+TEST(SphereUv, ClosedFormsAtAxesSeamAndPoles) {
+  const auto at = [](vec3 d) {
+    float sin_theta = -1.0f;
+    const vec2 uv = sphere_uv(d, &sin_theta);
+    return std::tuple{uv.x, uv.y, sin_theta};
+  };
+  const struct {
+    vec3 d;
+    float u, v;
+  } axes[] = {{{1, 0, 0}, 0.0f, 0.5f},  {{0, 1, 0}, 0.25f, 0.5f}, {{-1, 0, 0}, 0.5f, 0.5f},
+              {{0, -1, 0}, 0.75f, 0.5f}, {{0, 0, 1}, 0.0f, 1.0f},  {{0, 0, -1}, 0.0f, 0.0f}};
+  for (const auto& a : axes) {
+    const auto [u, v, sin_theta] = at(a.d);
+    const std::string where = "at (" + std::to_string(a.d.x) + ", " + std::to_string(a.d.y) + ", " + std::to_string(a.d.z) + ")";
+    EXPECT_FLOAT_EQ(u, a.u) << where;
+    EXPECT_FLOAT_EQ(v, a.v) << where;
+    EXPECT_FLOAT_EQ(sin_theta, std::abs(a.d.z) == 1.0f ? 0.0f : 1.0f) << where;
+  }
+  // The seam: just below +x, u is just below 1 (or 0 once it rounds to 1).
+  const auto [u_seam, v_seam, s_seam] = at(vec3(1.0f, -1e-6f, 0.0f));
+  EXPECT_LT(u_seam, 1.0f);
+  EXPECT_GT(u_seam, 0.999999f);
+  EXPECT_EQ(std::get<0>(at(vec3(1.0f, -1e-30f, 0.0f))), 0.0f);  // phi = -1e-30 rounds to a full turn
+  // Near the pole: theta = 1e-4 gives v = 1 - 1e-4 / pi.
+  const float th = 1e-4f;
+  const auto [u_pole, v_pole, s_pole] = at(vec3(std::sin(th), 0.0f, std::cos(th)));
+  EXPECT_NEAR(v_pole, 1.0 - 1e-4 / kPi, 1e-7);
+  EXPECT_NEAR(s_pole, std::sin(th), 1e-10);
+  EXPECT_LT(v_pole, 1.0f) << "theta by acos(z) in float would be 0 here";
+  std::mt19937 gen(11);
+  std::normal_distribution<float> normal;
+  double worst_u = 0.0, worst_v = 0.0;
+  for (int i = 0; i < 100000; ++i) {
+    const vec3 d = glm::normalize(vec3(normal(gen), normal(gen), normal(gen)));
+    const auto [u, v, sin_theta] = at(d);
+    double phi = std::atan2(double(d.y), double(d.x));
+    if (phi < 0.0) phi += 2.0 * 3.14159265358979323846;
+    const double u_true = phi / (2.0 * 3.14159265358979323846);
+    // theta of d as it is (a float-normalised d is 1 +- 1e-7 long, which acos(z) would read as an angle).
+    const double v_true = 1.0 - std::atan2(std::hypot(double(d.x), double(d.y)), double(d.z)) / 3.14159265358979323846;
+    ASSERT_GE(u, 0.0f);
+    ASSERT_LT(u, 1.0f);
+    if (u_true < 1.0 - 1e-6) worst_u = std::max(worst_u, std::abs(u - u_true));
+    worst_v = std::max(worst_v, std::abs(v - v_true));
+    ASSERT_NEAR(sin_theta, std::sqrt(double(d.x) * d.x + double(d.y) * d.y), 2e-7);
+  }
+  // A few ulp of numbers below 1 (float's ulp at 0.5..1 is 6e-8).
+  EXPECT_LT(worst_u, 4e-7);
+  EXPECT_LT(worst_v, 4e-7);
 }
 
 // The footprint resolve() passes to OIIO at a camera ray's hit is the

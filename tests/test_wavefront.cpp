@@ -961,7 +961,8 @@ INSTANTIATE_TEST_SUITE_P(Scenes, VectorStages, testing::ValuesIn(vector_cases())
 // What the stages leave to core, path by path, as `pathlab render` names
 // it: no light sample under solid-angle sampling, nor with an emitter placed
 // by an instance beside delta lights and the sky; of a textured emitter's
-// light samples, only the texel.
+// light samples, only the texel; of hits on every textured shape (spheres
+// and emitters among them), only the texels.
 TEST(Wavefront, StagesNameWhatCoreDoesPathByPath) {
   const auto describe = [](Scene scene) {
     const RenderSettings settings = scene.render;
@@ -977,6 +978,9 @@ TEST(Wavefront, StagesNameWhatCoreDoesPathByPath) {
   const std::string textured = describe(test::cornell_with_textures());
   EXPECT_NE(textured.find("the emission textures' reads at light samples"), std::string::npos) << textured;
   EXPECT_EQ(textured.find("the light samples ("), std::string::npos) << textured;
+  EXPECT_EQ(textured.find("the texture reads"), std::string::npos) << textured;
+  EXPECT_NE(textured.find("the texels at hits on 'floor', 'walls', 'red', 'mirror', 'disney', 'ball' and 'light' ("), std::string::npos)
+      << textured;
 }
 
 // Every kind of scene runs the vectorised stages at a vector SIMD target

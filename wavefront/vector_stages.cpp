@@ -88,8 +88,6 @@ void general_texels(const Scene& scene, const Wave& wave, std::size_t i);
 // triangle at barycentrics b1, b2) of light entry `light` carries, for an
 // emitter whose emission is a texture.
 void general_light_emission(const Scene& scene, std::int32_t light, float b1, float b2, const float p[3], float Le[3]);
-// Surfel::emitted towards the path's wo, for a kTexturedEmission shape's hit.
-void general_emitted(const Scene& scene, const Wave& wave, std::size_t i, float Le[3]);
 }  // namespace pathlab::vector_stages
 #endif
 
@@ -164,6 +162,8 @@ using pathlab::HWY_NAMESPACE::solid_angle_triangle_point;
 using pathlab::HWY_NAMESPACE::sphere_cone;
 using pathlab::HWY_NAMESPACE::sphere_cone_density;
 using pathlab::HWY_NAMESPACE::sphere_point;
+using pathlab::HWY_NAMESPACE::sphere_uv;
+using pathlab::HWY_NAMESPACE::sphere_uv_per_area;
 using pathlab::HWY_NAMESPACE::sun_direction;
 using pathlab::HWY_NAMESPACE::splat3;
 using pathlab::HWY_NAMESPACE::tangent_frame;
@@ -741,37 +741,60 @@ void resolve(const Scene& sc, const Wave& w) {
       if (!hn::AllFalse(df, textured)) {
         // CompiledScene::shading_frame's Frame(n) where no vertex normals made one.
         if (const M flat = hn::AndNot(here, textured); !hn::AllFalse(df, flat)) store_normal_frame(flat);
-        // CompiledScene::read_textures' footprint: the texture coordinates (Mesh::uv_at: the vertices' blended
-        // by the barycentrics, as blend_normals blends normals; or the barycentrics) and the width of the ray
-        // cone there in uv (footprint_width), from the triangle's edges (placed by its instance) and uv edges.
-        const VI tri = shape_int(textured, sc, shape, kFirstTriangle) + load(w, kPrim, i0, textured);
-        const V3 p0 = gather3(textured, sc.triangles, tri, 12, 0);
-        V3 e1 = gather3(textured, sc.triangles, tri, 12, 3) - p0, e2 = gather3(textured, sc.triangles, tri, 12, 6) - p0;
-        if (const M on = hn::And(textured, placed); !hn::AllFalse(df, on)) {
-          const V3 c0 = placement(on, kToWorld), c1 = placement(on, kToWorld + 3), c2 = placement(on, kToWorld + 6);
-          e1 = select(on, to_world(c0, c1, c2, e1.x, e1.y, e1.z), e1);
-          e2 = select(on, to_world(c0, c1, c2, e2.x, e2.y, e2.z), e2);
+        // CompiledScene::read_textures' footprint: the texture coordinates and the width of the ray cone there in
+        // uv (footprint_width), from the uv area per world area.
+        VF tex_u = hn::Zero(df), tex_v = hn::Zero(df), uv_per_area = hn::Zero(df);
+        if (const M tmesh = hn::AndNot(sphere, textured); !hn::AllFalse(df, tmesh)) {
+          // A mesh's: Mesh::uv_at (the vertices' blended by the barycentrics, as blend_normals blends normals;
+          // or the barycentrics), from the triangle's edges (placed by its instance) and uv edges.
+          const VI tri = shape_int(tmesh, sc, shape, kFirstTriangle) + load(w, kPrim, i0, tmesh);
+          const V3 p0 = gather3(tmesh, sc.triangles, tri, 12, 0);
+          V3 e1 = gather3(tmesh, sc.triangles, tri, 12, 3) - p0, e2 = gather3(tmesh, sc.triangles, tri, 12, 6) - p0;
+          if (const M on = hn::And(tmesh, placed); !hn::AllFalse(df, on)) {
+            const V3 c0 = placement(on, kToWorld), c1 = placement(on, kToWorld + 3), c2 = placement(on, kToWorld + 6);
+            e1 = select(on, to_world(c0, c1, c2, e1.x, e1.y, e1.z), e1);
+            e2 = select(on, to_world(c0, c1, c2, e2.x, e2.y, e2.z), e2);
+          }
+          const VF b1 = load(w, kHitU, i0, tmesh), b2 = load(w, kHitV, i0, tmesh);
+          V3 uv{b1, b2, hn::Zero(df)}, a = zero3(), b = zero3();
+          const VI uvs_at = shape_int(tmesh, sc, shape, kUvsAt);
+          const M has_uvs = hn::And(tmesh, fmask(hn::Not(uvs_at < hn::Zero(DI()))));
+          if (!hn::AllFalse(df, has_uvs)) {
+            const VI at = uvs_at + load(w, kPrim, i0, has_uvs);
+            V3 t[3];
+            for (int k = 0; k < 3; ++k)
+              t[k] = V3{gather(has_uvs, sc.triangle_uvs, at, 6, 2 * k), gather(has_uvs, sc.triangle_uvs, at, 6, 2 * k + 1),
+                        hn::Zero(df)};
+            uv = select(has_uvs, blend_normals(df, b1, b2, t[0], t[1], t[2]), uv);
+            a = t[1] - t[0];
+            b = t[2] - t[0];
+          }
+          tex_u = uv.x;
+          tex_v = uv.y;
+          uv_per_area = triangle_uv_per_area(df, e1, e2, has_uvs, a.x, a.y, b.x, b.y);
         }
-        const VF b1 = load(w, kHitU, i0, textured), b2 = load(w, kHitV, i0, textured);
-        V3 uv{b1, b2, hn::Zero(df)}, a = zero3(), b = zero3();
-        const VI uvs_at = shape_int(textured, sc, shape, kUvsAt);
-        const M has_uvs = hn::And(textured, fmask(hn::Not(uvs_at < hn::Zero(DI()))));
-        if (!hn::AllFalse(df, has_uvs)) {
-          const VI at = uvs_at + load(w, kPrim, i0, has_uvs);
-          V3 t[3];
-          for (int k = 0; k < 3; ++k)
-            t[k] = V3{gather(has_uvs, sc.triangle_uvs, at, 6, 2 * k), gather(has_uvs, sc.triangle_uvs, at, 6, 2 * k + 1),
-                      hn::Zero(df)};
-          uv = select(has_uvs, blend_normals(df, b1, b2, t[0], t[1], t[2]), uv);
-          a = t[1] - t[0];
-          b = t[2] - t[0];
+        if (const M tsphere = hn::And(sphere, textured); !hn::AllFalse(df, tsphere)) {
+          // A sphere's: sphere_uv of the direction from its centre to the point in its own space (the placed
+          // point taken back by the instance's to_local, as core does), and sphere_uv_per_area.
+          V3 local = p;
+          if (const M on = hn::And(tsphere, placed); !hn::AllFalse(df, on))
+            local = select(on,
+                           affine_point(placement(on, kToLocal), placement(on, kToLocal + 3), placement(on, kToLocal + 6),
+                                        placement(on, kToLocal + 9), p),
+                           p);
+          const VF radius = shape_value(tsphere, sc, shape, kRadius);
+          const V3 dir = local - shape_value3(tsphere, sc, shape, kCenter);
+          VF su, sv, sin_theta;
+          sphere_uv(df, V3{dir.x / radius, dir.y / radius, dir.z / radius}, su, sv, sin_theta);
+          tex_u = hn::IfThenElse(tsphere, su, tex_u);
+          tex_v = hn::IfThenElse(tsphere, sv, tex_v);
+          uv_per_area = hn::IfThenElse(tsphere, sphere_uv_per_area(df, radius, sin_theta), uv_per_area);
         }
-        const VF uv_per_area = triangle_uv_per_area(df, e1, e2, has_uvs, a.x, a.y, b.x, b.y);
         const V3 o = load3(w, kOx, i0, textured), d = load3(w, kDx, i0, textured);
         const VF width = footprint_width(df, load(w, kConeWidth, i0, textured), load(w, kConeSpread, i0, textured),
                                          hn::Sqrt(dot(p - o, p - o)), dot(d, n), uv_per_area);
-        store(w, kTexU, i0, textured, uv.x);
-        store(w, kTexV, i0, textured, uv.y);
+        store(w, kTexU, i0, textured, tex_u);
+        store(w, kTexV, i0, textured, tex_v);
         store(w, kTexWidth, i0, textured, width);
         store_mask(w, kHasParams, i0, textured, shape_flag(textured, sc, shape, kTexturedParams));
         // The texels: OpenImageIO's lookups, by core, path by path, into the slot's SurfaceParams and kMapR...
@@ -789,7 +812,6 @@ void resolve(const Scene& sc, const Wave& w) {
         }
       }
     }
-    if (sc.textured) by_core = hn::Or(by_core, shape_flag(found, sc, shape, kTexturedEmission));
     for_each_lane(by_core, i0, [&](std::size_t i, std::size_t) { general_resolve(sc, w, i); });
   }
 }
@@ -1048,21 +1070,20 @@ void add_emission(const Scene& sc, const Wave& w) {
       const VI shape = load(w, kShape, i0, found);
       const V3 wo = -load3(w, kDx, i0, found);
       const V3 n = load3(w, kNx, i0, found);
-      V3 Le = emitted_towards(df, shape_flag(found, sc, shape, kTwoSided), n, wo,
-                              zero_unless(shape_flag(found, sc, shape, kEmits), shape_value3(found, sc, shape, kEmission)));
+      V3 emission = zero_unless(shape_flag(found, sc, shape, kEmits), shape_value3(found, sc, shape, kEmission));
       if (sc.textured) {
-        // Textured emission: Surfel::emitted, path by path.
+        // A textured emission's radiance at the hit: the texel resolve() read into the slot's SurfaceParams
+        // (evaluate_textured), as Surfel::emitted takes it.
         const M textured = shape_flag(found, sc, shape, kTexturedEmission);
         if (!hn::AllFalse(df, textured)) {
           HWY_ALIGN float radiance[3][kMaxLanes] = {};
           for_each_lane(textured, i0, [&](std::size_t i, std::size_t j) {
-            float e[3];
-            general_emitted(sc, w, i, e);
-            for (int c = 0; c < 3; ++c) radiance[c][j] = e[c];
+            for (int c = 0; c < 3; ++c) radiance[c][j] = w.params[i].emission[c];
           });
-          Le = select(textured, load_lanes(radiance), Le);
+          emission = select(textured, load_lanes(radiance), emission);
         }
       }
+      const V3 Le = emitted_towards(df, shape_flag(found, sc, shape, kTwoSided), n, wo, emission);
       const M lit = hn::AndNot(is_black(df, Le), found);
       // LightSampler::pdf(prev.p, s).
       VF light_pdf;
@@ -2072,11 +2093,6 @@ static Surfel general_surfel(const Scene& sc, const Wave& w, std::size_t i) {
   const pathlab::Scene& scene = sc.compiled->scene();
   s.material = &scene.materials[scene.shapes[s.shape].material];
   return s;
-}
-
-void general_emitted(const Scene& sc, const Wave& w, std::size_t i, float Le[3]) {
-  const Spectrum e = general_surfel(sc, w, i).emitted(-at(w, kDx, i));
-  for (int c = 0; c < 3; ++c) Le[c] = e[c];
 }
 
 void general_eval(const Scene& sc, const Wave& w, std::size_t i, const float wi[3], float f[3], float* pdf) {

@@ -155,9 +155,9 @@ struct Scene {
   bool general = false;
   // Some shape the lanes shade has a shading frame of its own (ShapeField
   // kFramed): made in resolve() from its vertex normals (kNormalsAt) and
-  // tangents (kTangentsAt), tilted by a normal map, or by core
-  // (CompiledScene::resolve) for a textured sphere or emitter; the rest is
-  // the lanes'.
+  // tangents (kTangentsAt) or the geometric normal, tilted by a normal map;
+  // and an emitter that scatters nothing but reads its emission from a
+  // texture (a frame no lane shades in, resolved for that texel).
   bool framed = false;
   // Some shape the lanes shade is a mirror or a dielectric (ShapeField
   // kLaneMaterial): else every lane shaded in the lanes is Lambert's or
@@ -268,7 +268,7 @@ enum ShapeField : int {
   kFlipped = 16,       // 1 if a sphere's normals point inwards
   kOneSided = 17,      // 1 if its material is one-sided (black from behind the geometric normal)
   kGeneral = 18,       // 1 if it is shaded by core's Surfel (not untextured Lambert or Disney, flat mirror or glass)
-  kTexturedEmission = 19,  // 1 if its emission is textured (Surfel::emitted, path by path)
+  kTexturedEmission = 19,  // 1 if its emission is textured (add_emission reads the texel from Wave::params)
   kResolveByCore = 20,     // 1 if kGeneral and its Surfel needs CompiledScene::resolve (a shading frame of its
                            // own, textures); else resolve() makes its Frame(n) in the lanes
   kLaneMaterial = 21,      // what the lanes shade it with (LaneMaterial), unless kGeneral
@@ -291,25 +291,23 @@ enum ShapeField : int {
   kEnergy = 47,            // bits of an int32: its energy tables' first float in Scene::energy, -1 if none
   kFramed = 48,            // 1 if the lanes shade it in a frame of its own (vertex normals, tangents,
                            // textures), which resolve() makes (kNormalsAt, kTangentsAt; Frame(n) for a flat
-                           // kTexturedHits mesh; tilted by a normal map) or CompiledScene::resolve path by
-                           // path (textured spheres and emitters)
-                           // (kFsX..., kShadingNormal)
+                           // kTexturedHits mesh or sphere; tilted by a normal map) (kFsX..., kShadingNormal);
+                           // also 1 for an emitter that scatters nothing but has an emission texture
   kNormalsAt = 49,         // bits of an int32: a kFramed mesh's triangle 0 in Scene::vertex_normals, whose
-                           // vertex normals make its frame in the lanes; -1 if it has none or core makes
-                           // its frame (a textured emitter)
+                           // vertex normals make its frame in the lanes; -1 if it has none
   kTexturedHits = 50,      // 1 if its material reads textures at hits and the lanes resolve the hit (a kFramed
-                           // mesh without an emission texture): they make its frame and the lookups'
-                           // footprint, core reads the texels into the slot's SurfaceParams (and the normal
-                           // map's into kMapR...), path by path
+                           // mesh or sphere): they make its frame and the lookups' footprint, core reads the
+                           // texels into the slot's SurfaceParams (its emission too, which add_emission takes)
+                           // and the normal map's into kMapR..., path by path
   kUvsAt = 51,             // bits of an int32: a kTexturedHits mesh's triangle 0 in Scene::triangle_uvs; -1 if
                            // the mesh has no texture coordinates (its barycentrics are)
   kTangentsAt = 52,        // bits of an int32: a kFramed mesh's triangle 0 in Scene::vertex_tangents, whose
                            // tangents make its frame in the lanes (about its vertex normals' or geometric
-                           // normal); -1 if it has none or core makes its frame (a textured emitter)
-  kNormalMapped = 53,      // 1 if a kTexturedHits mesh's material has a normal map, which tilts its frame in
+                           // normal); -1 if it has none
+  kNormalMapped = 53,      // 1 if a kTexturedHits shape's material has a normal map, which tilts its frame in
                            // the lanes (normal_map_frame) from the texel core reads (kMapR...)
   kNormalMapScale = 54,    // its NormalMap::scale
-  kTexturedParams = 55,    // 1 if a kTexturedHits mesh's material has textured parameters (kHasParams), 0 if
+  kTexturedParams = 55,    // 1 if a kTexturedHits shape's material has textured parameters (kHasParams), 0 if
                            // it reads only a normal map
   kShapeFields = 56,
 };

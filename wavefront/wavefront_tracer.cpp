@@ -442,10 +442,13 @@ struct WavefrontTracer::VectorStages {
       // slot's SurfaceParams and frame, which the lanes shade with.
       const bool reads_textures = m.reads_textures_at_hits();
       const bool shaded_in_lanes = m.scatters() && in_lanes(m);
-      const bool framed = shaded_in_lanes && !cosine && (shading_frame(sh) || reads_textures);
-      // A textured mesh (but an emitter's, whose hits core resolves): the lanes resolve its hits, frame, normal
-      // map's tilt and footprint included, and core reads only the texels.
-      const bool textured_hits = framed && reads_textures && sh.kind == Shape::Kind::Triangles && !m.emission_textured;
+      // An emitter that scatters nothing but whose emission is a texture: the lanes resolve its hits too (in a
+      // frame no lane shades in), for the texel core reads for the emission there.
+      const bool emission_texels = !m.scatters() && m.emission_textured;
+      const bool framed = (shaded_in_lanes && !cosine && (shading_frame(sh) || reads_textures)) || emission_texels;
+      // A textured mesh or sphere: the lanes resolve its hits, frame, normal map's tilt and footprint included,
+      // and core reads only the texels.
+      const bool textured_hits = framed && reads_textures;
       // The frame the lanes make: of vertex normals, of tangents (about those normals, or the geometric one).
       const bool frame_in_lanes = framed && (!reads_textures || textured_hits);
       const bool normals_in_lanes = frame_in_lanes && sh.mesh.has_normals();
@@ -482,6 +485,10 @@ struct WavefrontTracer::VectorStages {
       if (textured_hits && sh.mesh.has_uvs() && !per_triangle(v->triangle_uvs, sh.mesh.uvs, 2, vs::kUvsAt))
         return no("more than 2^27 textured triangles");
       const bool general = m.scatters() && (cosine || !in_lanes(m) || (shading_frame(sh) && !framed));
+      // Every hit on a textured emitter is resolved, its texel read into the slot's SurfaceParams, whose emission
+      // add_emission() takes: in the lanes (kTexturedHits) or by core (kResolveByCore).
+      if (m.emission_textured && !textured_hits && !general)
+        throw std::logic_error("wavefront: the emission texture of '" + m.name + "' would not be read at hits");
       f[vs::kGeneral] = general ? 1.0f : 0.0f;
       f[vs::kFramed] = framed ? 1.0f : 0.0f;
       sc.framed = sc.framed || framed;

@@ -1,9 +1,11 @@
-// An environment image's lat-long convention (core/environment_map.h)
-// written once over Highway's vectors: a direction in the map's frame to its
-// (u, v) and back, and (u, v) to its texel. core/environment_map.cpp calls
-// them at width 1 (core/simd/width1.h) for both tracers' scalar code, the
-// wavefront's vectorised stages at their SIMD width (an escaped ray's sky
-// and the map's light samples).
+// The lat-long conventions written once over Highway's vectors: an
+// environment image's (core/environment_map.h: a direction in the map's
+// frame to its (u, v) and back, and (u, v) to its texel) and a textured
+// sphere's texture coordinates (core/texture.h). core/environment_map.cpp,
+// core/texture.cpp and core/compiled_scene.cpp call them at width 1
+// (core/simd/width1.h) for both tracers' scalar code, the wavefront's
+// vectorised stages at their SIMD width (an escaped ray's sky, the map's
+// light samples, and hits on textured spheres).
 //
 // Highway's "-inl.h" convention: no include guard but the toggle below.
 #if defined(PATHLAB_CORE_SIMD_ENVIRONMENT_INL_H_) == defined(HWY_TARGET_TOGGLE)
@@ -60,6 +62,30 @@ HWY_INLINE V env_texel(D d, V uv, V size) {
 template <class D, class V = VecOf<D>>
 HWY_INLINE V env_solid_angle_pdf(D d, V uv_pdf, V sin_theta) {
   return IfThenElseZero(sin_theta > Zero(d), uv_pdf / (Set(d, 2.0f * kPi * kPi) * sin_theta));
+}
+
+// A sphere's texture coordinates at the direction `dir` from its centre (in
+// its own space, about unit length): pbrt's (phi, theta) about the z axis,
+// u = phi / 2 pi in [0, 1) (a half turn below 0 is the second half; u = 1 -
+// tiny rounding up to 1 is 0 again, as the environment's), v = 1 - theta / pi
+// (1 at +z). theta = atan2(sin theta, z) with sin theta = sqrt(x^2 + y^2),
+// which the footprint reads too: acos(z) loses all precision near the
+// poles, where z rounds to 1 long before x and y do.
+template <class D, class V = VecOf<D>>
+HWY_INLINE void sphere_uv(D d, const Vec3<V>& dir, V& u, V& v, V& sin_theta) {
+  V a = atan2_lanes(d, dir.y, dir.x) * Set(d, kInv2Pi);
+  a = IfThenElse(a < Zero(d), a + Set(d, 1.0f), a);
+  u = IfThenElseZero(a < Set(d, 1.0f), a);
+  sin_theta = Sqrt(dir.x * dir.x + dir.y * dir.y);
+  v = Set(d, 1.0f) - atan2_lanes(d, sin_theta, dir.z) * Set(d, kInvPi);
+}
+
+// The uv area per world area of a sphere of `radius` at sin theta (its
+// sphere_uv): dA = r^2 sin theta dtheta dphi = 2 pi^2 r^2 sin theta du dv,
+// sin theta at least 1e-4 (the poles, where a texel shrinks to a point).
+template <class D, class V = VecOf<D>>
+HWY_INLINE V sphere_uv_per_area(D d, V radius, V sin_theta) {
+  return Set(d, 1.0f) / (Set(d, 2.0f * kPi * kPi) * radius * radius * Max(sin_theta, Set(d, 1e-4f)));
 }
 
 }  // namespace pathlab::HWY_NAMESPACE
