@@ -230,7 +230,15 @@ void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayH
     const vec3 d = (p_local - shape.center) / shape.radius;
     float sin_theta;
     s->uv = sphere_uv(d, &sin_theta);
-    uv_per_area = generic::sphere_uv_per_area(kScalar, F{shape.radius}, F{sin_theta}).raw;
+    F per_area = generic::sphere_uv_per_area(kScalar, F{shape.radius}, F{sin_theta});
+    if (hit.instance != kNoInstance) {
+      // Per world area: the instance scales the sphere's areas there by placed_area_scale.
+      const Placement& place = placements_[hit.instance];
+      const mat3 l(place.to_world);
+      per_area = per_area / generic::placed_area_scale(lanes(l[0]), lanes(l[1]), lanes(l[2]), lanes(place.to_normal[0]),
+                                                       lanes(place.to_normal[1]), lanes(place.to_normal[2]), lanes(d));
+    }
+    uv_per_area = per_area.raw;
   } else {
     const Triangle& t = triangles_[first_triangle_[hit.shape] + hit.prim];
     vec3 e1 = t.p1 - t.p0, e2 = t.p2 - t.p0;

@@ -9,6 +9,7 @@
 #include "core/simd/width1.h"
 #include "tests/simd_kernels.h"
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -214,6 +215,30 @@ TEST(SimdOffsetRayOrigin, EveryTargetComputesTheBitsOfCoresScalarFunction) {
 // sin_cos_turn and exp2_lanes (core/simd/sampling-inl.h), pathlab's own
 // transcendentals for the lanes: within a few ulps of libm, and the same
 // bits on every target and at width 1 (libm's are not the lanes').
+// placed_area_scale (Nanson's formula, |det L| |L^-T n|) against its
+// definition: the area |L t1 x L t2| of the unit square of two orthonormal
+// tangents t1, t2 of n after L, for a turned, sheared, non-uniformly scaled
+// and a mirroring L, at random normals.
+TEST(SimdGeometry, PlacedAreaScaleIsTheAreaOfThePlacedTangentSquare) {
+  std::mt19937 gen(9);
+  std::normal_distribution<float> normal;
+  const mat3 turn = mat3(glm::rotate(glm::mat4(1.0f), 0.7f, glm::normalize(vec3(0.3f, 1.0f, -0.4f))));
+  const mat3 shear(vec3(1.0f, 0.0f, 0.0f), vec3(0.6f, 1.0f, 0.0f), vec3(-0.3f, 0.2f, 1.0f));
+  const auto diagonal = [](float x, float y, float z) { return mat3(vec3(x, 0, 0), vec3(0, y, 0), vec3(0, 0, z)); };
+  for (const mat3& l : {turn * diagonal(2.0f, 3.0f, 0.5f) * shear, diagonal(-1.5f, 0.4f, 2.0f)}) {
+    const mat3 t = glm::transpose(glm::inverse(l));
+    for (int i = 0; i < 1000; ++i) {
+      const vec3 n = glm::normalize(vec3(normal(gen), normal(gen), normal(gen)));
+      const Frame f(n);
+      const double want = glm::length(glm::cross(glm::dvec3(l * f.s), glm::dvec3(l * f.t)));
+      using namespace width1;
+      const float got = generic::placed_area_scale(lanes(l[0]), lanes(l[1]), lanes(l[2]), lanes(t[0]), lanes(t[1]),
+                                                   lanes(t[2]), lanes(n)).raw;
+      ASSERT_NEAR(got, want, 1e-5 * want) << i;
+    }
+  }
+}
+
 TEST(SimdTranscendentals, CloseToLibmAndTheSameBitsOnEveryTarget) {
   const SimdChoice restore;
   std::mt19937 g(20261203);

@@ -295,6 +295,47 @@ TEST_F(TexturesTest, ConeFootprintAtAPlaneIsTheClosedForm) {
   }
 }
 
+// A textured sphere placed by an instance reads the texture over the same
+// footprint as the sphere it becomes in world space: a unit sphere scaled
+// 2.5 times against a sphere of radius 2.5, seen from the side (on the
+// equator, away from the seam), the cone filter over a noise texture whose
+// every MIP level differs. A footprint in the group's units (2.5 times too
+// wide in uv) reads another level.
+TEST_F(TexturesTest, PlacedSphereFiltersAsTheSphereItBecomes) {
+  std::mt19937 gen(5);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  std::vector<float> noise(256 * 256 * 3);
+  for (float& v : noise) v = uniform(gen);
+  write_image(dir_ / "noise.exr", 256, 256, 3, noise);
+  const auto scene = [&](const std::string& shapes) {
+    return parse_scene(R"({"pathlab_scene": 1,
+      "camera": {"position": [0, -10, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov_y": 40},
+      "film": {"resolution": [64, 64]},
+      "render": {"max_depth": 1},
+      "materials": {"m": {"type": "diffuse", "albedo": {"texture": "noise.exr", "colorspace": "linear"}}},
+      )" + shapes + "}",
+                       dir_ / "scene.json");
+  };
+  const CompiledScene world{scene(R"("shapes": [{"type": "sphere", "material": "m", "center": [0, 0, 0], "radius": 2.5}])")};
+  const CompiledScene placed{scene(R"("shapes": [],
+      "groups": {"ball": [{"type": "sphere", "material": "m", "center": [0, 0, 0], "radius": 1}]},
+      "instances": [{"group": "ball", "transform": [{"scale": 2.5}]}])")};
+  const TextureRef& ref = world.scene().materials[0].textured.at(0).texture;
+  for (const vec2 pixel : {vec2(32.3f, 31.8f), vec2(27.5f, 36.2f), vec2(40.1f, 30.4f)}) {
+    const Ray ray = world.camera().generate_ray(pixel, vec2(0.5f));
+    Surfel a, b;
+    SurfaceParams pa, pb;
+    ASSERT_TRUE(world.intersect(ray, &a, world.camera_cone(TextureFilter::Cone), &pa));
+    ASSERT_TRUE(placed.intersect(ray, &b, placed.camera_cone(TextureFilter::Cone), &pb));
+    ASSERT_NE(b.instance, kNoInstance);
+    EXPECT_NEAR(a.uv.x, b.uv.x, 1e-5f);
+    EXPECT_NEAR(a.uv.y, b.uv.y, 1e-5f);
+    expect_near(pb.albedo, pa.albedo, 2e-4f, "placed against world");
+    // The filter matters here: the finest level reads something else.
+    EXPECT_GT(glm::length(world.textures()->color(ref, {a.uv, 0.0f}) - pa.albedo), 1e-2f) << "the footprint is too small to test";
+  }
+}
+
 // ------------------------------------------------------------ normal maps
 
 TEST_F(TexturesTest, ConstantNormalMapTiltsTheShadingNormalByItsAngle) {

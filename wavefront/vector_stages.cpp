@@ -151,6 +151,7 @@ using pathlab::HWY_NAMESPACE::normal_map_frame;
 using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::place_normal;
+using pathlab::HWY_NAMESPACE::placed_area_scale;
 using pathlab::HWY_NAMESPACE::piecewise_point;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::shading_normal;
@@ -783,12 +784,21 @@ void resolve(const Scene& sc, const Wave& w) {
                                         placement(on, kToLocal + 9), p),
                            p);
           const VF radius = shape_value(tsphere, sc, shape, kRadius);
-          const V3 dir = local - shape_value3(tsphere, sc, shape, kCenter);
+          const V3 off = local - shape_value3(tsphere, sc, shape, kCenter);
+          const V3 dir{off.x / radius, off.y / radius, off.z / radius};
           VF su, sv, sin_theta;
-          sphere_uv(df, V3{dir.x / radius, dir.y / radius, dir.z / radius}, su, sv, sin_theta);
+          sphere_uv(df, dir, su, sv, sin_theta);
+          VF per_area = sphere_uv_per_area(df, radius, sin_theta);
+          if (const M on = hn::And(tsphere, placed); !hn::AllFalse(df, on))
+            // Per world area: the instance scales the sphere's areas there by placed_area_scale.
+            per_area = hn::IfThenElse(on,
+                                      per_area / placed_area_scale(placement(on, kToWorld), placement(on, kToWorld + 3),
+                                                                   placement(on, kToWorld + 6), to_normal[0],
+                                                                   to_normal[1], to_normal[2], dir),
+                                      per_area);
           tex_u = hn::IfThenElse(tsphere, su, tex_u);
           tex_v = hn::IfThenElse(tsphere, sv, tex_v);
-          uv_per_area = hn::IfThenElse(tsphere, sphere_uv_per_area(df, radius, sin_theta), uv_per_area);
+          uv_per_area = hn::IfThenElse(tsphere, per_area, uv_per_area);
         }
         const V3 o = load3(w, kOx, i0, textured), d = load3(w, kDx, i0, textured);
         const VF width = footprint_width(df, load(w, kConeWidth, i0, textured), load(w, kConeSpread, i0, textured),

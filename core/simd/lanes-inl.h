@@ -361,6 +361,15 @@ template <class D, class V = VecOf<D>>
 HWY_INLINE Vec3<V> place_normal(D d, const Vec3<V>& c0, const Vec3<V>& c1, const Vec3<V>& c2, const Vec3<V>& n) {
   return normalize(d, to_world(c0, c1, c2, n.x, n.y, n.z));
 }
+// The factor by which an instance's linear part L (columns c0, c1, c2; its
+// inverse transpose's t0, t1, t2) scales the area of a surface whose unit
+// normal is n in the group's space (Nanson's formula): |det L| |L^-T n|.
+template <class V>
+HWY_INLINE V placed_area_scale(const Vec3<V>& c0, const Vec3<V>& c1, const Vec3<V>& c2, const Vec3<V>& t0,
+                               const Vec3<V>& t1, const Vec3<V>& t2, const Vec3<V>& n) {
+  const Vec3<V> m = to_world(t0, t1, t2, n.x, n.y, n.z);
+  return Abs(dot(c0, cross(c1, c2))) * Sqrt(dot(m, m));
+}
 
 // square_to_uniform_triangle (core/sampling.cpp): barycentrics (b1, b2) =
 // (uy sqrt(ux), 1 - sqrt(ux)).
