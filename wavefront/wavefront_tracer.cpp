@@ -435,11 +435,10 @@ struct WavefrontTracer::VectorStages {
       f[vs::kFlipped] = sh.flip_normals ? 1.0f : 0.0f;
       f[vs::kOneSided] = m.one_sided ? 1.0f : 0.0f;
       sc.one_sided = sc.one_sided || m.one_sided;
-      // A mesh with vertex normals or tangents has a shading frame of its own, which the lanes shade in (with
-      // Surfel's rules under a shading normal). The lanes make the frame of vertex normals (kNormalsAt), core
-      // (CompiledScene::resolve_shading) one of tangents.
-      // A textured material's too: core's resolve reads its textures (and normal map) at the hit into the
-      // slot's SurfaceParams and frame, which the lanes shade with.
+      // A mesh with vertex normals or tangents has a shading frame of its own, which the lanes make (kNormalsAt,
+      // kTangentsAt) and shade in (with Surfel's rules under a shading normal); so has a shape whose material
+      // reads textures (kTexturedHits), whose frame a normal map may tilt. Not under the cosine strategy, whose
+      // scatter is core's everywhere.
       const bool reads_textures = m.reads_textures_at_hits();
       const bool shaded_in_lanes = m.scatters() && in_lanes(m);
       // An emitter that scatters nothing but whose emission is a texture: the lanes resolve its hits too (in a
@@ -450,14 +449,13 @@ struct WavefrontTracer::VectorStages {
       // and core reads only the texels.
       const bool textured_hits = framed && reads_textures;
       // The frame the lanes make: of vertex normals, of tangents (about those normals, or the geometric one).
-      const bool frame_in_lanes = framed && (!reads_textures || textured_hits);
-      const bool normals_in_lanes = frame_in_lanes && sh.mesh.has_normals();
-      const bool tangents_in_lanes = frame_in_lanes && !sh.mesh.tangents.empty();
+      const bool normals_in_lanes = framed && sh.mesh.has_normals();
+      const bool tangents_in_lanes = framed && !sh.mesh.tangents.empty();
       if (textured_hits) {
         add_name(texel_names, "'" + m.name + "'");
       } else if (shaded_in_lanes && reads_textures) {
         add_name(textured_names, "'" + m.name + "'");
-      } else if (shaded_in_lanes && shading_frame(sh) && !frame_in_lanes) {
+      } else if (shaded_in_lanes && shading_frame(sh) && !framed) {
         v->general.push_back("the shading frame of " + sh.description);
       }
       // Each triangle's three vertices' attribute (n floats each) appended to `table`, the shape's `field`
