@@ -440,43 +440,55 @@ TEST_F(TexturesTest, AlbedoAovReadsTheTexture) {
 
 // A textured emitter over a floor, sampled as a light ("light": true: MIS
 // with light sampling) and found only by rays ("light": false): both
-// estimate the same image. Compared on the four quadrants of the image,
-// each channel, by a z-test Šidák-corrected for the 12 comparisons at
-// alpha = 1e-3 (fixed seeds; the variances are the films' own estimates).
+// estimate the same image, in both tracers, for a rectangle (the light
+// sample's texel at the triangle's barycentrics, a hit's at its uv) and a
+// sphere (sphere_uv of the light sample's point from the centre, and the
+// hit's, in the wavefront's lanes). Compared on the four quadrants of the
+// image, each channel, by a z-test Šidák-corrected for the 48 comparisons
+// at alpha = 1e-3 (fixed seeds; the variances are the films' own estimates).
 TEST_F(TexturesTest, TexturedEmitterAsLightAndAsSurfaceAgree) {
   // 4x4 emission texels from 0 to ~3 (linear), very non-uniform.
   std::vector<float> texels;
   for (int i = 0; i < 16; ++i) texels.insert(texels.end(), {0.2f * i, 0.05f * (15 - i), (i % 3) * 0.8f});
   write_image(dir_ / "emit.exr", 4, 4, 3, texels);
-  auto render_image = [&](bool light) {
-    const std::string text = std::string(R"({"pathlab_scene": 1,
-      "camera": {"position": [0, 3, 3], "look_at": [0, 0, 0], "fov_y": 50},
-      "film": {"resolution": [16, 16]},
-      "render": {"spp": 256, "max_depth": 1, "strategy": "mis", "seed": 5},
-      "materials": {"floor": {"type": "diffuse", "albedo": 0.8},
-                    "lamp": {"type": "emissive", "radiance": {"texture": "emit.exr", "colorspace": "linear", "scale": 4}, "light": )") +
-                             (light ? "true" : "false") + R"(}},
-      "shapes": [{"type": "rectangle", "material": "floor", "transform": [{"scale": 3}, {"rotate": {"axis": [1, 0, 0], "angle": -90}}]},
-                 {"type": "rectangle", "material": "lamp", "transform": [{"scale": 0.8}, {"rotate": {"axis": [1, 0, 0], "angle": 90}}, {"translate": [0.3, 1.2, 0]}]}]})";
-    const CompiledScene compiled(parse_scene(text, dir_ / "s.json"));
-    EXPECT_EQ(compiled.lights().area_light_count(), light ? 2u : 0u);
-    const ReferenceTracer tracer(compiled, compiled.scene().render);
-    Film film(16, 16, FilterKind::Box, FilmMoments::MeanAndVariance);
-    render(tracer, film);
-    return film;
-  };
-  const Film a = render_image(true), b = render_image(false);
-  const double z_max = test::sidak_z(1e-3, 12);
-  for (int q = 0; q < 4; ++q)
-    for (int c = 0; c < 3; ++c) {
-      double ma = 0, mb = 0, va = 0, vb = 0;
-      for (int y = (q / 2) * 8; y < (q / 2) * 8 + 8; ++y)
-        for (int x = (q % 2) * 8; x < (q % 2) * 8 + 8; ++x) {
-          ma += a.mean(x, y)[c], mb += b.mean(x, y)[c];
-          va += a.variance_of_mean(x, y)[c], vb += b.variance_of_mean(x, y)[c];
+  const double z_max = test::sidak_z(1e-3, 48);
+  for (const bool sphere : {false, true})
+    for (const bool wavefront : {false, true}) {
+      SCOPED_TRACE(std::string(sphere ? "sphere" : "rectangle") + (wavefront ? ", wavefront" : ", reference"));
+      auto render_image = [&](bool light) {
+        const std::string lamp =
+            sphere ? R"({"type": "sphere", "material": "lamp", "center": [0.3, 1.0, 0], "radius": 0.45})"
+                   : R"({"type": "rectangle", "material": "lamp", "transform": [{"scale": 0.8}, {"rotate": {"axis": [1, 0, 0], "angle": 90}}, {"translate": [0.3, 1.2, 0]}]})";
+        const std::string text = std::string(R"({"pathlab_scene": 1,
+          "camera": {"position": [0, 3, 3], "look_at": [0, 0, 0], "fov_y": 50},
+          "film": {"resolution": [16, 16]},
+          "render": {"spp": 256, "max_depth": 1, "strategy": "mis", "seed": 5},
+          "materials": {"floor": {"type": "diffuse", "albedo": 0.8},
+                        "lamp": {"type": "emissive", "radiance": {"texture": "emit.exr", "colorspace": "linear", "scale": 4}, "light": )") +
+                                 (light ? "true" : "false") + R"(}},
+          "shapes": [{"type": "rectangle", "material": "floor", "transform": [{"scale": 3}, {"rotate": {"axis": [1, 0, 0], "angle": -90}}]},
+                     )" + lamp + "]}";
+        const CompiledScene compiled(parse_scene(text, dir_ / "s.json"));
+        EXPECT_EQ(compiled.lights().area_light_count(), light ? (sphere ? 1u : 2u) : 0u);
+        Film film(16, 16, FilterKind::Box, FilmMoments::MeanAndVariance);
+        if (wavefront)
+          render(WavefrontTracer(compiled, compiled.scene().render), film);
+        else
+          render(ReferenceTracer(compiled, compiled.scene().render), film);
+        return film;
+      };
+      const Film a = render_image(true), b = render_image(false);
+      for (int q = 0; q < 4; ++q)
+        for (int c = 0; c < 3; ++c) {
+          double ma = 0, mb = 0, va = 0, vb = 0;
+          for (int y = (q / 2) * 8; y < (q / 2) * 8 + 8; ++y)
+            for (int x = (q % 2) * 8; x < (q % 2) * 8 + 8; ++x) {
+              ma += a.mean(x, y)[c], mb += b.mean(x, y)[c];
+              va += a.variance_of_mean(x, y)[c], vb += b.variance_of_mean(x, y)[c];
+            }
+          const double z = (ma - mb) / std::sqrt(va + vb);
+          EXPECT_LT(std::abs(z), z_max) << "quadrant " << q << " channel " << c << ": " << ma / 64 << " vs " << mb / 64;
         }
-      const double z = (ma - mb) / std::sqrt(va + vb);
-      EXPECT_LT(std::abs(z), z_max) << "quadrant " << q << " channel " << c << ": " << ma / 64 << " vs " << mb / 64;
     }
 }
 
