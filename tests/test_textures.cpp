@@ -43,6 +43,16 @@ void expect_near(const Spectrum& a, const Spectrum& b, float tol, const std::str
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], tol) << what << " channel " << c;
 }
 
+// A 256x256 RGB image of uniform noise (seeded), so that every MIP level
+// reads a different value at a point: a footprint off by a factor shows.
+void write_noise(const std::filesystem::path& path, unsigned seed) {
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+  std::vector<float> noise(256 * 256 * 3);
+  for (float& v : noise) v = uniform(gen);
+  write_image(path, 256, 256, 3, noise);
+}
+
 class TexturesTest : public test::TempDirTest {};
 
 TEST_F(TexturesTest, PointLookupsReadTheTexelsAndWrapAsAsked) {
@@ -263,11 +273,7 @@ TEST(SphereUv, ClosedFormsAtAxesSeamAndPoles) {
 // is noise, so that every MIP level reads a different value there, and the
 // test sees a footprint off by a factor of two.
 TEST_F(TexturesTest, ConeFootprintAtAPlaneIsTheClosedForm) {
-  std::mt19937 gen(7);
-  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-  std::vector<float> noise(256 * 256 * 3);
-  for (float& v : noise) v = uniform(gen);
-  write_image(dir_ / "noise.exr", 256, 256, 3, noise);
+  write_noise(dir_ / "noise.exr", 7);
   const float d = 4.0f, tilt = 60.0f, half = 1.0f;
   const int res = 64;
   for (const std::string filter : {"cone", "point"}) {
@@ -302,11 +308,7 @@ TEST_F(TexturesTest, ConeFootprintAtAPlaneIsTheClosedForm) {
 // every MIP level differs. A footprint in the group's units (2.5 times too
 // wide in uv) reads another level.
 TEST_F(TexturesTest, PlacedSphereFiltersAsTheSphereItBecomes) {
-  std::mt19937 gen(5);
-  std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
-  std::vector<float> noise(256 * 256 * 3);
-  for (float& v : noise) v = uniform(gen);
-  write_image(dir_ / "noise.exr", 256, 256, 3, noise);
+  write_noise(dir_ / "noise.exr", 5);
   const auto scene = [&](const std::string& shapes) {
     return parse_scene(R"({"pathlab_scene": 1,
       "camera": {"position": [0, -10, 0], "look_at": [0, 0, 0], "up": [0, 0, 1], "fov_y": 40},
