@@ -75,4 +75,8 @@ void EdgeList::direction_curve(const std::function<dvec3(double)>& dir, double s
   }
 }
 
+void EdgeList::point_curve(const std::function<dvec3(double)>& p, double s0, double s1, int pieces) {
+  direction_curve([&](double s) { return p(s) - eye_; }, s0, s1, pieces);
+}
+
 }  // namespace pathlab

@@ -52,6 +52,8 @@ class EdgeList {
   // A curve of directions at infinity, dir(s) for s in [s0, s1], in
   // `pieces` chords.
   void direction_curve(const std::function<dvec3(double)>& dir, double s0, double s1, int pieces);
+  // A curve of world points, p(s) for s in [s0, s1], in `pieces` chords.
+  void point_curve(const std::function<dvec3(double)>& p, double s0, double s1, int pieces);
   void note_unlisted(const std::string& what) { unlisted_ += (unlisted_.empty() ? "" : "; ") + what; }
 
  private:

@@ -5,17 +5,28 @@
 // exactly, whatever the strategy. a(x) is what the renderer reads: the
 // texture filtered over the ray cone's footprint (core/ray_cone.h), which
 // this model computes itself, in double precision, from the camera's pixel
-// angle, the hit's distance and angle, and the triangle's uv-to-world area
+// angle, the hit's distance and angle, and the surface's uv-to-world area
 // ratio, and then looks up through the same Textures code (core/texture.h).
 // So a footprint computed wrongly in CompiledScene::resolve (or a cone the
 // tracers carry wrongly) makes the check fail, while the texture filter
 // itself is taken as given (tests/test_textures.cpp checks lookups against
 // closed forms).
+//
+// The room is a flat-shaded mesh with texture coordinates (a box), or a
+// sphere, whose texture coordinates are pbrt's (phi, theta) about the z axis
+// through its centre (docs/scene-format.md): here phi and theta from libm's
+// double atan2, the uv area per world area 1 / (2 pi^2 r^2 sin theta) with
+// sin theta at least 1e-4, as the renderer's. The sphere's seam (phi = 0,
+// where u wraps from 1 to 0) is an edge; its poles lie on it.
 #include "analytic-scenes/models.h"
 #include "analytic-scenes/room.h"
 #include "core/ray_cone.h"
 #include "core/texture.h"
 
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
 #include <sstream>
 
 namespace pathlab::analytic {
@@ -34,12 +45,21 @@ class TexturedRoom final : public AnalyticModel {
 
   std::string_view name() const override { return kName; }
   // The room's edges, where the texture coordinates and the footprint jump;
-  // the bilinear texture is continuous within a wall.
-  void edges(EdgeList& out) const override { out.mesh_edges(room_); }
+  // the bilinear texture is continuous within a wall. A sphere's seam.
+  void edges(EdgeList& out) const override {
+    if (room_.kind != Shape::Kind::Sphere) return out.mesh_edges(room_);
+    const dvec3 c(room_.center);
+    const double r = room_.radius;
+    out.point_curve([&](double theta) { return c + r * dvec3(std::sin(theta), 0.0, std::cos(theta)); }, 0.0, std::numbers::pi, 64);
+  }
   std::string describe() const override {
     std::ostringstream s;
-    s << "room of " << room_.mesh.triangles.size() << " triangles emitting Le = (" << Le_.x << ", " << Le_.y << ", "
-      << Le_.z << "), albedo from a texture, cone spread " << spread_ << " rad, depth cap 1: L = Le (1 + a(x))";
+    if (room_.kind == Shape::Kind::Sphere)
+      s << "sphere of radius " << room_.radius;
+    else
+      s << "room of " << room_.mesh.triangles.size() << " triangles";
+    s << " emitting Le = (" << Le_.x << ", " << Le_.y << ", " << Le_.z << "), albedo from a texture, cone spread "
+      << spread_ << " rad, depth cap 1: L = Le (1 + a(x))";
     return s.str();
   }
 
@@ -48,6 +68,19 @@ class TexturedRoom final : public AnalyticModel {
     double best = kInfinity;
     vec2 uv(0.0f);
     double uv_per_area = 0.0, cos_theta = 1.0;
+    if (room_.kind == Shape::Kind::Sphere) {
+      const std::optional<double> t = hit_sphere(room_.center, room_.radius, ray);
+      if (!t) return Spectrum(0.0f);  // cannot happen inside a closed room
+      best = *t;
+      const double r = room_.radius;
+      const dvec3 n = (o + best * d - dvec3(room_.center)) / r;
+      double phi = std::atan2(n.y, n.x);
+      if (phi < 0.0) phi += 2.0 * std::numbers::pi;
+      const double sin_theta = std::hypot(n.x, n.y);
+      uv = vec2(static_cast<float>(phi / (2.0 * std::numbers::pi)), static_cast<float>(1.0 - std::atan2(sin_theta, n.z) / std::numbers::pi));
+      uv_per_area = 1.0 / (2.0 * std::numbers::pi * std::numbers::pi * r * r * std::max(sin_theta, 1e-4));
+      cos_theta = std::abs(glm::dot(d, n));
+    }
     const TriangleMesh& m = room_.mesh;
     for (const glm::uvec3& t : m.triangles) {
       const dvec3 p0(m.positions[t.x]), p1(m.positions[t.y]), p2(m.positions[t.z]);
@@ -85,8 +118,8 @@ class TexturedRoom final : public AnalyticModel {
 }  // namespace
 
 std::unique_ptr<AnalyticModel> make_textured_room(const Scene& scene) {
-  if (scene.shapes.size() != 1 || scene.shapes[0].kind != Shape::Kind::Triangles)
-    refuse(scene, kName, "the scene must hold exactly one shape: the room, a closed triangle mesh (a box)");
+  if (scene.shapes.size() != 1)
+    refuse(scene, kName, "the scene must hold exactly one shape: the room, a closed triangle mesh (a box) or a sphere");
   const Shape& room = scene.shapes[0];
   const Material& m = scene.materials[room.material];
   if (!is_closed(room)) refuse(scene, kName, "the room is not closed");
@@ -95,7 +128,7 @@ std::unique_ptr<AnalyticModel> make_textured_room(const Scene& scene) {
   if (m.textured.size() != 1 || m.normal_map || m.one_sided)
     refuse(scene, kName, "the room's material may texture its albedo only (no other texture, no normal map, two-sided)");
   if (!emits_inwards(room, m) || is_black(m.emission)) refuse(scene, kName, "the room must emit towards its inside");
-  if (!room.mesh.has_uvs()) refuse(scene, kName, "the room needs texture coordinates");
+  if (room.kind == Shape::Kind::Triangles && !room.mesh.has_uvs()) refuse(scene, kName, "the room needs texture coordinates");
   if (room.mesh.has_normals()) refuse(scene, kName, "the room must be flat-shaded");
   if (scene.render.max_depth != 1) refuse(scene, kName, "the model holds for max_depth 1 only");
   if (!scene.delta_lights.empty() || scene.environment) refuse(scene, kName, "the room's walls must be the only light");
