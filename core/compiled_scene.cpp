@@ -226,17 +226,17 @@ void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayH
   if (shape.kind == Shape::Kind::Sphere) {
     // pbrt's (phi, theta) parametrisation about the z axis, in the shape's
     // own space: u = phi / 2 pi, v = 1 - theta / pi (v = 1 at +z).
-    const vec3 p_local = hit.instance == kNoInstance ? s->p : affine_point(placements_[hit.instance].to_local, s->p);
+    const Placement* place = hit.instance == kNoInstance ? nullptr : &placements_[hit.instance];
+    const vec3 p_local = place ? affine_point(place->to_local, s->p) : s->p;
     const vec3 d = (p_local - shape.center) / shape.radius;
     float sin_theta;
     s->uv = sphere_uv(d, &sin_theta);
     F per_area = generic::sphere_uv_per_area(kScalar, F{shape.radius}, F{sin_theta});
-    if (hit.instance != kNoInstance) {
+    if (place) {
       // Per world area: the instance scales the sphere's areas there by placed_area_scale.
-      const Placement& place = placements_[hit.instance];
-      const mat3 l(place.to_world);
-      per_area = per_area / generic::placed_area_scale(lanes(l[0]), lanes(l[1]), lanes(l[2]), lanes(place.to_normal[0]),
-                                                       lanes(place.to_normal[1]), lanes(place.to_normal[2]), lanes(d));
+      const mat3 l(place->to_world);
+      per_area = per_area / generic::placed_area_scale(lanes(l[0]), lanes(l[1]), lanes(l[2]), lanes(place->to_normal[0]),
+                                                       lanes(place->to_normal[1]), lanes(place->to_normal[2]), lanes(d));
     }
     uv_per_area = per_area.raw;
   } else {

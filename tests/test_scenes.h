@@ -302,8 +302,9 @@ inline Scene cornell_with_textures(bool textured_impulses = false) {
 // scale), in Lambert and Disney materials under a textured light and an
 // environment (so that paths a shading normal sends below a surface still
 // carry light); normal maps on the floor (a flat rectangle), the red wall
-// and the world-space octahedron (vertex normals); and a glowing sphere
-// that scatters and emits, both by textures.
+// and the world-space octahedron (vertex normals); a glowing sphere that
+// scatters and emits, both by textures; and a small octahedron of the
+// textured light (vertex normals on an emitter that scatters nothing).
 inline Scene cornell_with_textured_meshes() {
   const std::filesystem::path& d = textured_scene_dir();
   if (!std::filesystem::exists(d / "gem.obj")) {
@@ -336,6 +337,7 @@ inline Scene cornell_with_textured_meshes() {
     {"type": "mesh", "file": "tent.obj", "material": "disney"},
     {"type": "mesh", "file": "gem.obj", "material": "red", "transform": [{"scale": 0.3}, {"translate": [0.5, 0.4, 0.0]}]},
     {"type": "sphere", "material": "glow", "center": [0.55, -0.75, 0.45], "radius": 0.2},
+    {"type": "mesh", "file": "gem.obj", "material": "light", "transform": [{"scale": 0.12}, {"translate": [-0.6, 0.45, -0.5]}]},
     {"type": "rectangle", "material": "light", "transform": [{"scale": [0.25, 0.2, 1]}, {"rotate": {"axis": [1, 0, 0], "angle": 90}}, {"translate": [0, 0.998, 0]}]}
   ],
   "lights": [{"type": "environment", "radiance": [0.3, 0.35, 0.4]}],

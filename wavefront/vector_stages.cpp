@@ -777,8 +777,10 @@ void resolve(const Scene& sc, const Wave& w) {
         if (const M tsphere = hn::And(sphere, textured); !hn::AllFalse(df, tsphere)) {
           // A sphere's: sphere_uv of the direction from its centre to the point in its own space (the placed
           // point taken back by the instance's to_local, as core does), and sphere_uv_per_area.
+          const M on = hn::And(tsphere, placed);
+          const bool any_placed = !hn::AllFalse(df, on);
           V3 local = p;
-          if (const M on = hn::And(tsphere, placed); !hn::AllFalse(df, on))
+          if (any_placed)
             local = select(on,
                            affine_point(placement(on, kToLocal), placement(on, kToLocal + 3), placement(on, kToLocal + 6),
                                         placement(on, kToLocal + 9), p),
@@ -789,7 +791,7 @@ void resolve(const Scene& sc, const Wave& w) {
           VF su, sv, sin_theta;
           sphere_uv(df, dir, su, sv, sin_theta);
           VF per_area = sphere_uv_per_area(df, radius, sin_theta);
-          if (const M on = hn::And(tsphere, placed); !hn::AllFalse(df, on))
+          if (any_placed)
             // Per world area: the instance scales the sphere's areas there by placed_area_scale.
             per_area = hn::IfThenElse(on,
                                       per_area / placed_area_scale(placement(on, kToWorld), placement(on, kToWorld + 3),

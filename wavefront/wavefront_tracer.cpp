@@ -448,9 +448,10 @@ struct WavefrontTracer::VectorStages {
       // A textured mesh or sphere: the lanes resolve its hits, frame, normal map's tilt and footprint included,
       // and core reads only the texels.
       const bool textured_hits = framed && reads_textures;
-      // The frame the lanes make: of vertex normals, of tangents (about those normals, or the geometric one).
-      const bool normals_in_lanes = framed && sh.mesh.has_normals();
-      const bool tangents_in_lanes = framed && !sh.mesh.tangents.empty();
+      // The frame the lanes make: of vertex normals, of tangents (about those normals, or the geometric one);
+      // an emitter that scatters nothing shades in no frame, so it gets Frame(n) and no tables.
+      const bool normals_in_lanes = framed && !emission_texels && sh.mesh.has_normals();
+      const bool tangents_in_lanes = framed && !emission_texels && !sh.mesh.tangents.empty();
       if (textured_hits) {
         add_name(texel_names, "'" + m.name + "'");
       } else if (shaded_in_lanes && reads_textures) {
