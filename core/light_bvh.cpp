@@ -1,5 +1,7 @@
 #include "core/light_bvh.h"
 
+#include "core/simd/width1.h"
+
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
@@ -9,19 +11,6 @@ namespace pathlab {
 namespace {
 
 constexpr double kPiD = 3.14159265358979323846;
-
-// cos and sin of max(0, a - b) for angles a, b in [0, pi] given by theirs.
-struct CosSin {
-  double cos, sin;
-};
-CosSin minus_clamped(CosSin a, CosSin b) {
-  if (a.cos >= b.cos) return {1.0, 0.0};  // a <= b
-  return {a.cos * b.cos + a.sin * b.sin, a.sin * b.cos - a.cos * b.sin};
-}
-CosSin from_cos(double c) {
-  c = std::clamp(c, -1.0, 1.0);
-  return {c, std::sqrt(std::max(0.0, 1.0 - c * c))};
-}
 
 // A float no greater than c: a cone's cosine stored in a node must not make
 // the cone narrower than the one computed.
@@ -100,48 +89,24 @@ LightBounds merge(const LightBounds& a, const LightBounds& b) {
   return out;
 }
 
+// importance, split, pick and share are core/simd/light_bvh-inl.h's generic
+// code at width 1: the wavefront's vectorised stages walk the same source
+// in double lanes.
+
 double importance(const LightBounds& b, const LightQuery& q) {
-  const dvec3 c = centroid(b);
-  const dvec3 half = 0.5 * (dvec3(b.hi) - dvec3(b.lo));
-  const double r2 = glm::dot(half, half);
-  const dvec3 d = dvec3(q.p) - c;  // centre -> shading point
-  const double d2 = glm::dot(d, d);
-  const double dist2 = std::max({d2, 0.25 * r2, DBL_MIN});
-  // Inside the bounding sphere every direction is possible (theta_b = pi):
-  // the cone and the surface's side cannot rule anything out.
-  if (!(d2 > r2)) {
-    const double imp = b.phi / dist2;
-    return std::isfinite(imp) ? imp : DBL_MAX;
-  }
-  const double sin2_b = r2 / d2;
-  const CosSin theta_b{std::sqrt(std::max(0.0, 1.0 - sin2_b)), std::sqrt(sin2_b)};
-  const dvec3 wi = d / std::sqrt(d2);
-  // The emitters: the smallest angle between a normal in the cone and a
-  // direction from the box to the point.
-  double cos_w = glm::dot(dvec3(b.axis), wi);
-  if (b.two_sided) cos_w = std::abs(cos_w);
-  const CosSin theta_x = minus_clamped(from_cos(cos_w), from_cos(b.cos_o));
-  const double cos_p = minus_clamped(theta_x, theta_b).cos;
-  if (cos_p <= double(b.cos_e)) return 0.0;
-  double imp = b.phi * cos_p / dist2;
-  // The receiver: the smallest angle between its normal and a direction to the box.
-  if (q.n != vec3(0.0f)) {
-    const double cos_pi = minus_clamped(from_cos(glm::dot(dvec3(q.n), -wi)), theta_b).cos;
-    if (cos_pi <= 0.0) return 0.0;
-    imp *= cos_pi;
-  }
-  if (!(imp >= 0.0)) return 0.0;
-  return std::isfinite(imp) ? imp : DBL_MAX;
+  using namespace width1;
+  const generic::BvhBounds<D1, lane1::M> bounds{lanes(dvec3(b.lo)), lanes(dvec3(b.hi)), lanes(dvec3(b.axis)),
+                                                 D1{b.cos_o},        D1{b.cos_e},        D1{b.phi},
+                                                 lane1::M{b.two_sided}};
+  return generic::bvh_importance(kScalarD, bounds, lanes(dvec3(q.p)), lanes(dvec3(q.n))).raw;
 }
 
 std::optional<std::uint32_t> LightBvh::split(double i0, double i1, std::uint32_t count) {
-  i0 = i0 > 0.0 ? i0 : 0.0;
-  i1 = i1 > 0.0 ? i1 : 0.0;
-  const double m = std::max(i0, i1);
-  if (!(m > 0.0)) return std::nullopt;
-  const double a = i0 / m, b = i1 / m;  // in [0, 1], one of them 1: the sum cannot overflow
-  const double first = std::floor(double(count) * (a / (a + b)) + 0.5);
-  return static_cast<std::uint32_t>(std::min(first, double(count)));
+  using namespace width1;
+  lane1::M valid;
+  const D1 first = generic::bvh_split(kScalarD, D1{i0}, D1{i1}, D1{double(count)}, valid);
+  if (!valid.raw) return std::nullopt;
+  return static_cast<std::uint32_t>(first.raw);
 }
 
 LightBvh::LightBvh(std::vector<LightBounds> lights) {
@@ -151,6 +116,7 @@ LightBvh::LightBvh(std::vector<LightBounds> lights) {
   std::iota(order.begin(), order.end(), 0u);
   nodes_.reserve(2 * lights.size() - 1);
   build(order, lights, 0, lights.size(), 0, 0);
+  table_ = make_table();
 }
 
 LightBounds LightBvh::build(std::vector<std::uint32_t>& order, std::vector<LightBounds>& lights, std::size_t begin,
@@ -242,49 +208,30 @@ LightBounds LightBvh::build(std::vector<std::uint32_t>& order, std::vector<Light
   return both;
 }
 
+namespace {
+constexpr lane1::One<std::int64_t> kIndex{};     // a node's index
+constexpr lane1::One<std::uint64_t> kTrail{};    // a light's trail
+}  // namespace
+
 std::optional<LightBvh::Pick> LightBvh::pick(const LightQuery& q, std::uint32_t k, std::uint32_t count) const {
   if (nodes_.empty() || k >= count) return std::nullopt;
-  if (!(importance(nodes_[0].bounds, q) > 0.0)) return std::nullopt;
-  std::uint32_t node = 0;
-  while (!nodes_[node].leaf) {
-    const std::uint32_t c0 = node + 1, c1 = nodes_[node].index;
-    const std::optional<std::uint32_t> first = split(importance(nodes_[c0].bounds, q), importance(nodes_[c1].bounds, q), count);
-    if (!first) return std::nullopt;
-    if (k < *first) {
-      node = c0;
-      count = *first;
-    } else {
-      k -= *first;  // re-based to the second child's part
-      count -= *first;
-      node = c1;
-    }
-  }
-  return Pick{nodes_[node].index, count};
+  using namespace width1;
+  D1 light, share;
+  generic::bvh_pick(kScalarD, kIndex, table_.data(), lanes(dvec3(q.p)), lanes(dvec3(q.n)), D1{double(k)},
+                    D1{double(count)}, lane1::M{true}, light, share);
+  if (!(share.raw > 0.0)) return std::nullopt;
+  return Pick{static_cast<std::uint32_t>(light.raw), static_cast<std::uint32_t>(share.raw)};
 }
 
 std::uint32_t LightBvh::share(const LightQuery& q, std::uint32_t light, std::uint32_t count) const {
   if (nodes_.empty() || light >= trail_.size() || count == 0) return 0;
-  if (!(importance(nodes_[0].bounds, q) > 0.0)) return 0;
-  std::uint64_t trail = trail_[light];
-  std::uint32_t node = 0;
-  while (!nodes_[node].leaf) {
-    const std::uint32_t c0 = node + 1, c1 = nodes_[node].index;
-    const std::optional<std::uint32_t> first = split(importance(nodes_[c0].bounds, q), importance(nodes_[c1].bounds, q), count);
-    if (!first) return 0;
-    if (trail & 1) {
-      count -= *first;
-      node = c1;
-    } else {
-      count = *first;
-      node = c0;
-    }
-    if (count == 0) return 0;
-    trail >>= 1;
-  }
-  return count;
+  using namespace width1;
+  const D1 share = generic::bvh_share(kScalarD, kIndex, kTrail, table_.data(), trail_.data(), lanes(dvec3(q.p)),
+                                      lanes(dvec3(q.n)), D1{double(light)}, D1{double(count)}, lane1::M{true});
+  return static_cast<std::uint32_t>(share.raw);
 }
 
-std::vector<double> LightBvh::node_table() const {
+std::vector<double> LightBvh::make_table() const {
   std::vector<double> table;
   table.reserve(nodes_.size() * kBvhFields);
   for (const Node& node : nodes_) {

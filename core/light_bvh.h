@@ -104,11 +104,11 @@ class LightBvh {
   // i0 and i1: the first child's part, or nothing when both are 0.
   static std::optional<std::uint32_t> split(double i0, double i1, std::uint32_t count);
 
-  // The tree as pick() and share() walk it, for code that walks it in bulk
-  // (the wavefront's vectorised stages, core/simd/light_bvh-inl.h): the
+  // The tree as pick() and share() walk it (core/simd/light_bvh-inl.h, at
+  // width 1 here and in the wavefront's vectorised stages' lanes): the
   // nodes as a table of kBvhFields doubles each (BvhField), in order, and
   // per light the trail share() follows.
-  std::vector<double> node_table() const;
+  const std::vector<double>& node_table() const { return table_; }
   const std::vector<std::uint64_t>& trails() const { return trail_; }
 
  private:
@@ -119,8 +119,10 @@ class LightBvh {
   };
   LightBounds build(std::vector<std::uint32_t>& order, std::vector<LightBounds>& lights, std::size_t begin,
                     std::size_t end, std::uint64_t trail, int depth);
+  std::vector<double> make_table() const;
 
   std::vector<Node> nodes_;
+  std::vector<double> table_;  // node_table()
   std::vector<std::uint64_t> trail_;  // per light: bit d set = child 1 at depth d
   int depth_ = 0;
 };

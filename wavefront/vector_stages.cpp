@@ -116,9 +116,8 @@ using pathlab::HWY_NAMESPACE::affine_point;
 using pathlab::HWY_NAMESPACE::area_light_pdf;
 using pathlab::HWY_NAMESPACE::area_light_pdf_at;
 using pathlab::HWY_NAMESPACE::blend_normals;
-using pathlab::HWY_NAMESPACE::bvh_field;
-using pathlab::HWY_NAMESPACE::bvh_importance;
-using pathlab::HWY_NAMESPACE::bvh_split;
+using pathlab::HWY_NAMESPACE::bvh_pick;
+using pathlab::HWY_NAMESPACE::bvh_share;
 using pathlab::HWY_NAMESPACE::camera_direction;
 using pathlab::HWY_NAMESPACE::CameraPlane;
 using pathlab::HWY_NAMESPACE::concentric_disk;
@@ -427,66 +426,6 @@ MD half_mask(M m, bool upper) { return half_d(hn::IfThenElseZero(m, k(1.0f)), up
 VF join_f(VD lo, VD hi) {
   const hn::Rebind<float, DD> dfh;
   return hn::Combine(DF(), hn::DemoteTo(dfh, hi), hn::DemoteTo(dfh, lo));
-}
-
-// One level of a walk down the light BVH (LightBvh::pick and share): for the
-// lanes of ok still above a leaf (`walking`), their children c0 and c1 and
-// the first child's part of `count` (LightBvh::split); a walking lane whose
-// children both have importance 0 leaves ok. False when no lane walks.
-struct BvhLevel {
-  MD walking;
-  VDI c0, c1;
-  VD first;
-};
-bool bvh_level(const Lights& lights, const V3D& p, const V3D& n, VDI node, VD count, MD& ok, BvhLevel& level) {
-  const DD dd;
-  const double* t = lights.bvh_nodes;
-  level.walking = hn::AndNot(bvh_field(dd, t, node, kBvhLeaf) != hn::Zero(dd), ok);
-  if (hn::AllFalse(dd, level.walking)) return false;
-  level.c0 = node + hn::Set(DDI(), 1);
-  level.c1 = hn::IfThenElse(hn::RebindMask(DDI(), level.walking), hn::ConvertTo(DDI(), bvh_field(dd, t, node, kBvhIndex)),
-                            level.c0);
-  MD valid;
-  level.first = bvh_split(dd, bvh_importance(dd, t, level.c0, p, n), bvh_importance(dd, t, level.c1, p, n), count, valid);
-  ok = hn::AndNot(hn::AndNot(valid, level.walking), ok);
-  return true;
-}
-
-// LightBvh::pick for the lanes of `active`: the light grid point k (of
-// `count`) leads to, and its share (0 where the walk ends on two children
-// of importance 0, or the root has none).
-void bvh_pick(const Lights& lights, const V3D& p, const V3D& n, VD k, VD count, MD active, VD& light, VD& share) {
-  const DD dd;
-  VDI node = hn::Zero(DDI());
-  MD ok = hn::And(active, bvh_importance(dd, lights.bvh_nodes, node, p, n) > hn::Zero(dd));
-  for (BvhLevel l; bvh_level(lights, p, n, node, count, ok, l);) {
-    const MD to_first = hn::And(l.walking, k < l.first), to_second = hn::AndNot(k < l.first, l.walking);
-    node = hn::IfThenElse(hn::RebindMask(DDI(), to_first), l.c0, hn::IfThenElse(hn::RebindMask(DDI(), to_second), l.c1, node));
-    k = hn::IfThenElse(to_second, k - l.first, k);  // re-based to the second child's part
-    count = hn::IfThenElse(to_first, l.first, hn::IfThenElse(to_second, count - l.first, count));
-  }
-  light = bvh_field(dd, lights.bvh_nodes, node, kBvhIndex);
-  share = hn::IfThenElseZero(ok, count);
-}
-
-// LightBvh::share: the grid points (of `count`) that lead to `light`, down
-// the light's trail (bit d set: the second child at depth d).
-VD bvh_share(const Lights& lights, const V3D& p, const V3D& n, VD light, VD count, MD active) {
-  const DD dd;
-  const hn::RebindToUnsigned<DD> du64;
-  const VDI light_index = hn::IfThenElseZero(hn::RebindMask(DDI(), active), hn::ConvertTo(DDI(), light));
-  auto trail = hn::GatherIndex(du64, lights.bvh_trail, light_index);
-  VDI node = hn::Zero(DDI());
-  MD ok = hn::And(active, bvh_importance(dd, lights.bvh_nodes, node, p, n) > hn::Zero(dd));
-  for (BvhLevel l; bvh_level(lights, p, n, node, count, ok, l);) {
-    const MD second = hn::RebindMask(dd, hn::And(trail, hn::Set(du64, 1)) != hn::Zero(du64));
-    const MD to_first = hn::AndNot(second, l.walking), to_second = hn::And(l.walking, second);
-    node = hn::IfThenElse(hn::RebindMask(DDI(), to_first), l.c0, hn::IfThenElse(hn::RebindMask(DDI(), to_second), l.c1, node));
-    count = hn::IfThenElse(to_first, l.first, hn::IfThenElse(to_second, count - l.first, count));
-    ok = hn::AndNot(hn::And(l.walking, count == hn::Zero(dd)), ok);
-    trail = hn::IfThenElse(hn::RebindMask(du64, l.walking), hn::ShiftRight<1>(trail), trail);
-  }
-  return hn::IfThenElseZero(ok, count);
 }
 
 // fn(slot, lane) for each lane of m, in lane order (the general materials'
@@ -919,7 +858,8 @@ VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI 
       const VD grid = hn::Set(DD(), static_cast<double>(sc.lights.bvh_grid));
       VD share[2];
       for (int h = 0; h < 2; ++h)
-        share[h] = bvh_share(sc.lights, half_d(qp, h), half_d(qn, h), half_d(tl, h), grid, half_mask(in_tree, h));
+        share[h] = bvh_share(DD(), DDI(), hn::RebindToUnsigned<DD>(), sc.lights.bvh_nodes, sc.lights.bvh_trail,
+                             half_d(qp, h), half_d(qn, h), half_d(tl, h), grid, half_mask(in_tree, h));
       pmf = hn::IfThenElse(in_tree, join_f(share[0], share[1]) * k(0x1p-24f), pmf);
     }
     pdf_zero = pmf == k(0.0f);  // a light the tree gives nothing from here: density 0
@@ -1156,8 +1096,8 @@ VI pick_light(const Scene& sc, VF u_choice, const V3& sp, const V3& n, const V3&
     const V3 qn = facing_normal(df, n, wo);  // light_query's
     VD share[2], tree_light[2];
     for (int h = 0; h < 2; ++h)
-      bvh_pick(lights, half_d(sp, h), half_d(qn, h), grid_k[h], hn::Set(DD(), static_cast<double>(lights.bvh_grid)),
-               half_mask(tree, h), tree_light[h], share[h]);
+      bvh_pick(DD(), DDI(), lights.bvh_nodes, half_d(sp, h), half_d(qn, h), grid_k[h],
+               hn::Set(DD(), static_cast<double>(lights.bvh_grid)), half_mask(tree, h), tree_light[h], share[h]);
     const VF shares = join_f(share[0], share[1]);
     const M tree_ok = hn::And(tree, shares > k(0.0f));
     picked = hn::Or(picked, tree_ok);

@@ -184,7 +184,6 @@ struct WavefrontTracer::VectorStages {
   // What core shades or samples path by path (stages_description): the
   // materials by name, then shapes' shading frames and lights.
   std::vector<std::string> general_materials, general;
-  std::vector<double> bvh_nodes;
   std::vector<std::int32_t> bvh_entry, bvh_light;
 
   // Null, with *why_not saying what stops it, unless the selected SIMD
@@ -394,12 +393,11 @@ struct WavefrontTracer::VectorStages {
         v->general.push_back("the emission textures' reads at light samples");
       }
       if (const LightBvh* bvh = lights.bvh(); bvh && !bvh->empty()) {
-        // The light BVH as the stages walk it (core/simd/light_bvh-inl.h).
-        v->bvh_nodes = bvh->node_table();
+        // The light BVH as core walks it (core/simd/light_bvh-inl.h), in lanes.
         for (std::uint32_t l = 0; l < bvh->trails().size(); ++l)
           v->bvh_entry.push_back(static_cast<std::int32_t>(lights.bvh_entry(l)));
         for (std::size_t e = 0; e < n_lights; ++e) v->bvh_light.push_back(static_cast<std::int32_t>(lights.bvh_light(e)));
-        sc.lights.bvh_nodes = v->bvh_nodes.data();
+        sc.lights.bvh_nodes = bvh->node_table().data();
         sc.lights.bvh_trail = bvh->trails().data();
         sc.lights.bvh_entry = v->bvh_entry.data();
         sc.lights.bvh_light = v->bvh_light.data();

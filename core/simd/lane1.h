@@ -86,6 +86,10 @@ inline M operator==(V<T> a, V<T> b) {
   return {a.raw == b.raw};
 }
 template <typename T>
+inline M operator!=(V<T> a, V<T> b) {
+  return {a.raw != b.raw};
+}
+template <typename T>
 inline M operator>(V<T> a, V<T> b) {
   return {a.raw > b.raw};
 }
@@ -115,8 +119,18 @@ inline V<T> IfThenZeroElse(M m, V<T> no) {
   return m.raw ? V<T>{T(0)} : no;
 }
 inline M And(M a, M b) { return {a.raw && b.raw}; }
+inline M AndNot(M not_a, M b) { return {!not_a.raw && b.raw}; }
 inline M Not(M a) { return {!a.raw}; }
 inline M Or(M a, M b) { return {a.raw || b.raw}; }
+// A mask for lanes of another type: one lane is one lane.
+template <typename T>
+inline M RebindMask(One<T>, M m) {
+  return m;
+}
+template <typename T>
+inline bool AllFalse(One<T>, M m) {
+  return !m.raw;
+}
 
 // x86's maxps/minps, operand order included (see the top of the file).
 inline V<float> Max(V<float> a, V<float> b) { return a.raw > b.raw ? a : b; }
@@ -127,7 +141,6 @@ inline V<double> Sqrt(V<double> a) { return {std::sqrt(a.raw)}; }
 // default rounding mode's nearbyint).
 inline V<float> Round(V<float> a) { return {std::nearbyint(a.raw)}; }
 inline V<float> Floor(V<float> a) { return {std::floor(a.raw)}; }
-inline bool AllFalse(One<float>, M m) { return !m.raw; }
 inline V<float> Abs(V<float> a) { return {std::fabs(a.raw)}; }
 inline V<float> Neg(V<float> a) { return {-a.raw}; }
 inline V<float> CopySign(V<float> magnitude, V<float> sign) { return {std::copysign(magnitude.raw, sign.raw)}; }
@@ -192,6 +205,16 @@ constexpr U64 ShiftLeftSame(U64 a, int bits) { return {a.raw << bits}; }
 constexpr U64 mul_wide32(One<std::uint64_t>, U64 a, U64 b) { return {(a.raw & 0xffffffffu) * (b.raw & 0xffffffffu)}; }
 constexpr U64 mul64(One<std::uint64_t>, U64 z, std::uint64_t c) { return {z.raw * c}; }
 // (The third, permutation_image, is in core/sobol.h, beside its table.)
+
+// 64-bit signed integer lanes: indices into a table (core/simd/light_bvh-inl.h's
+// node indices), converted from doubles by truncation (cvttpd2qq) and read
+// by GatherIndex.
+using I64 = V<std::int64_t>;
+inline I64 ConvertTo(One<std::int64_t>, V<double> v) { return {static_cast<std::int64_t>(v.raw)}; }
+template <typename T>
+inline V<T> GatherIndex(One<T>, const T* base, I64 index) {
+  return {base[index.raw]};
+}
 
 }  // namespace lane1
 }  // namespace pathlab

@@ -16,6 +16,7 @@
 #include "core/simd/lane1.h"
 #include "core/simd/environment-inl.h"
 #include "core/simd/lanes-inl.h"
+#include "core/simd/light_bvh-inl.h"
 #include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"
 #include "core/simd/spherical-inl.h"
