@@ -70,38 +70,41 @@ width1::F3 rotate(const mat3& m, const width1::F3& v) {
 }
 }  // namespace
 
+// lookup and sample are core/simd/environment-inl.h's env_lookup and
+// env_sample_direction (after distribution2d_sample) at width 1, as the
+// wavefront's lanes run them on the same cdfs.
+
 EnvironmentMap::Lookup EnvironmentMap::lookup(const vec3& dir) const {
   using namespace width1;
-  const vec3 local = scalars(rotate(to_local_, lanes(dir)));
-  const glm::ivec2 t = texel_of(direction_to_uv(local));
+  // The cdfs' entries, 0 off the mask (as a masked gather reads).
+  const auto entry = [](std::span<const float> cdf, lane1::M m, F i) {
+    return F{m.raw ? cdf[static_cast<std::size_t>(i.raw)] : 0.0f};
+  };
+  const auto row = [&](lane1::M m, F i) { return entry(distribution_.marginal().cdf(), m, i); };
+  const auto column = [&](lane1::M m, F y, F i) {
+    return entry(distribution_.conditional(static_cast<std::size_t>(y.raw)).cdf(), m, i);
+  };
+  F x, y;
+  const F pdf = generic::env_lookup(kScalar, lane1::M{true}, rotate(to_local_, lanes(dir)), distribution_.width(),
+                                    distribution_.height(), row, column, x, y);
   Lookup out;
-  out.radiance = texels_.at(t.x, t.y);
-  // sin theta from the direction itself, not the texel: the density of the
-  // map's (u, v) -> direction is 1 / (2 pi^2 sin theta) at that point. From
-  // x and z, not 1 - y^2, which is 0 within 3e-4 rad of a pole in float.
-  const float sin_theta = std::sqrt(local.x * local.x + local.z * local.z);
-  out.pdf = generic::env_solid_angle_pdf(
-                kScalar, F{distribution_.pdf(static_cast<std::size_t>(t.x), static_cast<std::size_t>(t.y))},
-                F{sin_theta})
-                .raw;
+  out.radiance = texels_.at(static_cast<int>(x.raw), static_cast<int>(y.raw));
+  out.pdf = pdf.raw;
   return out;
 }
 
 std::optional<EnvironmentMap::Sample> EnvironmentMap::sample(vec2 u) const {
   using namespace width1;
   const Distribution2D::Sample s = distribution_.sample(u);
-  F sin_theta;
-  const F3 local = generic::env_uv_to_direction(kScalar, F{s.p.x}, F{s.p.y}, sin_theta);
-  if (!(s.pdf > 0.0f) || !(sin_theta.raw > 0.0f)) return std::nullopt;
+  lane1::M ok{true};
+  F pdf;
+  const F3 wi = generic::env_sample_direction(kScalar, ok, F{s.p.x}, F{s.p.y}, F{s.pdf}, lanes(to_world_[0]),
+                                              lanes(to_world_[1]), lanes(to_world_[2]), pdf);
+  if (!ok.raw) return std::nullopt;
   Sample out;
-  out.wi = scalars(generic::normalize(kScalar, rotate(to_world_, local)));
-  // The density and radiance of the texel drawn (as pbrt-v4's
-  // ImageInfiniteLight does), not of a lookup of wi: a point drawn within
-  // rounding of a texel's edge can map back into the neighbour, and next to
-  // a sun that neighbour may be black (density 0). They equal pdf(wi) and
-  // radiance(wi) everywhere else.
-  out.pdf = generic::env_solid_angle_pdf(kScalar, F{s.pdf}, sin_theta).raw;
-  if (std::isinf(out.pdf)) return std::nullopt;
+  out.wi = scalars(wi);
+  out.pdf = pdf.raw;
+  // The radiance of the texel drawn (as its density: env_sample_direction).
   out.radiance = texels_.at(static_cast<int>(s.x), static_cast<int>(s.y));
   return out;
 }

@@ -4,8 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace pathlab {
+
+namespace {
+// A cdf's entry i (a whole float) in a lane of m, as the generic code reads
+// it (cdf_sample's cdf_entry; 0 off the mask, as a masked gather reads).
+auto cdf_entries(std::span<const float> cdf) {
+  return [cdf](lane1::M m, width1::F i) { return width1::F{m.raw ? cdf[static_cast<std::size_t>(i.raw)] : 0.0f}; };
+}
+}  // namespace
 
 // The warps are written once for every SIMD width (core/simd/sampling-inl.h)
 // and called here at width 1 (core/simd/width1.h).
@@ -125,19 +134,27 @@ Distribution1D::Distribution1D(std::span<const float> weights) : n_(weights.size
 
 Distribution1D::Sample Distribution1D::sample(float u) const {
   if (!(total_ > 0.0)) return {};
-  // The last i with cdf[i] <= u: a zero-width cell j has cdf[j] == cdf[j + 1],
-  // so whenever cdf[j] <= u the search moves past it. u < 1 = cdf[n].
-  const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
-  const std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - cdf_.begin()) - 1, n_ - 1);
-  // Placed in the cell by where u falls in it (core/simd/sampling-inl.h's
-  // piecewise_point, which the wavefront's lanes run on the same cdf).
+  if (n_ > kMaxExactFloatIndex) {
+    // Beyond the float indices of the generic search (no lane reads a cdf
+    // this long): the last i with cdf[i] <= u, std::upper_bound's answer.
+    const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
+    const std::size_t i = std::min<std::size_t>(static_cast<std::size_t>(it - cdf_.begin()) - 1, n_ - 1);
+    using namespace width1;
+    const F x = generic::piecewise_point(kScalar, F{u}, F{cdf_[i]}, F{cdf_[i + 1]}, F{static_cast<float>(i)},
+                                         F{static_cast<float>(n_)});
+    return {x.raw, pdf(i), i};
+  }
+  // core/simd/lights-inl.h's cdf_sample, which the wavefront's lanes run on
+  // the same cdf.
   using namespace width1;
-  const F x = generic::piecewise_point(kScalar, F{u}, F{cdf_[i]}, F{cdf_[i + 1]}, F{static_cast<float>(i)},
-                                       F{static_cast<float>(n_)});
-  return {x.raw, pdf(i), i};
+  F cell, density;
+  const F x = generic::cdf_sample(kScalar, lane1::M{true}, n_, F{u}, cdf_entries(cdf_), cell, density);
+  return {x.raw, density.raw, static_cast<std::size_t>(cell.raw)};
 }
 
 Distribution2D::Distribution2D(std::span<const float> weights, std::size_t width, std::size_t height) {
+  if (width > kMaxExactFloatIndex || height > kMaxExactFloatIndex)
+    throw std::length_error("Distribution2D: more than 2^24 rows or columns");
   std::vector<float> row_sums(height);
   conditional_.reserve(height);
   for (std::size_t y = 0; y < height; ++y) {
@@ -148,10 +165,18 @@ Distribution2D::Distribution2D(std::span<const float> weights, std::size_t width
 }
 
 Distribution2D::Sample Distribution2D::sample(vec2 u) const {
-  const Distribution1D::Sample row = marginal_.sample(u.y);
-  if (!(row.pdf > 0.0f)) return {};
-  const Distribution1D::Sample col = conditional_[row.cell].sample(u.x);
-  return {vec2(col.x, row.x), row.pdf * col.pdf, col.cell, row.cell};
+  // core/simd/lights-inl.h's distribution2d_sample, as the wavefront's lanes
+  // run it on the same cdfs.
+  using namespace width1;
+  lane1::M ok{true};
+  const auto column_cdf = [this](lane1::M m, F row, F i) {
+    return cdf_entries(conditional_[static_cast<std::size_t>(row.raw)].cdf())(m, i);
+  };
+  F px, py, density, x, y;
+  generic::distribution2d_sample(kScalar, ok, width(), height(), F{u.x}, F{u.y}, cdf_entries(marginal_.cdf()),
+                                 column_cdf, px, py, density, x, y);
+  if (!ok.raw) return {};
+  return {vec2(px.raw, py.raw), density.raw, static_cast<std::size_t>(x.raw), static_cast<std::size_t>(y.raw)};
 }
 
 }  // namespace pathlab

@@ -96,6 +96,8 @@ class Distribution2D {
   Distribution2D() = default;
   Distribution2D(std::span<const float> weights, std::size_t width, std::size_t height);
 
+  std::size_t width() const { return conditional_.empty() ? 0 : conditional_[0].size(); }
+  std::size_t height() const { return marginal_.size(); }
   // Density on [0, 1)^2 in cell (x, y).
   float pdf(std::size_t x, std::size_t y) const { return marginal_.pdf(y) * conditional_[y].pdf(x); }
 
@@ -104,7 +106,8 @@ class Distribution2D {
     float pdf = 0.0f;
     std::size_t x = 0, y = 0;  // its cell
   };
-  // u.y picks the row, u.x the column within it.
+  // u.y picks the row, u.x the column within it (width and height at most
+  // kMaxExactFloatIndex, the generic search's float indices).
   Sample sample(vec2 u) const;
   // The rows' distribution and each row's columns', for code that samples
   // it in bulk (the wavefront's lanes).

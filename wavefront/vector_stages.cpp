@@ -122,17 +122,15 @@ using pathlab::HWY_NAMESPACE::camera_direction;
 using pathlab::HWY_NAMESPACE::CameraPlane;
 using pathlab::HWY_NAMESPACE::concentric_disk;
 using pathlab::HWY_NAMESPACE::delta_light_seen;
+using pathlab::HWY_NAMESPACE::env_sample_direction;
 using pathlab::HWY_NAMESPACE::ClosureLanes;
 using pathlab::HWY_NAMESPACE::dielectric_sample;
+using pathlab::HWY_NAMESPACE::distribution2d_sample;
 using pathlab::HWY_NAMESPACE::disney_eval;
 using pathlab::HWY_NAMESPACE::disney_pdf;
 using pathlab::HWY_NAMESPACE::disney_sample;
 using pathlab::HWY_NAMESPACE::dot;
 using pathlab::HWY_NAMESPACE::emitted_towards;
-using pathlab::HWY_NAMESPACE::env_direction_to_uv;
-using pathlab::HWY_NAMESPACE::env_solid_angle_pdf;
-using pathlab::HWY_NAMESPACE::env_texel;
-using pathlab::HWY_NAMESPACE::env_uv_to_direction;
 using pathlab::HWY_NAMESPACE::facing_normal;
 using pathlab::HWY_NAMESPACE::footprint_width;
 using pathlab::HWY_NAMESPACE::frame;
@@ -151,7 +149,6 @@ using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::place_normal;
 using pathlab::HWY_NAMESPACE::placed_area_scale;
-using pathlab::HWY_NAMESPACE::piecewise_point;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::shading_normal;
 using pathlab::HWY_NAMESPACE::spawn_origin;
@@ -896,61 +893,49 @@ V3 rotate(const float* m, const V3& v) {
                   v.z);
 }
 
-// Cell `at` of a Distribution1D's cdf in the lanes of m: its ends, and its
-// density (Distribution1D::pdf: the step times the cells' count n).
-struct CdfCell {
-  VF lo, hi;
-  VF pdf(VF n) const { return (hi - lo) * n; }
-};
-CdfCell cdf_cell(M m, const float* cdf, VI at) { return {gather(m, cdf, at, 1, 0), gather(m, cdf, at, 1, 1)}; }
-
-// An environment image's texel (x, y): its index among the texels, and
-// where row y's column cdf starts.
+// An environment image's texel (x, y): its index among the texels.
 VI texel_index(const Sky& s, VI x, VI y) { return y * hn::Set(DI(), static_cast<std::int32_t>(s.width)) + x; }
-VI column_cdf_row(const Sky& s, VI y) { return y * hn::Set(DI(), static_cast<std::int32_t>(s.width) + 1); }
 
-// EnvironmentMap::lookup in the lanes of m: the radiance of the texel dir
-// falls in, and the density in solid angle with which the map is sampled
-// there (sin theta from the direction itself).
+// The image sampler's cdfs as the generic code reads them (entry i of the
+// rows', entry i of row y's), gathered in the lanes of m.
+struct SkyCdfs {
+  const Sky& s;
+  VF row(M m, VF i) const { return gather(m, s.row_cdf, hn::ConvertTo(DI(), i), 1, 0); }
+  VF column(M m, VF y, VF i) const {
+    const VI start = hn::ConvertTo(DI(), y) * hn::Set(DI(), static_cast<std::int32_t>(s.width) + 1);
+    return gather(m, s.column_cdf, start + hn::ConvertTo(DI(), i), 1, 0);
+  }
+};
+
+// EnvironmentMap::lookup in the lanes of m (core/simd/environment-inl.h's
+// env_lookup): the radiance of the texel dir falls in, and the density in
+// solid angle with which the map is sampled there.
 void env_lookup(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) {
-  const DF df;
-  const V3 local = rotate(s.to_local, dir);
-  VF u, v;
-  env_direction_to_uv(df, local, u, v);
-  const VI x = hn::ConvertTo(DI(), env_texel(df, u, k(s.width))), y = hn::ConvertTo(DI(), env_texel(df, v, k(s.height)));
-  Le = gather3(m, s.image, texel_index(s, x, y), 3, 0);
-  // Distribution2D::pdf: the row's density times the column's.
-  const VF uv_pdf = cdf_cell(m, s.row_cdf, y).pdf(k(s.height)) * cdf_cell(m, s.column_cdf, column_cdf_row(s, y) + x).pdf(k(s.width));
-  pdf = hn::IfThenElseZero(m, env_solid_angle_pdf(df, uv_pdf, hn::Sqrt(local.x * local.x + local.z * local.z)));
+  const SkyCdfs cdf{s};
+  const auto row = [&](M valid, VF i) { return cdf.row(valid, i); };
+  const auto column = [&](M valid, VF y, VF i) { return cdf.column(valid, y, i); };
+  VF x, y;
+  pdf = pathlab::HWY_NAMESPACE::env_lookup(DF(), m, rotate(s.to_local, dir), static_cast<std::size_t>(s.width),
+                                           static_cast<std::size_t>(s.height), row, column, x, y);
+  pdf = hn::IfThenElseZero(m, pdf);
+  Le = gather3(m, s.image, texel_index(s, hn::ConvertTo(DI(), x), hn::ConvertTo(DI(), y)), 3, 0);
 }
 
-// EnvironmentMap::sample in the lanes of ok (u = (ux, uy)): Distribution2D::
-// sample (uy the row, ux the column in it: pick_cdf over each cdf's upper
-// ends, then piecewise_point), the direction of the point drawn, and the
-// radiance and density of the texel drawn; the lanes it gives none leave ok.
+// EnvironmentMap::sample in the lanes of ok (u = (ux, uy)):
+// distribution2d_sample and env_sample_direction (core/simd/), and the
+// radiance of the texel drawn; the lanes it gives none leave ok.
 void env_sample(const Sky& s, VF ux, VF uy, M& ok, V3& wi, V3& Le, VF& pdf) {
   const DF df;
-  const auto row_cdf = [&](M valid, VF i) { return gather(valid, s.row_cdf, hn::ConvertTo(DI(), i), 1, 1); };
-  const VF y = pick_cdf(df, ok, static_cast<std::size_t>(s.height), uy, row_cdf);
-  const VI yi = hn::ConvertTo(DI(), y);
-  const CdfCell row_cell = cdf_cell(ok, s.row_cdf, yi);
-  const VF row_pdf = row_cell.pdf(k(s.height));
-  const VF py = piecewise_point(df, uy, row_cell.lo, row_cell.hi, y, k(s.height));
-  ok = hn::And(ok, row_pdf > k(0.0f));
-  const VI row = column_cdf_row(s, yi);
-  const auto column_cdf = [&](M valid, VF i) { return gather(valid, s.column_cdf, row + hn::ConvertTo(DI(), i), 1, 1); };
-  const VF x = pick_cdf(df, ok, static_cast<std::size_t>(s.width), ux, column_cdf);
-  const VI xi = hn::ConvertTo(DI(), x);
-  const CdfCell column_cell = cdf_cell(ok, s.column_cdf, row + xi);
-  const VF px = piecewise_point(df, ux, column_cell.lo, column_cell.hi, x, k(s.width));
-  const VF uv_pdf = row_pdf * column_cell.pdf(k(s.width));
-  VF sin_theta;
-  const V3 local = env_uv_to_direction(df, px, py, sin_theta);
-  ok = hn::And(ok, hn::And(uv_pdf > k(0.0f), sin_theta > k(0.0f)));
-  wi = normalize(df, rotate(s.to_world, local));
-  pdf = env_solid_angle_pdf(df, uv_pdf, sin_theta);
-  ok = hn::AndNot(hn::IsInf(pdf), ok);
-  Le = gather3(ok, s.image, texel_index(s, xi, yi), 3, 0);
+  const SkyCdfs cdf{s};
+  const auto row = [&](M valid, VF i) { return cdf.row(valid, i); };
+  const auto column = [&](M valid, VF y, VF i) { return cdf.column(valid, y, i); };
+  VF px, py, uv_pdf, x, y;
+  distribution2d_sample(df, ok, static_cast<std::size_t>(s.width), static_cast<std::size_t>(s.height), ux, uy, row,
+                        column, px, py, uv_pdf, x, y);
+  wi = env_sample_direction(df, ok, px, py, uv_pdf, splat3(df, s.to_world[0], s.to_world[1], s.to_world[2]),
+                            splat3(df, s.to_world[3], s.to_world[4], s.to_world[5]),
+                            splat3(df, s.to_world[6], s.to_world[7], s.to_world[8]), pdf);
+  Le = gather3(ok, s.image, texel_index(s, hn::ConvertTo(DI(), x), hn::ConvertTo(DI(), y)), 3, 0);
 }
 
 // The sun disks' radiance and density along dir added to Le and pdf.

@@ -20,6 +20,7 @@
 #include "core/math.h"
 #include "core/simd/lane1.h"
 #include "core/simd/lanes-inl.h"
+#include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"
 
 HWY_BEFORE_NAMESPACE();
@@ -62,6 +63,42 @@ HWY_INLINE V env_texel(D d, V uv, V size) {
 template <class D, class V = VecOf<D>>
 HWY_INLINE V env_solid_angle_pdf(D d, V uv_pdf, V sin_theta) {
   return IfThenElseZero(sin_theta > Zero(d), uv_pdf / (Set(d, 2.0f * kPi * kPi) * sin_theta));
+}
+
+// EnvironmentMap::lookup: the texel (x, y) of a direction in the map's
+// frame among width x height (whole floats), and the density in solid
+// angle with which the map samples it: Distribution2D::pdf of that cell
+// (row_cdf(m, i), column_cdf(m, row, i), as distribution2d_sample reads
+// them) at sin theta from the direction itself, not the texel.
+template <class D, class M, class RowCdf, class ColumnCdf, class V = VecOf<D>>
+HWY_INLINE V env_lookup(D d, M m, const Vec3<V>& local, std::size_t width, std::size_t height,
+                        const RowCdf& row_cdf, const ColumnCdf& column_cdf, V& x, V& y) {
+  V u, v;
+  env_direction_to_uv(d, local, u, v);
+  x = env_texel(d, u, Set(d, static_cast<float>(width)));
+  y = env_texel(d, v, Set(d, static_cast<float>(height)));
+  const auto row = [&](M valid, V i) { return column_cdf(valid, y, i); };
+  const V uv_pdf = cdf_density(d, m, height, row_cdf, y) * cdf_density(d, m, width, row, x);
+  // From x and z, not 1 - y^2, which is 0 within 3e-4 rad of a pole in float.
+  return env_solid_angle_pdf(d, uv_pdf, Sqrt(local.x * local.x + local.z * local.z));
+}
+
+// EnvironmentMap::sample's direction (turned into the world by the columns
+// c0, c1, c2) for the point (px, py) that distribution2d_sample drew with
+// density uv_pdf, and its density in solid angle (the texel drawn's, as
+// pbrt-v4's ImageInfiniteLight: a point within rounding of a texel's edge
+// can map back into its neighbour). Lanes where either density is 0 or
+// infinite, or the point is a pole, leave ok.
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE Vec3<V> env_sample_direction(D d, M& ok, V px, V py, V uv_pdf, const Vec3<V>& c0, const Vec3<V>& c1,
+                                        const Vec3<V>& c2, V& pdf) {
+  V sin_theta;
+  const Vec3<V> local = env_uv_to_direction(d, px, py, sin_theta);
+  ok = And(ok, And(uv_pdf > Zero(d), sin_theta > Zero(d)));
+  const Vec3<V> wi = normalize(d, to_world(c0, c1, c2, local.x, local.y, local.z));
+  pdf = env_solid_angle_pdf(d, uv_pdf, sin_theta);
+  ok = And(ok, Not(IsInf(pdf)));
+  return wi;
 }
 
 // A sphere's texture coordinates at the direction `dir` from its centre (in

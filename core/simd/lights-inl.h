@@ -1,5 +1,6 @@
 // LightSampler's steps (core/light_sampler.cpp) written once over Highway's
-// vectors: the pick from a cdf, what an area light's point gives a shading
+// vectors: the pick from a cdf (and a piecewise-constant density's samples,
+// Distribution1D and Distribution2D, core/sampling.cpp), what an area light's point gives a shading
 // point (direction, distance, density), and what a delta light does. core/light_sampler.cpp calls
 // them at width 1 (core/simd/width1.h) for both tracers' scalar code, the
 // wavefront's vectorised stages at their SIMD width.
@@ -42,6 +43,43 @@ HWY_INLINE V pick_cdf(D d, M m, std::size_t count, V u, const Lookup& cdf_at) {
     idx = IfThenElse(And(valid, Not(u < cdf_at(valid, cand - Set(d, 1.0f)))), cand, idx);
   }
   return Min(idx, Set(d, static_cast<float>(count - 1)));
+}
+
+// A piecewise-constant density's cdf (Distribution1D, core/sampling.h): count
+// cells, count + 1 entries from 0 to 1, entry i read by cdf_entry(m, i) (i a
+// whole float; the caller's table lookup).
+//
+// cdf_density: the density of cell `cell`, its step times count
+// (Distribution1D::pdf).
+template <class D, class M, class Lookup, class V = VecOf<D>>
+HWY_INLINE V cdf_density(D d, M m, std::size_t count, const Lookup& cdf_entry, V cell) {
+  return (cdf_entry(m, cell + Set(d, 1.0f)) - cdf_entry(m, cell)) * Set(d, static_cast<float>(count));
+}
+// cdf_sample (Distribution1D::sample): the cell u falls in (pick_cdf over
+// the cells' upper ends; zero-width cells skipped), its density, and the
+// point placed in it by where u falls (piecewise_point).
+template <class D, class M, class Lookup, class V = VecOf<D>>
+HWY_INLINE V cdf_sample(D d, M m, std::size_t count, V u, const Lookup& cdf_entry, V& cell, V& pdf) {
+  const V one = Set(d, 1.0f), n = Set(d, static_cast<float>(count));
+  cell = pick_cdf(d, m, count, u, [&](M valid, V i) { return cdf_entry(valid, i + one); });
+  const V lo = cdf_entry(m, cell), hi = cdf_entry(m, cell + one);
+  pdf = (hi - lo) * n;
+  return piecewise_point(d, u, lo, hi, cell, n);
+}
+// Distribution2D::sample: the row by uy from the rows' cdf (row_cdf(m, i)),
+// then the column by ux from that row's cdf (column_cdf(m, row, i)); the
+// point (px, py), its density (the row's times the column's) and its cell
+// (x, y). Lanes whose row has density 0 leave ok.
+template <class D, class M, class RowCdf, class ColumnCdf, class V = VecOf<D>>
+HWY_INLINE void distribution2d_sample(D d, M& ok, std::size_t width, std::size_t height, V ux, V uy,
+                                      const RowCdf& row_cdf, const ColumnCdf& column_cdf, V& px, V& py, V& pdf, V& x,
+                                      V& y) {
+  V row_pdf, column_pdf;
+  py = cdf_sample(d, ok, height, uy, row_cdf, y, row_pdf);
+  ok = And(ok, row_pdf > Zero(d));
+  const auto row = [&](M valid, V i) { return column_cdf(valid, y, i); };
+  px = cdf_sample(d, ok, width, ux, row, x, column_pdf);
+  pdf = row_pdf * column_pdf;
 }
 
 // An area light's point lp (normal ln) seen from ref: the direction wi, the
