@@ -5,8 +5,10 @@
 #include "core/scene_limits.h"
 #include "core/simd/width1.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -79,6 +81,10 @@ bool placed_in_range(const Box& box, const mat4& to_world) {
   return true;
 }
 
+namespace {
+double max_abs(const dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
+}  // namespace
+
 void check_scene_range(const Scene& scene) {
   const std::string file = scene.file.empty() ? "<built-in " + scene.name + ">" : scene.file.string();
   const std::string limit = " (the limit is 1e16 in each coordinate, so that every ray stays within Embree's 1.8e18)";
@@ -101,13 +107,44 @@ void check_scene_range(const Scene& scene) {
       if (!within_scene_range(s.mesh.positions[v]))
         fail(s.description + ": vertex " + std::to_string(v) + " lies beyond the scene coordinate limit");
   }
+  for (const DeltaLight& l : scene.delta_lights)
+    if (l.kind != DeltaLight::Kind::Directional && !within_scene_range(l.position)) fail("a light's position lies beyond the scene coordinate limit");
+  // Where rays start: the camera's lens, and points of the scene's surfaces
+  // and lights (every ray direction is a unit vector).
+  double reach = std::max(0.0, max_abs(dvec3(c.position)) + double(c.aperture_radius));
+  const auto reach_box = [&reach](const Box& b) {
+    if (!b.empty()) reach = std::max({reach, max_abs(dvec3(b.lo)), max_abs(dvec3(b.hi))});
+  };
+  for (const Shape& s : scene.shapes)
+    if (!s.in_group) reach_box(bounds(s));
   for (const Instance& i : scene.instances) {
     Box box;
     for (const std::uint32_t id : scene.groups[i.group].shapes) box.add(bounds(scene.shapes[id]));
     if (!placed_in_range(box, i.to_world)) fail(i.description + ": the instance lies beyond the scene coordinate limit");
+    reach_box(placed(box, i.to_world));
   }
   for (const DeltaLight& l : scene.delta_lights)
-    if (l.kind != DeltaLight::Kind::Directional && !within_scene_range(l.position)) fail("a light's position lies beyond the scene coordinate limit");
+    if (l.kind != DeltaLight::Kind::Directional) reach = std::max(reach, max_abs(dvec3(l.position)));
+  // Embree carries every ray into an instance's space (the inverse placement:
+  // origin L^-1 (o - t), direction L^-1 d) and tests it there against the
+  // same bound, so a placement that shrinks its group a great deal blows the
+  // scene's rays up beyond it. Keep them within kMaxSceneCoordinate there
+  // too: |L^-1|_inf (the largest absolute row sum) times the reach of an
+  // origin (and times 1, a unit direction's).
+  for (const Instance& i : scene.instances) {
+    const glm::dmat3 inverse = glm::inverse(glm::dmat3(mat3(i.to_world)));
+    double norm = 0.0;
+    for (int r = 0; r < 3; ++r)
+      norm = std::max(norm, std::abs(inverse[0][r]) + std::abs(inverse[1][r]) + std::abs(inverse[2][r]));
+    const double local = norm * std::max(1.0, reach + max_abs(dvec3(i.to_world[3])));
+    if (!(local <= double(kMaxSceneCoordinate))) {
+      std::ostringstream m;
+      m << i.description << ": the placement shrinks its group so much that a ray of the scene, carried into the "
+        << "group's space as Embree does, would reach " << local << " (inverse placement's row sum " << norm
+        << ", rays start up to " << reach << " from the origin); scale the group's content instead";
+      fail(m.str());
+    }
+  }
 }
 
 bool invertible_placement(const mat4& to_world) {

@@ -846,6 +846,19 @@ TEST_F(BadInput, SingularOrHugeInstanceTransform) {
   expect_rejected(render(write("both.json", both)), {"both.json:", "/instances/0", "exactly one of 'transform'"});
 }
 
+// Embree tests a ray in an instance's space, where a placement that shrinks
+// its group 1e18 times makes the scene's rays 1e18 times longer: that used to
+// abort the process on Embree's ray.valid() assertion. A shrink by 1e-6 is fine.
+TEST_F(BadInput, InstanceShrinkingItsGroupBeyondEmbreesRange) {
+  const std::string tiny = scene(kMaterials, kLamp, kGroup + ",\n  \"instances\": [{\"group\": \"ball\", \"transform\": "
+                                                      "{\"scale\": [1e-18, 1, 1]}}]");
+  expect_rejected(render(write("tiny.json", tiny)), {"tiny.json:", "instances[0] (ball)", "shrinks its group", "would reach"});
+  const std::string small = scene(kMaterials, kLamp, kGroup + ",\n  \"instances\": [{\"group\": \"ball\", \"transform\": "
+                                                       "{\"scale\": [1e-6, 1, 1]}}]");
+  const CliResult r = render(write("small.json", small));
+  EXPECT_EQ(r.code, 0) << r.err;
+}
+
 TEST_F(BadInput, GroupNeverPlacedIsAWarning) {
   const std::string text = scene(kMaterials, kSphere + ",\n" + kLamp, kGroup);
   expect_warned_and_rendered(render(write("unplaced.json", text)), {"/groups/ball", "never placed"});
