@@ -347,9 +347,9 @@ mat4 local_transform(const tinygltf::Node& node) {
   if (node.translation.size() == 3)
     m = glm::translate(m, vec3(static_cast<float>(node.translation[0]), static_cast<float>(node.translation[1]),
                                static_cast<float>(node.translation[2])));
-  if (node.rotation.size() == 4)
-    m = m * glm::mat4_cast(glm::normalize(glm::quat(static_cast<float>(node.rotation[3]), static_cast<float>(node.rotation[0]),
-                                                    static_cast<float>(node.rotation[1]), static_cast<float>(node.rotation[2]))));
+  if (node.rotation.size() == 4)  // normalised in double: a long finite quaternion overflows a float's length
+    m = m * glm::mat4_cast(glm::quat(glm::normalize(
+                glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]))));
   if (node.scale.size() == 3)
     m = glm::scale(m, vec3(static_cast<float>(node.scale[0]), static_cast<float>(node.scale[1]), static_cast<float>(node.scale[2])));
   return m;

@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <limits>
 #include <system_error>
+#include <vector>
 
 namespace pathlab::gltf {
 
@@ -94,6 +96,44 @@ class Checker {
       fail_at(ptr + "/" + key, "no " + std::string(what) + " " + std::to_string(i) + " (the file has " +
                                    std::to_string(n) + ")");
     return static_cast<std::int64_t>(i);
+  }
+
+  // An array member of exactly n finite numbers (absent: empty).
+  std::vector<double> numbers(const json& o, const std::string& ptr, const std::string& key, std::size_t n) const {
+    if (!o.contains(key)) return {};
+    const json& v = o[key];
+    if (!v.is_array() || v.size() != n)
+      fail_at(ptr + "/" + key, "expected an array of " + std::to_string(n) + " numbers, found " + v.dump().substr(0, 60));
+    std::vector<double> out;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (!v[k].is_number() || !std::isfinite(v[k].get<double>()))
+        fail_at(ptr + "/" + key + "/" + std::to_string(k), "expected a finite number, found " + v[k].dump().substr(0, 40));
+      out.push_back(v[k].get<double>());
+    }
+    return out;
+  }
+  // A node's transform: a 16-number affine `matrix` (column-major, last row
+  // 0 0 0 1) or any of `translation` (3), `rotation` (a quaternion x y z w
+  // of non-zero length) and `scale` (3), never both kinds (glTF 2.0, 5.25).
+  // A malformed one would otherwise be dropped and the mesh placed as if
+  // it had none.
+  void node_transform(const json& node, const std::string& ptr) const {
+    if (!node.is_object()) fail_at(ptr, "expected an object");
+    const std::vector<double> matrix = numbers(node, ptr, "matrix", 16);
+    const std::vector<double> rotation = numbers(node, ptr, "rotation", 4);
+    const bool translation = !numbers(node, ptr, "translation", 3).empty();
+    const bool scale = !numbers(node, ptr, "scale", 3).empty();
+    const bool trs = translation || !rotation.empty() || scale;
+    if (!matrix.empty() && trs) fail_at(ptr, "a node has either 'matrix' or 'translation', 'rotation' and 'scale', not both");
+    if (!matrix.empty() && (matrix[3] != 0.0 || matrix[7] != 0.0 || matrix[11] != 0.0 || matrix[15] != 1.0))
+      fail_at(ptr + "/matrix", "not an affine transform: its last row (elements 3, 7, 11, 15) must be 0, 0, 0, 1");
+    if (!rotation.empty()) {
+      const double length = std::sqrt(rotation[0] * rotation[0] + rotation[1] * rotation[1] +
+                                      rotation[2] * rotation[2] + rotation[3] * rotation[3]);
+      if (!(length > 0.0) || !std::isfinite(length))
+        fail_at(ptr + "/rotation", "a rotation is a unit quaternion; this one has no direction: " +
+                                       node["rotation"].dump().substr(0, 60));
+    }
   }
 
   std::set<std::filesystem::path> buffers(const Container& c);
@@ -267,6 +307,7 @@ void Checker::nodes_and_scenes() {
     const std::string ptr = "/nodes/" + std::to_string(i);
     index(nodes[i], ptr, "mesh", count("meshes"), "mesh");
     index(nodes[i], ptr, "camera", count("cameras"), "camera");
+    node_transform(nodes[i], ptr);
     if (nodes[i].contains("extensions") && nodes[i]["extensions"].contains("KHR_lights_punctual"))
       index(nodes[i]["extensions"]["KHR_lights_punctual"], ptr + "/extensions/KHR_lights_punctual", "light", lights,
             "light", true);

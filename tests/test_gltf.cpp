@@ -773,6 +773,46 @@ TEST_F(Gltf, SingularPlacementsAreCopiesAndOverflowIsRefused) {
   EXPECT_NE(error.find("huge.gltf: /nodes/2: the transform moves vertices beyond the scene coordinate limit 1e16"), std::string::npos) << error;
 }
 
+// A node's transform that glTF does not allow is an error naming it: it used
+// to be dropped (tinygltf leaves a malformed array empty) and the mesh placed
+// as if it had none. A long but finite quaternion is normalised (in double).
+TEST_F(Gltf, MalformedNodeTransformsAreRefused) {
+  const auto error_with = [this](const nlohmann::json& node) {
+    GltfWriter w;
+    add_pyramid(w, -1);
+    w.doc["meshes"][0]["primitives"][0].erase("material");
+    w.node(node);
+    return error_of(w, "bad.gltf");
+  };
+  const std::pair<nlohmann::json, std::string> cases[] = {
+      {{{"mesh", 0}, {"matrix", {1, 0, 0}}}, "/nodes/0/matrix: expected an array of 16 numbers"},
+      {{{"mesh", 0}, {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.5, 0, 0, "x"}}}, "/nodes/0/matrix/15: expected a finite number"},
+      {{{"mesh", 0}, {"matrix", {1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 2}}}, "/nodes/0/matrix: not an affine transform"},
+      {{{"mesh", 0}, {"translation", {0.5, 0}}}, "/nodes/0/translation: expected an array of 3 numbers"},
+      {{{"mesh", 0}, {"scale", {1, "2", 1}}}, "/nodes/0/scale/1: expected a finite number"},
+      {{{"mesh", 0}, {"rotation", {0, 0, 0, 0}}}, "/nodes/0/rotation: a rotation is a unit quaternion"},
+      {{{"mesh", 0}, {"translation", {1, 0, 0}}, {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}},
+       "/nodes/0: a node has either 'matrix' or"},
+  };
+  for (const auto& [node, expected] : cases) {
+    const std::string error = error_with(node);
+    EXPECT_NE(error.find("bad.gltf: " + expected), std::string::npos) << node.dump() << "\n" << error;
+  }
+  const auto placed_by = [&](const json& rotation, const std::string& name) {
+    GltfWriter w;
+    add_pyramid(w, -1);
+    w.doc["meshes"][0]["primitives"][0].erase("material");
+    w.node({{"mesh", 0}, {"rotation", rotation}});
+    const GltfContent c = load_all(w, name);
+    EXPECT_EQ(c.primitives.size(), 1u);
+    return c.primitives.empty() ? std::vector<vec3>{} : c.primitives[0].mesh.positions;
+  };
+  const double h = std::sqrt(0.5);
+  const std::vector<vec3> unit = placed_by({h, 0, 0, h}, "unit"), long_ = placed_by({1e30, 0, 0, 1e30}, "long");
+  ASSERT_EQ(unit.size(), long_.size());
+  for (std::size_t i = 0; i < unit.size(); ++i) EXPECT_LT(glm::length(unit[i] - long_[i]), 1e-6f) << i;
+}
+
 // The same file instanced and with flattening forced renders the same image
 // with the same seed, up to float rounding of the hit points: the mirror,
 // the parent and the scene transform must all reach the instances. Smooth
