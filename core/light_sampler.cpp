@@ -221,17 +221,23 @@ std::optional<LightSampler::Pick> LightSampler::pick(const LightQuery& ref, floa
     const std::size_t i = pick(cdf_, u_choice);
     return Pick{i, pmf_[i]};
   }
-  // The grid point of u (a multiple of 2^-24: core/rng.h).
-  const double scaled = std::floor(static_cast<double>(u_choice) * double(kGrid));
-  const std::uint32_t k = static_cast<std::uint32_t>(std::clamp(scaled, 0.0, double(kGrid - 1)));
+  // The grid point of u and, past the tree's, the sky's entry that holds
+  // it: core/simd/lights-inl.h's light_grid_point and sky_entry_of at
+  // width 1, as the wavefront's lanes pick.
+  using namespace width1;
+  const std::uint32_t k =
+      static_cast<std::uint32_t>(generic::light_grid_point(kScalarD, D1{static_cast<double>(u_choice)}).raw);
   const std::uint32_t tree_count = sky_start_[0];
   if (k < tree_count) {
     const std::optional<LightBvh::Pick> p = bvh_->pick(ref, k, tree_count);
     if (!p) return std::nullopt;
     return Pick{tree_entry_[p->light], static_cast<float>(p->share) * 0x1p-24f};
   }
-  const std::size_t j =
-      static_cast<std::size_t>(std::upper_bound(sky_start_.begin(), sky_start_.end(), k) - sky_start_.begin()) - 1;
+  const auto starts = [this](lane1::M m, F i) {
+    return F{m.raw ? static_cast<float>(sky_start_[static_cast<std::size_t>(i.raw)]) : 0.0f};
+  };
+  const auto j = static_cast<std::size_t>(
+      generic::sky_entry_of(kScalar, lane1::M{true}, sky_entry_.size(), F{static_cast<float>(k)}, starts).raw);
   return Pick{sky_entry_[j], pmf_[sky_entry_[j]]};
 }
 

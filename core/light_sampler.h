@@ -214,6 +214,9 @@ class LightSampler {
     Triangle triangle;  // the emitting triangle (unused for a sphere or the environment)
   };
   std::span<const Entry> entries() const { return entries_; }
+  // The density of entry e's points, uniform in area: 1 / area (the
+  // wavefront's lanes read it from a table of these).
+  static float area_density(const Entry& e);
   std::span<const float> cdf() const { return cdf_; }
   std::span<const float> pmf() const { return pmf_; }
   // True if an environment or a sun disk is sampled (a light escaping rays find).
@@ -266,8 +269,6 @@ class LightSampler {
     SphereCone cone;       // a sphere's cone
   };
   SolidAngleView solid_angle_view(const Entry& e, const vec3& ref) const;
-  static float area_density(const Entry& e);  // 1 / area
-
   // Adds the radiance and density (with its pick probability) of every sun
   // disk whose cone holds `dir`.
   void add_suns(const vec3& dir, Spectrum* Le, float* pdf) const;

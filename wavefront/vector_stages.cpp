@@ -146,7 +146,9 @@ using pathlab::HWY_NAMESPACE::NoEnergy;
 using pathlab::HWY_NAMESPACE::opposite_sides;
 using pathlab::HWY_NAMESPACE::normal_map_frame;
 using pathlab::HWY_NAMESPACE::normalize;
+using pathlab::HWY_NAMESPACE::light_grid_point;
 using pathlab::HWY_NAMESPACE::pick_cdf;
+using pathlab::HWY_NAMESPACE::sky_entry_of;
 using pathlab::HWY_NAMESPACE::place_normal;
 using pathlab::HWY_NAMESPACE::placed_area_scale;
 using pathlab::HWY_NAMESPACE::select;
@@ -1065,11 +1067,7 @@ VI pick_light(const Scene& sc, VF u_choice, const V3& sp, const V3& n, const V3&
   // light_query(s, wo) below bvh_grid, else picks the sky's entry j with
   // k in [starts[j], starts[j + 1]).
   VD grid_k[2];
-  for (int h = 0; h < 2; ++h) {
-    const VD scaled = hn::Floor(half_d(u_choice, h) * hn::Set(DD(), 0x1p24));
-    grid_k[h] = hn::IfThenElse(scaled < hn::Zero(DD()), hn::Zero(DD()),
-                               hn::IfThenElse(hn::Set(DD(), 0x1p24 - 1) < scaled, hn::Set(DD(), 0x1p24 - 1), scaled));
-  }
+  for (int h = 0; h < 2; ++h) grid_k[h] = light_grid_point(DD(), half_d(u_choice, h));
   const VF grid_point = join_f(grid_k[0], grid_k[1]);  // exact: below 2^24
   const M tree = lights.bvh_nodes ? hn::And(ok, grid_point < k(static_cast<float>(lights.bvh_grid))) : hn::FirstN(df, 0);
   // Without a sky the grid is the tree's (an empty tree picks nothing, as LightBvh::pick).
@@ -1091,10 +1089,10 @@ VI pick_light(const Scene& sc, VF u_choice, const V3& sp, const V3& n, const V3&
     light = hn::IfThenElseZero(hn::RebindMask(DI(), tree_ok), hn::GatherIndex(DI(), lights.bvh_entry, tl));
   }
   if (!hn::AllFalse(df, sky)) {
-    // upper_bound(starts, k) - 1: the last j whose start k is not below.
     const Sky& s = sc.skies;
-    VF entry = k(s.entries[0]);
-    for (std::size_t j = 1; j < s.count; ++j) entry = hn::IfThenElse(grid_point < k(s.starts[j]), entry, k(s.entries[j]));
+    const auto starts = [&](M valid, VF i) { return gather(valid, s.starts, hn::ConvertTo(DI(), i), 1, 0); };
+    const VI j = hn::ConvertTo(DI(), sky_entry_of(df, sky, s.count, grid_point, starts));
+    const VF entry = gather(sky, s.entries, j, 1, 0);
     light = hn::IfThenElse(hn::RebindMask(DI(), sky), hn::ConvertTo(DI(), entry), light);
     pmf = hn::IfThenElse(sky, light_value(sky, lights, light, kLightPmf), pmf);
   }

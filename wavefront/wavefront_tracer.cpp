@@ -371,7 +371,7 @@ struct WavefrontTracer::VectorStages {
         v->light_sphere.push_back(sphere ? 1.0f : 0.0f);
         v->light_textured.push_back(m.emission_textured ? 1.0f : 0.0f);
         v->light_triangle.push_back(m.two_sided_emission ? 1.0f : 0.0f);
-        v->inv_area.push_back(1.0f / e.area);
+        v->inv_area.push_back(LightSampler::area_density(e));
       }
       const std::size_t n_lights = lights.entries().size();
       if (n_lights >= 1 && n_lights <= 16) {  // small enough to keep by column

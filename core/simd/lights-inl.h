@@ -45,6 +45,23 @@ HWY_INLINE V pick_cdf(D d, M m, std::size_t count, V u, const Lookup& cdf_at) {
   return Min(idx, Set(d, static_cast<float>(count - 1)));
 }
 
+// LightSampler::pick under the light BVH: the grid point of a LightChoice
+// number u (a multiple of 2^-24, core/rng.h), floor(u 2^24) clamped to
+// [0, 2^24 - 1] as std::clamp does, a whole number in a double.
+template <class DD, class VD = VecOf<DD>>
+HWY_INLINE VD light_grid_point(DD dd, VD u) {
+  const VD scaled = Floor(u * Set(dd, 0x1p24));
+  return IfThenElse(scaled < Zero(dd), Zero(dd), IfThenElse(Set(dd, 0x1p24 - 1) < scaled, Set(dd, 0x1p24 - 1), scaled));
+}
+// ... and past the tree's grid points: the sky entry j whose grid points
+// [start j, start j + 1) hold the grid point k (a whole float), the last j
+// whose start k is not below (std::upper_bound - 1), by pick_cdf over the
+// upper ends of `count` entries; starts(m, i) reads start i.
+template <class D, class M, class Lookup, class V = VecOf<D>>
+HWY_INLINE V sky_entry_of(D d, M m, std::size_t count, V k, const Lookup& starts) {
+  return pick_cdf(d, m, count, k, [&](M valid, V i) { return starts(valid, i + Set(d, 1.0f)); });
+}
+
 // A piecewise-constant density's cdf (Distribution1D, core/sampling.h): count
 // cells, count + 1 entries from 0 to 1, entry i read by cdf_entry(m, i) (i a
 // whole float; the caller's table lookup).
