@@ -89,16 +89,24 @@ LightBounds merge(const LightBounds& a, const LightBounds& b) {
   return out;
 }
 
+namespace {
+constexpr lane1::One<std::int64_t> kIndex{};     // a node's index
+constexpr lane1::One<std::uint64_t> kTrail{};    // a light's trail
+
+width1::generic::BvhBounds<width1::D1, lane1::M> bounds_of(const LightBounds& b) {
+  using namespace width1;
+  return {lanes(dvec3(b.lo)), lanes(dvec3(b.hi)), lanes(dvec3(b.axis)), D1{b.cos_o}, D1{b.cos_e}, D1{b.phi},
+          lane1::M{b.two_sided}};
+}
+}  // namespace
+
 // importance, split, pick and share are core/simd/light_bvh-inl.h's generic
 // code at width 1: the wavefront's vectorised stages walk the same source
 // in double lanes.
 
 double importance(const LightBounds& b, const LightQuery& q) {
   using namespace width1;
-  const generic::BvhBounds<D1, lane1::M> bounds{lanes(dvec3(b.lo)), lanes(dvec3(b.hi)), lanes(dvec3(b.axis)),
-                                                 D1{b.cos_o},        D1{b.cos_e},        D1{b.phi},
-                                                 lane1::M{b.two_sided}};
-  return generic::bvh_importance(kScalarD, bounds, lanes(dvec3(q.p)), lanes(dvec3(q.n))).raw;
+  return generic::bvh_importance(kScalarD, bounds_of(b), lanes(dvec3(q.p)), lanes(dvec3(q.n))).raw;
 }
 
 std::optional<std::uint32_t> LightBvh::split(double i0, double i1, std::uint32_t count) {
@@ -208,16 +216,25 @@ LightBounds LightBvh::build(std::vector<std::uint32_t>& order, std::vector<Light
   return both;
 }
 
-namespace {
-constexpr lane1::One<std::int64_t> kIndex{};     // a node's index
-constexpr lane1::One<std::uint64_t> kTrail{};    // a light's trail
-}  // namespace
+
+// The walks' Tree (core/simd/light_bvh-inl.h's BvhTable reads the same from
+// node_table() in the lanes): the nodes themselves, whose floats the table
+// holds as doubles.
+struct LightBvh::Nodes {
+  const std::vector<Node>& nodes;
+  width1::D1 importance(lane1::I64 node, const width1::D3& p, const width1::D3& n) const {
+    return width1::generic::bvh_importance(width1::kScalarD, bounds_of(nodes[static_cast<std::size_t>(node.raw)].bounds),
+                                           p, n);
+  }
+  width1::D1 leaf(lane1::I64 node) const { return {nodes[static_cast<std::size_t>(node.raw)].leaf ? 1.0 : 0.0}; }
+  width1::D1 index(lane1::I64 node) const { return {double(nodes[static_cast<std::size_t>(node.raw)].index)}; }
+};
 
 std::optional<LightBvh::Pick> LightBvh::pick(const LightQuery& q, std::uint32_t k, std::uint32_t count) const {
   if (nodes_.empty() || k >= count) return std::nullopt;
   using namespace width1;
   D1 light, share;
-  generic::bvh_pick(kScalarD, kIndex, table_.data(), lanes(dvec3(q.p)), lanes(dvec3(q.n)), D1{double(k)},
+  generic::bvh_pick(kScalarD, kIndex, Nodes{nodes_}, lanes(dvec3(q.p)), lanes(dvec3(q.n)), D1{double(k)},
                     D1{double(count)}, lane1::M{true}, light, share);
   if (!(share.raw > 0.0)) return std::nullopt;
   return Pick{static_cast<std::uint32_t>(light.raw), static_cast<std::uint32_t>(share.raw)};
@@ -226,7 +243,7 @@ std::optional<LightBvh::Pick> LightBvh::pick(const LightQuery& q, std::uint32_t 
 std::uint32_t LightBvh::share(const LightQuery& q, std::uint32_t light, std::uint32_t count) const {
   if (nodes_.empty() || light >= trail_.size() || count == 0) return 0;
   using namespace width1;
-  const D1 share = generic::bvh_share(kScalarD, kIndex, kTrail, table_.data(), trail_.data(), lanes(dvec3(q.p)),
+  const D1 share = generic::bvh_share(kScalarD, kIndex, kTrail, Nodes{nodes_}, trail_.data(), lanes(dvec3(q.p)),
                                       lanes(dvec3(q.n)), D1{double(light)}, D1{double(count)}, lane1::M{true});
   return static_cast<std::uint32_t>(share.raw);
 }

@@ -120,6 +120,7 @@ class LightBvh {
   LightBounds build(std::vector<std::uint32_t>& order, std::vector<LightBounds>& lights, std::size_t begin,
                     std::size_t end, std::uint64_t trail, int depth);
   std::vector<double> make_table() const;
+  struct Nodes;  // the tree as the generic walks read it at width 1 (light_bvh.cpp)
 
   std::vector<Node> nodes_;
   std::vector<double> table_;  // node_table()

@@ -117,6 +117,7 @@ using pathlab::HWY_NAMESPACE::area_light_pdf;
 using pathlab::HWY_NAMESPACE::area_light_pdf_at;
 using pathlab::HWY_NAMESPACE::blend_normals;
 using pathlab::HWY_NAMESPACE::bvh_pick;
+using pathlab::HWY_NAMESPACE::BvhTable;
 using pathlab::HWY_NAMESPACE::bvh_share;
 using pathlab::HWY_NAMESPACE::camera_direction;
 using pathlab::HWY_NAMESPACE::CameraPlane;
@@ -857,7 +858,8 @@ VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI 
       const VD grid = hn::Set(DD(), static_cast<double>(sc.lights.bvh_grid));
       VD share[2];
       for (int h = 0; h < 2; ++h)
-        share[h] = bvh_share(DD(), DDI(), hn::RebindToUnsigned<DD>(), sc.lights.bvh_nodes, sc.lights.bvh_trail,
+        share[h] = bvh_share(DD(), DDI(), hn::RebindToUnsigned<DD>(), BvhTable<DD, DDI>{DD(), DDI(), sc.lights.bvh_nodes},
+                             sc.lights.bvh_trail,
                              half_d(qp, h), half_d(qn, h), half_d(tl, h), grid, half_mask(in_tree, h));
       pmf = hn::IfThenElse(in_tree, join_f(share[0], share[1]) * k(0x1p-24f), pmf);
     }
@@ -1079,7 +1081,7 @@ VI pick_light(const Scene& sc, VF u_choice, const V3& sp, const V3& n, const V3&
     const V3 qn = facing_normal(df, n, wo);  // light_query's
     VD share[2], tree_light[2];
     for (int h = 0; h < 2; ++h)
-      bvh_pick(DD(), DDI(), lights.bvh_nodes, half_d(sp, h), half_d(qn, h), grid_k[h],
+      bvh_pick(DD(), DDI(), BvhTable<DD, DDI>{DD(), DDI(), lights.bvh_nodes}, half_d(sp, h), half_d(qn, h), grid_k[h],
                hn::Set(DD(), static_cast<double>(lights.bvh_grid)), half_mask(tree, h), tree_light[h], share[h]);
     const VF shares = join_f(share[0], share[1]);
     const M tree_ok = hn::And(tree, shares > k(0.0f));

@@ -131,6 +131,10 @@ template <typename T>
 inline bool AllFalse(One<T>, M m) {
   return !m.raw;
 }
+template <typename T>
+inline bool AllTrue(One<T>, M m) {
+  return m.raw;
+}
 
 // x86's maxps/minps, operand order included (see the top of the file).
 inline V<float> Max(V<float> a, V<float> b) { return a.raw > b.raw ? a : b; }

@@ -7,9 +7,9 @@
 // Max(b, a), the clamps and comparisons as selects; VectorStages.* holds the
 // lanes to the width-1 bits.
 //
-// The tree is read from LightBvh::node_table(): kBvhFields doubles per node
-// (BvhField, core/light_bvh.h), gathered by node index (int64 lanes; at
-// width 1 an index into the table). Operations are called unqualified (see
+// The walks read the tree through a Tree (BvhTable below: the lanes gather
+// LightBvh::node_table(), kBvhFields doubles per node; core reads its
+// nodes), by node index (int64 lanes). Operations are called unqualified (see
 // core/simd/lanes-inl.h); the descriptors are passed in: dd for the
 // doubles, di for the node indices (int64), du for the lights' trails
 // (uint64).
@@ -83,6 +83,7 @@ HWY_INLINE VD bvh_importance(DD dd, const BvhBounds<VD, MD>& b, const Vec3<VD>& 
   // the cone and the surface's side cannot rule anything out; phi / d^2.
   const auto inside = Not(d2 > r2);
   const VD inside_imp = finite_or_max(b.phi / dist2);
+  if (AllTrue(dd, inside)) return inside_imp;  // (the scalar walk's early returns: the same values)
 
   const VD sin2_b = r2 / d2;
   const VD tb_cos = Sqrt(Max(Set(dd, 1.0) - sin2_b, zero)), tb_sin = Sqrt(sin2_b);
@@ -97,6 +98,7 @@ HWY_INLINE VD bvh_importance(DD dd, const BvhBounds<VD, MD>& b, const Vec3<VD>& 
   bvh_minus_clamped(dd, w_cos, w_sin, o_cos, o_sin, x_cos, x_sin);
   bvh_minus_clamped(dd, x_cos, x_sin, tb_cos, tb_sin, p_cos, p_sin);
   auto zero_imp = p_cos <= b.cos_e;
+  if (AllTrue(dd, Or(inside, zero_imp))) return IfThenElseZero(inside, inside_imp);
   VD imp = b.phi * p_cos / dist2;
   // The receiver, when the query has a normal: the smallest angle between
   // its normal and a direction to the box.
@@ -111,23 +113,35 @@ HWY_INLINE VD bvh_importance(DD dd, const BvhBounds<VD, MD>& b, const Vec3<VD>& 
   return IfThenElse(inside, inside_imp, outside_imp);
 }
 
-// The importance of each lane's node of the table.
-template <class DD, class DI, class VD = VecOf<DD>, class VI = VecOf<DI>>
-HWY_INLINE VD bvh_node_importance(DD dd, DI di, const double* table, VI node, const Vec3<VD>& p, const Vec3<VD>& n) {
-  auto field3 = [&](int f) {
-    return Vec3<VD>{bvh_field(dd, di, table, node, f), bvh_field(dd, di, table, node, f + 1),
-                    bvh_field(dd, di, table, node, f + 2)};
-  };
-  const BvhBounds<VD, decltype(p.x == p.x)> b{
-      field3(kBvhLo),
-      field3(kBvhHi),
-      field3(kBvhAxis),
-      bvh_field(dd, di, table, node, kBvhCosO),
-      bvh_field(dd, di, table, node, kBvhCosE),
-      bvh_field(dd, di, table, node, kBvhPhi),
-      bvh_field(dd, di, table, node, kBvhTwoSided) != Zero(dd)};
-  return bvh_importance(dd, b, p, n);
-}
+// The tree as the walks below read it, from LightBvh::node_table() by
+// gathers (the wavefront's lanes). A walk asks a tree three things of each
+// lane's node (an int64 index): its importance for {p, n}, whether it is a
+// leaf (not 0) and its index (the light of a leaf, the second child of an
+// interior node), the last two as doubles. core's LightBvh answers them from
+// its nodes at width 1 (core/light_bvh.cpp), with the same bits: the table
+// holds the nodes' floats as doubles.
+template <class DD, class DI>
+struct BvhTable {
+  DD dd;
+  DI di;
+  const double* table;
+  using VD = VecOf<DD>;
+  using VI = VecOf<DI>;
+  VD field(VI node, int f) const { return bvh_field(dd, di, table, node, f); }
+  VD importance(VI node, const Vec3<VD>& p, const Vec3<VD>& n) const {
+    auto field3 = [&](int f) { return Vec3<VD>{field(node, f), field(node, f + 1), field(node, f + 2)}; };
+    const BvhBounds<VD, decltype(p.x == p.x)> b{field3(kBvhLo),
+                                                field3(kBvhHi),
+                                                field3(kBvhAxis),
+                                                field(node, kBvhCosO),
+                                                field(node, kBvhCosE),
+                                                field(node, kBvhPhi),
+                                                field(node, kBvhTwoSided) != Zero(dd)};
+    return bvh_importance(dd, b, p, n);
+  }
+  VD leaf(VI node) const { return field(node, kBvhLeaf); }
+  VD index(VI node) const { return field(node, kBvhIndex); }
+};
 
 // LightBvh::split: the first child's part of `count` points (a whole
 // number in a double), valid where both importances are not 0.
@@ -153,16 +167,15 @@ struct BvhLevel {
   VI c0, c1;
   VD first;
 };
-template <class DD, class DI, class VD, class VI, class MD>
-HWY_INLINE bool bvh_level(DD dd, DI di, const double* table, const Vec3<VD>& p, const Vec3<VD>& n, VI node, VD count,
+template <class DD, class DI, class Tree, class VD, class VI, class MD>
+HWY_INLINE bool bvh_level(DD dd, DI di, const Tree& tree, const Vec3<VD>& p, const Vec3<VD>& n, VI node, VD count,
                           MD& ok, BvhLevel<VD, VI, MD>& level) {
-  level.walking = AndNot(bvh_field(dd, di, table, node, kBvhLeaf) != Zero(dd), ok);
+  level.walking = AndNot(tree.leaf(node) != Zero(dd), ok);
   if (AllFalse(dd, level.walking)) return false;
   level.c0 = node + Set(di, 1);
-  level.c1 = IfThenElse(RebindMask(di, level.walking), ConvertTo(di, bvh_field(dd, di, table, node, kBvhIndex)), level.c0);
+  level.c1 = IfThenElse(RebindMask(di, level.walking), ConvertTo(di, tree.index(node)), level.c0);
   MD valid;
-  level.first = bvh_split(dd, bvh_node_importance(dd, di, table, level.c0, p, n),
-                          bvh_node_importance(dd, di, table, level.c1, p, n), count, valid);
+  level.first = bvh_split(dd, tree.importance(level.c0, p, n), tree.importance(level.c1, p, n), count, valid);
   ok = AndNot(AndNot(valid, level.walking), ok);
   return true;
 }
@@ -170,34 +183,34 @@ HWY_INLINE bool bvh_level(DD dd, DI di, const double* table, const Vec3<VD>& p, 
 // LightBvh::pick for the lanes of `active`: the light grid point k (of
 // `count`; whole numbers in doubles) leads to, and its share (0 where the
 // walk ends on two children of importance 0, or the root has none).
-template <class DD, class DI, class VD, class MD>
-HWY_INLINE void bvh_pick(DD dd, DI di, const double* table, const Vec3<VD>& p, const Vec3<VD>& n, VD k, VD count,
+template <class DD, class DI, class Tree, class VD, class MD>
+HWY_INLINE void bvh_pick(DD dd, DI di, const Tree& tree, const Vec3<VD>& p, const Vec3<VD>& n, VD k, VD count,
                          MD active, VD& light, VD& share) {
   using VI = VecOf<DI>;
   VI node = Zero(di);
-  MD ok = And(active, bvh_node_importance(dd, di, table, node, p, n) > Zero(dd));
-  for (BvhLevel<VD, VI, MD> l; bvh_level(dd, di, table, p, n, node, count, ok, l);) {
+  MD ok = And(active, tree.importance(node, p, n) > Zero(dd));
+  for (BvhLevel<VD, VI, MD> l; bvh_level(dd, di, tree, p, n, node, count, ok, l);) {
     const MD to_first = And(l.walking, k < l.first), to_second = AndNot(k < l.first, l.walking);
     node = IfThenElse(RebindMask(di, to_first), l.c0, IfThenElse(RebindMask(di, to_second), l.c1, node));
     k = IfThenElse(to_second, k - l.first, k);  // re-based to the second child's part
     count = IfThenElse(to_first, l.first, IfThenElse(to_second, count - l.first, count));
   }
-  light = bvh_field(dd, di, table, node, kBvhIndex);
+  light = tree.index(node);
   share = IfThenElseZero(ok, count);
 }
 
 // LightBvh::share for the lanes of `active`: the grid points (of `count`)
 // that lead to `light`, down the light's trail (LightBvh::trails(); bit d
 // set: the second child at depth d).
-template <class DD, class DI, class DU, class VD, class MD>
-HWY_INLINE VD bvh_share(DD dd, DI di, DU du, const double* table, const std::uint64_t* trails, const Vec3<VD>& p,
+template <class DD, class DI, class DU, class Tree, class VD, class MD>
+HWY_INLINE VD bvh_share(DD dd, DI di, DU du, const Tree& tree, const std::uint64_t* trails, const Vec3<VD>& p,
                         const Vec3<VD>& n, VD light, VD count, MD active) {
   using VI = VecOf<DI>;
   const VI light_index = IfThenElseZero(RebindMask(di, active), ConvertTo(di, light));
   auto trail = GatherIndex(du, trails, light_index);
   VI node = Zero(di);
-  MD ok = And(active, bvh_node_importance(dd, di, table, node, p, n) > Zero(dd));
-  for (BvhLevel<VD, VI, MD> l; bvh_level(dd, di, table, p, n, node, count, ok, l);) {
+  MD ok = And(active, tree.importance(node, p, n) > Zero(dd));
+  for (BvhLevel<VD, VI, MD> l; bvh_level(dd, di, tree, p, n, node, count, ok, l);) {
     const MD second = RebindMask(dd, And(trail, Set(du, 1)) != Zero(du));
     const MD to_first = AndNot(second, l.walking), to_second = And(l.walking, second);
     node = IfThenElse(RebindMask(di, to_first), l.c0, IfThenElse(RebindMask(di, to_second), l.c1, node));
