@@ -74,23 +74,30 @@ constexpr HWY_INLINE V64 mul32(D64 d64, V64 a, V64 b) {
 // sobol::sample: point `index` (its low 32 bits) of Sobol's sequence in
 // dimension `axis`, unscrambled, as a 32-bit fixed-point value (dimension 1
 // by the five butterflies over supersets).
+// sobol_sample_reversed is the point with its digits in reverse order (digit
+// k after the point in bit k - 1), as scramble_reversed takes it: a zsobol
+// draw skips the two reversals that would cancel.
 template <class D64, class V64 = VecOf<D64>>
-constexpr HWY_INLINE V64 sobol_sample(D64 d64, V64 index, int axis) {
+constexpr HWY_INLINE V64 sobol_sample_reversed(D64 d64, V64 index, int axis) {
   V64 f = And(index, Set(d64, 0xffffffffu));
-  if (axis == 0) return reverse_bits32(d64, f);
+  if (axis == 0) return f;
   for (unsigned b = 0; b < 5; ++b)
     f = Xor(f, And(ShiftRightSame(f, 1 << b), Set(d64, sobol::kSupersetMasks[b])));
-  return reverse_bits32(d64, f);
+  return f;
+}
+template <class D64, class V64 = VecOf<D64>>
+constexpr HWY_INLINE V64 sobol_sample(D64 d64, V64 index, int axis) {
+  return reverse_bits32(d64, sobol_sample_reversed(d64, index, axis));
 }
 
 // sobol::scramble: the nested scrambling of the 32-bit value v by `seed`.
+// scramble_reversed takes v with its digits reversed (reverse_bits32(v)).
 template <class D64, class V64 = VecOf<D64>>
-constexpr HWY_INLINE V64 scramble(D64 d64, V64 v, V64 seed) {
+constexpr HWY_INLINE V64 scramble_reversed(D64 d64, V64 v, V64 seed) {
   const V64 mask = Set(d64, 0xffffffffu), odd = Set(d64, 1);
   const V64 more = mix64(d64, Xor(seed, Set(d64, sobol::kScrambleSalt)));
   const V64 k0 = And(seed, mask), k1 = ShiftRight<32>(seed);
   const V64 k2 = And(more, mask), k3 = ShiftRight<32>(more);
-  v = reverse_bits32(d64, v);
   v = And(v + k0, mask);
   v = mul32(d64, v, Or(k1, odd));
   v = Xor(v, mul32(d64, v, Set(d64, sobol::kScrambleEven0)));
@@ -98,6 +105,10 @@ constexpr HWY_INLINE V64 scramble(D64 d64, V64 v, V64 seed) {
   v = mul32(d64, v, Or(k3, odd));
   v = Xor(v, mul32(d64, v, Set(d64, sobol::kScrambleEven1)));
   return reverse_bits32(d64, v);
+}
+template <class D64, class V64 = VecOf<D64>>
+constexpr HWY_INLINE V64 scramble(D64 d64, V64 v, V64 seed) {
+  return scramble_reversed(d64, reverse_bits32(d64, v), seed);
 }
 
 // A zsobol stream's number (SampleStream::get, get2): the top 24 bits of the
@@ -111,7 +122,7 @@ constexpr HWY_INLINE V64 zsobol_top24(D64 d64, V64 index, V64 key, unsigned bits
   const V64 permuted = permute_digits(d64, index, bits, h);
   const auto value = [&](int axis) {
     const V64 seed = h + Set(d64, 1 + static_cast<std::uint64_t>(axis));
-    return ShiftRight<8>(scramble(d64, sobol_sample(d64, permuted, axis), mix64(d64, seed)));
+    return ShiftRight<8>(scramble_reversed(d64, sobol_sample_reversed(d64, permuted, axis), mix64(d64, seed)));
   };
   if (second) *second = value(1);
   return value(axis0);
