@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cfloat>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -637,6 +638,20 @@ void read_lights(const Node& node, Scene* scene, const std::filesystem::path& fo
       sun.direction = glm::normalize(d);
       // A sun disk (0.53 for the sun seen from the earth); 0 keeps a delta light.
       sun.angular_radius = glm::radians(0.5f * unit_number(l, "angular_diameter", 0.0f, 0.0f, 90.0f));
+      if (sun.angular_radius > 0.0f) {
+        // The disk's radiance E / (pi sin^2 alpha) and its cone's density
+        // 1 / (2 pi (1 - cos alpha)) must be floats (LightSampler keeps them
+        // so): a disk far smaller than any sun would be black, every sample
+        // of it counted bad.
+        const double alpha = sun.angular_radius, sin2 = std::sin(alpha) * std::sin(alpha);
+        const double one_minus_cos = 2.0 * std::sin(0.5 * alpha) * std::sin(0.5 * alpha);
+        const double radiance = double(max_component(sun.intensity)) / (kPi * sin2);
+        if (!(radiance <= double(FLT_MAX)) || !(1.0 / (2.0 * kPi * one_minus_cos) <= double(FLT_MAX)))
+          l.child("angular_diameter")
+              .fail("a sun disk this small has a radiance (" + format_number(radiance) +
+                    " from the irradiance over pi sin^2 of its radius) or a density beyond the float range; give 0 "
+                    "for a delta directional light");
+      }
       scene->delta_lights.push_back(sun);
     } else if (type == "environment") {
       l.allow_only({"type", "radiance", "file", "scale", "transform", "clamp_negative"});

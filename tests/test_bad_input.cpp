@@ -209,6 +209,9 @@ TEST_F(BadInput, BadSpotAndDirectionalLights) {
        "\"angular_diameter\"", "angular_diameter must lie in [0, 90], found 120"},
       {R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1, "angular_diameter": -0.5})",
        "\"angular_diameter\"", "angular_diameter must lie in [0, 90], found -0.5"},
+      // Its radiance E / (pi sin^2 alpha) ~ 4e44 is no float: it rendered black, every sample bad.
+      {R"({"type": "directional", "direction": [0, -1, 0], "irradiance": 1, "angular_diameter": 1e-20})",
+       "\"angular_diameter\"", "a sun disk this small has a radiance"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.light);
