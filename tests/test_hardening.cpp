@@ -385,6 +385,19 @@ TEST_F(Hardening, MeshFileAboveTheLimitAndBadLimit) {
   expect_no_output();
 }
 
+// The memory estimate counts what `--aov bounces` keeps per pixel (about
+// 1.7 kB: every layer's sums and images), not the 64 bytes of another AOV:
+// at 1024^2 it needs about 1.8 GB, which a 1000 MB limit refuses (it used to
+// estimate 135 MB and allocate 1.7 GB).
+TEST_F(Hardening, BouncesAovCountsItsLayersAgainstTheLimit) {
+  const std::string scene = file("ok.json", scene_text(kCamera, kSphere + ",\n" + kLamp));
+  const ProcessResult r = run_pathlab({"render", scene, "-o", exr(), "--spp", "1", "--resolution", "1024x1024", "--aov",
+                                       "bounces", "--quiet"},
+                                      {"PATHLAB_MAX_MEMORY_MB=1000"});
+  expect_clean_rejection(r.code, r.err, {"1024x1024 film with 1 AOV(s) needs", "the limit is 1000 MB"});
+  expect_no_output();
+}
+
 TEST_F(Hardening, PlyElementCountsBeyondTheBody) {
   file("count.ply",
        "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"

@@ -172,11 +172,16 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
   // The film and what is written from it, before anything is allocated or a
   // folder made (core/limits.h): per pixel the film's sums (56 bytes), its
   // second moments (48) when kept, a splatting filter's sums (80), the image
-  // and its PNG (15), and each AOV's buffer and channels (64).
+  // and its PNG (15), and each AOV's buffer and channels (64), but `bounces`:
+  // per layer and technique its sums and, written, a mean and a variance
+  // image and their float channels (about 1.7 kB).
   {
     const bool moments = progressive || variance_aov;
+    constexpr std::uint64_t kBouncesPerPixel =
+        sizeof(std::uint64_t) + std::uint64_t{kBounceLayers} * kTechniques * (sizeof(BounceAccumulator::Sums) + 4 * sizeof(vec3));
     const std::uint64_t per_pixel = 56 + (moments ? 48 : 0) + (s.film.filter == FilterKind::Box ? 0 : 80) + 15 +
-                                    64 * static_cast<std::uint64_t>(layers.size());
+                                    64 * static_cast<std::uint64_t>(layers.size() - (bounces_aov ? 1 : 0)) +
+                                    (bounces_aov ? kBouncesPerPixel : 0);
     check_memory(static_cast<std::uint64_t>(s.film.width) * static_cast<std::uint64_t>(s.film.height) * per_pixel,
                  "the " + std::to_string(s.film.width) + "x" + std::to_string(s.film.height) + " film" +
                      (layers.empty() ? std::string() : " with " + std::to_string(layers.size()) + " AOV(s)"));
