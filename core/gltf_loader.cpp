@@ -607,7 +607,12 @@ std::uint32_t Flattener::material(int index) {
     if (m.normalTexture.index >= 0)
       if (auto t = texture(m.normalTexture.index, m.normalTexture.texCoord, m.normalTexture.extensions,
                            TextureColorSpace::Linear, at + "/normalTexture"))
+      {
+        if (!(std::abs(m.normalTexture.scale) <= double(kMaxNormalMapScale)))
+          fail(file_, at + "/normalTexture/scale",
+               "a normal map's scale must lie in [-1e6, 1e6] (beyond, the tilted normal's length overflows)");
         normal_map = NormalMap{*t, static_cast<float>(m.normalTexture.scale)};
+      }
     if (m.emissiveTexture.index >= 0)
       if (auto t = texture(m.emissiveTexture.index, m.emissiveTexture.texCoord, m.emissiveTexture.extensions,
                            TextureColorSpace::Srgb, at + "/emissiveTexture"))

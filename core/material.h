@@ -131,7 +131,9 @@ struct TexturedParam {
   TextureRef texture;
 };
 // A tangent-space normal map (glTF's convention: +y up, n = 2 c - 1 with
-// x and y times `scale`).
+// x and y times `scale`). The loaders keep |scale| <= kMaxNormalMapScale: the
+// tilted normal's squared length (x s)^2 + (y s)^2 + z^2 must be a float.
+inline constexpr float kMaxNormalMapScale = 1e6f;
 struct NormalMap {
   TextureRef texture;
   float scale = 1.0f;

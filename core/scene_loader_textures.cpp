@@ -54,7 +54,11 @@ TextureRef read_texture(const Node& node, Scene& scene, TextureUse use, TextureC
   if (node.has("scale")) {
     const Node s = node.child("scale");
     if (normal_map) {
-      ref.scale = Spectrum(static_cast<float>(s.number()));  // glTF's normalTexture.scale: may be negative
+      // glTF's normalTexture.scale: may be negative. Within kMaxNormalMapScale,
+      // so that the tilted normal's squared length stays a float.
+      if (!(std::abs(s.number()) <= double(kMaxNormalMapScale)))
+        s.fail("a normal map's scale must lie in [-1e6, 1e6] (beyond, the tilted normal's length overflows)");
+      ref.scale = Spectrum(static_cast<float>(s.number()));
     } else {
       if (s.value().is_number() && s.number() < 0.0) s.fail("scale must not be negative");
       ref.scale = s.color(false);

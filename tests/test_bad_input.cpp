@@ -446,6 +446,12 @@ TEST_F(BadInput, BadTextureKeys) {
   const std::string scale = textured_scene("\"texture\": \"rgb.exr\", \"scale\": -1");
   expect_rejected(render(write("scale.json", scale)),
                   {"scale.json:" + where_in(scale, "\"scale\""), "/materials/tex/albedo/scale", "scale must not be negative"});
+  // A normal map's scale beyond 1e6 made x^2 overflow: the map was silently off.
+  const std::string tilt = scene("    \"tex\": {\"type\": \"diffuse\", \"normal_map\": {\"texture\": \"rgb.exr\", "
+                                 "\"scale\": 1e20}},\n" + kMaterials,
+                                 "    {\"type\": \"rectangle\", \"material\": \"tex\"},\n" + kLamp);
+  expect_rejected(render(write("tilt.json", tilt)), {"tilt.json:" + where_in(tilt, "\"scale\""),
+                                                     "/materials/tex/normal_map/scale", "must lie in [-1e6, 1e6]"});
   const std::string wrap = textured_scene("\"texture\": \"rgb.exr\", \"wrap\": \"repaet\"");
   expect_rejected(render(write("wrap.json", wrap)),
                   {"wrap.json:" + where_in(wrap, "\"wrap\""), "unknown wrap mode 'repaet' (did you mean 'repeat'?)"});
