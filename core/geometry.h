@@ -61,7 +61,9 @@ struct Triangle {
 Triangle make_triangle(const Shape& shape, std::uint32_t tri);
 
 // The point with barycentrics (b1, b2) of a triangle, recomputed from the
-// vertices (more accurate than origin + t * dir far from the origin).
+// vertices (more accurate than origin + t * dir far from the origin). Its
+// p_error also holds Embree's error in telling a ray origin from the
+// triangle (core/simd/lanes-inl.h, triangle_point).
 SurfacePoint triangle_point(const Triangle& t, vec2 b);
 SurfacePoint triangle_point(const Shape& shape, std::uint32_t tri, vec2 b);
 // A point near `p_approx` projected back onto the sphere.

@@ -320,16 +320,26 @@ HWY_INLINE V area_to_solid_angle(D d, V pdf_area, V dist, V cos_light) {
   return IfThenElseZero(c > Zero(d), pdf_area * dist * dist / c);
 }
 
-// A point of a triangle from barycentrics b1, b2 and its rounding error
-// bound (triangle_point, core/geometry.cpp): b0 = (1 - b1) - b2,
-// p = (b0 p0 + b1 p1) + b2 p2, error = gamma(7) ((|b0 p0| + |b1 p1|) + |b2 p2|).
+// A point of a triangle from barycentrics b1, b2 and the bound by which a
+// ray leaving it must move off the triangle (triangle_point,
+// core/geometry.cpp): b0 = (1 - b1) - b2, p = (b0 p0 + b1 p1) + b2 p2, and
+// per axis its rounding error gamma(7) ((|b0 p0| + |b1 p1|) + |b2 p2|)
+// plus gamma(8) times its largest distance to a vertex. The second term is
+// Embree's: its triangle test (tnear = 0) tells an origin from the plane by
+// the vertices taken relative to that origin, rounded within a few ulps of
+// |v - o|, so an origin nearer its own triangle than that can hit it again.
+// Where the vertices' coordinates are small next to the triangle (an edge
+// on a coordinate axis: the point's own error is about 0 across it), the
+// first term alone let shadow rays hit their own triangle.
 template <class D, class V = VecOf<D>>
 HWY_INLINE void triangle_point(D d, V b1, V b2, const Vec3<V>& p0, const Vec3<V>& p1, const Vec3<V>& p2, Vec3<V>& p,
                                Vec3<V>& error) {
   const V b0 = Set(d, 1.0f) - b1 - b2;
   const Vec3<V> a0 = b0 * p0, a1 = b1 * p1, a2 = b2 * p2;
   p = (a0 + a1) + a2;
-  error = Set(d, gamma_bound(7)) * ((abs(a0) + abs(a1)) + abs(a2));
+  const Vec3<V> r0 = abs(p0 - p), r1 = abs(p1 - p), r2 = abs(p2 - p);
+  const Vec3<V> reach{Max(Max(r0.x, r1.x), r2.x), Max(Max(r0.y, r1.y), r2.y), Max(Max(r0.z, r1.z), r2.z)};
+  error = Set(d, gamma_bound(7)) * ((abs(a0) + abs(a1)) + abs(a2)) + Set(d, gamma_bound(8)) * reach;
 }
 
 // An instance's placement (CompiledScene::resolve) is an affine map given by
