@@ -39,6 +39,19 @@ Scene box_and_sphere_at(const vec3& offset) {
   return scene;
 }
 
+// One grey mesh named "quad", seen from `camera`.
+Scene one_quad_scene(const std::string& name, const vec3& camera, TriangleMesh mesh) {
+  Scene scene;
+  scene.name = name;
+  scene.materials.push_back(diffuse_material(Spectrum(0.5f)));
+  scene.camera.position = camera;
+  Shape quad;
+  quad.description = "quad";
+  quad.mesh = std::move(mesh);
+  scene.shapes.push_back(quad);
+  return scene;
+}
+
 // A ray leaving the point `sp` in a cosine-distributed direction of its
 // front (every fourth one grazing, cos theta ~ 1e-3), drawn from stream
 // (seed, a, i), offset as a surfel spawns it.
@@ -99,21 +112,14 @@ TEST(RayOffset, NoSelfIntersectionAtTheOrigin) { expect_no_self_hits(vec3(0.0f))
 TEST(RayOffset, NoSelfIntersectionOnACoordinatePlaneThroughTheOrigin) {
   for (const float size : {1.0f, 1e-3f}) {
     for (int axis = 0; axis < 3; ++axis) {
-      Scene scene;
-      scene.name = "plane";
-      scene.materials.push_back(diffuse_material(Spectrum(0.5f)));
-      scene.camera.position = vec3(0, 5, 5);
-      Shape quad;
-      quad.description = "quad";
       const auto corner = [&](float a, float b) {
         vec3 p(0.0f);
         p[(axis + 1) % 3] = a * size;
         p[(axis + 2) % 3] = b * size;
         return p;
       };
-      quad.mesh = {{corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1)}, {{0, 1, 2}, {0, 2, 3}}};
-      scene.shapes.push_back(quad);
-      const CompiledScene compiled(std::move(scene));
+      const CompiledScene compiled(one_quad_scene(
+          "plane", vec3(0, 5, 5), {{corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1)}, {{0, 1, 2}, {0, 2, 3}}}));
       int self_hits = 0;
       for (std::uint32_t i = 0; i < 4000; ++i) {
         const vec2 u(sample_u(3, axis, i, 0, Dim::LightX), sample_u(3, axis, i, 0, Dim::LightY));
@@ -137,17 +143,10 @@ TEST(RayOffset, NoSelfIntersectionOnACoordinatePlaneThroughTheOrigin) {
 // again (before the bound held Embree's error too, a review measured shadow
 // rays hitting it: the image 0.8 % dark, z -36).
 TEST(RayOffset, EdgeOnACoordinateAxis) {
-  Scene scene;
-  scene.name = "axis-edge";
-  scene.materials.push_back(diffuse_material(Spectrum(0.5f)));
-  scene.camera.position = vec3(2, 0.3, 2.5);
-  Shape quad;
-  quad.description = "quad";
   const float c = 0.809016994f, s = 0.587785252f;
-  quad.mesh = {{{-c, -1, s}, {0, -1, 0}, {c, -1, -s}, {-c, 1, s}, {0, 1, 0}, {c, 1, -s}},
-               {{0, 1, 4}, {0, 4, 3}, {1, 2, 5}, {1, 5, 4}}};
-  scene.shapes.push_back(quad);
-  const CompiledScene compiled(std::move(scene));
+  const CompiledScene compiled(one_quad_scene("axis-edge", vec3(2, 0.3, 2.5),
+                                              {{{-c, -1, s}, {0, -1, 0}, {c, -1, -s}, {-c, 1, s}, {0, 1, 0}, {c, 1, -s}},
+                                               {{0, 1, 4}, {0, 4, 3}, {1, 2, 5}, {1, 5, 4}}}));
   int self_hits = 0, old_self_hits = 0;
   for (std::uint32_t i = 0; i < 40000; ++i) {
     const std::uint32_t tri = i % 4;
