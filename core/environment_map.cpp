@@ -76,17 +76,9 @@ width1::F3 rotate(const mat3& m, const width1::F3& v) {
 
 EnvironmentMap::Lookup EnvironmentMap::lookup(const vec3& dir) const {
   using namespace width1;
-  // The cdfs' entries, 0 off the mask (as a masked gather reads).
-  const auto entry = [](std::span<const float> cdf, lane1::M m, F i) {
-    return F{m.raw ? cdf[static_cast<std::size_t>(i.raw)] : 0.0f};
-  };
-  const auto row = [&](lane1::M m, F i) { return entry(distribution_.marginal().cdf(), m, i); };
-  const auto column = [&](lane1::M m, F y, F i) {
-    return entry(distribution_.conditional(static_cast<std::size_t>(y.raw)).cdf(), m, i);
-  };
   F x, y;
   const F pdf = generic::env_lookup(kScalar, lane1::M{true}, rotate(to_local_, lanes(dir)), distribution_.width(),
-                                    distribution_.height(), row, column, x, y);
+                                    distribution_.height(), Cdfs2D{distribution_}, x, y);
   Lookup out;
   out.radiance = texels_.at(static_cast<int>(x.raw), static_cast<int>(y.raw));
   out.pdf = pdf.raw;

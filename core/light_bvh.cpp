@@ -216,7 +216,6 @@ LightBounds LightBvh::build(std::vector<std::uint32_t>& order, std::vector<Light
   return both;
 }
 
-
 // The walks' Tree (core/simd/light_bvh-inl.h's BvhTable reads the same from
 // node_table() in the lanes): the nodes themselves, whose floats the table
 // holds as doubles.

@@ -8,14 +8,6 @@
 
 namespace pathlab {
 
-namespace {
-// A cdf's entry i (a whole float) in a lane of m, as the generic code reads
-// it (cdf_sample's cdf_entry; 0 off the mask, as a masked gather reads).
-auto cdf_entries(std::span<const float> cdf) {
-  return [cdf](lane1::M m, width1::F i) { return width1::F{m.raw ? cdf[static_cast<std::size_t>(i.raw)] : 0.0f}; };
-}
-}  // namespace
-
 // The warps are written once for every SIMD width (core/simd/sampling-inl.h)
 // and called here at width 1 (core/simd/width1.h).
 
@@ -148,7 +140,8 @@ Distribution1D::Sample Distribution1D::sample(float u) const {
   // the same cdf.
   using namespace width1;
   F cell, density;
-  const F x = generic::cdf_sample(kScalar, lane1::M{true}, n_, F{u}, cdf_entries(cdf_), cell, density);
+  const F x = generic::cdf_sample(kScalar, lane1::M{true}, n_, F{u},
+                                  [this](lane1::M m, F i) { return cdf_entry(cdf_, m, i); }, cell, density);
   return {x.raw, density.raw, static_cast<std::size_t>(cell.raw)};
 }
 
@@ -169,12 +162,8 @@ Distribution2D::Sample Distribution2D::sample(vec2 u) const {
   // run it on the same cdfs.
   using namespace width1;
   lane1::M ok{true};
-  const auto column_cdf = [this](lane1::M m, F row, F i) {
-    return cdf_entries(conditional_[static_cast<std::size_t>(row.raw)].cdf())(m, i);
-  };
   F px, py, density, x, y;
-  generic::distribution2d_sample(kScalar, ok, width(), height(), F{u.x}, F{u.y}, cdf_entries(marginal_.cdf()),
-                                 column_cdf, px, py, density, x, y);
+  generic::distribution2d_sample(kScalar, ok, width(), height(), F{u.x}, F{u.y}, Cdfs2D{*this}, px, py, density, x, y);
   if (!ok.raw) return {};
   return {vec2(px.raw, py.raw), density.raw, static_cast<std::size_t>(x.raw), static_cast<std::size_t>(y.raw)};
 }

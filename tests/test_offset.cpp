@@ -147,20 +147,19 @@ TEST(RayOffset, EdgeOnACoordinateAxis) {
   const CompiledScene compiled(one_quad_scene("axis-edge", vec3(2, 0.3, 2.5),
                                               {{{-c, -1, s}, {0, -1, 0}, {c, -1, -s}, {-c, 1, s}, {0, 1, 0}, {c, 1, -s}},
                                                {{0, 1, 4}, {0, 4, 3}, {1, 2, 5}, {1, 5, 4}}}));
+  // Triangles 0 and 3 have the edge; their corner off it is p0 and p1.
+  // Barycentrics (b1, b2) of a point a fraction `along` up the edge and
+  // `off` (below 1e-3) towards that corner.
+  const auto near_edge = [](std::uint32_t tri, float along, float off) {
+    return tri == 0 ? vec2(along * (1.0f - off), (1.0f - along) * (1.0f - off)) : vec2(off, along * (1.0f - off));
+  };
   int self_hits = 0, old_self_hits = 0;
   for (std::uint32_t i = 0; i < 40000; ++i) {
-    const std::uint32_t tri = i % 4;
-    // Barycentrics putting the point within 1e-3 of the middle edge.
-    const float along = sample_u(5, tri, i, 0, Dim::LightX), off = 1e-3f * sample_u(5, tri, i, 0, Dim::LightY);
-    const glm::uvec3 t = compiled.scene().shapes[0].mesh.triangles[tri];
+    const std::uint32_t tri = (i / 2) % 2 == 0 ? 0u : 3u;
+    const vec2 b = near_edge(tri, sample_u(5, tri, i, 0, Dim::LightX), 1e-3f * sample_u(5, tri, i, 0, Dim::LightY));
     const Triangle tr = make_triangle(compiled.scene().shapes[0], tri);
-    // The corner off the edge is the one whose x is not 0.
-    vec2 b;
-    if (compiled.scene().shapes[0].mesh.positions[t.x].x != 0.0f) b = vec2(along * (1.0f - off), (1.0f - along) * (1.0f - off));
-    else if (compiled.scene().shapes[0].mesh.positions[t.y].x != 0.0f) b = vec2(off, along * (1.0f - off));
-    else b = vec2(along * (1.0f - off), off);
     const SurfacePoint sp = triangle_point(tr, b);
-    const SurfacePoint side{sp.p, sp.p_error, i % 2 == 1 ? -sp.n : sp.n};
+    const SurfacePoint side{sp.p, sp.p_error, i % 2 == 1 ? -sp.n : sp.n};  // both sides of both triangles
     Surfel hit;
     self_hits += compiled.intersect(leaving(side, 6, tri, i), &hit);
     // The point's rounding error alone, the bound before: the test's rays

@@ -901,7 +901,7 @@ V3 rotate(const float* m, const V3& v) {
 VI texel_index(const Sky& s, VI x, VI y) { return y * hn::Set(DI(), static_cast<std::int32_t>(s.width)) + x; }
 
 // The image sampler's cdfs as the generic code reads them (entry i of the
-// rows', entry i of row y's), gathered in the lanes of m.
+// rows', entry i of row y's; core/simd/lights-inl.h), gathered in the lanes of m.
 struct SkyCdfs {
   const Sky& s;
   VF row(M m, VF i) const { return gather(m, s.row_cdf, hn::ConvertTo(DI(), i), 1, 0); }
@@ -915,12 +915,9 @@ struct SkyCdfs {
 // env_lookup): the radiance of the texel dir falls in, and the density in
 // solid angle with which the map is sampled there.
 void env_lookup(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) {
-  const SkyCdfs cdf{s};
-  const auto row = [&](M valid, VF i) { return cdf.row(valid, i); };
-  const auto column = [&](M valid, VF y, VF i) { return cdf.column(valid, y, i); };
   VF x, y;
   pdf = pathlab::HWY_NAMESPACE::env_lookup(DF(), m, rotate(s.to_local, dir), static_cast<std::size_t>(s.width),
-                                           static_cast<std::size_t>(s.height), row, column, x, y);
+                                           static_cast<std::size_t>(s.height), SkyCdfs{s}, x, y);
   pdf = hn::IfThenElseZero(m, pdf);
   Le = gather3(m, s.image, texel_index(s, hn::ConvertTo(DI(), x), hn::ConvertTo(DI(), y)), 3, 0);
 }
@@ -930,12 +927,9 @@ void env_lookup(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) {
 // radiance of the texel drawn; the lanes it gives none leave ok.
 void env_sample(const Sky& s, VF ux, VF uy, M& ok, V3& wi, V3& Le, VF& pdf) {
   const DF df;
-  const SkyCdfs cdf{s};
-  const auto row = [&](M valid, VF i) { return cdf.row(valid, i); };
-  const auto column = [&](M valid, VF y, VF i) { return cdf.column(valid, y, i); };
   VF px, py, uv_pdf, x, y;
-  distribution2d_sample(df, ok, static_cast<std::size_t>(s.width), static_cast<std::size_t>(s.height), ux, uy, row,
-                        column, px, py, uv_pdf, x, y);
+  distribution2d_sample(df, ok, static_cast<std::size_t>(s.width), static_cast<std::size_t>(s.height), ux, uy,
+                        SkyCdfs{s}, px, py, uv_pdf, x, y);
   wi = env_sample_direction(df, ok, px, py, uv_pdf, splat3(df, s.to_world[0], s.to_world[1], s.to_world[2]),
                             splat3(df, s.to_world[3], s.to_world[4], s.to_world[5]),
                             splat3(df, s.to_world[6], s.to_world[7], s.to_world[8]), pdf);

@@ -68,17 +68,17 @@ HWY_INLINE V env_solid_angle_pdf(D d, V uv_pdf, V sin_theta) {
 // EnvironmentMap::lookup: the texel (x, y) of a direction in the map's
 // frame among width x height (whole floats), and the density in solid
 // angle with which the map samples it: Distribution2D::pdf of that cell
-// (row_cdf(m, i), column_cdf(m, row, i), as distribution2d_sample reads
-// them) at sin theta from the direction itself, not the texel.
-template <class D, class M, class RowCdf, class ColumnCdf, class V = VecOf<D>>
-HWY_INLINE V env_lookup(D d, M m, const Vec3<V>& local, std::size_t width, std::size_t height,
-                        const RowCdf& row_cdf, const ColumnCdf& column_cdf, V& x, V& y) {
+// (its cdfs read as distribution2d_sample reads them) at sin theta from the
+// direction itself, not the texel.
+template <class D, class M, class Cdfs, class V = VecOf<D>>
+HWY_INLINE V env_lookup(D d, M m, const Vec3<V>& local, std::size_t width, std::size_t height, const Cdfs& cdfs, V& x,
+                        V& y) {
   V u, v;
   env_direction_to_uv(d, local, u, v);
   x = env_texel(d, u, Set(d, static_cast<float>(width)));
   y = env_texel(d, v, Set(d, static_cast<float>(height)));
-  const auto row = [&](M valid, V i) { return column_cdf(valid, y, i); };
-  const V uv_pdf = cdf_density(d, m, height, row_cdf, y) * cdf_density(d, m, width, row, x);
+  const V uv_pdf = cdf_density(d, m, height, [&](M valid, V i) { return cdfs.row(valid, i); }, y) *
+                   cdf_density(d, m, width, [&](M valid, V i) { return cdfs.column(valid, y, i); }, x);
   // From x and z, not 1 - y^2, which is 0 within 3e-4 rad of a pole in float.
   return env_solid_angle_pdf(d, uv_pdf, Sqrt(local.x * local.x + local.z * local.z));
 }

@@ -49,13 +49,6 @@ HWY_INLINE void bvh_minus_clamped(DD dd, VD a_cos, VD a_sin, VD b_cos, VD b_sin,
   sin = IfThenElseZero(Not(le), a_sin * b_cos - a_cos * b_sin);
 }
 
-// Field f of each lane's node (node: the node's index; 0 for a lane off
-// the walk).
-template <class DD, class DI, class VI = VecOf<DI>>
-HWY_INLINE VecOf<DD> bvh_field(DD dd, DI di, const double* table, VI node, int f) {
-  return GatherIndex(dd, table, node * Set(di, kBvhFields) + Set(di, f));
-}
-
 // One node's bounds, as doubles (LightBounds' fields; two_sided a mask).
 template <class VD, class MD>
 struct BvhBounds {
@@ -127,7 +120,8 @@ struct BvhTable {
   const double* table;
   using VD = VecOf<DD>;
   using VI = VecOf<DI>;
-  VD field(VI node, int f) const { return bvh_field(dd, di, table, node, f); }
+  // Field f of each lane's node (0 for a lane off the walk).
+  VD field(VI node, int f) const { return GatherIndex(dd, table, node * Set(di, kBvhFields) + Set(di, f)); }
   VD importance(VI node, const Vec3<VD>& p, const Vec3<VD>& n) const {
     auto field3 = [&](int f) { return Vec3<VD>{field(node, f), field(node, f + 1), field(node, f + 2)}; };
     const BvhBounds<VD, decltype(p.x == p.x)> b{field3(kBvhLo),

@@ -83,19 +83,20 @@ HWY_INLINE V cdf_sample(D d, M m, std::size_t count, V u, const Lookup& cdf_entr
   pdf = (hi - lo) * n;
   return piecewise_point(d, u, lo, hi, cell, n);
 }
-// Distribution2D::sample: the row by uy from the rows' cdf (row_cdf(m, i)),
-// then the column by ux from that row's cdf (column_cdf(m, row, i)); the
-// point (px, py), its density (the row's times the column's) and its cell
-// (x, y). Lanes whose row has density 0 leave ok.
-template <class D, class M, class RowCdf, class ColumnCdf, class V = VecOf<D>>
-HWY_INLINE void distribution2d_sample(D d, M& ok, std::size_t width, std::size_t height, V ux, V uy,
-                                      const RowCdf& row_cdf, const ColumnCdf& column_cdf, V& px, V& py, V& pdf, V& x,
-                                      V& y) {
+// A Distribution2D's cdfs, as the two functions below read them: an object
+// whose row(m, i) is entry i of the rows' cdf and column(m, y, i) entry i of
+// row y's (i, y whole floats; the caller's table lookups).
+//
+// Distribution2D::sample: the row by uy from the rows' cdf, then the column
+// by ux from that row's; the point (px, py), its density (the row's times
+// the column's) and its cell (x, y). Lanes whose row has density 0 leave ok.
+template <class D, class M, class Cdfs, class V = VecOf<D>>
+HWY_INLINE void distribution2d_sample(D d, M& ok, std::size_t width, std::size_t height, V ux, V uy, const Cdfs& cdfs,
+                                      V& px, V& py, V& pdf, V& x, V& y) {
   V row_pdf, column_pdf;
-  py = cdf_sample(d, ok, height, uy, row_cdf, y, row_pdf);
+  py = cdf_sample(d, ok, height, uy, [&](M valid, V i) { return cdfs.row(valid, i); }, y, row_pdf);
   ok = And(ok, row_pdf > Zero(d));
-  const auto row = [&](M valid, V i) { return column_cdf(valid, y, i); };
-  px = cdf_sample(d, ok, width, ux, row, x, column_pdf);
+  px = cdf_sample(d, ok, width, ux, [&](M valid, V i) { return cdfs.column(valid, y, i); }, x, column_pdf);
   pdf = row_pdf * column_pdf;
 }
 

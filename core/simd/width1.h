@@ -13,6 +13,7 @@
 #endif
 
 #include "core/math.h"
+#include "core/sampling.h"
 #include "core/simd/lane1.h"
 #include "core/simd/environment-inl.h"
 #include "core/simd/lanes-inl.h"
@@ -37,5 +38,17 @@ using D3 = generic::Vec3<D1>;
 inline constexpr lane1::One<double> kScalarD{};
 inline D3 lanes(const dvec3& v) { return {{v.x}, {v.y}, {v.z}}; }
 inline dvec3 scalars(const D3& v) { return dvec3(v.x.raw, v.y.raw, v.z.raw); }
+
+// Entry i (a whole float) of a cdf in a lane of m, as the generic samplers
+// read it (core/simd/lights-inl.h); 0 off the mask, as a masked gather reads.
+inline F cdf_entry(std::span<const float> cdf, lane1::M m, F i) {
+  return F{m.raw ? cdf[static_cast<std::size_t>(i.raw)] : 0.0f};
+}
+// A Distribution2D's cdfs as distribution2d_sample and env_lookup read them.
+struct Cdfs2D {
+  const Distribution2D& d;
+  F row(lane1::M m, F i) const { return cdf_entry(d.marginal().cdf(), m, i); }
+  F column(lane1::M m, F y, F i) const { return cdf_entry(d.conditional(static_cast<std::size_t>(y.raw)).cdf(), m, i); }
+};
 
 }  // namespace pathlab::width1
