@@ -44,6 +44,48 @@ void build_distribution(const std::vector<double>& weights, std::vector<float>* 
 
 constexpr std::uint32_t kGrid = 1u << 24;  // LightChoice numbers are multiples of 1 / kGrid
 
+// Entry e (a triangle or sphere) as core/simd/lights-inl.h's area_light_sample
+// reads it, as the wavefront's lanes gather it from their light table.
+width1::generic::AreaLight<width1::F, lane1::M> area_light(const Scene& scene, const LightSampler::Entry& e) {
+  using namespace width1;
+  const Shape& shape = scene.shapes[e.shape];
+  const bool sphere = shape.kind == Shape::Kind::Sphere;
+  generic::AreaLight<F, lane1::M> light;
+  light.p0 = lanes(sphere ? shape.center : e.triangle.p0);
+  light.p1 = sphere ? F3{F{shape.radius}, F{0.0f}, F{0.0f}} : lanes(e.triangle.p1);
+  light.p2 = lanes(sphere ? vec3(0.0f) : e.triangle.p2);
+  light.n = lanes(sphere ? vec3(0.0f) : e.triangle.n);
+  light.sphere = lane1::M{sphere};
+  light.flip = lane1::M{sphere && shape.flip_normals};
+  light.two_sided = lane1::M{scene.materials[shape.material].two_sided_emission};
+  light.inv_area = F{LightSampler::area_density(e)};
+  return light;
+}
+
+// Whether entry e is sampled in solid angle from ref under `sampling` (the
+// fallback rule of core/sampling_spherical.h), with which density, and with
+// `draw` the point drawn there with u: core/simd/spherical-inl.h's
+// solid_angle_draw at width 1, carried to floats as the lanes carry it.
+// sample() and pdf() both ask this, so they cannot apply different rules.
+width1::generic::SolidAngleDraw<width1::F, lane1::M> solid_angle_draw(const Scene& scene, LightSampling sampling,
+                                                              const LightSampler::Entry& e, const vec3& ref,
+                                                              lane1::M m, bool draw, vec2 u) {
+  using namespace width1;
+  generic::SolidAngleDraw<F, lane1::M> out{lane1::M{false}, F{0.0f}, F{0.0f}, F{0.0f}, lanes(vec3(0.0f))};
+  if (sampling != LightSampling::SolidAngle || !m.raw) return out;
+  const generic::AreaLight<F, lane1::M> light = area_light(scene, e);
+  const auto in_double = [](const F3& v) { return lanes(dvec3(scalars(v))); };
+  const generic::SolidAngleDraw<D1, lane1::M> view =
+      generic::solid_angle_draw(kScalarD, m, light.sphere, lanes(dvec3(ref)), in_double(light.p0),
+                                in_double(light.p1), in_double(light.p2), draw, D1{double(u.x)}, D1{double(u.y)});
+  out.use = view.use;
+  out.density = F{static_cast<float>(view.density.raw)};
+  out.b1 = F{static_cast<float>(view.b1.raw)};
+  out.b2 = F{static_cast<float>(view.b2.raw)};
+  out.n = lanes(vec3(scalars(view.n)));
+  return out;
+}
+
 }  // namespace
 
 float spot_profile(float cos_theta, float cos_outer, float cos_inner) {
@@ -303,52 +345,23 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
     if (!(ls.pdf > 0.0f) || is_black(ls.Le)) return std::nullopt;  // rounded out of the cone
     return ls;
   }
-  const Entry& e = entries_[i];
-  const Shape& shape = scene_->shapes[e.shape];
-  const Material& m = scene_->materials[shape.material];
-  const bool textured = textures_ && m.emission_textured;
-  vec2 b(0.0f);  // the triangle point's barycentrics (b1, b2), for a textured emitter
-  SurfacePoint sp;
-  const SolidAngleView view = solid_angle_view(e, ref);
-  if (view.density > 0.0) {
-    if (shape.kind == Shape::Kind::Sphere) {
-      const dvec3 n = sample_sphere_cone_normal(view.cone, u);
-      sp = sphere_point(shape, shape.center + shape.radius * vec3(n));
-    } else {
-      using namespace width1;
-      D1 b1, b2;
-      generic::solid_angle_triangle_point(kScalarD, lanes(dvec3(ref)), lanes(dvec3(e.triangle.p0)),
-                                          lanes(dvec3(e.triangle.p1)), lanes(dvec3(e.triangle.p2)), D1{view.omega},
-                                          D1{double(u.x)}, D1{double(u.y)}, b1, b2);
-      b = vec2(static_cast<float>(b1.raw), static_cast<float>(b2.raw));
-      sp = triangle_point(e.triangle, b);
-    }
-  } else if (shape.kind == Shape::Kind::Sphere) {
-    sp = sample_sphere(shape, u);
-  } else if (!textured) {
-    sp = sample_triangle(e.triangle, u);
-  } else {
-    b = square_to_uniform_triangle(u);  // what sample_triangle does, keeping b
-    sp = triangle_point(e.triangle, b);
-  }
-  ls.p = sp.p;
-  ls.p_error = sp.p_error;
-  ls.n = sp.n;
+  // A triangle or a sphere: core/simd/lights-inl.h's area_light_sample at width 1.
   using namespace width1;
-  F3 wi;
-  F dist, cos_light;
-  if (!generic::light_point_seen(kScalar, lanes(ref), lanes(ls.p), lanes(ls.n), lane1::M{m.two_sided_emission}, wi,
-                                 dist, cos_light)
+  const Entry& e = entries_[i];
+  const lane1::M one{true};
+  const auto solid_angle = [&](lane1::M m) { return solid_angle_draw(*scene_, light_sampling_, e, ref, m, true, u); };
+  generic::AreaLightSample<F> s;
+  if (!generic::area_light_sample(kScalar, one, lanes(ref), area_light(*scene_, e), F{pmf}, F{u.x}, F{u.y}, solid_angle,
+                                  PATHLAB_FAULT(LightPdfWithoutDistance), s)
            .raw)
-    return std::nullopt;  // no distance, or the back of a one-sided emitter
-  ls.wi = scalars(wi);
-  ls.dist = dist.raw;
-  ls.pdf = view.density > 0.0 ? pmf * static_cast<float>(view.density)
-                              : generic::area_light_pdf(kScalar, F{pmf}, F{area_density(e)}, dist, cos_light,
-                                                                        PATHLAB_FAULT(LightPdfWithoutDistance))
-                                                    .raw;
-  if (!generic::usable_light_pdf(kScalar, F{ls.pdf}).raw) return std::nullopt;  // seen edge-on
-  ls.Le = emission_at_point(i, b, ls.p);
+    return std::nullopt;  // no distance, the back of a one-sided emitter, or seen edge-on
+  ls.p = scalars(s.p);
+  ls.p_error = scalars(s.error);
+  ls.n = scalars(s.n);
+  ls.wi = scalars(s.wi);
+  ls.dist = s.dist.raw;
+  ls.pdf = s.pdf.raw;
+  ls.Le = emission_at_point(i, vec2(s.b1.raw, s.b2.raw), ls.p);
   return ls;
 }
 
@@ -371,8 +384,8 @@ float LightSampler::pdf(const LightQuery& query, const Surfel& hit) const {
   const float pmf = pick_pmf(query, i);
   if (light_sampling_ == LightSampling::SolidAngle) {
     if (pmf == 0.0f) return 0.0f;
-    const SolidAngleView view = solid_angle_view(entries_[i], ref);
-    if (view.density > 0.0) return pmf * static_cast<float>(view.density);
+    const auto view = solid_angle_draw(*scene_, light_sampling_, entries_[i], ref, lane1::M{true}, false, vec2(0.0f));
+    if (view.use.raw) return pmf * view.density.raw;
   }
   // Under bvh a light the tree gives nothing from here has density 0 (not
   // 0 times a density that may be infinite edge-on).
@@ -381,31 +394,6 @@ float LightSampler::pdf(const LightQuery& query, const Surfel& hit) const {
   return generic::area_light_pdf_at(kScalar, lanes(ref), lanes(hit.p), lanes(hit.n), F{pmf}, F{area_density(entries_[i])},
                                     PATHLAB_FAULT(LightPdfWithoutDistance))
       .raw;
-}
-
-LightSampler::SolidAngleView LightSampler::solid_angle_view(const Entry& e, const vec3& ref) const {
-  SolidAngleView view;
-  if (light_sampling_ != LightSampling::SolidAngle) return view;
-  const Shape& shape = scene_->shapes[e.shape];
-  // The rule and the densities as the wavefront's lanes compute them
-  // (core/simd/spherical-inl.h at width 1).
-  using namespace width1;
-  const D3 o = lanes(dvec3(ref));
-  if (shape.kind == Shape::Kind::Sphere) {
-    view.cone = sphere_cone(dvec3(ref), dvec3(shape.center), shape.radius);
-    if (!view.cone.outside) return view;  // inside (or on) the sphere: by area
-    view.density = generic::sphere_cone_density(kScalarD, D1{view.cone.one_minus_cos_max}).raw;
-  } else {
-    D1 omega, density;
-    const bool sampled = generic::triangle_view(kScalarD, o, lanes(dvec3(e.triangle.p0)), lanes(dvec3(e.triangle.p1)),
-                                                lanes(dvec3(e.triangle.p2)), omega, density)
-                             .raw;
-    view.omega = omega.raw;
-    if (!sampled) return view;
-    view.density = density.raw;
-  }
-  if (!std::isfinite(view.density)) view.density = 0.0;
-  return view;
 }
 
 void LightSampler::add_suns(const vec3& dir, Spectrum* Le, float* pdf) const {

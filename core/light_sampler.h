@@ -259,16 +259,6 @@ class LightSampler {
   // pick sky entry j; the tree takes [0, sky_start_[0]).
   void build_bvh(const std::vector<double>& power);
 
-  // Whether entry `e` (a triangle or sphere) is sampled in solid angle from
-  // `ref` (the fallback rule of core/sampling_spherical.h), and with which
-  // density: density 0 means by area. sample() and pdf() both ask this, so
-  // they cannot apply different rules.
-  struct SolidAngleView {
-    double density = 0.0;  // 1 / solid angle, without the pick probability; 0: by area
-    double omega = 0.0;    // a triangle's solid angle
-    SphereCone cone;       // a sphere's cone
-  };
-  SolidAngleView solid_angle_view(const Entry& e, const vec3& ref) const;
   // Adds the radiance and density (with its pick probability) of every sun
   // disk whose cone holds `dir`.
   void add_suns(const vec3& dir, Spectrum* Le, float* pdf) const;

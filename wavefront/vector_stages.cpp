@@ -113,7 +113,9 @@ std::size_t lanes() { return 1; }
 
 using pathlab::HWY_NAMESPACE::add_sun;
 using pathlab::HWY_NAMESPACE::affine_point;
-using pathlab::HWY_NAMESPACE::area_light_pdf;
+using pathlab::HWY_NAMESPACE::area_light_sample;
+using pathlab::HWY_NAMESPACE::AreaLight;
+using pathlab::HWY_NAMESPACE::AreaLightSample;
 using pathlab::HWY_NAMESPACE::area_light_pdf_at;
 using pathlab::HWY_NAMESPACE::blend_normals;
 using pathlab::HWY_NAMESPACE::bvh_pick;
@@ -139,7 +141,6 @@ using pathlab::HWY_NAMESPACE::geometric_side_ok;
 using pathlab::HWY_NAMESPACE::is_black;
 using pathlab::HWY_NAMESPACE::lambert_eval;
 using pathlab::HWY_NAMESPACE::lambert_sample;
-using pathlab::HWY_NAMESPACE::light_point_seen;
 using pathlab::HWY_NAMESPACE::mirror_sample;
 using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
@@ -156,11 +157,9 @@ using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::shading_normal;
 using pathlab::HWY_NAMESPACE::spawn_origin;
 using pathlab::HWY_NAMESPACE::spawn_to;
-using pathlab::HWY_NAMESPACE::sample_sphere_cone_normal;
 using pathlab::HWY_NAMESPACE::scattered_cone;
-using pathlab::HWY_NAMESPACE::solid_angle_triangle_point;
-using pathlab::HWY_NAMESPACE::sphere_cone;
-using pathlab::HWY_NAMESPACE::sphere_cone_density;
+using pathlab::HWY_NAMESPACE::solid_angle_draw;
+using pathlab::HWY_NAMESPACE::SolidAngleDraw;
 using pathlab::HWY_NAMESPACE::sphere_point;
 using pathlab::HWY_NAMESPACE::sphere_uv;
 using pathlab::HWY_NAMESPACE::sphere_uv_per_area;
@@ -173,11 +172,8 @@ using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
 using pathlab::HWY_NAMESPACE::transform_point;
 using pathlab::HWY_NAMESPACE::triangle_uv_per_area;
-using pathlab::HWY_NAMESPACE::triangle_view;
 using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::uniform_sphere;
-using pathlab::HWY_NAMESPACE::uniform_triangle;
-using pathlab::HWY_NAMESPACE::usable_light_pdf;
 using pathlab::HWY_NAMESPACE::CospowLobes;
 using pathlab::HWY_NAMESPACE::VndfLobes;
 using pathlab::HWY_NAMESPACE::zero_unless;
@@ -767,59 +763,28 @@ void resolve(const Scene& sc, const Wave& w) {
   }
 }
 
-// Under light_sampling solid_angle: LightSampler::solid_angle_view from ref
-// of the lights in the lanes of m (triangles p0 p1 p2; spheres, where
-// `sphere`: centre p0, radius p1.x), computed in the double halves of the
-// registers (core/simd/spherical-inl.h): `use` where the rule samples them
-// in solid angle, with that density (as a float, as sample() and pdf() take
-// it); and when u (lu, lv) is given, the point sample() draws there: a
-// triangle's barycentrics (b1, b2), a sphere's unit normal n (as floats).
-struct SolidAngleLanes {
-  M use;
-  VF density, b1, b2;
-  V3 n;
-};
+// Under light_sampling solid_angle: core/simd/spherical-inl.h's
+// solid_angle_draw from ref of the lights in the lanes of m (triangles p0
+// p1 p2; spheres, where `sphere`: centre p0, radius p1.x), computed in the
+// double halves of the registers and carried to floats, as LightSampler's
+// sample() and pdf() carry it; with u (lu, lv) given, the point drawn.
+using SolidAngleLanes = SolidAngleDraw<VF, M>;
 SolidAngleLanes solid_angle_lanes(M m, M sphere, const V3& ref, const V3& p0, const V3& p1, const V3& p2,
                                   const VF* lu = nullptr, const VF* lv = nullptr) {
   const DD dd;
   VD use[2], density[2], b1[2], b2[2];
   V3D n[2];
   for (int h = 0; h < 2; ++h) {
-    use[h] = density[h] = b1[h] = b2[h] = hn::Zero(dd);
-    n[h] = {use[h], use[h], use[h]};
     const MD in = half_mask(m, h);
-    if (hn::AllFalse(dd, in)) continue;
-    const MD spheres = hn::And(in, half_mask(sphere, h));
-    const MD triangles = hn::AndNot(spheres, in);
-    const V3D o = half_d(ref, h), q0 = half_d(p0, h), q1 = half_d(p1, h), q2 = half_d(p2, h);
-    MD sampled = hn::FirstN(dd, 0);
-    VD dens = hn::Zero(dd);
-    if (!hn::AllFalse(dd, triangles)) {
-      VD omega, density_t;
-      const MD t = hn::And(triangles, triangle_view(dd, o, q0, q1, q2, omega, density_t));
-      sampled = t;
-      dens = hn::IfThenElse(t, density_t, dens);
-      if (lu && !hn::AllFalse(dd, t)) {
-        VD tb1, tb2;
-        solid_angle_triangle_point(dd, o, q0, q1, q2, omega, half_d(*lu, h), half_d(*lv, h), tb1, tb2);
-        b1[h] = hn::IfThenElseZero(t, tb1);
-        b2[h] = hn::IfThenElseZero(t, tb2);
-      }
-    }
-    if (!hn::AllFalse(dd, spheres)) {
-      V3D axis;
-      VD dist, sin2_max, one_minus_cos_max;
-      const MD s = hn::And(spheres, sphere_cone(dd, o, q0, q1.x, axis, dist, sin2_max, one_minus_cos_max));
-      sampled = hn::Or(sampled, s);
-      dens = hn::IfThenElse(s, sphere_cone_density(dd, one_minus_cos_max), dens);
-      if (lu && !hn::AllFalse(dd, s))
-        n[h] = select(s, sample_sphere_cone_normal(dd, axis, dist, sin2_max, one_minus_cos_max, half_d(*lu, h),
-                                                   half_d(*lv, h)),
-                      n[h]);
-    }
-    sampled = hn::And(sampled, hn::IsFinite(dens));  // else density 0: by area
-    use[h] = hn::IfThenElseZero(sampled, hn::Set(dd, 1.0));
-    density[h] = hn::IfThenElseZero(sampled, dens);
+    const VD zero = hn::Zero(dd);
+    const SolidAngleDraw<VD, MD> view =
+        solid_angle_draw(dd, in, half_mask(sphere, h), half_d(ref, h), half_d(p0, h), half_d(p1, h), half_d(p2, h),
+                         lu != nullptr, lu ? half_d(*lu, h) : zero, lv ? half_d(*lv, h) : zero);
+    use[h] = hn::IfThenElseZero(view.use, hn::Set(dd, 1.0));
+    density[h] = view.density;
+    b1[h] = view.b1;
+    b2[h] = view.b2;
+    n[h] = view.n;
   }
   SolidAngleLanes sa;
   sa.use = hn::And(m, join_f(use[0], use[1]) != k(0.0f));
@@ -1096,73 +1061,41 @@ VI pick_light(const Scene& sc, VF u_choice, const V3& sp, const V3& n, const V3&
   return light;
 }
 
-// LightSampler::sample's point on a triangle or sphere light, uniform in
-// area (square_to_uniform_triangle and triangle_point; sample_sphere), with
-// the density pmf / area in solid angle, in the lanes of ok; those it gives
-// no sample leave ok.
+// LightSampler::sample's point on a triangle or sphere light in the lanes
+// of ok (core/simd/lights-inl.h's area_light_sample, the solid-angle rule in
+// the registers' double halves), with its radiance and the shadow ray
+// towards it; the lanes it gives no sample leave ok.
 LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, VF pmf, VF lu, VF lv, const V3& sp,
                           const V3& n, M& ok) {
   const DF df;
+  const Lights& lights = sc.lights;
+  AreaLight<VF, M> e;
+  e.p0 = light_value3(ok, lights, light, kLightP0);
+  e.p1 = light_value3(ok, lights, light, kLightP1);
+  e.p2 = light_value3(ok, lights, light, kLightP2);
+  e.n = light_value3(ok, lights, light, kLightNormal);
+  e.sphere = sphere_lights(ok, lights, light);
+  e.flip = e.p1.y != k(0.0f);  // a sphere's; its p1 is (radius, flip, 0)
+  e.two_sided = light_value(ok, lights, light, kLightTwoSided) != k(0.0f);
+  e.inv_area = light_value(ok, lights, light, kLightInvArea);
+  const auto solid_angle = [&](M m) {
+    if (sc.solid_angle) return solid_angle_lanes(m, e.sphere, sp, e.p0, e.p1, e.p2, &lu, &lv);
+    return SolidAngleLanes{hn::FirstN(df, 0), k(0.0f), k(0.0f), k(0.0f), zero3()};
+  };
+  AreaLightSample<VF> s;
+  ok = area_light_sample(df, ok, sp, e, pmf, lu, lv, solid_angle, false, s);
   LightLanes ls;
-  VF b1, b2;
-  uniform_triangle(df, lu, lv, b1, b2);
-  const V3 p0 = light_value3(ok, sc.lights, light, kLightP0), p1 = light_value3(ok, sc.lights, light, kLightP1),
-           p2 = light_value3(ok, sc.lights, light, kLightP2), Le = light_value3(ok, sc.lights, light, kLightLe);
-  V3 ln = light_value3(ok, sc.lights, light, kLightNormal);
-  ls.Le = Le;
-  const VF two_sided = light_value(ok, sc.lights, light, kLightTwoSided);
-  V3 lp, lerr;
-  triangle_point(df, b1, b2, p0, p1, p2, lp, lerr);
-  const M spheres = sphere_lights(ok, sc.lights, light);
-  if (!hn::AllFalse(df, spheres)) {
-    // sample_sphere: a uniform direction from the centre, projected onto the sphere.
-    V3 dir, s_p, s_err, s_n;
-    uniform_sphere(df, lu, lv, dir.x, dir.y, dir.z);
-    const V3 center = p0;
-    const VF radius = p1.x;
-    sphere_point(df, center, radius, p1.y != k(0.0f), center + radius * dir, s_p, s_err, s_n);
-    lp = select(spheres, s_p, lp);
-    lerr = select(spheres, s_err, lerr);
-    ln = select(spheres, s_n, ln);
-  }
-  // Under solid_angle, where the rule says so: a triangle's point along a
-  // direction in the spherical triangle it subtends, a sphere's where a
-  // direction in its cone meets it (LightSampler::sample).
-  SolidAngleLanes sa;
-  if (sc.solid_angle) {
-    sa = solid_angle_lanes(ok, spheres, sp, p0, p1, p2, &lu, &lv);
-    if (const M tri = hn::AndNot(spheres, sa.use); !hn::AllFalse(df, tri)) {
-      V3 t_p, t_err;
-      triangle_point(df, sa.b1, sa.b2, p0, p1, p2, t_p, t_err);
-      lp = select(tri, t_p, lp);
-      lerr = select(tri, t_err, lerr);
-      b1 = hn::IfThenElse(tri, sa.b1, b1);
-      b2 = hn::IfThenElse(tri, sa.b2, b2);
-    }
-    if (const M cone = hn::And(spheres, sa.use); !hn::AllFalse(df, cone)) {
-      V3 s_p, s_err, s_n;
-      const VF radius = p1.x;
-      sphere_point(df, p0, radius, p1.y != k(0.0f), p0 + radius * sa.n, s_p, s_err, s_n);
-      lp = select(cone, s_p, lp);
-      lerr = select(cone, s_err, lerr);
-      ln = select(cone, s_n, ln);
-    }
-  }
-
-  VF dist, cos_light;
-  ok = hn::And(ok, light_point_seen(df, sp, lp, ln, two_sided != k(0.0f), ls.wi, dist, cos_light));
-  const VF inv_area = light_value(ok, sc.lights, light, kLightInvArea);
-  ls.pdf = area_light_pdf(df, pmf, inv_area, dist, cos_light);
-  if (sc.solid_angle) ls.pdf = hn::IfThenElse(sa.use, pmf * sa.density, ls.pdf);
-  ok = hn::And(ok, usable_light_pdf(df, ls.pdf));  // not seen edge-on
-  if (sc.lights.textured) {
+  ls.wi = s.wi;
+  ls.pdf = s.pdf;
+  ls.Le = light_value3(ok, lights, light, kLightLe);
+  if (lights.textured) {
     // An emission texture's texel at the point, read by core, path by path.
-    if (const M textured = hn::And(ok, gather(ok, sc.lights.textured, light, 1, 0) != k(0.0f));
+    if (const M textured = hn::And(ok, gather(ok, lights.textured, light, 1, 0) != k(0.0f));
         !hn::AllFalse(df, textured)) {
       HWY_ALIGN float at[5][kMaxLanes], radiance[3][kMaxLanes];
       HWY_ALIGN std::int32_t entry[kMaxLanes];
-      hn::Store(b1, df, at[0]), hn::Store(b2, df, at[1]);
-      hn::Store(lp.x, df, at[2]), hn::Store(lp.y, df, at[3]), hn::Store(lp.z, df, at[4]);
+      hn::Store(s.b1, df, at[0]), hn::Store(s.b2, df, at[1]);
+      hn::Store(s.p.x, df, at[2]), hn::Store(s.p.y, df, at[3]), hn::Store(s.p.z, df, at[4]);
       hn::Store(light, DI(), entry);
       hn::Store(ls.Le.x, df, radiance[0]), hn::Store(ls.Le.y, df, radiance[1]), hn::Store(ls.Le.z, df, radiance[2]);
       for_each_lane(textured, i0, [&](std::size_t, std::size_t j) {
@@ -1175,10 +1108,10 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI lig
     }
   }
 
-  // Surfel::spawn_to(lp, lerr, ln).
+  // Surfel::spawn_to(p, error, n).
   V3 origin, dir;
   VF len;
-  spawn_to(df, sp, load3(w, kErrX, i0, ok), n, lp, lerr, ln, origin, dir, len);
+  spawn_to(df, sp, load3(w, kErrX, i0, ok), n, s.p, s.error, s.n, origin, dir, len);
   const VF ray[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
   std::copy(std::begin(ray), std::end(ray), ls.ray);
   return ls;

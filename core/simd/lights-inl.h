@@ -141,6 +141,64 @@ HWY_INLINE auto usable_light_pdf(D d, V pdf) {
   return And(pdf > Zero(d), Not(IsInf(pdf)));
 }
 
+// An area light as LightSampler::sample reads it in a lane: a triangle's
+// vertices p0 p1 p2 and unit normal n, or where `sphere` a sphere of centre
+// p0 and radius p1.x (its normals inwards where `flip`); whether it emits
+// from both sides; its area density (1 / area).
+template <class V, class M>
+struct AreaLight {
+  Vec3<V> p0, p1, p2, n;
+  M sphere, flip, two_sided;
+  V inv_area;
+};
+// What LightSampler::sample draws on an area light: the point p (its
+// rounding error bound, its normal n; a triangle's barycentrics (b1, b2) of
+// p1 and p2, for an emission texture), the direction wi towards it from the
+// shading point, its distance and the sample's density in solid angle.
+template <class V>
+struct AreaLightSample {
+  Vec3<V> p, error, n, wi;
+  V b1, b2, dist, pdf;
+};
+
+// LightSampler::sample's point on the area light e, chosen with
+// probability pmf, seen from ref, in the lanes of ok; the lanes it gives no
+// sample (no distance, the back of a one-sided emitter, edge-on) leave the
+// mask it returns. solid_angle(ok) is the caller's solid_angle_draw (core/
+// simd/spherical-inl.h) of those lanes with (ux, uy), carried to floats (its
+// `use` none where light_sampling is area): where it says so, the point is
+// the one drawn in solid angle with that density, elsewhere one uniform in
+// area (square_to_uniform_triangle and triangle_point, sample_sphere) with
+// density pmf inv_area d^2 / |cos|. drop_distance: area_light_pdf's fault.
+template <class D, class M, class SolidAngle, class V = VecOf<D>>
+HWY_INLINE M area_light_sample(D d, M ok, const Vec3<V>& ref, const AreaLight<V, M>& e, V pmf, V ux, V uy,
+                               const SolidAngle& solid_angle, bool drop_distance, AreaLightSample<V>& s) {
+  const auto sa = solid_angle(ok);
+  const M spheres = And(ok, e.sphere), triangles = AndNot(e.sphere, ok);
+  uniform_triangle(d, ux, uy, s.b1, s.b2);
+  const M triangles_sa = AndNot(e.sphere, sa.use);
+  s.b1 = IfThenElse(triangles_sa, sa.b1, s.b1);
+  s.b2 = IfThenElse(triangles_sa, sa.b2, s.b2);
+  s.p = s.error = {Zero(d), Zero(d), Zero(d)};
+  s.n = e.n;
+  if (!AllFalse(d, triangles)) triangle_point(d, s.b1, s.b2, e.p0, e.p1, e.p2, s.p, s.error);
+  if (!AllFalse(d, spheres)) {
+    // A direction from the centre (uniform, or the cone's), projected onto the sphere.
+    Vec3<V> dir, p, error, n;
+    uniform_sphere(d, ux, uy, dir.x, dir.y, dir.z);
+    dir = select(sa.use, sa.n, dir);
+    const V radius = e.p1.x;
+    sphere_point(d, e.p0, radius, e.flip, e.p0 + radius * dir, p, error, n);
+    s.p = select(spheres, p, s.p);
+    s.error = select(spheres, error, s.error);
+    s.n = select(spheres, n, s.n);
+  }
+  V cos_light;
+  ok = And(ok, light_point_seen(d, ref, s.p, s.n, e.two_sided, s.wi, s.dist, cos_light));
+  s.pdf = IfThenElse(sa.use, pmf * sa.density, area_light_pdf(d, pmf, e.inv_area, s.dist, cos_light, drop_distance));
+  return And(ok, usable_light_pdf(d, s.pdf));
+}
+
 // spot_profile (core/scene.h): 1 for cos_theta >= cos_inner, 0 for
 // cos_theta <= cos_outer, a smoothstep in cos_theta between.
 template <class D, class V = VecOf<D>>

@@ -227,6 +227,54 @@ HWY_INLINE V sphere_cone_density(D d, V one_minus_cos_max) {
   return Set(d, 1.0) / (Set(d, 6.283185307179586) * one_minus_cos_max);
 }
 
+// LightSampler's solid-angle rule for the area lights in the lanes of m,
+// seen from o (triangles p0 p1 p2; where `sphere`, a sphere of centre p0
+// and radius p1.x): `use` where the rule samples a light in the solid angle
+// it subtends (a triangle's spherical triangle within the rule's bounds, a
+// sphere's cone from outside it), with that density (1 / solid angle,
+// without the pick probability; a density that is not finite falls back to
+// area). With `draw`, the point drawn there with (ux, uy): a triangle's
+// barycentrics (b1, b2), a sphere's unit normal n. Off `use`, 0.
+template <class V, class M>
+struct SolidAngleDraw {
+  M use;
+  V density, b1, b2;
+  Vec3<V> n;
+};
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE SolidAngleDraw<V, M> solid_angle_draw(D d, M m, M sphere, const Vec3<V>& o, const Vec3<V>& p0,
+                                                 const Vec3<V>& p1, const Vec3<V>& p2, bool draw, V ux, V uy) {
+  SolidAngleDraw<V, M> out{AndNot(m, m), Zero(d), Zero(d), Zero(d), {Zero(d), Zero(d), Zero(d)}};
+  if (AllFalse(d, m)) return out;
+  const M spheres = And(m, sphere), triangles = AndNot(sphere, m);
+  M sampled = out.use;
+  V density = Zero(d);
+  if (!AllFalse(d, triangles)) {
+    V omega, density_t;
+    const M t = And(triangles, triangle_view(d, o, p0, p1, p2, omega, density_t));
+    sampled = t;
+    density = IfThenElse(t, density_t, density);
+    if (draw && !AllFalse(d, t)) {
+      V b1, b2;
+      solid_angle_triangle_point(d, o, p0, p1, p2, omega, ux, uy, b1, b2);
+      out.b1 = IfThenElseZero(t, b1);
+      out.b2 = IfThenElseZero(t, b2);
+    }
+  }
+  if (!AllFalse(d, spheres)) {
+    Vec3<V> axis;
+    V dist, sin2_max, one_minus_cos_max;
+    const M s = And(spheres, sphere_cone(d, o, p0, p1.x, axis, dist, sin2_max, one_minus_cos_max));
+    sampled = Or(sampled, s);
+    density = IfThenElse(s, sphere_cone_density(d, one_minus_cos_max), density);
+    if (draw && !AllFalse(d, s))
+      out.n = select(s, sample_sphere_cone_normal(d, axis, dist, sin2_max, one_minus_cos_max, ux, uy), out.n);
+  }
+  out.use = And(sampled, IsFinite(density));
+  out.density = IfThenElseZero(out.use, density);
+  return out;
+}
+
 }  // namespace pathlab::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
