@@ -79,7 +79,8 @@ std::optional<BsdfSample> scatter_closure(const MaterialView& m, const Frame& fr
   // The weight is the true f cos over the mixture's density at the final
   // direction, whatever lobe drew it.
   const float pdf = disney::pdf<F>(m.closure, wo_local, ds->wi, m.shading.sampling);
-  if (!(pdf > 0.0f) || pdf < m.shading.min_pdf) return std::nullopt;
+  if (!width1::generic::usable_bsdf_pdf(width1::kScalar, width1::F{pdf}, width1::F{m.shading.min_pdf}).raw)
+    return std::nullopt;
   const Spectrum f = disney::eval<F>(m.closure, wo_local, ds->wi);
   vec3 wi = ds->wi;
   wi.z *= side;
@@ -96,6 +97,42 @@ std::optional<BsdfSample> scatter_dielectric(const MaterialView& m, const Frame&
                     ds.transmitted ? Lobe::DielectricTransmission : Lobe::DielectricReflection, true};
 }
 
+// Surfel's rules around the BSDFs at width 1 (core/simd/lanes-inl.h's
+// surface_eval_ok, surface_scatter_ok and scattered_side_ok, which the
+// wavefront's lanes apply too): the one-sided policy, and the shading-normal
+// policy (surfel.h): with a shading normal, a reflection needs wi and wo on
+// the same side of the geometric surface, a transmission opposite sides.
+// Without one the shading frame is the geometric frame and the lobes' own
+// hemisphere tests already say the same.
+bool eval_ok(const Surfel& s, const vec3& wi, const vec3& wo) {
+  if (!s.material->one_sided && !s.shading_normal) return true;  // as the lanes skip it
+  using namespace width1;
+  return generic::surface_eval_ok(kScalar, lane1::M{s.material->one_sided}, lane1::M{s.shading_normal},
+                                  F{glm::dot(wo, s.n)}, F{glm::dot(wi, s.n)})
+      .raw;
+}
+bool scatter_ok(const Surfel& s, const vec3& wo) {
+  const bool dielectric = s.material->type == MaterialType::Dielectric;
+  if (!s.material->one_sided && !(dielectric && s.shading_normal)) return true;
+  using namespace width1;
+  return generic::surface_scatter_ok(kScalar, lane1::M{s.material->one_sided},
+                                     lane1::M{dielectric && s.shading_normal}, F{glm::dot(wo, s.n)},
+                                     F{glm::dot(wo, s.frame.n)})
+      .raw;
+}
+// The side the reflection models see wo from (its z in the shading frame: wo_fz).
+float upper_side(float wo_fz) {
+  using namespace width1;
+  return generic::upper_side(kScalar, F{wo_fz}).raw;
+}
+bool scattered_ok(const Surfel& s, const vec3& wi, const vec3& wo, bool transmitted) {
+  if (!s.shading_normal) return true;
+  using namespace width1;
+  return generic::scattered_side_ok(kScalar, lane1::M{s.shading_normal}, lane1::M{transmitted}, F{glm::dot(wo, s.n)},
+                                    F{glm::dot(wi, s.n)})
+      .raw;
+}
+
 }  // namespace
 
 Spectrum Surfel::emitted(const vec3& wo) const {
@@ -105,21 +142,10 @@ Spectrum Surfel::emitted(const vec3& wo) const {
                                           lanes(params ? params->emission : material->emission)));
 }
 
-// The shading-normal policy (surfel.h): with a shading normal, a reflection
-// needs wi and wo on the same side of the geometric surface, a transmission
-// opposite sides. Without one the shading frame is the geometric frame and
-// the lobes' own hemisphere tests already say the same.
-// The generic geometric_side_ok (core/simd/lanes-inl.h) at width 1.
-bool geometric_side_ok(const vec3& n, const vec3& wi, const vec3& wo, bool transmission) {
-  using namespace width1;
-  return generic::geometric_side_ok(kScalar, lane1::M{transmission}, F{glm::dot(wi, n)}, F{glm::dot(wo, n)}).raw;
-}
-
 Spectrum Surfel::eval(const vec3& wi, const vec3& wo) const {
   if (material->is_pure_impulse() || material->type == MaterialType::Emissive) return Spectrum(0.0f);
-  if (material->one_sided && !(on_front(wo) && on_front(wi))) return Spectrum(0.0f);
+  if (!eval_ok(*this, wi, wo)) return Spectrum(0.0f);
   const MaterialView m = view_of(*material, params);
-  if (shading_normal && !geometric_side_ok(n, wi, wo, false)) return Spectrum(0.0f);
   const LocalDirs d = to_local_upper(frame, wo, wi);
   switch (m.shading.path) {
     case ShadingPath::LambertOnly: return eval_as<0>(m, d);
@@ -132,7 +158,7 @@ Spectrum Surfel::eval(const vec3& wi, const vec3& wo) const {
 
 float Surfel::pdf(const vec3& wi, const vec3& wo) const {
   if (material->is_pure_impulse() || material->type == MaterialType::Emissive) return 0.0f;
-  if (material->one_sided && !on_front(wo)) return 0.0f;  // scatter() samples nothing there
+  if (!scatter_ok(*this, wo)) return 0.0f;  // scatter() samples nothing there
   const MaterialView m = view_of(*material, params);
   const LocalDirs d = to_local_upper(frame, wo, wi);
   switch (m.shading.path) {
@@ -145,14 +171,9 @@ float Surfel::pdf(const vec3& wi, const vec3& wo) const {
 }
 
 std::optional<BsdfSample> Surfel::scatter(const vec3& wo, float u_lobe, vec2 u) const {
-  if (material->one_sided && !on_front(wo)) return std::nullopt;  // the back of a one-sided surface is black
-  if (!shading_normal) return scatter_in_frame(wo, u_lobe, u);
-  // The dielectric tells inside from outside by the side of wo: with a
-  // shading normal that must be the geometric side too.
-  if (material->type == MaterialType::Dielectric && (glm::dot(wo, n) < 0.0f) != (glm::dot(wo, frame.n) < 0.0f))
-    return std::nullopt;
+  if (!scatter_ok(*this, wo)) return std::nullopt;
   std::optional<BsdfSample> s = scatter_in_frame(wo, u_lobe, u);
-  if (s && !geometric_side_ok(n, s->wi, wo, s->lobe == Lobe::DielectricTransmission)) return std::nullopt;
+  if (s && !scattered_ok(*this, s->wi, wo, s->lobe == Lobe::DielectricTransmission)) return std::nullopt;
   return s;
 }
 
@@ -160,7 +181,7 @@ std::optional<BsdfSample> Surfel::scatter_in_frame(const vec3& wo, float u_lobe,
   const MaterialView m = view_of(*material, params);
   if (m.type == MaterialType::Dielectric) return scatter_dielectric(m, frame, wo, u_lobe);
   vec3 wo_local = frame.to_local(wo);
-  const float side = wo_local.z < 0.0f ? -1.0f : 1.0f;
+  const float side = upper_side(wo_local.z);
   wo_local.z *= side;
   switch (m.shading.path) {
     case ShadingPath::LambertOnly: break;
@@ -207,13 +228,13 @@ std::optional<BsdfSample> Surfel::scatter_in_frame(const vec3& wo, float u_lobe,
 std::optional<BsdfSample> Surfel::scatter_cosine(const vec3& wo, vec2 u) const {
   if (material->is_pure_impulse()) return std::nullopt;
   if (material->one_sided && !on_front(wo)) return std::nullopt;
-  const float side = glm::dot(wo, frame.n) < 0.0f ? -1.0f : 1.0f;
+  const float side = upper_side(glm::dot(wo, frame.n));
   vec3 wi_local = square_to_cosine_hemisphere(u);
   const float pdf = cosine_hemisphere_pdf(wi_local);
   if (pdf <= 0.0f) return std::nullopt;
   wi_local.z *= side;
   const vec3 wi = frame.to_world(wi_local);
-  if (shading_normal && !geometric_side_ok(n, wi, wo, false)) return std::nullopt;
+  if (!scattered_ok(*this, wi, wo, false)) return std::nullopt;
   return BsdfSample{wi, eval(wi, wo) / pdf, pdf, Lobe::Lambert, false};
 }
 

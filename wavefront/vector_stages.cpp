@@ -137,7 +137,11 @@ using pathlab::HWY_NAMESPACE::emitted_towards;
 using pathlab::HWY_NAMESPACE::facing_normal;
 using pathlab::HWY_NAMESPACE::footprint_width;
 using pathlab::HWY_NAMESPACE::frame;
-using pathlab::HWY_NAMESPACE::geometric_side_ok;
+using pathlab::HWY_NAMESPACE::scattered_side_ok;
+using pathlab::HWY_NAMESPACE::surface_eval_ok;
+using pathlab::HWY_NAMESPACE::surface_scatter_ok;
+using pathlab::HWY_NAMESPACE::upper_side;
+using pathlab::HWY_NAMESPACE::usable_bsdf_pdf;
 using pathlab::HWY_NAMESPACE::is_black;
 using pathlab::HWY_NAMESPACE::lambert_eval;
 using pathlab::HWY_NAMESPACE::lambert_sample;
@@ -145,7 +149,6 @@ using pathlab::HWY_NAMESPACE::mirror_sample;
 using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::NoEnergy;
-using pathlab::HWY_NAMESPACE::opposite_sides;
 using pathlab::HWY_NAMESPACE::normal_map_frame;
 using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::light_grid_point;
@@ -1379,13 +1382,13 @@ M shading_frame(const Scene& sc, const Wave& w, std::size_t i0, M m, VI shape, c
   }
   return framed;
 }
-// Surfel's rule under a shading normal (geometric_side_ok): the lanes of
-// `framed` whose hit has one and whose wo and wi (wo_z, wi_z: their dot
-// products with the geometric normal) break it, a reflection or, in the
-// lanes of `transmitted`, a transmission.
-M across_geometric_sides(const Wave& w, std::size_t i0, M framed, M transmitted, VF wo_z, VF wi_z) {
-  if (hn::AllFalse(DF(), framed)) return framed;
-  return hn::AndNot(geometric_side_ok(DF(), transmitted, wi_z, wo_z), load_mask(w, kShadingNormal, i0, framed));
+// The lanes of m whose material is one-sided (Material::one_sided).
+M one_sided_lanes(const Scene& sc, M m, VI shape) {
+  return sc.one_sided ? shape_flag(m, sc, shape, kOneSided) : hn::FirstN(DF(), 0);
+}
+// The lanes of `framed` (shading_frame) whose hit has a shading normal (Surfel::shading_normal).
+M shading_normal_lanes(const Wave& w, std::size_t i0, M framed) {
+  return hn::AllFalse(DF(), framed) ? framed : load_mask(w, kShadingNormal, i0, framed);
 }
 
 // Surfel::eval and Surfel::pdf towards wi for the lanes of ok (which lose
@@ -1396,22 +1399,14 @@ M across_geometric_sides(const Wave& w, std::size_t i0, M framed, M transmitted,
 void eval_bsdf(const Scene& sc, const Wave& w, std::size_t i0, VI shape, const V3& wo, const V3& n, const V3& wi, M& ok,
                V3& f, VF& pdf_bsdf) {
   const DF df;
-  const VF wo_z = dot(wo, n);
-  // A one-sided material is black unless wo and wi both leave its front
-  // (Surfel::eval); with wo in front, upper below is wi in front.
-  if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), wo_z > k(0.0f)));
   // In the geometric normal's frame, or the hit's own (kFramed).
   V3 fs, ft, fn, wo_local, wi_local;
   const M framed = shading_frame(sc, w, i0, ok, shape, n, fs, ft, fn);
   const M textured = textured_lanes(sc, w, i0, framed);
-  if (!hn::AllFalse(df, framed)) {
-    // Surfel::eval: a one-sided material's wi in front too (not implied by wo's side in a frame of its own), and
-    // under a shading normal wo and wi on one geometric side.
-    const VF wi_z = dot(wi, n);
-    if (sc.one_sided)
-      ok = hn::AndNot(hn::And(hn::And(framed, shape_flag(framed, sc, shape, kOneSided)), hn::Not(wi_z > k(0.0f))), ok);
-    ok = hn::AndNot(across_geometric_sides(w, i0, framed, hn::FirstN(df, 0), wo_z, wi_z), ok);
-  }
+  // Surfel::eval's rules (surface_eval_ok): a one-sided surface's front, a shading normal's geometric side.
+  const M one_sided = one_sided_lanes(sc, ok, shape), shading_normal = shading_normal_lanes(w, i0, framed);
+  if (!hn::AllFalse(df, hn::Or(one_sided, shading_normal)))
+    ok = hn::And(ok, surface_eval_ok(df, one_sided, shading_normal, dot(wo, n), dot(wi, n)));
   to_local_upper(df, fs, ft, fn, wo, wi, wo_local, wi_local);
   lambert_eval(df, albedo_lanes(ok, sc, w, i0, shape, textured), wi_local.z, f, pdf_bsdf);
   if (sc.impulses) {
@@ -1585,16 +1580,24 @@ void scatter(const Scene& sc, const Wave& w) {
     ok = hn::Or(hn::Or(hn::Or(general, impulses), disneys), hn::And(ok, usable));
     const V3 wo = -load3(w, kDx, i0, ok);
     const V3 n = load3(w, kNx, i0, ok);
-    // Surfel::scatter: nothing from behind a one-sided material.
-    if (sc.one_sided) ok = hn::And(ok, hn::Or(hn::Not(shape_flag(ok, sc, shape, kOneSided)), dot(wo, n) > k(0.0f)));
     // The geometric normal's frame, or the hit's own (kFramed).
     V3 fs, ft, fn;
     const M framed = shading_frame(sc, w, i0, ok, shape, n, fs, ft, fn);
     const M textured = textured_lanes(sc, w, i0, framed);
-    const VF side = hn::IfThenElse(dot(wo, fn) < k(0.0f), k(-1.0f), k(1.0f));
+    // Surfel::scatter's rules before the draw (surface_scatter_ok): nothing
+    // from behind a one-sided material, nor from a dielectric whose two
+    // normals disagree about wo's side.
+    const VF wo_z = dot(wo, n), wo_fz = dot(wo, fn);
+    const M one_sided = one_sided_lanes(sc, ok, shape), shading_normal = shading_normal_lanes(w, i0, framed);
+    M glass = hn::FirstN(df, 0);
+    if (!hn::AllFalse(df, impulses))
+      glass = hn::And(impulses, shape_value(impulses, sc, shape, kLaneMaterial) == k(static_cast<float>(kLaneDielectric)));
+    if (const M glass_shading_normal = hn::And(glass, shading_normal); !hn::AllFalse(df, hn::Or(one_sided, glass_shading_normal)))
+      ok = hn::And(ok, surface_scatter_ok(df, one_sided, glass_shading_normal, wo_z, wo_fz));
+    const VF side = upper_side(df, wo_fz);
     V3 wi = to_world(fs, ft, fn, local.x, local.y, local.z * side);
     V3 weight = albedo_lanes(ok, sc, w, i0, shape, textured);
-    M impulse = hn::FirstN(df, 0);
+    M impulse = hn::FirstN(df, 0), transmitted = impulse;
     const M im = hn::And(impulses, ok), g = hn::And(general, ok), dm = hn::And(disneys, ok);
     // The lobe choice, drawn once for the impulses' lanes, the Disney lanes and core's.
     const VF u_lobe = hn::AllFalse(df, hn::Or(hn::Or(im, g), dm)) ? hn::Zero(df) : rng.u(Dim::LobeChoice);
@@ -1611,7 +1614,7 @@ void scatter(const Scene& sc, const Wave& w) {
         VF family;
         M drawn = disney_sample<F>(df, c, wo_up, u_lobe, du, dv, sampler, energy, local_d, family);
         const VF pdf_d = disney_pdf<F>(df, c, wo_up, local_d, sampler, energy, {});
-        drawn = hn::And(drawn, hn::And(pdf_d > k(0.0f), hn::Not(pdf_d < k(sc.min_pdf))));
+        drawn = hn::And(drawn, usable_bsdf_pdf(df, pdf_d, k(sc.min_pdf)));
         const V3 f = disney_eval<F>(df, c, wo_up, local_d, energy, {});
         wi = select(dm, to_world(fs, ft, fn, local_d.x, local_d.y, local_d.z * side), wi);
         weight = select(dm, f / pdf_d, weight);
@@ -1619,15 +1622,12 @@ void scatter(const Scene& sc, const Wave& w) {
         ok = hn::AndNot(hn::AndNot(drawn, dm), ok);
       });
     }
-    // Surfel::scatter under a shading normal: wi on wo's geometric side (the impulses' rule below).
-    if (const M lobes = hn::AndNot(im, framed); !hn::AllFalse(df, lobes))
-      ok = hn::AndNot(across_geometric_sides(w, i0, lobes, hn::FirstN(df, 0), dot(wo, n), dot(wi, n)), ok);
     if (!hn::AllFalse(df, im)) {
       // Surfel::scatter_in_frame of a mirror (wo's side up, as the
       // reflection models take it) and of a dielectric (the frame as is).
       const VF material = shape_value(im, sc, shape, kLaneMaterial);
       const M mirror = hn::And(im, material == k(static_cast<float>(kLaneMirror)));
-      const M glass = hn::And(im, material == k(static_cast<float>(kLaneDielectric)));
+      glass = hn::And(im, glass);
       const V3 wo_local = to_local(fs, ft, fn, wo);
       if (!hn::AllFalse(df, mirror)) {
         V3 local_m, weight_m;
@@ -1639,7 +1639,6 @@ void scatter(const Scene& sc, const Wave& w) {
         pdf = hn::IfThenElse(mirror, pdf_m, pdf);
         ok = hn::AndNot(hn::AndNot(mirrored, mirror), ok);
       }
-      M transmitted = hn::FirstN(df, 0);
       if (!hn::AllFalse(df, glass)) {
         V3 local_g, weight_g;
         VF pdf_g;
@@ -1658,18 +1657,12 @@ void scatter(const Scene& sc, const Wave& w) {
         ok = hn::AndNot(hn::AndNot(crossed, glass), ok);
         transmitted = hn::And(glass, transmitted);
       }
-      // Surfel::scatter under a shading normal (kFramed): a dielectric
-      // tells inside from outside by wo's side, which must be its side of
-      // both normals; wi on wo's geometric side, or across it if
-      // transmitted (geometric_side_ok).
-      if (const M fim = hn::And(framed, im); !hn::AllFalse(df, fim)) {
-        const VF wo_z = dot(wo, n);
-        const M glass_fim = hn::And(glass, fim);
-        const M inside_out = hn::And(load_mask(w, kShadingNormal, i0, glass_fim), opposite_sides(df, wo_z, dot(wo, fn)));
-        ok = hn::AndNot(hn::Or(inside_out, across_geometric_sides(w, i0, fim, transmitted, wo_z, dot(wi, n))), ok);
-      }
       impulse = im;
     }
+    // Surfel::scatter's rule after the draw (scattered_side_ok): under a
+    // shading normal, wi on wo's geometric side, or across it if transmitted.
+    if (const M lobes = hn::AndNot(g, hn::And(ok, shading_normal)); !hn::AllFalse(df, lobes))
+      ok = hn::And(ok, scattered_side_ok(df, lobes, transmitted, wo_z, dot(wi, n)));
     if (!hn::AllFalse(df, g)) {
       // Any other material: Surfel::scatter, path by path.
       HWY_ALIGN float u[3][kMaxLanes], dir[3][kMaxLanes] = {}, wt[3][kMaxLanes] = {}, density[kMaxLanes] = {};

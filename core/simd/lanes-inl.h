@@ -261,6 +261,47 @@ HWY_INLINE M geometric_side_ok(D d, M transmission, V wi_z, V wo_z) {
   return Or(And(transmission, across), And(Not(transmission), wi_z * wo_z > Zero(d)));
 }
 
+// Surfel's rules around the BSDFs (core/surfel.cpp), for both tracers:
+// wo_z, wi_z are wo's and wi's dot products with the geometric normal, wo_fz
+// wo's with the shading frame's.
+//
+// Surfel::eval (and the light sample's f): nothing unless wo and wi both
+// leave the front of a one-sided surface, and, under a shading normal,
+// unless they are on one geometric side (a reflection: no lobe evaluated
+// transmits).
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE M surface_eval_ok(D d, M one_sided, M shading_normal, V wo_z, V wi_z) {
+  const M front = And(wo_z > Zero(d), wi_z > Zero(d));
+  const M reflection = AndNot(shading_normal, shading_normal);
+  return And(Or(Not(one_sided), front), Or(Not(shading_normal), geometric_side_ok(d, reflection, wi_z, wo_z)));
+}
+// Surfel::scatter before the BSDF draws: nothing from the back of a
+// one-sided surface, nor from a dielectric under a shading normal where wo
+// is on different sides of its two normals (it tells inside from outside by
+// wo's side).
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE M surface_scatter_ok(D d, M one_sided, M dielectric_shading_normal, V wo_z, V wo_fz) {
+  return And(Or(Not(one_sided), wo_z > Zero(d)), Not(And(dielectric_shading_normal, opposite_sides(d, wo_z, wo_fz))));
+}
+// Surfel::scatter after the draw: under a shading normal, wi on wo's
+// geometric side, or across it where the draw transmitted.
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE M scattered_side_ok(D d, M shading_normal, M transmitted, V wo_z, V wi_z) {
+  return Or(Not(shading_normal), geometric_side_ok(d, transmitted, wi_z, wo_z));
+}
+// The side the reflection models see wo from: -1 where it is below the
+// shading frame (wo_fz < 0), which they flip to +z, else 1.
+template <class D, class V = VecOf<D>>
+HWY_INLINE V upper_side(D d, V wo_fz) {
+  return IfThenElse(wo_fz < Zero(d), Set(d, -1.0f), Set(d, 1.0f));
+}
+// A mixture's draw is usable where its density is > 0 and not below the
+// material's min_pdf (Surfel::scatter of a Disney closure).
+template <class D, class V = VecOf<D>>
+HWY_INLINE auto usable_bsdf_pdf(D d, V pdf, V min_pdf) {
+  return And(pdf > Zero(d), Not(pdf < min_pdf));
+}
+
 // Surfel::emitted: the emission Le towards wo, 0 behind a one-sided
 // emitter (n the geometric normal).
 template <class D, class M, class V = VecOf<D>>
