@@ -382,17 +382,15 @@ float LightSampler::pdf(const LightQuery& query, const Surfel& hit) const {
   const std::size_t i = static_cast<std::size_t>(first) + hit.prim;
   const vec3& ref = query.p;
   const float pmf = pick_pmf(query, i);
-  if (light_sampling_ == LightSampling::SolidAngle) {
-    if (pmf == 0.0f) return 0.0f;
-    const auto view = solid_angle_draw(*scene_, light_sampling_, entries_[i], ref, lane1::M{true}, false, vec2(0.0f));
-    if (view.use.raw) return pmf * view.density.raw;
-  }
-  // Under bvh a light the tree gives nothing from here has density 0 (not
-  // 0 times a density that may be infinite edge-on).
-  if (kind_ == LightSamplerKind::Bvh && pmf == 0.0f) return 0.0f;
+  // core/simd/lights-inl.h's emitter_hit_pdf at width 1, as the lanes take it.
   using namespace width1;
-  return generic::area_light_pdf_at(kScalar, lanes(ref), lanes(hit.p), lanes(hit.n), F{pmf}, F{area_density(entries_[i])},
-                                    PATHLAB_FAULT(LightPdfWithoutDistance))
+  const auto solid_angle = [&](lane1::M m) {
+    return solid_angle_draw(*scene_, light_sampling_, entries_[i], ref, m, false, vec2(0.0f));
+  };
+  const bool zero_unpicked = kind_ == LightSamplerKind::Bvh || light_sampling_ == LightSampling::SolidAngle;
+  return generic::emitter_hit_pdf(kScalar, lane1::M{true}, lanes(ref), lanes(hit.p), lanes(hit.n), F{pmf},
+                                  F{area_density(entries_[i])}, zero_unpicked, solid_angle,
+                                  PATHLAB_FAULT(LightPdfWithoutDistance))
       .raw;
 }
 

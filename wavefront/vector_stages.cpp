@@ -117,6 +117,7 @@ using pathlab::HWY_NAMESPACE::area_light_sample;
 using pathlab::HWY_NAMESPACE::AreaLight;
 using pathlab::HWY_NAMESPACE::AreaLightSample;
 using pathlab::HWY_NAMESPACE::area_light_pdf_at;
+using pathlab::HWY_NAMESPACE::emitter_hit_pdf;
 using pathlab::HWY_NAMESPACE::blend_normals;
 using pathlab::HWY_NAMESPACE::bvh_pick;
 using pathlab::HWY_NAMESPACE::BvhTable;
@@ -813,7 +814,6 @@ VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI 
   const VI entry = first + load(w, kPrim, i0, light);
   const VF inv_area = light_value(light, sc.lights, entry, kLightInvArea);
   VF pmf = light_value(light, sc.lights, entry, kLightPmf);
-  M pdf_zero = hn::FirstN(df, 0);
   if (sc.lights.bvh_nodes && !hn::AllFalse(df, light)) {
     // LightSampler::pick_pmf from the previous vertex's query: the
     // tree's share for the tree's lights (their power pmf is 0).
@@ -831,21 +831,17 @@ VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI 
                              half_d(qp, h), half_d(qn, h), half_d(tl, h), grid, half_mask(in_tree, h));
       pmf = hn::IfThenElse(in_tree, join_f(share[0], share[1]) * k(0x1p-24f), pmf);
     }
-    pdf_zero = pmf == k(0.0f);  // a light the tree gives nothing from here: density 0
   }
+  // LightSampler::pdf's densities and zero rule (emitter_hit_pdf), the
+  // solid-angle rule in the registers' double halves.
   const V3 prev = load3(w, kPrevX, i0, light);
-  VF pdf = area_light_pdf_at(df, prev, load3(w, kPx, i0, light), n, pmf, inv_area);
-  if (sc.solid_angle && !hn::AllFalse(df, light)) {
-    // In the cone or spherical triangle the light subtends, where the rule
-    // says so; a light picked with probability 0 has density 0.
-    const SolidAngleLanes sa = solid_angle_lanes(light, sphere_lights(light, sc.lights, entry), prev,
-                                                 light_value3(light, sc.lights, entry, kLightP0),
-                                                 light_value3(light, sc.lights, entry, kLightP1),
-                                                 light_value3(light, sc.lights, entry, kLightP2));
-    pdf = hn::IfThenElse(sa.use, pmf * sa.density, pdf);
-    pdf_zero = hn::Or(pdf_zero, pmf == k(0.0f));
-  }
-  return hn::IfThenZeroElse(pdf_zero, hn::IfThenElseZero(light, pdf));
+  const auto solid_angle = [&](M m) {
+    if (!sc.solid_angle) return SolidAngleLanes{hn::FirstN(df, 0), k(0.0f), k(0.0f), k(0.0f), zero3()};
+    return solid_angle_lanes(m, sphere_lights(m, sc.lights, entry), prev, light_value3(m, sc.lights, entry, kLightP0),
+                             light_value3(m, sc.lights, entry, kLightP1), light_value3(m, sc.lights, entry, kLightP2));
+  };
+  return emitter_hit_pdf(df, light, prev, load3(w, kPx, i0, light), n, pmf, inv_area,
+                         sc.lights.bvh || sc.solid_angle, solid_angle);
 }
 
 // emission_weight (core/strategy_weights.h) for the lanes of lit (0 elsewhere).

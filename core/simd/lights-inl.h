@@ -135,6 +135,22 @@ HWY_INLINE V area_light_pdf_at(D d, const Vec3<V>& ref, const Vec3<V>& p, const 
   return area_light_pdf(d, pmf, inv_area, dist, dot(n, to) / dist, drop_distance);
 }
 
+// LightSampler::pdf of an area light's point p (normal n) that a ray from
+// ref found, the light picked with probability pmf there, in the lanes of
+// m: pmf / solid angle where solid_angle(lanes) (the caller's
+// solid_angle_draw without a draw, as area_light_sample takes it) says the
+// light is sampled in solid angle, else area_light_pdf_at. Where
+// zero_unpicked (under bvh or solid_angle) a light picked with probability 0
+// has density 0 (not 0 times a density that may be infinite edge-on).
+template <class D, class M, class SolidAngle, class V = VecOf<D>>
+HWY_INLINE V emitter_hit_pdf(D d, M m, const Vec3<V>& ref, const Vec3<V>& p, const Vec3<V>& n, V pmf, V inv_area,
+                             bool zero_unpicked, const SolidAngle& solid_angle, bool drop_distance = false) {
+  const M live = zero_unpicked ? AndNot(pmf == Zero(d), m) : m;
+  const auto sa = solid_angle(live);
+  const V pdf = area_light_pdf_at(d, ref, p, n, pmf, inv_area, drop_distance);
+  return IfThenElseZero(live, IfThenElse(sa.use, pmf * sa.density, pdf));
+}
+
 // A light sample's density is usable: > 0 and finite (not seen edge-on).
 template <class D, class V = VecOf<D>>
 HWY_INLINE auto usable_light_pdf(D d, V pdf) {
