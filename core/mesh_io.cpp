@@ -645,14 +645,25 @@ constexpr double (*kDecode[])(const unsigned char*) = {
     decode<std::int32_t>, decode<std::uint32_t>, decode<float>,        decode<double>};
 
 // Reads the values of a PLY body one at a time, as doubles (exact for
-// every PLY type). ASCII values are whitespace-separated tokens; line
-// breaks are not significant, which also tolerates "\r\n" and extra spaces.
+// every PLY type). ASCII values are whitespace-separated tokens, one
+// element per line as the format has it: blank lines between elements and
+// "\r\n" or extra spaces are tolerated, but a value too many or too few on
+// a line is reported at that line, not later where the shifted values no
+// longer make sense.
 class PlyBody {
  public:
   PlyBody(const fs::path& file, std::string_view body, Encoding encoding, int first_line)
       : file_(file), body_(body), encoding_(encoding), line_(first_line) {}
 
-  // False when the data ran out before the value.
+  // ASCII: moves to the start of the next element's line, past blank lines.
+  void begin_element() {
+    if (encoding_ != Encoding::Ascii) return;
+    for (; pos_ < body_.size() && is_space(body_[pos_]); ++pos_)
+      if (body_[pos_] == '\n') ++line_;
+  }
+
+  // False when the data ran out before the value, or (ASCII) the element's
+  // line did (then at_line_end()).
   bool next(Scalar type, double& out) {
     if (encoding_ == Encoding::Ascii) return next_ascii(out);
     const std::size_t size = kScalarSize[static_cast<int>(type)];
@@ -665,12 +676,33 @@ class PlyBody {
     out = kDecode[static_cast<int>(type)](bytes);
     return true;
   }
+  bool at_line_end() const { return pos_ < body_.size() && body_[pos_] == '\n'; }
+
+  // ASCII: the first token left on the current line (after an element's
+  // last value), or empty; moves past the line.
+  std::string_view rest_of_line() {
+    if (encoding_ != Encoding::Ascii) return {};
+    skip_blanks();
+    const std::size_t start = pos_;
+    while (pos_ < body_.size() && !is_space(body_[pos_])) ++pos_;
+    const std::string_view token = body_.substr(start, pos_ - start);
+    if (token.empty() && pos_ < body_.size()) {  // at the '\n'
+      ++pos_;
+      ++line_;
+    }
+    return token;
+  }
+
+  // The current line for messages (ASCII), else 0 (none).
+  int line() const { return encoding_ == Encoding::Ascii ? line_ : 0; }
 
  private:
+  void skip_blanks() {
+    while (pos_ < body_.size() && body_[pos_] != '\n' && is_space(body_[pos_])) ++pos_;
+  }
   bool next_ascii(double& out) {
-    for (; pos_ < body_.size() && is_space(body_[pos_]); ++pos_)
-      if (body_[pos_] == '\n') ++line_;
-    if (pos_ == body_.size()) return false;
+    skip_blanks();
+    if (pos_ == body_.size() || body_[pos_] == '\n') return false;
     const std::size_t start = pos_;
     while (pos_ < body_.size() && !is_space(body_[pos_])) ++pos_;
     const std::string_view token = body_.substr(start, pos_ - start);
@@ -688,6 +720,14 @@ class PlyBody {
   std::size_t pos_ = 0;
   int line_;  // ASCII only, for messages
 };
+
+// "x, y, z" or "list vertex_indices": an element's properties as a message shows them.
+std::string property_names(const PlyElement& element) {
+  std::string out;
+  for (const PlyProperty& p : element.properties)
+    out += (out.empty() ? "" : ", ") + std::string(p.is_list ? "list " : "") + p.name;
+  return out;
+}
 
 std::string plural(const std::string& element) {
   if (element == "vertex") return "vertices";
@@ -780,11 +820,21 @@ RawMesh parse_ply(const fs::path& file, std::string_view text) {
     const bool is_face = std::count(role.begin(), role.end(), kFaceIndices) > 0;
     if (element.properties.empty()) continue;  // nothing stored, however large the count
     for (std::uint64_t i = 0; i < element.count; ++i) {
-      const auto read = [&](Scalar type) {
+      const auto which = [&] { return element.name + " " + std::to_string(i); };  // for messages
+      int values = 0;  // on this element's line so far
+      body.begin_element();
+      const auto read = [&](Scalar type, const PlyProperty& prop) {
         double value = 0.0;
-        if (!body.next(type, value))
+        if (!body.next(type, value)) {
+          if (body.at_line_end())
+            fail(file, which() + " ends after " + std::to_string(values) + (values == 1 ? " value" : " values") +
+                           ", inside its " + (prop.is_list ? "list '" : "property '") + prop.name +
+                           "' (the header gives it: " + property_names(element) + "; ASCII PLY has one element per line)",
+                 body.line());
           fail(file, "truncated: expected " + std::to_string(element.count) + " " + plural(element.name) +
                          ", found " + std::to_string(i));
+        }
+        ++values;
         return value;
       };
       vec3 position(0.0f), normal(0.0f);
@@ -792,27 +842,33 @@ RawMesh parse_ply(const fs::path& file, std::string_view text) {
       for (std::size_t p = 0; p < element.properties.size(); ++p) {
         const PlyProperty& prop = element.properties[p];
         if (!prop.is_list) {
-          const auto value = static_cast<float>(read(prop.type));
+          const auto value = static_cast<float>(read(prop.type, prop));
           if (role[p] >= kX && role[p] <= kZ) position[role[p]] = value;
           else if (role[p] >= kNx && role[p] <= kNz) normal[role[p] - kNx] = value;
           else if (role[p] == kU) uv.x = value;
           else if (role[p] == kV) uv.y = value;
           continue;
         }
-        const double length = read(prop.count_type);
+        const double length = read(prop.count_type, prop);
         if (!(length >= 0.0 && length <= 1e9 && std::floor(length) == length))
-          fail(file, "PLY " + element.name + " " + std::to_string(i) + " has an invalid list length");
+          fail(file, "PLY " + which() + " has an invalid list length", body.line());
         if (role[p] == kFaceIndices && length < 3)
           fail(file, "face " + std::to_string(i) + " has " + std::to_string(static_cast<int>(length)) +
-                         " vertices (at least 3 needed)");
+                         " vertices (at least 3 needed)", body.line());
         for (std::size_t k = 0; k < static_cast<std::size_t>(length); ++k) {
-          const double value = read(prop.type);
+          const double value = read(prop.type, prop);
           if (role[p] != kFaceIndices) continue;
           if (!(std::floor(value) == value && std::abs(value) < 1e18))
-            fail(file, "face " + std::to_string(i) + " has an invalid vertex index");
+            fail(file, "face " + std::to_string(i) + " has an invalid vertex index", body.line());
           raw.indices.push_back(static_cast<std::int64_t>(value));
         }
       }
+      const int line = body.line();
+      if (const std::string_view extra = body.rest_of_line(); !extra.empty())
+        fail(file, which() + " has more values than the header gives it (" + property_names(element) +
+                       "): the first extra is '" + std::string(extra.substr(0, 40)) +
+                       "' (ASCII PLY has one element per line)",
+             line);
       if (is_vertex) {
         raw.positions.push_back(position);
         if (has_normals) raw.normals.push_back(normal);
@@ -821,6 +877,13 @@ RawMesh parse_ply(const fs::path& file, std::string_view text) {
       if (is_face) raw.face_start.push_back(raw.indices.size());
     }
   }
+  // ASCII: a line beyond the elements the header declares (a count too small).
+  body.begin_element();
+  const int line = body.line();
+  if (const std::string_view extra = body.rest_of_line(); !extra.empty())
+    fail(file, "'" + std::string(extra.substr(0, 40)) +
+                   "' after the last element the header declares (is an element count in the header too small?)",
+         line);
   return raw;
 }
 

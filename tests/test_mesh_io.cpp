@@ -408,6 +408,32 @@ TEST_F(MeshIoErrors, PlyBadBodyValues) {
                {"no usable triangles (2 degenerate dropped)"});
 }
 
+// ASCII PLY holds one element per line: a value too many or too few is
+// reported at its line and element, not where the shifted values end up
+// (once "face 0 has 0 vertices" for an extra value on a vertex line).
+TEST_F(MeshIoErrors, PlyAsciiLineWithAValueTooManyOrTooFew) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string faces = "3 0 1 2\n3 0 2 3\n";
+  // Line 10 is the first body line.
+  expect_error("vertex_extra.ply", head + "0 0 0\n1 0 0 7\n1 1 0\n0 1 0\n" + faces,
+               {":11: ", "vertex 1 has more values than the header gives it (x, y, z): the first extra is '7'"});
+  expect_error("vertex_short.ply", head + "0 0 0\n1 0\n1 1 0\n0 1 0\n" + faces,
+               {":11: ", "vertex 1 ends after 2 values, inside its property 'z'"});
+  expect_error("face_extra.ply", head + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2 3\n3 0 2 3\n",
+               {":14: ", "face 0 has more values than the header gives it (list vertex_indices): the first extra is '3'"});
+  expect_error("face_short.ply", head + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1\n3 0 2 3\n",
+               {":14: ", "face 0 ends after 3 values, inside its list 'vertex_indices'"});
+  expect_error("after.ply", head + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n" + faces + "\n3 1 2 3\n",
+               {":17: ", "'3' after the last element the header declares"});
+  // Blank lines, "\r\n" and spaces around the values are fine; so is a last line without its '\n'.
+  MeshLoadReport report;
+  EXPECT_EQ(load_mesh(write("spaced.ply", head + "\n 0 0 0 \r\n\n1\t0 0\r\n1 1 0\n0 1 0\n\n3 0 1 2\n3 0 2 3"), &report)
+                .triangles.size(),
+            2u);
+}
+
 TEST_F(MeshIoErrors, BinaryPlyNonFiniteCoordinate) {
   std::string binary = binary_ply(true, true, "vertex_indices");
   const std::size_t body = binary.find("end_header\n") + 11;
