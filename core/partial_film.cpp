@@ -120,6 +120,15 @@ json sum_json(const Sum1& s) { return json::array({hex64(s.low()), hex64(s.high(
 
 // ----------------------------------------------------------------- reading
 
+XXH128_hash_t hash_from_bytes(const unsigned char (&b)[16]) {
+  XXH128_hash_t h;
+  h.low64 = 0;
+  h.high64 = 0;
+  for (int i = 0; i < 8; ++i) h.low64 |= static_cast<XXH64_hash_t>(b[i]) << (8 * i);
+  for (int i = 0; i < 8; ++i) h.high64 |= static_cast<XXH64_hash_t>(b[8 + i]) << (8 * i);
+  return h;
+}
+
 class Reader {
  public:
   explicit Reader(const fs::path& path) : path_(path), in_(path, std::ios::binary) {
@@ -152,18 +161,53 @@ class Reader {
     unsigned char b[16];
     in_.read(reinterpret_cast<char*>(b), 16);
     if (!in_) fail("read failed");
-    XXH128_hash_t h;
-    h.low64 = 0;
-    h.high64 = 0;
-    for (int i = 0; i < 8; ++i) h.low64 |= static_cast<XXH64_hash_t>(b[i]) << (8 * i);
-    for (int i = 0; i < 8; ++i) h.high64 |= static_cast<XXH64_hash_t>(b[8 + i]) << (8 * i);
-    return hex128(h);
+    return hex128(hash_from_bytes(b));
   }
   [[noreturn]] void fail(const std::string& why) const {
     throw InputError(path_.string() + ": not a usable partial film: " + why);
   }
+  // A header the file's checksum vouches for was written so (by another
+  // version of pathlab, or another program); one it does not is damaged,
+  // which a flipped bit in its length or a digit of its resolution must
+  // not pass for a truncated file.
+  [[noreturn]] void header_fail(const std::string& why) const {
+    if (intact())
+      fail(why + ": not a partial film of this pathlab version (format version " + std::to_string(kFormatVersion) + ")");
+    fail("its header is corrupt: " + why + " (its checksum does not match its content)");
+  }
+  // True if a complete JSON value starts after the length field and more
+  // follows it: the header is all there, so its length field is wrong.
+  bool complete_json_header() const {
+    std::ifstream in(path_, std::ios::binary);
+    in.seekg(sizeof kMagic + 8);
+    try {
+      json header;
+      in >> header;
+    } catch (const json::exception&) {
+      return false;
+    }
+    return in && in.peek() != std::char_traits<char>::eof();
+  }
 
  private:
+  // True if the last 16 bytes are the XXH3-128 of all before them.
+  bool intact() const {
+    if (size_ < 16) return false;
+    std::ifstream in(path_, std::ios::binary);
+    const std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(), &XXH3_freeState);
+    XXH3_128bits_reset(state.get());
+    std::vector<char> buffer(std::size_t{1} << 20);
+    for (std::uint64_t left = size_ - 16; left > 0;) {
+      const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(left, buffer.size()));
+      if (!in.read(buffer.data(), static_cast<std::streamsize>(n))) return false;
+      XXH3_128bits_update(state.get(), buffer.data(), n);
+      left -= n;
+    }
+    unsigned char b[16];
+    if (!in.read(reinterpret_cast<char*>(b), 16)) return false;
+    return XXH128_isEqual(hash_from_bytes(b), XXH3_128bits_digest(state.get())) != 0;
+  }
+
   fs::path path_;
   std::ifstream in_;
   std::uint64_t size_ = 0, position_ = 0;
@@ -177,7 +221,7 @@ std::uint64_t parse_hex64(const json& j, const Reader& r, const char* key) {
   std::uint64_t v = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v, 16);
   if (text.empty() || ec != std::errc() || end != text.data() + text.size())
-    r.fail(std::string("its header's stats.") + key + " holds \"" + text.substr(0, 40) + "\", not a 64-bit hex word");
+    r.header_fail(std::string("its stats.") + key + " holds \"" + text.substr(0, 40) + "\", not a 64-bit hex word");
   return v;
 }
 Sum1 parse_sum(const json& j, const Reader& r, const char* key) {
@@ -312,17 +356,26 @@ PartialFilm read_partial_film(const fs::path& path) {
   r.read(magic, sizeof magic);
   if (std::memcmp(magic, kMagic, sizeof kMagic) != 0) r.fail("it does not start with PLPFILM1 (not a pathlab partial film)");
   const std::uint64_t header_size = r.read_u64();
-  if (header_size > r.size() - r.position()) r.fail("truncated (it ends inside its header)");
+  if (header_size > r.size() - r.position()) {
+    // Cut inside its header, or its length field damaged: then the whole
+    // header is there, and more after it.
+    if (r.complete_json_header())
+      r.header_fail("its length field says " + std::to_string(header_size) + " bytes, more than the " +
+                    std::to_string(r.size() - r.position()) + " after it");
+    r.fail("truncated (it ends inside its header)");
+  }
   std::string text(header_size, '\0');
   r.read(text.data(), text.size());
   const json h = json::parse(text, nullptr, false);
-  if (h.is_discarded() || !h.is_object()) r.fail("its header is not JSON (corrupted)");
+  if (h.is_discarded() || !h.is_object()) r.header_fail("it is not JSON");
+  // A length a few bytes too long that took in only blanks of the film's words.
+  if (!text.ends_with('}')) r.header_fail("it does not end where its length field says (" + std::to_string(header_size) + " bytes)");
 
   // Every count as the integer type it is kept in: a corrupted header's
   // 8.9e68 or -1 is refused here, not converted.
   const auto count = [&r]<std::integral T>(const json& v, const char* name, T) -> T {
     const std::optional<T> n = json_integer<T>(v);
-    if (!n) r.fail(std::string(name) + " is " + v.dump() + ", not an integer from 0 to " +
+    if (!n) r.header_fail(std::string(name) + " is " + v.dump() + ", not an integer from 0 to " +
                    std::to_string(std::numeric_limits<T>::max()));
     return *n;
   };
@@ -330,17 +383,26 @@ PartialFilm read_partial_film(const fs::path& path) {
   const auto u64 = [&](const json& v, const char* name) { return count(v, name, std::uint64_t{}); };
   try {
     if (json_integer<int>(h.at("format_version")) != kFormatVersion)
-      r.fail("format version " + h.at("format_version").dump() + ", this pathlab reads " + std::to_string(kFormatVersion));
+      r.header_fail("format version " + h.at("format_version").dump() + ", this pathlab reads " +
+                    std::to_string(kFormatVersion));
     const std::uint32_t width = u32(h.at("width"), "its width"), height = u32(h.at("height"), "its height");
-    if (width < 1 || height < 1 || width > 65536 || height > 65536) r.fail("its resolution is out of range");
+    if (width < 1 || height < 1 || width > 65536 || height > 65536)
+      r.header_fail("its resolution " + std::to_string(width) + "x" + std::to_string(height) + " is out of range");
     const std::string filter = h.at("filter").get<std::string>(), moments = h.at("moments").get<std::string>();
     if ((filter != "box" && filter != "bilinear") || (moments != "mean" && moments != "mean_and_variance"))
-      r.fail("unknown filter or moments in its header");
+      r.header_fail("unknown filter or moments");
     // The arrays must be in the file before a film of that size is made: a
     // corrupted resolution would otherwise allocate (and zero) up to 240 GB.
     const std::uint64_t pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
     const std::uint64_t words_per_pixel = Film::kPixelWords + (moments == "mean" ? 0 : Film::kMomentWords) +
                                           (filter == "box" ? 0 : Film::kSplatWords);
+    // Before the file's size is judged: a damaged resolution is no truncation.
+    const json& counts = h.at("words");
+    if (json_integer<std::uint64_t>(counts.at(0)) != pixels * Film::kPixelWords ||
+        json_integer<std::uint64_t>(counts.at(1)) != (moments == "mean" ? 0 : pixels * Film::kMomentWords) ||
+        json_integer<std::uint64_t>(counts.at(2)) != (filter == "box" ? 0 : pixels * Film::kSplatWords))
+      r.header_fail("its array sizes " + counts.dump() + " do not match its resolution " + std::to_string(width) + "x" +
+                    std::to_string(height) + ", filter and moments");
     if (pixels * words_per_pixel * 8 + 16 > r.size() - r.position())
       r.fail("truncated: a " + std::to_string(width) + "x" + std::to_string(height) + " film needs " +
              std::to_string(pixels * words_per_pixel * 8) + " bytes of arrays, the file has " +
@@ -350,7 +412,7 @@ PartialFilm read_partial_film(const fs::path& path) {
                        {}};
     PartialFilmInfo& pf = result.info;
     pf.passes = {u32(h.at("passes").at(0), "its first pass"), u32(h.at("passes").at(1), "its pass range's end")};
-    if (pf.passes.end < pf.passes.begin) r.fail("its pass range ends before it begins");
+    if (pf.passes.end < pf.passes.begin) r.header_fail("its pass range ends before it begins");
     pf.target_spp = u32(h.at("target_spp"), "target_spp");
     pf.processes = u32(h.at("processes"), "processes");
     pf.resumes = u32(h.at("resumes"), "resumes");
@@ -375,17 +437,12 @@ PartialFilm read_partial_film(const fs::path& path) {
     result.film.restore_counts(u64(h.at("bad_sample_count"), "bad_sample_count"), u64(h.at("film_rays"), "film_rays"),
                                std::move(kept));
     const Film::Words words = result.film.words();
-    const json& counts = h.at("words");
-    if (json_integer<std::uint64_t>(counts.at(0)) != words.pixels.size() ||
-        json_integer<std::uint64_t>(counts.at(1)) != words.moments.size() ||
-        json_integer<std::uint64_t>(counts.at(2)) != words.splat.size())
-      r.fail("its header's array sizes do not match its resolution, filter and moments");
     for (const std::span<std::uint64_t> a : {words.pixels, words.moments, words.splat}) r.read(a.data(), a.size_bytes());
     const std::string computed = hex128(r.digest());
     if (r.read_checksum() != computed) r.fail("its checksum does not match its content (the file is corrupted)");
     return result;
   } catch (const json::exception& e) {
-    r.fail(std::string("its header is incomplete or malformed (") + e.what() + ")");
+    r.header_fail(std::string("it is incomplete or malformed (") + e.what() + ")");
   }
 }
 

@@ -13,6 +13,7 @@
 #include "tests/temp_dir.h"
 
 #include <gtest/gtest.h>
+#include <xxhash.h>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -263,6 +264,68 @@ TEST_F(PartialFilmFile, DamagedFilesAreRefusedNamingTheFileAndTheProblem) {
   }
 }
 
+// A flipped bit in the header (its length field or its text) is damage,
+// not a truncated file: the length's high bits once read as "truncated (it
+// ends inside its header)", a resolution's digit as "truncated: a 7x4 film
+// needs ...". A header the checksum vouches for is another version's.
+TEST_F(PartialFilmFile, AFlippedBitInTheHeaderIsReportedAsACorruptHeader) {
+  const PartialFilm pf = make(FilterKind::Box, FilmMoments::MeanAndVariance, {0, 4});
+  const fs::path good = dir_ / "good.pfilm";
+  write_partial_film(pf.film, pf.info, good);
+  std::string bytes;
+  {
+    std::ifstream in(good, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  std::uint64_t header_size = 0;
+  std::memcpy(&header_size, bytes.data() + 8, 8);
+  const fs::path file = dir_ / "flipped.pfilm";
+  std::size_t corrupt_header = 0;
+  // Every bit of the length field and of the header's text.
+  for (std::size_t at = 8; at < 16 + header_size; ++at)
+    for (int bit = 0; bit < 8; ++bit) {
+      std::string damaged = bytes;
+      damaged[at] = static_cast<char>(damaged[at] ^ (1 << bit));
+      std::ofstream(file, std::ios::binary | std::ios::trunc) << damaged;
+      const std::string message = error_reading(file);
+      ASSERT_NE(message.find(file.string()), std::string::npos) << "byte " << at << " bit " << bit << ": " << message;
+      EXPECT_EQ(message.find("truncated"), std::string::npos) << "byte " << at << " bit " << bit << ": " << message;
+      const bool header = message.find("its header is corrupt: ") != std::string::npos;
+      EXPECT_TRUE(header || message.find("its checksum does not match its content") != std::string::npos)
+          << "byte " << at << " bit " << bit << ": " << message;
+      corrupt_header += header;
+      if (at >= 10 && at < 16) {
+        EXPECT_NE(message.find("its header is corrupt: its length field says"), std::string::npos) << message;
+      }
+    }
+  EXPECT_GT(corrupt_header, 8u * header_size / 2);
+
+  // The width 5 read as 7: the arrays' sizes in the header tell the damage.
+  std::string seven = bytes;
+  const std::size_t width = seven.find("\"width\": 5");
+  ASSERT_NE(width, std::string::npos);
+  seven[width + 9] = '7';
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << seven;
+  std::string message = error_reading(file);
+  EXPECT_NE(message.find("its header is corrupt: its array sizes [140,120,0] do not match its resolution 7x4"),
+            std::string::npos)
+      << message;
+
+  // Another format version, its checksum right: not damage, another version.
+  std::string other = bytes.substr(0, bytes.size() - 16);
+  const std::size_t version = other.find("\"format_version\": 1");
+  ASSERT_NE(version, std::string::npos);
+  other[version + 18] = '2';
+  const XXH128_hash_t h = XXH3_128bits(other.data(), other.size());
+  for (int i = 0; i < 8; ++i) other.push_back(static_cast<char>(h.low64 >> (8 * i)));
+  for (int i = 0; i < 8; ++i) other.push_back(static_cast<char>(h.high64 >> (8 * i)));
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << other;
+  message = error_reading(file);
+  EXPECT_NE(message.find("format version 2, this pathlab reads 1: not a partial film of this pathlab version"),
+            std::string::npos)
+      << message;
+}
+
 TEST_F(PartialFilmFile, MergeRefusesOverlapsGapsAndOtherRenders) {
   const auto merge = [&](std::vector<PartialFilm> parts) -> std::string {
     std::vector<fs::path> names;
@@ -452,8 +515,11 @@ TEST_F(PiecesCli, ADamagedCheckpointIsRefusedWithExit2AndNothingWritten) {
   }
   std::string flipped = bytes;
   flipped[bytes.size() - 40] = static_cast<char>(flipped[bytes.size() - 40] ^ 0x04);
+  std::string length_flipped = bytes;  // the header's length field, once "truncated"
+  length_flipped[13] = static_cast<char>(length_flipped[13] ^ 0x01);
   for (const auto& [content, problem] : std::vector<std::pair<std::string, std::string>>{
            {bytes.substr(0, bytes.size() / 2), "truncated"}, {flipped, "checksum"}, {"", "empty"},
+           {length_flipped, "its header is corrupt: its length field says"},
            {"P3\n1 1\n255\n0 0 0\n", "too short"}}) {
     std::ofstream(ck, std::ios::binary) << content;
     std::vector<std::string> args{"render", "-o", (dir_ / "out.exr").string(), "--spp", "4", "--resume", ck,
