@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/json_number.h"
+#include "core/limits.h"
 #include "core/render.h"
 #include "core/temp_files.h"
 
@@ -131,7 +132,10 @@ XXH128_hash_t hash_from_bytes(const unsigned char (&b)[16]) {
 
 class Reader {
  public:
-  explicit Reader(const fs::path& path) : path_(path), in_(path, std::ios::binary) {
+  explicit Reader(const fs::path& path) : path_(path) {
+    // A folder opens as a stream whose every read fails ("read failed").
+    if (const std::string kind = special_file_kind(path); !kind.empty()) fail("it is " + kind + ", not a file");
+    in_.open(path, std::ios::binary);
     if (!in_) fail(fs::exists(path) ? "cannot be read" : "does not exist");
     in_.seekg(0, std::ios::end);
     size_ = static_cast<std::uint64_t>(in_.tellg());

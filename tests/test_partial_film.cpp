@@ -251,6 +251,7 @@ TEST_F(PartialFilmFile, DamagedFilesAreRefusedNamingTheFileAndTheProblem) {
       {write("foreign.pfilm", std::string("\x89PNG\r\n\x1a\n") + std::string(100, 'x')), "not a pathlab partial film"},
       {write("longer.pfilm", bytes + "x"), "after its checksum"},
       {dir_ / "missing.pfilm", "does not exist"},
+      {fs::create_directories(dir_ / "folder.pfilm") ? dir_ / "folder.pfilm" : dir_, "it is a folder, not a file"},
       {write("width.pfilm", with_header("\"width\": 5", "\"width\": 8.88889e+68")),
        "its width is 8.88889e+68, not an integer from 0 to 4294967295"},
       {write("target.pfilm", with_header("\"target_spp\": 16", "\"target_spp\": -1")),
@@ -535,6 +536,20 @@ TEST_F(PiecesCli, ADamagedCheckpointIsRefusedWithExit2AndNothingWritten) {
     std::ifstream in(ck, std::ios::binary);
     EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), content) << problem;
   }
+}
+
+// A folder opens as a stream that fails every read: it was "read failed".
+TEST_F(PiecesCli, ResumeFromAFolderSaysItIsAFolder) {
+  const fs::path folder = dir_ / "ck.pfilm";
+  fs::create_directories(folder);
+  std::vector<std::string> args{"render", "-o", (dir_ / "out.exr").string(), "--spp", "4", "--resume", folder.string()};
+  for (const std::string& a : base("reference")) args.push_back(a);
+  const test::CliResult r = run_cli(args);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find(folder.string() + ": not a usable partial film: it is a folder, not a file"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("read failed"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out.exr"));
 }
 
 // ------------------------------------------------------- Signals and kill -9
