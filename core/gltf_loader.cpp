@@ -459,7 +459,12 @@ void Flattener::place_node(std::size_t index, const mat4& world) {
     const std::string at = "/cameras/" + std::to_string(node.camera);
     if (cam.type == "perspective") {
       const double yfov = cam.perspective.yfov;
-      if (!(yfov > 0.0 && yfov < M_PI)) fail(file_, at + "/perspective/yfov", "yfov must lie in (0, pi) radians");
+      // As the scene's fov_y (core/scene_limits.h): just below pi is 180 degrees as a float.
+      const double max_yfov = kMaxFovYDegrees * M_PI / 180.0;
+      if (!(yfov > 0.0 && yfov <= max_yfov && static_cast<float>(yfov * 180.0 / M_PI) > 0.0f))
+        fail(file_, at + "/perspective/yfov",
+             "yfov " + exact_number(yfov) + " is outside (0, " + format_number(max_yfov) + "] radians (0 to " +
+                 format_number(kMaxFovYDegrees) + " degrees; docs/scene-format.md)");
       GltfCamera c;
       // A glTF camera looks down its -z axis with +y up.
       c.desc.position = vec3(xf * vec4(0, 0, 0, 1));

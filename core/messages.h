@@ -3,9 +3,11 @@
 #pragma once
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <string>
 #include <string_view>
+#include <system_error>
 
 namespace pathlab {
 
@@ -34,6 +36,14 @@ inline std::string format_number(double v) {
   char text[32];
   std::snprintf(text, sizeof text, "%.7g", v);
   return text;
+}
+
+// A number for a message with as many digits as tell it apart: 179.999999,
+// which format_number rounds to 180 (beside a limit of 180, misleading).
+inline std::string exact_number(double v) {
+  char text[32];
+  const auto [end, ec] = std::to_chars(text, text + sizeof text, v);
+  return ec == std::errc() ? std::string(text, end) : format_number(v);
 }
 
 }  // namespace pathlab

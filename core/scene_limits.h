@@ -48,6 +48,11 @@ std::uint64_t embree_rejected_rays();
 // zero. docs/scene-format.md ("Limits") states the same rule.
 inline constexpr float kMaxSceneCoordinate = 1e16f;
 inline constexpr float kMinSphereRadius = 1e-18f;
+// The largest vertical field of view, in degrees. The camera works with
+// tan(fov_y / 2) in float: its error grows towards 180 (3e-6 relative at
+// 179, 3e-5 at 179.9), and just below 180 the float angle rounds to 180,
+// whose tangent is -2.3e7: an image turned upside down, or garbage.
+inline constexpr double kMaxFovYDegrees = 179.0;
 // True if every coordinate of `p` lies within +-kMaxSceneCoordinate (NaN does not).
 inline bool within_scene_range(const vec3& p) {
   return std::abs(p.x) <= kMaxSceneCoordinate && std::abs(p.y) <= kMaxSceneCoordinate &&

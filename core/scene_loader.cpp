@@ -49,8 +49,13 @@ CameraDesc read_camera(const Node& node) {
       node.fail("the view is straight up or down, so the default up [0, 1, 0] is parallel to it; give 'up'");
     node.child("up").fail("up must not be zero or parallel to the viewing direction");
   }
-  c.fov_y_degrees = static_cast<float>(node.number_or("fov_y", 40.0));
-  if (!(c.fov_y_degrees > 0.0f && c.fov_y_degrees < 180.0f)) node.child("fov_y").fail("fov_y must lie in (0, 180) degrees");
+  // Checked before it becomes a float: 179.9999999 is 180 as one.
+  const double fov_y = node.number_or("fov_y", 40.0);
+  c.fov_y_degrees = static_cast<float>(fov_y);
+  if (!(fov_y > 0.0 && fov_y <= kMaxFovYDegrees) || !(c.fov_y_degrees > 0.0f))
+    node.child("fov_y").fail("fov_y " + exact_number(fov_y) + " is outside (0, " + format_number(kMaxFovYDegrees) +
+                             "] degrees" + (fov_y > 0.0 && c.fov_y_degrees == 0.0f ? " (it is 0 as a float)" : "") +
+                             " (docs/scene-format.md: towards 180 the camera's float arithmetic fails)");
   c.aperture_radius = static_cast<float>(node.number_or("aperture_radius", 0.0));
   if (c.aperture_radius < 0.0f) node.child("aperture_radius").fail("aperture_radius must not be negative");
   if (!within_scene_range(glm::abs(c.position) + vec3(c.aperture_radius)))

@@ -493,6 +493,25 @@ TEST_F(BadInput, CameraLookingStraightDownWithDefaultUp) {
   expect_rejected(render(write("down.json", text)), {"down.json:3:3:", "/camera", "parallel", "'up'"});
 }
 
+// Just below 180 the angle is 180 as a float: 179.999999 was refused as
+// "fov_y must lie in (0, 180)", and 179.99999 rendered with tan(fov_y / 2)
+// 30 % off. The limit is 179, stated with the value as written.
+TEST_F(BadInput, FieldOfViewNear180OrBelowFloatRangeNamesTheValueAndTheRange) {
+  const auto with_fov = [](const std::string& fov) {
+    std::string text = scene(kMaterials, kSphere + ",\n" + kLamp);
+    text.replace(text.find("[0, 0, 0]}"), 10, "[0, 0, 0], \"fov_y\": " + fov + "}");
+    return text;
+  };
+  for (const std::string fov : {"179.999999", "179.99999", "179.5", "180"}) {
+    SCOPED_TRACE(fov);
+    expect_rejected(render(write("fov.json", with_fov(fov))),
+                    {"fov.json:3:", "/camera/fov_y", "fov_y " + fov + " is outside (0, 179] degrees"});
+  }
+  expect_rejected(render(write("tiny.json", with_fov("1e-50"))),
+                  {"tiny.json:3:", "/camera/fov_y", "fov_y 1e-50 is outside (0, 179] degrees (it is 0 as a float)"});
+  EXPECT_EQ(render(write("wide.json", with_fov("179"))).code, 0);
+}
+
 // ------------------------------------------------------------ meshes
 
 TEST_F(BadInput, MissingMesh) {

@@ -773,6 +773,19 @@ TEST_F(Gltf, SingularPlacementsAreCopiesAndOverflowIsRefused) {
   EXPECT_NE(error.find("huge.gltf: /nodes/2: the transform moves vertices beyond the scene coordinate limit 1e16"), std::string::npos) << error;
 }
 
+// Just below pi the angle is 180 degrees as a float (tan(fov / 2) -2.3e7):
+// held to the scene's fov_y limit, 179 degrees.
+TEST_F(Gltf, ACameraFieldOfViewNearPiIsRefusedWithTheRange) {
+  for (const double yfov : {3.141592652589793 - 1e-9, 3.13}) {
+    GltfWriter w = quad(test::kGltfByte);
+    w.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", yfov}, {"znear", 0.1}}}}};
+    w.node({{"translation", {0, 0, 4}}, {"camera", 0}});
+    const std::string error = error_of(w, "wide.gltf");
+    EXPECT_NE(error.find("wide.gltf: /cameras/0/perspective/yfov: yfov "), std::string::npos) << error;
+    EXPECT_NE(error.find(" is outside (0, 3.124139] radians (0 to 179 degrees"), std::string::npos) << error;
+  }
+}
+
 // A node's transform that glTF does not allow is an error naming it: it used
 // to be dropped (tinygltf leaves a malformed array empty) and the mesh placed
 // as if it had none. A long but finite quaternion is normalised (in double).

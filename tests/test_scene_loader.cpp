@@ -739,7 +739,7 @@ TEST(SceneLoaderErrors, CameraProblems) {
   const std::string down = camera(R"({"position": [0, 5, 0], "look_at": [0, 0, 0]})");
   EXPECT_EQ(down.rfind("scene.json:1:22: /camera: ", 0), 0u) << down;
   EXPECT_NE(down.find("default up [0, 1, 0] is parallel"), std::string::npos) << down;
-  EXPECT_NE(camera(R"({"position": [0, 0, 1], "look_at": [0, 0, 0], "fov_y": 180})").find("/camera/fov_y: fov_y must lie in (0, 180)"),
+  EXPECT_NE(camera(R"({"position": [0, 0, 1], "look_at": [0, 0, 0], "fov_y": 180})").find("/camera/fov_y: fov_y 180 is outside (0, 179] degrees"),
             std::string::npos);
   EXPECT_NE(camera(R"({"position": [0, 0, 1], "look_at": [0, 0, 0], "aperture_radius": -1})").find("must not be negative"),
             std::string::npos);
