@@ -62,8 +62,14 @@ CameraDesc read_camera(const Node& node) {
     node.child("aperture_radius").fail("the aperture reaches beyond the scene coordinate limit " + kRangeRule);
   c.focus_distance = static_cast<float>(node.number_or("focus_distance", glm::length(c.look_at - c.position)));
   if (!(c.focus_distance > 0.0f)) node.child("focus_distance").fail("focus_distance must be positive");
-  if (!(c.focus_distance <= kMaxSceneCoordinate))
+  if (!(c.focus_distance <= kMaxSceneCoordinate)) {
+    // Not given, it is the distance to look_at: that is what to change.
+    if (!node.has("focus_distance"))
+      node.child("look_at").fail("look_at lies " + format_number(c.focus_distance) +
+                                 " from position, and focus_distance (not given) is that distance, beyond the scene "
+                                 "coordinate limit " + kRangeRule + "; move look_at nearer, or give focus_distance");
     node.child("focus_distance").fail("focus_distance exceeds the scene coordinate limit " + kRangeRule);
+  }
   return c;
 }
 

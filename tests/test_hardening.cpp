@@ -159,6 +159,11 @@ TEST_F(Hardening, PositionsBeyondEmbreesRangeAreRefusedAtLoad) {
           scene_text("{\"position\": [0, 0, 4], \"look_at\": [0, 0, 0], \"aperture_radius\": 0.1, \"focus_distance\": 1e30}",
                      kSphere + ",\n" + kLamp),
           {"focus.json:3:", "/camera/focus_distance", "exceeds the scene coordinate limit"});
+  // Without focus_distance, it is the distance to look_at: look_at is what to
+  // change (this once blamed the absent focus_distance).
+  refused("look-at.json", scene_text("{\"position\": [0, 0, 4], \"look_at\": [1e16, 0, -1e16]}", kSphere + ",\n" + kLamp),
+          {"look-at.json:3:", "/camera/look_at: look_at lies 1.414214e+16 from position, and focus_distance (not given)",
+           "move look_at nearer, or give focus_distance"});
   refused("denormal.json",
           scene_text(kCamera, "    {\"type\": \"sphere\", \"material\": \"white\", \"radius\": 1e-45},\n" + kLamp),
           {"denormal.json:7:", "/shapes/0/radius", "radius must lie in [1e-18, 1e16]"});
@@ -180,6 +185,11 @@ TEST_F(Hardening, PositionsWithinTheRuleRender) {
   const ProcessResult r = render(file("far-ok.json", text));
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::is_regular_file(dir_ / "x.exr"));
+  // A look_at beyond 1e16 from position, with focus_distance given.
+  const std::string focused = scene_text(
+      "{\"position\": [0, 0, 4], \"look_at\": [1e16, 0, -1e16], \"focus_distance\": 4}", kSphere + ",\n" + kLamp);
+  const ProcessResult f = render(file("focused.json", focused));
+  EXPECT_EQ(f.code, 0) << f.err;
 }
 
 // A ray Embree would abort on never reaches it, through any of the accel's
