@@ -3,7 +3,6 @@
 #include "core/data_dir.h"
 #include "core/environment_map.h"
 #include "core/error.h"
-#include "core/film.h"
 #include "core/geometry.h"
 #include "core/gltf_loader.h"
 #include "core/json_document.h"
@@ -230,20 +229,6 @@ void reject_misplaced(const Node& node, const std::string& type,
       node.child(key).fail((type == "emissive" ? "an " : "a ") + type + " material has no '" + key + "'; " + advice);
 }
 
-// A light's radiance (a material's `emission` or `radiance`, a uniform
-// environment's `radiance`): a camera ray that meets the light carries it
-// unchanged, and the film leaves out every sample with a component of
-// kFilmRadianceLimit (2^32) or more, so a brighter light renders black with
-// every sample of it counted bad, and the render would still succeed.
-Spectrum radiance_in_film_range(const Node& node, const char* key, const Spectrum& radiance) {
-  if (node.has(key) && !(max_component(radiance) < kFilmRadianceLimit))
-    node.child(key).fail(std::string(key) + " " + format_number(max_component(radiance)) +
-                         " is not below the film's limit 2^32 = 4294967296 (docs/scene-format.md: a sample that "
-                         "sees the light carries it, and the film leaves out every sample of 2^32 or more); "
-                         "choose a larger unit of radiance");
-  return radiance;
-}
-
 // A material's textured parameters, read before the constants are (a
 // Disney material is rebuilt from its parameters, so they are applied last).
 struct MaterialTextures {
@@ -283,7 +268,7 @@ Material read_material(const Node& node, const std::string& name, Scene& scene) 
     node.allow_only({"type", refl, "emission", "two_sided", "light", "one_sided", "normal_map", "alpha"});
     m.type = type == "diffuse" ? MaterialType::Diffuse : MaterialType::Mirror;
     m.albedo = colour(refl, MaterialParam::Albedo, true, Spectrum(type == "diffuse" ? 0.5f : 1.0f));
-    m.emission = radiance_in_film_range(node, "emission", colour("emission", MaterialParam::Emission, false, Spectrum(0.0f)));
+    m.emission = colour("emission", MaterialParam::Emission, false, Spectrum(0.0f));
   } else if (type == "emissive") {
     reject_misplaced(node, type,
                      {{"emission", "its emitted light is 'radiance'"},
@@ -294,7 +279,7 @@ Material read_material(const Node& node, const std::string& name, Scene& scene) 
     m.type = MaterialType::Emissive;
     m.albedo = Spectrum(0.0f);
     node.required("radiance");
-    m.emission = radiance_in_film_range(node, "radiance", colour("radiance", MaterialParam::Emission, false, Spectrum(0.0f)));
+    m.emission = colour("radiance", MaterialParam::Emission, false, Spectrum(0.0f));
   } else if (type == "disney") {
     reject_misplaced(node, type,
                      {{"albedo", "its colour is 'base_color'"},
@@ -325,7 +310,7 @@ Material read_material(const Node& node, const std::string& name, Scene& scene) 
     const std::string keep = m.name;
     m = disney_material(p);
     m.name = keep;
-    m.emission = radiance_in_film_range(node, "emission", colour("emission", MaterialParam::Emission, false, Spectrum(0.0f)));
+    m.emission = colour("emission", MaterialParam::Emission, false, Spectrum(0.0f));
   } else if (type == "dielectric") {
     reject_misplaced(node, type,
                      {{"albedo", "its tints are 'reflectance' and 'transmittance'"},
@@ -687,7 +672,7 @@ void read_lights(const Node& node, Scene* scene, const std::filesystem::path& fo
       if (l.has("radiance")) {
         for (const char* key : {"scale", "transform", "clamp_negative"})
           if (l.has(key)) l.child(key).fail(std::string(key) + " applies to an environment image ('file') only");
-        scene->environment = radiance_in_film_range(l, "radiance", l.required("radiance").color(false));
+        scene->environment = l.required("radiance").color(false);
       } else {
         scene->environment_map = read_environment_map(l, folder, scene);
       }

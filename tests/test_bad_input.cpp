@@ -512,30 +512,6 @@ TEST_F(BadInput, FieldOfViewNear180OrBelowFloatRangeNamesTheValueAndTheRange) {
   EXPECT_EQ(render(write("wide.json", with_fov("179"))).code, 0);
 }
 
-// A light of radiance 2^32 or more renders black, every sample that sees it
-// left out of the film as bad, and the render used to exit 0: refused at
-// the key, with the bound.
-TEST_F(BadInput, RadianceAtOrAboveTheFilmsLimit) {
-  const auto lamp = [&](const std::string& materials, const std::string& extra = "") {
-    return scene(materials, kSphere + ",\n" + kLamp, extra);
-  };
-  const std::string bright = "    \"white\": {\"type\": \"diffuse\", \"albedo\": 0.5},\n"
-                             "    \"lamp\": {\"type\": \"emissive\", \"radiance\": 1e30}";
-  const std::string text = lamp(bright);
-  expect_rejected(render(write("bright.json", text)),
-                  {"bright.json:" + where_in(text, "\"radiance\": 1e30"), "/materials/lamp/radiance",
-                   "radiance 1e+30 is not below the film's limit 2^32 = 4294967296"});
-  const std::string glowing = "    \"white\": {\"type\": \"diffuse\", \"albedo\": 0.5, \"emission\": [0, 4294967296, 0]},\n"
-                              "    \"lamp\": {\"type\": \"emissive\", \"radiance\": 2}";
-  expect_rejected(render(write("glowing.json", lamp(glowing))),
-                  {"glowing.json:", "/materials/white/emission", "emission 4.294967e+09 is not below the film's limit"});
-  expect_rejected(render(write("sky.json", lamp(kMaterials, R"("lights": [{"type": "environment", "radiance": [1, 1, 5e9]}])"))),
-                  {"sky.json:", "/lights/0/radiance", "radiance 5e+09 is not below the film's limit"});
-  const std::string below = "    \"white\": {\"type\": \"diffuse\", \"albedo\": 0.5},\n"
-                            "    \"lamp\": {\"type\": \"emissive\", \"radiance\": 4e9}";
-  EXPECT_EQ(render(write("below.json", lamp(below))).code, 0);
-}
-
 // ------------------------------------------------------------ meshes
 
 TEST_F(BadInput, MissingMesh) {
