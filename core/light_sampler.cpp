@@ -309,44 +309,56 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
   const vec3& ref = query.p;
   LightSample ls;
   ls.light = static_cast<std::uint32_t>(i);
-  if (static_cast<std::int64_t>(i) == env_index_) {
+  using namespace width1;
+  const bool env = static_cast<std::int64_t>(i) == env_index_;
+  if (env || (!suns_.empty() && static_cast<std::int64_t>(i) >= suns_.front().entry)) {
+    // The environment or a sun disk (the last entries, in order):
+    // core/simd/lights-inl.h's sky_sample at width 1, reading the sky as
+    // this sampler holds it.
+    struct SkyView {
+      const LightSampler& sampler;
+      std::size_t entry;
+      float pmf;
+      bool image() const { return sampler.scene_->environment_map != nullptr; }
+      lane1::M sample_image(lane1::M, F ux, F uy, F3& wi, F3& Le, F& pdf) const {
+        const std::optional<EnvironmentMap::Sample> es = sampler.scene_->environment_map->sample(vec2(ux.raw, uy.raw));
+        if (!es) return lane1::M{false};
+        wi = lanes(es->wi);
+        Le = lanes(es->radiance);
+        pdf = F{es->pdf};
+        return lane1::M{true};
+      }
+      F env_pmf() const { return F{pmf}; }
+      void add_suns(const F3& dir, F3& Le, F& pdf) const {
+        vec3 L = scalars(Le);
+        sampler.add_suns(scalars(dir), &L, &pdf.raw);
+        Le = lanes(L);
+      }
+      void along(lane1::M, const F3& dir, F3& Le, F& pdf) const {
+        const Sky there = sampler.sky(scalars(dir));
+        Le = lanes(there.Le);
+        pdf = F{there.pdf};
+      }
+      void sun_directions(lane1::M, F ux, F uy, F3& wi) const {
+        const SunDisk& sun = sampler.suns_[entry - static_cast<std::size_t>(sampler.suns_.front().entry)];
+        const Frame& f = sun.frame;
+        wi = generic::sun_direction(kScalar, lanes(f.s), lanes(f.t), lanes(f.n), F{sun.one_minus_cos}, ux, uy);
+      }
+    };
+    F3 wi, Le;
+    F pdf;
+    if (!generic::sky_sample(kScalar, lane1::M{true}, lane1::M{env}, F{u.x}, F{u.y}, SkyView{*this, i, pmf}, wi, Le,
+                             pdf)
+             .raw)
+      return std::nullopt;  // the image drew nothing, or a sun's direction rounded out of its cone
+    ls.wi = scalars(wi);
+    ls.Le = scalars(Le);
+    ls.pdf = pdf.raw;
     ls.dist = kInfinity;
     ls.infinite = true;
-    if (const EnvironmentMap* map = scene_->environment_map.get()) {
-      const std::optional<EnvironmentMap::Sample> es = map->sample(u);
-      if (!es) return std::nullopt;
-      ls.wi = es->wi;
-      ls.Le = es->radiance;
-      ls.pdf = pmf * es->pdf;
-    } else {
-      ls.wi = square_to_uniform_sphere(u);
-      ls.Le = *scene_->environment;
-      ls.pdf = pmf * kInv4Pi;
-    }
-    // A sun disk in the same direction: the sample stands for every infinite
-    // light there (their radiance summed, their densities summed: one
-    // technique for the sky as a whole, as the escape weighs it).
-    if (!suns_.empty()) add_suns(ls.wi, &ls.Le, &ls.pdf);
-    return ls;
-  }
-  // The sun disks are the last entries, in order.
-  if (!suns_.empty() && static_cast<std::int64_t>(i) >= suns_.front().entry) {
-    const SunDisk* sun = &suns_[i - static_cast<std::size_t>(suns_.front().entry)];
-    // Uniform in the cone (core/simd/lights-inl.h's sun_direction).
-    using namespace width1;
-    const Frame& f = sun->frame;
-    ls.wi = scalars(generic::sun_direction(kScalar, lanes(f.s), lanes(f.t), lanes(f.n), F{sun->one_minus_cos}, F{u.x},
-                                           F{u.y}));
-    ls.dist = kInfinity;
-    ls.infinite = true;
-    const Sky sky_there = sky(ls.wi);
-    ls.Le = sky_there.Le;
-    ls.pdf = sky_there.pdf;
-    if (!(ls.pdf > 0.0f) || is_black(ls.Le)) return std::nullopt;  // rounded out of the cone
     return ls;
   }
   // A triangle or a sphere: core/simd/lights-inl.h's area_light_sample at width 1.
-  using namespace width1;
   const Entry& e = entries_[i];
   const lane1::M one{true};
   const auto solid_angle = [&](lane1::M m) { return solid_angle_draw(*scene_, light_sampling_, e, ref, m, true, u); };

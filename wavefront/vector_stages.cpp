@@ -155,6 +155,7 @@ using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::light_grid_point;
 using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::sky_entry_of;
+using pathlab::HWY_NAMESPACE::sky_sample;
 using pathlab::HWY_NAMESPACE::place_normal;
 using pathlab::HWY_NAMESPACE::placed_area_scale;
 using pathlab::HWY_NAMESPACE::select;
@@ -1116,53 +1117,41 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI lig
   return ls;
 }
 
-// LightSampler::sample of the sky's entries in the lanes of ok: a uniform
-// direction for the environment, one in its cone for a sun disk, with the
-// sky's radiance and density there (one technique for the whole sky), and
-// the shadow ray escaping along it (Surfel::spawn). A sun disk's lanes whose
-// direction rounded out of every cone leave ok.
+// LightSampler::sample of the sky's entries in the lanes of ok
+// (core/simd/lights-inl.h's sky_sample), and the shadow ray escaping along
+// the direction (Surfel::spawn); the lanes it gives no sample leave ok.
 LightLanes sky_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, VF lu, VF lv, const V3& sp, const V3& n,
                      M& ok) {
   const DF df;
   const Sky& s = sc.skies;
-  LightLanes ls;
-  ls.wi = ls.Le = zero3();
-  ls.pdf = hn::Zero(df);
-  M sun_lanes = hn::FirstN(df, 0);
+  // The sky as sky_sample reads it: Sky's tables, each lane's entry.
+  struct SkyView {
+    const Sky& s;
+    VI light;
+    bool image() const { return s.image != nullptr; }
+    M sample_image(M m, VF ux, VF uy, V3& wi, V3& Le, VF& pdf) const {
+      M drawn = m;
+      env_sample(s, ux, uy, drawn, wi, Le, pdf);
+      return drawn;
+    }
+    VF env_pmf() const { return k(s.pmf); }
+    void add_suns(const V3& dir, V3& Le, VF& pdf) const { vector_stages::HWY_NAMESPACE::add_suns(s, dir, Le, pdf); }
+    void along(M m, const V3& dir, V3& Le, VF& pdf) const { sky_along(s, m, dir, Le, pdf); }
+    void sun_directions(M m, VF ux, VF uy, V3& wi) const {
+      const DF d;
+      for (std::size_t j = 0; j < s.suns; ++j) {
+        const float* sun = s.sun + j * kSunFields;
+        const M at_sun = hn::And(m, hn::RebindMask(d, light == hn::Set(DI(), static_cast<std::int32_t>(sun[kSunEntry]))));
+        if (hn::AllFalse(d, at_sun)) continue;
+        const auto at = [&](int f) { return splat3(d, sun[f], sun[f + 1], sun[f + 2]); };
+        wi = select(at_sun, sun_direction(d, at(kSunS), at(kSunT), at(kSunN), k(sun[kSunOneMinusCos]), ux, uy), wi);
+      }
+    }
+  };
   // The environment's lanes (none where it is not sampled: its entry is -1).
-  const M env = hn::And(ok, hn::RebindMask(DF(), light == hn::Set(DI(), static_cast<std::int32_t>(s.environment))));
-  const bool image = s.image && !hn::AllFalse(df, env);
-  V3 image_Le;
-  VF image_pdf;
-  if (image) {
-    // The texel drawn's radiance and density (EnvironmentMap::sample), then the sun disks there.
-    M drawn = env;
-    env_sample(s, lu, lv, drawn, ls.wi, image_Le, image_pdf);
-    image_pdf = k(s.pmf) * image_pdf;
-    add_suns(s, ls.wi, image_Le, image_pdf);
-    ok = hn::Or(hn::AndNot(env, ok), drawn);
-  } else if (!hn::AllFalse(df, env)) {
-    V3 wi;
-    uniform_sphere(df, lu, lv, wi.x, wi.y, wi.z);
-    ls.wi = select(env, wi, ls.wi);
-  }
-  for (std::size_t j = 0; j < s.suns; ++j) {
-    const float* sun = s.sun + j * kSunFields;
-    const M at_sun = hn::And(ok, hn::RebindMask(DF(), light == hn::Set(DI(), static_cast<std::int32_t>(sun[kSunEntry]))));
-    if (hn::AllFalse(df, at_sun)) continue;
-    sun_lanes = hn::Or(sun_lanes, at_sun);
-    const auto at = [&](int f) { return splat3(df, sun[f], sun[f + 1], sun[f + 2]); };
-    ls.wi = select(at_sun, sun_direction(df, at(kSunS), at(kSunT), at(kSunN), k(sun[kSunOneMinusCos]), lu, lv), ls.wi);
-  }
-  // Under an image, its lanes carry the texel drawn (above); the rest the sky along their direction.
-  const M along = image ? hn::AndNot(env, ok) : ok;
-  if (!hn::AllFalse(df, along)) sky_along(s, along, ls.wi, ls.Le, ls.pdf);
-  if (image) {
-    ls.Le = select(env, image_Le, ls.Le);
-    ls.pdf = hn::IfThenElse(env, image_pdf, ls.pdf);
-  }
-  // A sun's direction rounded out of its cone (the environment's lanes keep theirs, as sample() does).
-  ok = hn::AndNot(hn::And(sun_lanes, hn::Or(hn::Not(ls.pdf > k(0.0f)), is_black(df, ls.Le))), ok);
+  const M env = hn::RebindMask(df, light == hn::Set(DI(), static_cast<std::int32_t>(s.environment)));
+  LightLanes ls;
+  ok = sky_sample(df, ok, env, lu, lv, SkyView{s, light}, ls.wi, ls.Le, ls.pdf);
   const V3 origin = spawn_origin(df, sp, load3(w, kErrX, i0, ok), n, ls.wi);
   const VF ray[7] = {origin.x, origin.y, origin.z, ls.wi.x, ls.wi.y, ls.wi.z, k(std::numeric_limits<float>::infinity())};
   std::copy(std::begin(ray), std::end(ray), ls.ray);

@@ -279,6 +279,53 @@ HWY_INLINE void add_sun(D d, const Vec3<V>& dir, const Vec3<V>& n, V sin2, const
   pdf = IfThenElse(in, pdf + pdf_sun, pdf);
 }
 
+// LightSampler::sample of the sky's entries in the lanes of ok, `env` those
+// that picked the environment, the rest a sun disk: a direction (one drawn
+// from the environment image, uniform on the sphere for one radiance, or
+// uniform in the sun's cone), with the sky's radiance and density there
+// (the image's texel drawn and its density, or the sky along it: one
+// technique for the whole sky, as an escaping ray weighs it). Returns ok
+// without the lanes that get no sample: an image that draws nothing, a sun
+// direction rounded out of every cone.
+//
+// The caller's sky reads what the two tracers store differently:
+//   bool image()                                  an environment image is sampled
+//   M sample_image(m, ux, uy, wi, Le, pdf)        EnvironmentMap::sample (pdf without the pick)
+//   V env_pmf()                                   the environment's pick probability
+//   void add_suns(dir, Le, pdf)                   LightSampler::add_suns
+//   void along(m, dir, Le, pdf)                   LightSampler::sky
+//   void sun_directions(m, ux, uy, wi)            wi of the lanes of m: their sun's sun_direction
+template <class D, class M, class Sky, class V = VecOf<D>>
+HWY_INLINE M sky_sample(D d, M ok, M env, V ux, V uy, const Sky& sky, Vec3<V>& wi, Vec3<V>& Le, V& pdf) {
+  env = And(env, ok);
+  const M suns = AndNot(env, ok);
+  wi = Le = {Zero(d), Zero(d), Zero(d)};
+  pdf = Zero(d);
+  if (!AllFalse(d, suns)) sky.sun_directions(suns, ux, uy, wi);
+  const bool image = sky.image() && !AllFalse(d, env);
+  Vec3<V> image_Le = Le;  // zero: a draw that fails may leave them
+  V image_pdf = pdf;
+  if (image) {
+    Vec3<V> image_wi = Le;
+    const M drawn = sky.sample_image(env, ux, uy, image_wi, image_Le, image_pdf);
+    image_pdf = sky.env_pmf() * image_pdf;
+    sky.add_suns(image_wi, image_Le, image_pdf);
+    wi = select(env, image_wi, wi);
+    ok = Or(suns, drawn);
+  } else if (!AllFalse(d, env)) {
+    Vec3<V> uniform;
+    uniform_sphere(d, ux, uy, uniform.x, uniform.y, uniform.z);
+    wi = select(env, uniform, wi);
+  }
+  const M along = image ? suns : ok;
+  if (!AllFalse(d, along)) sky.along(along, wi, Le, pdf);
+  if (image) {
+    Le = select(env, image_Le, Le);
+    pdf = IfThenElse(env, image_pdf, pdf);
+  }
+  return AndNot(And(suns, Or(Not(pdf > Zero(d)), is_black(d, Le))), ok);
+}
+
 }  // namespace pathlab::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
