@@ -115,7 +115,12 @@ LightQuery light_query(const Surfel& s, const vec3& wo) {
 }
 
 Ray shadow_ray(const Surfel& s, const LightSample& ls) {
-  return ls.infinite ? s.spawn(ls.wi) : s.spawn_to(ls.p, ls.p_error, ls.n);
+  using namespace width1;
+  F3 origin, dir;
+  F tmax;
+  generic::shadow_ray(kScalar, lane1::M{true}, lane1::M{ls.infinite}, lanes(s.p), lanes(s.p_error), lanes(s.n),
+                      lanes(ls.wi), lanes(ls.p), lanes(ls.p_error), lanes(ls.n), origin, dir, tmax);
+  return Ray{scalars(origin), scalars(dir), tmax.raw};
 }
 
 std::vector<const DeltaLight*> sampled_delta_lights(const Scene& scene) {

@@ -160,8 +160,8 @@ using pathlab::HWY_NAMESPACE::place_normal;
 using pathlab::HWY_NAMESPACE::placed_area_scale;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::shading_normal;
+using pathlab::HWY_NAMESPACE::shadow_ray;
 using pathlab::HWY_NAMESPACE::spawn_origin;
-using pathlab::HWY_NAMESPACE::spawn_to;
 using pathlab::HWY_NAMESPACE::scattered_cone;
 using pathlab::HWY_NAMESPACE::solid_angle_draw;
 using pathlab::HWY_NAMESPACE::SolidAngleDraw;
@@ -1108,10 +1108,9 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI lig
     }
   }
 
-  // Surfel::spawn_to(p, error, n).
   V3 origin, dir;
   VF len;
-  spawn_to(df, sp, load3(w, kErrX, i0, ok), n, s.p, s.error, s.n, origin, dir, len);
+  shadow_ray(df, ok, hn::FirstN(df, 0), sp, load3(w, kErrX, i0, ok), n, s.wi, s.p, s.error, s.n, origin, dir, len);
   const VF ray[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
   std::copy(std::begin(ray), std::end(ray), ls.ray);
   return ls;
@@ -1152,8 +1151,10 @@ LightLanes sky_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, V
   const M env = hn::RebindMask(df, light == hn::Set(DI(), static_cast<std::int32_t>(s.environment)));
   LightLanes ls;
   ok = sky_sample(df, ok, env, lu, lv, SkyView{s, light}, ls.wi, ls.Le, ls.pdf);
-  const V3 origin = spawn_origin(df, sp, load3(w, kErrX, i0, ok), n, ls.wi);
-  const VF ray[7] = {origin.x, origin.y, origin.z, ls.wi.x, ls.wi.y, ls.wi.z, k(std::numeric_limits<float>::infinity())};
+  V3 origin, dir;
+  VF len;
+  shadow_ray(df, ok, ok, sp, load3(w, kErrX, i0, ok), n, ls.wi, zero3(), zero3(), zero3(), origin, dir, len);
+  const VF ray[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
   std::copy(std::begin(ray), std::end(ray), ls.ray);
   return ls;
 }
@@ -1209,16 +1210,10 @@ LightLanes delta_light(const Scene& sc, const Wave& w, std::size_t i0, const Str
                                     gather(ok, d.table, light, kDeltaFields, kDeltaCosOuter),
                                     gather(ok, d.table, light, kDeltaFields, kDeltaCosInner), ls.wi, dist, ls.Le));
   ls.pdf = gather(ok, d.table, light, kDeltaFields, kDeltaPmf);
-  // Surfel::spawn_to(position, 0, -wi) for a point or spot, Surfel::spawn(wi) for a directional light.
-  const V3 err = load3(w, kErrX, i0, ok);
-  V3 origin = zero3(), dir = zero3();
-  VF len = hn::Zero(df);
-  if (!hn::AllFalse(df, hn::AndNot(directional, ok))) spawn_to(df, sp, err, n, position, zero3(), -ls.wi, origin, dir, len);
-  if (const M along = hn::And(directional, ok); !hn::AllFalse(df, along)) {
-    origin = select(along, spawn_origin(df, sp, err, n, ls.wi), origin);
-    dir = select(along, ls.wi, dir);
-    len = hn::IfThenElse(along, k(std::numeric_limits<float>::infinity()), len);
-  }
+  // To a point's or spot's position (no error, its normal -wi), or escaping along a directional light's wi.
+  V3 origin, dir;
+  VF len;
+  shadow_ray(df, ok, directional, sp, load3(w, kErrX, i0, ok), n, ls.wi, position, zero3(), -ls.wi, origin, dir, len);
   const VF ray[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
   std::copy(std::begin(ray), std::end(ray), ls.ray);
   return ls;

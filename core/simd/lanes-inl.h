@@ -30,6 +30,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 HWY_BEFORE_NAMESPACE();
 namespace pathlab::HWY_NAMESPACE {
@@ -608,6 +609,25 @@ HWY_INLINE void spawn_to(D d, const Vec3<V>& p, const Vec3<V>& error, const Vec3
   const Vec3<V> to_end = end - origin;
   dist = Sqrt(dot(to_end, to_end));
   dir = to_end / dist;
+}
+
+// shadow_ray (core/light_sampler.cpp): from p (error bound `error`, normal
+// n) towards a light sample in the lanes of m: escaping along wi (tmax
+// infinite) where `infinite` (the sky, a directional light), else to the
+// light's point lp (its error bound and normal: an area light's, or a point
+// light's own with no error and the normal -wi). Zero off m.
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE void shadow_ray(D d, M m, M infinite, const Vec3<V>& p, const Vec3<V>& error, const Vec3<V>& n,
+                           const Vec3<V>& wi, const Vec3<V>& lp, const Vec3<V>& lp_error, const Vec3<V>& ln,
+                           Vec3<V>& origin, Vec3<V>& dir, V& tmax) {
+  origin = dir = {Zero(d), Zero(d), Zero(d)};
+  tmax = Zero(d);
+  if (!AllFalse(d, AndNot(infinite, m))) spawn_to(d, p, error, n, lp, lp_error, ln, origin, dir, tmax);
+  if (const M along = And(infinite, m); !AllFalse(d, along)) {
+    origin = select(along, spawn_origin(d, p, error, n, wi), origin);
+    dir = select(along, wi, dir);
+    tmax = IfThenElse(along, Set(d, std::numeric_limits<float>::infinity()), tmax);
+  }
 }
 
 // The camera's image plane (Camera::Plane, core/camera.h) in lanes.
