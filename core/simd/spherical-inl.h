@@ -181,7 +181,7 @@ HWY_INLINE Vec3<V> sample_sphere_cone_normal(D d, const Vec3<V>& axis, V dist, V
   return normalize(d, n);
 }
 
-// LightSampler::solid_angle_view of a triangle (p0, p1, p2) seen from o:
+// solid_angle_draw's view of a triangle (p0, p1, p2) seen from o:
 // its solid angle omega, and whether the fallback rule samples it in solid
 // angle (kMinSphericalTriangle <= omega <= kMaxSphericalTriangle), with
 // that density, 1 / omega (finite there).
