@@ -189,6 +189,14 @@ class PartialFilmFile : public test::TempDirTest {
     }
     return "";
   }
+  // The bytes of a small good film written to good.pfilm.
+  std::string good_bytes() {
+    const PartialFilm pf = make(FilterKind::Box, FilmMoments::MeanAndVariance, {0, 4});
+    const fs::path good = dir_ / "good.pfilm";
+    write_partial_film(pf.film, pf.info, good);
+    std::ifstream in(good, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
 };
 
 TEST_F(PartialFilmFile, WhatIsWrittenIsReadBackBitForBit) {
@@ -210,14 +218,7 @@ TEST_F(PartialFilmFile, WhatIsWrittenIsReadBackBitForBit) {
 }
 
 TEST_F(PartialFilmFile, DamagedFilesAreRefusedNamingTheFileAndTheProblem) {
-  const PartialFilm pf = make(FilterKind::Box, FilmMoments::MeanAndVariance, {0, 4});
-  const fs::path good = dir_ / "good.pfilm";
-  write_partial_film(pf.film, pf.info, good);
-  std::string bytes;
-  {
-    std::ifstream in(good, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  const std::string bytes = good_bytes();
   const auto write = [&](const std::string& name, const std::string& content) {
     std::ofstream(dir_ / name, std::ios::binary) << content;
     return dir_ / name;
@@ -270,14 +271,7 @@ TEST_F(PartialFilmFile, DamagedFilesAreRefusedNamingTheFileAndTheProblem) {
 // ends inside its header)", a resolution's digit as "truncated: a 7x4 film
 // needs ...". A header the checksum vouches for is another version's.
 TEST_F(PartialFilmFile, AFlippedBitInTheHeaderIsReportedAsACorruptHeader) {
-  const PartialFilm pf = make(FilterKind::Box, FilmMoments::MeanAndVariance, {0, 4});
-  const fs::path good = dir_ / "good.pfilm";
-  write_partial_film(pf.film, pf.info, good);
-  std::string bytes;
-  {
-    std::ifstream in(good, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), {});
-  }
+  const std::string bytes = good_bytes();
   std::uint64_t header_size = 0;
   std::memcpy(&header_size, bytes.data() + 8, 8);
   const fs::path file = dir_ / "flipped.pfilm";
