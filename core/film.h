@@ -45,6 +45,11 @@ struct BadSample {
 };
 
 inline constexpr double kFilmRadianceLimit = Sum1::kLimit;
+// The film rounds each sample to units of 2^-64 (Sum1): within 2^-65 of it,
+// an absolute resolution. A scene whose brightest emitter is below this
+// (2^-55, about 2.8e-17) loses more than 2^-10 of its light to the rounding,
+// samples below 2^-65 vanish, and the CLI warns (docs/overnight.md).
+inline constexpr double kFilmFaintRadiance = 0x1p-55;
 // True if the film can add L: finite and every component below
 // kFilmRadianceLimit (also false for NaN: every comparison with it is).
 inline bool in_film_range(const Spectrum& L) {

@@ -1,5 +1,9 @@
 #include "core/scene.h"
 
+#include "core/math.h"
+
+#include <algorithm>
+
 namespace pathlab {
 
 const char* strategy_name(Strategy s) {
@@ -47,6 +51,19 @@ std::optional<Intersection> parse_intersection(std::string_view name) {
   for (Intersection i : {Intersection::Robust, Intersection::Fast})
     if (name == intersection_name(i)) return i;
   return std::nullopt;
+}
+
+std::optional<float> constant_emitters_peak(const Scene& scene) {
+  if (scene.environment_map || !scene.delta_lights.empty()) return std::nullopt;
+  std::optional<float> peak;
+  const auto take = [&](const Spectrum& L) { peak = std::max(peak.value_or(0.0f), max_component(glm::abs(L))); };
+  if (scene.environment && !is_black(*scene.environment)) take(*scene.environment);
+  for (const Shape& shape : scene.shapes) {
+    const Material& m = scene.materials[shape.material];
+    if (m.emission_textured) return std::nullopt;
+    if (m.emits()) take(m.emission);
+  }
+  return peak;
 }
 
 }  // namespace pathlab

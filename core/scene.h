@@ -174,6 +174,12 @@ struct DeltaLight {
   float angular_radius = 0.0f;  // directional: half the angular diameter, radians (0: a delta light)
   bool is_sun_disk() const { return kind == Kind::Directional && angular_radius > 0.0f; }
 };
+// The largest radiance component of the scene's emitters when every one is
+// a constant (emitting shapes' materials without an emission texture, a
+// uniform environment); nullopt if there is none, or any other light (an
+// emission texture, an environment image, point, spot or directional lights,
+// sun disks), whose brightest sample this cannot bound.
+std::optional<float> constant_emitters_peak(const Scene& scene);
 // The spot profile: 1 for cos_theta >= cos_inner, 0 for cos_theta <= cos_outer,
 // a smoothstep in cos theta between.
 float spot_profile(float cos_theta, float cos_outer, float cos_inner);

@@ -192,6 +192,28 @@ TEST_F(Hardening, PositionsWithinTheRuleRender) {
   EXPECT_EQ(f.code, 0) << f.err;
 }
 
+// A scene lit only by emitters far below the film's fixed-point resolution
+// (2^-65 per sample) says so: a lamp of 1e-18 once rendered 28 % dark and one
+// of 1e-20 black, without a word. A lamp of 1e-12 does not warn.
+TEST_F(Hardening, EmittersTooFaintForTheFilmAreWarnedAbout) {
+  const auto with_lamp = [&](const std::string& name, const std::string& radiance) {
+    std::string text = scene_text(kCamera, kSphere + ",\n" + kLamp);
+    const std::string from = "\"radiance\": 2";
+    text.replace(text.find(from), from.size(), "\"radiance\": " + radiance);
+    return render(file(name, text));
+  };
+  for (const char* faint : {"1e-18", "1e-20"}) {
+    const ProcessResult r = with_lamp(std::string("faint") + faint + ".json", faint);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("pathlab: warning: the brightest emitter's radiance is " + std::string(faint)), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("choose a smaller unit of radiance"), std::string::npos) << r.err;
+  }
+  const ProcessResult dim = with_lamp("dim.json", "1e-12");
+  EXPECT_EQ(dim.code, 0) << dim.err;
+  EXPECT_EQ(dim.err.find("brightest emitter"), std::string::npos) << dim.err;
+}
+
 // A ray Embree would abort on never reaches it, through any of the accel's
 // entry points and batch modes: run in a child, so that a regression shows as
 // the child's SIGABRT rather than the end of this test program.
