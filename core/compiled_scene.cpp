@@ -38,6 +38,22 @@ vec3 place_normal(const mat3& to_normal, const vec3& n) {
   return scalars(generic::place_normal(kScalar, lanes(to_normal[0]), lanes(to_normal[1]), lanes(to_normal[2]), lanes(n)));
 }
 
+// An instance's placement as the generic texture inputs read it
+// (core/simd/texture_inputs-inl.h): its columns, at width 1 (null in world
+// space, where none is asked for).
+struct PlacementColumns {
+  const CompiledScene::Placement* place;
+  void linear(lane1::M, width1::F3 (&c)[3]) const {
+    for (int k = 0; k < 3; ++k) c[k] = width1::lanes(vec3(place->to_world[k]));
+  }
+  void to_local(lane1::M, width1::F3 (&c)[4]) const {
+    for (int k = 0; k < 4; ++k) c[k] = width1::lanes(vec3(place->to_local[k]));
+  }
+  void to_normal(lane1::M, width1::F3 (&c)[3]) const {
+    for (int k = 0; k < 3; ++k) c[k] = width1::lanes(place->to_normal[k]);
+  }
+};
+
 // The loaders check what a file says; a scene built in code gets the same
 // guarantees here: groups name existing shapes marked in_group, instances
 // existing groups, and every placement is finite and invertible.
@@ -218,45 +234,25 @@ void CompiledScene::shading_frame(const Shape& shape, const RayHit& hit, const v
 
 void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayHit& hit, const RayCone& cone,
                                   SurfaceParams* params, Surfel* s) const {
-  using namespace width1;  // the generic steps at width 1 (core/simd/lanes-inl.h)
+  using namespace width1;  // the generic steps at width 1 (core/simd/texture_inputs-inl.h)
   const Material& m = *s->material;
   // Texture coordinates and the uv-to-world area ratio that turns the cone's
   // width into a footprint in uv (core/ray_cone.h).
-  float uv_per_area = 0.0f;
+  const bool placed = hit.instance != kNoInstance;
+  const PlacementColumns place{placed ? &placements_[hit.instance] : nullptr};
+  generic::TextureInputs<F> in;
   if (shape.kind == Shape::Kind::Sphere) {
-    // pbrt's (phi, theta) parametrisation about the z axis, in the shape's
-    // own space: u = phi / 2 pi, v = 1 - theta / pi (v = 1 at +z).
-    const Placement* place = hit.instance == kNoInstance ? nullptr : &placements_[hit.instance];
-    const vec3 p_local = place ? affine_point(place->to_local, s->p) : s->p;
-    const vec3 d = (p_local - shape.center) / shape.radius;
-    float sin_theta;
-    s->uv = sphere_uv(d, &sin_theta);
-    F per_area = generic::sphere_uv_per_area(kScalar, F{shape.radius}, F{sin_theta});
-    if (place) {
-      // Per world area: the instance scales the sphere's areas there by placed_area_scale.
-      const mat3 l(place->to_world);
-      per_area = per_area / generic::placed_area_scale(lanes(l[0]), lanes(l[1]), lanes(l[2]), lanes(place->to_normal[0]),
-                                                       lanes(place->to_normal[1]), lanes(place->to_normal[2]), lanes(d));
-    }
-    uv_per_area = per_area.raw;
+    in = generic::sphere_texture_inputs(kScalar, lanes(s->p), lanes(shape.center), F{shape.radius}, lane1::M{placed},
+                                        place);
   } else {
     const Triangle& t = triangles_[first_triangle_[hit.shape] + hit.prim];
-    vec3 e1 = t.p1 - t.p0, e2 = t.p2 - t.p0;
-    if (hit.instance != kNoInstance) {
-      const mat3 l(placements_[hit.instance].to_world);
-      e1 = l * e1, e2 = l * e2;
-    }
-    vec2 a(0.0f), b(0.0f);
-    if (shape.mesh.has_uvs()) {
-      const glm::uvec3 v = shape.mesh.triangles[hit.prim];
-      a = shape.mesh.uvs[v.y] - shape.mesh.uvs[v.x], b = shape.mesh.uvs[v.z] - shape.mesh.uvs[v.x];
-    }
-    uv_per_area = generic::triangle_uv_per_area(kScalar, lanes(e1), lanes(e2), lane1::M{shape.mesh.has_uvs()}, F{a.x},
-                                                F{a.y}, F{b.x}, F{b.y})
-                      .raw;
+    const auto corners = [&](lane1::M) { return corner_uvs(shape.mesh, hit.prim); };
+    in = generic::triangle_texture_inputs(kScalar, F{hit.uv.x}, F{hit.uv.y}, lanes(t.p0), lanes(t.p1), lanes(t.p2),
+                                          lane1::M{shape.mesh.has_uvs()}, corners, lane1::M{placed}, place);
   }
-  const float width = generic::footprint_width(kScalar, F{cone.width}, F{cone.spread}, F{glm::length(s->p - ray.origin)},
-                                               F{glm::dot(ray.dir, s->n)}, F{uv_per_area})
+  s->uv = vec2(in.u.raw, in.v.raw);
+  const float width = generic::footprint_width(kScalar, F{cone.width}, F{cone.spread}, lanes(ray.origin),
+                                               lanes(ray.dir), lanes(s->p), lanes(s->n), in.uv_per_area)
                           .raw;
   const TextureFootprint at{s->uv, width};
   if (m.normal_map) {

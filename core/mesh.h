@@ -40,12 +40,9 @@ struct TriangleMesh {
   bool has_uvs() const { return !uvs.empty(); }
   // The texture coordinates at barycentrics b = (b1, b2) of triangle `t`, or
   // b itself on a mesh without them: what shading, alpha tests and light
-  // samples all read a triangle's textures at.
-  vec2 uv_at(std::uint32_t t, vec2 b) const {
-    if (!has_uvs()) return b;
-    const glm::uvec3 v = triangles[t];
-    return (1.0f - b.x - b.y) * uvs[v.x] + b.x * uvs[v.y] + b.y * uvs[v.z];
-  }
+  // samples all read a triangle's textures at. Generic code
+  // (core/simd/texture_inputs-inl.h uv_at) that the wavefront's lanes call too.
+  vec2 uv_at(std::uint32_t t, vec2 b) const;
   bool has_face_materials() const { return !face_material.empty(); }
 };
 

@@ -8,6 +8,7 @@
 #include "core/geometry.h"
 #include "core/limits.h"
 #include "core/messages.h"
+#include "core/simd/width1.h"
 
 #include <tiny_obj_loader.h>
 #include <zlib.h>
@@ -924,6 +925,13 @@ std::vector<char> read_file_maybe_gz(const std::filesystem::path& file) {
   }
   data.resize(size);
   return data;
+}
+
+vec2 TriangleMesh::uv_at(std::uint32_t t, vec2 b) const {
+  using namespace width1;  // the generic step at width 1 (core/simd/texture_inputs-inl.h)
+  F u, v;
+  generic::uv_at(kScalar, lane1::M{has_uvs()}, F{b.x}, F{b.y}, corner_uvs(*this, t), u, v);
+  return vec2(u.raw, v.raw);
 }
 
 std::vector<vec3> smooth_vertex_normals(const TriangleMesh& mesh) {

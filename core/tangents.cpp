@@ -71,14 +71,20 @@ void add_needed_tangents(Scene* scene) {
 Frame mesh_tangent_frame(const TriangleMesh& mesh, std::uint32_t tri, vec2 b, const mat3& to_world,
                          const vec3& n_mesh, const vec3& ns) {
   const glm::uvec3 v = mesh.triangles[tri];
-  const vec4 sum = (1.0f - b.x - b.y) * mesh.tangents[v.x] + b.x * mesh.tangents[v.y] + b.y * mesh.tangents[v.z];
+  const vec4& t0 = mesh.tangents[v.x];
+  const vec4& t1 = mesh.tangents[v.y];
+  const vec4& t2 = mesh.tangents[v.z];
   // The generic steps (core/simd/lanes-inl.h tangent_frame), which the
-  // wavefront's lanes take too: placed, made perpendicular to ns, its
-  // handedness turned by a mirroring placement and a normal that turned.
+  // wavefront's lanes take too: the vertices' tangents blended, placed, made
+  // perpendicular to ns, the handedness turned by a mirroring placement and
+  // a normal that turned.
   using namespace width1;
+  const F3 tangents[3] = {lanes(vec3(t0)), lanes(vec3(t1)), lanes(vec3(t2))};
+  const F w[3] = {F{t0.w}, F{t1.w}, F{t2.w}};
   F3 fs, ft;
-  generic::tangent_frame(kScalar, lanes(vec3(sum)), F{sum.w}, lanes(to_world[0]), lanes(to_world[1]), lanes(to_world[2]),
-                         lane1::M{glm::determinant(to_world) < 0.0f}, lanes(n_mesh), lanes(ns), fs, ft);
+  generic::tangent_frame(kScalar, F{b.x}, F{b.y}, tangents, w, lanes(to_world[0]), lanes(to_world[1]),
+                         lanes(to_world[2]), lane1::M{glm::determinant(to_world) < 0.0f}, lanes(n_mesh), lanes(ns), fs,
+                         ft);
   Frame f;
   f.s = scalars(fs);
   f.t = scalars(ft);

@@ -338,6 +338,45 @@ TEST_F(TexturesTest, PlacedSphereFiltersAsTheSphereItBecomes) {
   }
 }
 
+// The same for a textured rectangle (a mesh with texture coordinates)
+// placed by an instance that stretches it 3 times along x and 1.5 times
+// along y, then tilts it: the footprint's uv area per world area is of the
+// triangle's edges placed (texture_inputs-inl.h triangle_texture_inputs),
+// so it reads as the rectangle it becomes in world space does. Edges in the
+// group's units, or only one of them placed, read another level.
+TEST_F(TexturesTest, PlacedMeshFiltersAsTheMeshItBecomes) {
+  write_noise(dir_ / "noise.exr", 9);
+  const auto scene = [&](const std::string& shapes) {
+    return parse_scene(R"({"pathlab_scene": 1,
+      "camera": {"position": [0, 0, 10], "look_at": [0, 0, 0], "fov_y": 40},
+      "film": {"resolution": [64, 64]},
+      "render": {"max_depth": 1},
+      "materials": {"m": {"type": "diffuse", "albedo": {"texture": "noise.exr", "colorspace": "linear"}}},
+      )" + shapes + "}",
+                       dir_ / "scene.json");
+  };
+  const std::string place = R"([{"scale": [3, 1.5, 1]}, {"rotate": {"axis": [1, 0, 0], "angle": 30}}])";
+  const CompiledScene world{scene(R"("shapes": [{"type": "rectangle", "material": "m", "transform": )" + place + "}]")};
+  const CompiledScene placed{scene(R"("shapes": [],
+      "groups": {"quad": [{"type": "rectangle", "material": "m"}]},
+      "instances": [{"group": "quad", "transform": )" + place + "}]")};
+  const TextureRef& ref = world.scene().materials[0].textured.at(0).texture;
+  for (const vec2 pixel : {vec2(32.3f, 31.8f), vec2(24.5f, 36.2f), vec2(40.1f, 28.4f)}) {
+    const Ray ray = world.camera().generate_ray(pixel, vec2(0.5f));
+    Surfel a, b;
+    SurfaceParams pa, pb;
+    ASSERT_TRUE(world.intersect(ray, &a, world.camera_cone(TextureFilter::Cone), &pa));
+    ASSERT_TRUE(placed.intersect(ray, &b, placed.camera_cone(TextureFilter::Cone), &pb));
+    ASSERT_NE(b.instance, kNoInstance);
+    EXPECT_NEAR(a.uv.x, b.uv.x, 1e-5f);
+    EXPECT_NEAR(a.uv.y, b.uv.y, 1e-5f);
+    expect_near(pb.albedo, pa.albedo, 2e-4f, "placed against world");
+    // The filter matters here: the finest level reads something else.
+    EXPECT_GT(glm::length(world.textures()->color(ref, {a.uv, 0.0f}) - pa.albedo), 1e-2f)
+        << "the footprint is too small to test";
+  }
+}
+
 // ------------------------------------------------------------ normal maps
 
 TEST_F(TexturesTest, ConstantNormalMapTiltsTheShadingNormalByItsAngle) {

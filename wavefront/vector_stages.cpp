@@ -33,6 +33,7 @@
 #include "core/simd/sampling-inl.h"
 #include "core/simd/sobol-inl.h"
 #include "core/simd/spherical-inl.h"
+#include "core/simd/texture_inputs-inl.h"
 #include "core/material.h"
 #include "core/rng.h"
 #include "core/scene.h"
@@ -125,6 +126,7 @@ using pathlab::HWY_NAMESPACE::bvh_share;
 using pathlab::HWY_NAMESPACE::camera_direction;
 using pathlab::HWY_NAMESPACE::CameraPlane;
 using pathlab::HWY_NAMESPACE::concentric_disk;
+using pathlab::HWY_NAMESPACE::CornerUvs;
 using pathlab::HWY_NAMESPACE::delta_light_seen;
 using pathlab::HWY_NAMESPACE::env_sample_direction;
 using pathlab::HWY_NAMESPACE::ClosureLanes;
@@ -157,7 +159,6 @@ using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::sky_entry_of;
 using pathlab::HWY_NAMESPACE::sky_sample;
 using pathlab::HWY_NAMESPACE::place_normal;
-using pathlab::HWY_NAMESPACE::placed_area_scale;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::shading_normal;
 using pathlab::HWY_NAMESPACE::shadow_ray;
@@ -166,8 +167,7 @@ using pathlab::HWY_NAMESPACE::scattered_cone;
 using pathlab::HWY_NAMESPACE::solid_angle_draw;
 using pathlab::HWY_NAMESPACE::SolidAngleDraw;
 using pathlab::HWY_NAMESPACE::sphere_point;
-using pathlab::HWY_NAMESPACE::sphere_uv;
-using pathlab::HWY_NAMESPACE::sphere_uv_per_area;
+using pathlab::HWY_NAMESPACE::sphere_texture_inputs;
 using pathlab::HWY_NAMESPACE::sun_direction;
 using pathlab::HWY_NAMESPACE::splat3;
 using pathlab::HWY_NAMESPACE::tangent_frame;
@@ -175,8 +175,9 @@ using pathlab::HWY_NAMESPACE::thin_lens;
 using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
+using pathlab::HWY_NAMESPACE::TextureInputs;
 using pathlab::HWY_NAMESPACE::transform_point;
-using pathlab::HWY_NAMESPACE::triangle_uv_per_area;
+using pathlab::HWY_NAMESPACE::triangle_texture_inputs;
 using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::uniform_sphere;
 using pathlab::HWY_NAMESPACE::CospowLobes;
@@ -523,6 +524,23 @@ void prefetch_hits(const Scene& sc, const Wave& w) {
   }
 }
 
+// An instance's placement as core/simd/texture_inputs-inl.h reads it:
+// column(m, field) gathers a column of Scene::placements (PlacementField)
+// for the lanes of m.
+template <class Column>
+struct PlacementLanes {
+  const Column& column;
+  void linear(M m, V3 (&c)[3]) const {
+    for (int k = 0; k < 3; ++k) c[k] = column(m, kToWorld + 3 * k);
+  }
+  void to_local(M m, V3 (&c)[4]) const {
+    for (int k = 0; k < 4; ++k) c[k] = column(m, kToLocal + 3 * k);
+  }
+  void to_normal(M m, V3 (&c)[3]) const {
+    for (int k = 0; k < 3; ++k) c[k] = column(m, kToNormal + 3 * k);
+  }
+};
+
 void resolve(const Scene& sc, const Wave& w) {
   const DF df;
   for (std::size_t i0 = 0; i0 < w.n; i0 += lanes()) {
@@ -542,6 +560,7 @@ void resolve(const Scene& sc, const Wave& w) {
       placed = hn::And(found, fmask(instance != hn::Set(DI(), -1)));
     }
     const auto placement = [&](M m, int field) { return gather3(m, sc.placements, instance, kPlacementFloats, field); };
+    const PlacementLanes<decltype(placement)> place{placement};
     V3 p = zero3(), error = zero3(), n = zero3();
     if (!hn::AllFalse(df, mesh)) {
       // triangle_point (core/geometry.cpp) of the shape's triangle prim.
@@ -655,9 +674,6 @@ void resolve(const Scene& sc, const Wave& w) {
             t[k] = gather3(tangents, sc.vertex_tangents, tri, 12, 4 * k);
             tw[k] = gather(tangents, sc.vertex_tangents, tri, 12, 4 * k + 3);
           }
-          const V3 tsum = blend_normals(df, b1, b2, t[0], t[1], t[2]);
-          const VF b0 = k(1.0f) - b1 - b2;
-          const VF wsum = (b0 * tw[0] + b1 * tw[1]) + b2 * tw[2];
           V3 c0 = splat3(df, 1.0f, 0.0f, 0.0f), c1 = splat3(df, 0.0f, 1.0f, 0.0f), c2 = splat3(df, 0.0f, 0.0f, 1.0f);
           M mirrors = hn::FirstN(df, 0);
           if (const M on = hn::And(tangents, placed); !hn::AllFalse(df, on)) {
@@ -668,7 +684,7 @@ void resolve(const Scene& sc, const Wave& w) {
           }
           const V3 n_mesh = select(smooth, sum, select(shape_flag(tangents, sc, shape, kFlipped), -n, n));
           V3 tfs, tft;
-          tangent_frame(df, tsum, wsum, c0, c1, c2, mirrors, n_mesh, ns, tfs, tft);
+          tangent_frame(df, b1, b2, t, tw, c0, c1, c2, mirrors, n_mesh, ns, tfs, tft);
           fs = select(tangents, tfs, fs);
           ft = select(tangents, tft, ft);
         }
@@ -683,70 +699,42 @@ void resolve(const Scene& sc, const Wave& w) {
         // CompiledScene::shading_frame's Frame(n) where no vertex normals made one.
         if (const M flat = hn::AndNot(here, textured); !hn::AllFalse(df, flat)) store_normal_frame(flat);
         // CompiledScene::read_textures' footprint: the texture coordinates and the width of the ray cone there in
-        // uv (footprint_width), from the uv area per world area.
-        VF tex_u = hn::Zero(df), tex_v = hn::Zero(df), uv_per_area = hn::Zero(df);
+        // uv (footprint_width), from the uv area per world area (core/simd/texture_inputs-inl.h).
+        TextureInputs<VF> tex{hn::Zero(df), hn::Zero(df), hn::Zero(df)};
         if (const M tmesh = hn::AndNot(sphere, textured); !hn::AllFalse(df, tmesh)) {
-          // A mesh's: Mesh::uv_at (the vertices' blended by the barycentrics, as blend_normals blends normals;
-          // or the barycentrics), from the triangle's edges (placed by its instance) and uv edges.
+          // A mesh's: of the shape's triangle prim and, where the mesh has them (kUvsAt), its corners' uvs.
           const VI tri = shape_int(tmesh, sc, shape, kFirstTriangle) + load(w, kPrim, i0, tmesh);
-          const V3 p0 = gather3(tmesh, sc.triangles, tri, 12, 0);
-          V3 e1 = gather3(tmesh, sc.triangles, tri, 12, 3) - p0, e2 = gather3(tmesh, sc.triangles, tri, 12, 6) - p0;
-          if (const M on = hn::And(tmesh, placed); !hn::AllFalse(df, on)) {
-            const V3 c0 = placement(on, kToWorld), c1 = placement(on, kToWorld + 3), c2 = placement(on, kToWorld + 6);
-            e1 = select(on, to_world(c0, c1, c2, e1.x, e1.y, e1.z), e1);
-            e2 = select(on, to_world(c0, c1, c2, e2.x, e2.y, e2.z), e2);
-          }
-          const VF b1 = load(w, kHitU, i0, tmesh), b2 = load(w, kHitV, i0, tmesh);
-          V3 uv{b1, b2, hn::Zero(df)}, a = zero3(), b = zero3();
           const VI uvs_at = shape_int(tmesh, sc, shape, kUvsAt);
           const M has_uvs = hn::And(tmesh, fmask(hn::Not(uvs_at < hn::Zero(DI()))));
-          if (!hn::AllFalse(df, has_uvs)) {
-            const VI at = uvs_at + load(w, kPrim, i0, has_uvs);
-            V3 t[3];
-            for (int k = 0; k < 3; ++k)
-              t[k] = V3{gather(has_uvs, sc.triangle_uvs, at, 6, 2 * k), gather(has_uvs, sc.triangle_uvs, at, 6, 2 * k + 1),
-                        hn::Zero(df)};
-            uv = select(has_uvs, blend_normals(df, b1, b2, t[0], t[1], t[2]), uv);
-            a = t[1] - t[0];
-            b = t[2] - t[0];
-          }
-          tex_u = uv.x;
-          tex_v = uv.y;
-          uv_per_area = triangle_uv_per_area(df, e1, e2, has_uvs, a.x, a.y, b.x, b.y);
+          const auto corner_uvs = [&](M m) {
+            const VI at = uvs_at + load(w, kPrim, i0, m);
+            CornerUvs<VF> c;
+            for (int k = 0; k < 3; ++k) {
+              c.u[k] = gather(m, sc.triangle_uvs, at, 6, 2 * k);
+              c.v[k] = gather(m, sc.triangle_uvs, at, 6, 2 * k + 1);
+            }
+            return c;
+          };
+          tex = triangle_texture_inputs(df, load(w, kHitU, i0, tmesh), load(w, kHitV, i0, tmesh),
+                                        gather3(tmesh, sc.triangles, tri, 12, 0),
+                                        gather3(tmesh, sc.triangles, tri, 12, 3),
+                                        gather3(tmesh, sc.triangles, tri, 12, 6), has_uvs, corner_uvs,
+                                        hn::And(tmesh, placed), place);
         }
         if (const M tsphere = hn::And(sphere, textured); !hn::AllFalse(df, tsphere)) {
-          // A sphere's: sphere_uv of the direction from its centre to the point in its own space (the placed
-          // point taken back by the instance's to_local, as core does), and sphere_uv_per_area.
-          const M on = hn::And(tsphere, placed);
-          const bool any_placed = !hn::AllFalse(df, on);
-          V3 local = p;
-          if (any_placed)
-            local = select(on,
-                           affine_point(placement(on, kToLocal), placement(on, kToLocal + 3), placement(on, kToLocal + 6),
-                                        placement(on, kToLocal + 9), p),
-                           p);
-          const VF radius = shape_value(tsphere, sc, shape, kRadius);
-          const V3 off = local - shape_value3(tsphere, sc, shape, kCenter);
-          const V3 dir{off.x / radius, off.y / radius, off.z / radius};
-          VF su, sv, sin_theta;
-          sphere_uv(df, dir, su, sv, sin_theta);
-          VF per_area = sphere_uv_per_area(df, radius, sin_theta);
-          if (any_placed)
-            // Per world area: the instance scales the sphere's areas there by placed_area_scale.
-            per_area = hn::IfThenElse(on,
-                                      per_area / placed_area_scale(placement(on, kToWorld), placement(on, kToWorld + 3),
-                                                                   placement(on, kToWorld + 6), to_normal[0],
-                                                                   to_normal[1], to_normal[2], dir),
-                                      per_area);
-          tex_u = hn::IfThenElse(tsphere, su, tex_u);
-          tex_v = hn::IfThenElse(tsphere, sv, tex_v);
-          uv_per_area = hn::IfThenElse(tsphere, per_area, uv_per_area);
+          // A sphere's, at the point p (in its own space by the instance's to_local).
+          const TextureInputs<VF> ts = sphere_texture_inputs(df, p, shape_value3(tsphere, sc, shape, kCenter),
+                                                             shape_value(tsphere, sc, shape, kRadius),
+                                                             hn::And(tsphere, placed), place);
+          tex.u = hn::IfThenElse(tsphere, ts.u, tex.u);
+          tex.v = hn::IfThenElse(tsphere, ts.v, tex.v);
+          tex.uv_per_area = hn::IfThenElse(tsphere, ts.uv_per_area, tex.uv_per_area);
         }
-        const V3 o = load3(w, kOx, i0, textured), d = load3(w, kDx, i0, textured);
         const VF width = footprint_width(df, load(w, kConeWidth, i0, textured), load(w, kConeSpread, i0, textured),
-                                         hn::Sqrt(dot(p - o, p - o)), dot(d, n), uv_per_area);
-        store(w, kTexU, i0, textured, tex_u);
-        store(w, kTexV, i0, textured, tex_v);
+                                         load3(w, kOx, i0, textured), load3(w, kDx, i0, textured), p, n,
+                                         tex.uv_per_area);
+        store(w, kTexU, i0, textured, tex.u);
+        store(w, kTexV, i0, textured, tex.v);
         store(w, kTexWidth, i0, textured, width);
         store_mask(w, kHasParams, i0, textured, shape_flag(textured, sc, shape, kTexturedParams));
         // The texels: OpenImageIO's lookups, by core, path by path, into the slot's SurfaceParams and kMapR...

@@ -485,24 +485,29 @@ HWY_INLINE void frame_along(D d, const Vec3<V>& ns, const Vec3<V>& perp, V lengt
 }
 
 // mesh_tangent_frame (core/tangents.cpp): the shading frame of a mesh with
-// tangents at a hit. `sum` is the vertices' tangents (xyz; handedness w)
-// blended by the barycentrics (blend_normals' order), placed by the linear
-// part c0 c1 c2 of the instance's placement (the identity's columns in world
-// space: core multiplies by mat3(1) too); `mirrors` where that placement's
-// determinant is negative. The placed tangent is made perpendicular to the
-// shading normal ns (Gram-Schmidt) and is the frame's s, with t = w' n x s,
-// w' the handedness turned where the placement mirrors and where ns faces
-// away from the mesh's own normal n_mesh; Frame(ns) where the tangent has
+// tangents at a hit. tangents[k] and w[k] are the triangle's vertices'
+// tangents (xyz; handedness w), blended here by the barycentrics (b1, b2) in
+// blend_normals' order, the sum placed by the linear part c0 c1 c2 of the
+// instance's placement (the identity's columns in world space: core
+// multiplies by mat3(1) too); `mirrors` where that placement's determinant
+// is negative. The placed tangent is made perpendicular to the shading
+// normal ns (Gram-Schmidt) and is the frame's s, with t = w' n x s, w' the
+// handedness turned where the placement mirrors and where ns faces away
+// from the mesh's own normal n_mesh; Frame(ns) where the tangent has
 // (almost) no part perpendicular to ns or is not finite.
 template <class D, class M, class V = VecOf<D>>
-HWY_INLINE void tangent_frame(D d, const Vec3<V>& sum, V w, const Vec3<V>& c0, const Vec3<V>& c1, const Vec3<V>& c2,
-                              M mirrors, const Vec3<V>& n_mesh, const Vec3<V>& ns, Vec3<V>& fs, Vec3<V>& ft) {
+HWY_INLINE void tangent_frame(D d, V b1, V b2, const Vec3<V> (&tangents)[3], const V (&w)[3], const Vec3<V>& c0,
+                              const Vec3<V>& c1, const Vec3<V>& c2, M mirrors, const Vec3<V>& n_mesh,
+                              const Vec3<V>& ns, Vec3<V>& fs, Vec3<V>& ft) {
+  const Vec3<V> sum = blend_normals(d, b1, b2, tangents[0], tangents[1], tangents[2]);
+  const V b0 = Set(d, 1.0f) - b1 - b2;
+  const V w_sum = (b0 * w[0] + b1 * w[1]) + b2 * w[2];
   const Vec3<V> placed = to_world(c0, c1, c2, sum.x, sum.y, sum.z);
   const Vec3<V> s = placed - dot(placed, ns) * ns;
   const V length = Sqrt(dot(s, s));
   const auto usable = And(length > Set(d, 1e-4f) * Sqrt(dot(placed, placed)), IsFinite(length));
   const V one = Set(d, 1.0f);
-  V handed = IfThenElse(w < Zero(d), Neg(one), one);
+  V handed = IfThenElse(w_sum < Zero(d), Neg(one), one);
   handed = IfThenElse(mirrors, Neg(handed), handed);
   handed = IfThenElse(dot(ns, n_mesh) < Zero(d), Neg(handed), handed);
   frame_along(d, ns, s, length, usable, handed, fs, ft);
@@ -551,15 +556,18 @@ HWY_INLINE V triangle_uv_per_area(D d, const Vec3<V>& e1, const Vec3<V>& e2, M u
   const auto usable = area > Zero(d);
   return IfThenElse(usable, uv_area / IfThenElse(usable, area, Set(d, 1.0f)), Zero(d));
 }
-// The footprint's width in texture space: the ray cone's width at the hit
-// (`width` at the ray's origin plus `spread` per unit of `distance`: RayCone::
-// width_at), projected onto the surface (cos_theta between the ray and the
-// geometric normal, at least 1e-4 in magnitude) and scaled by
-// sqrt(uv_per_area); 0 (the finest level) where that is not finite.
+// The footprint's width in texture space at the hit p (geometric normal ng)
+// of the ray from o along dir: the ray cone's width there (`width` at the
+// ray's origin plus `spread` per unit of the distance |p - o|: RayCone::
+// width_at), projected onto the surface (the cosine dir . ng, at least 1e-4
+// in magnitude) and scaled by sqrt(uv_per_area) (texture_inputs-inl.h's);
+// 0 (the finest level) where that is not finite.
 template <class D, class V = VecOf<D>>
-HWY_INLINE V footprint_width(D d, V width, V spread, V distance, V cos_theta, V uv_per_area) {
-  const V w = width + spread * distance;
-  const V fw = w / Max(Set(d, 1e-4f), Abs(cos_theta)) * Sqrt(uv_per_area);
+HWY_INLINE V footprint_width(D d, V width, V spread, const Vec3<V>& o, const Vec3<V>& dir, const Vec3<V>& p,
+                             const Vec3<V>& ng, V uv_per_area) {
+  const Vec3<V> to = p - o;
+  const V w = width + spread * Sqrt(dot(to, to));
+  const V fw = w / Max(Set(d, 1e-4f), Abs(dot(dir, ng))) * Sqrt(uv_per_area);
   return IfThenElse(IsFinite(fw), fw, Zero(d));
 }
 

@@ -13,6 +13,7 @@
 #endif
 
 #include "core/math.h"
+#include "core/mesh.h"
 #include "core/sampling.h"
 #include "core/simd/lane1.h"
 #include "core/simd/environment-inl.h"
@@ -21,6 +22,7 @@
 #include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"
 #include "core/simd/spherical-inl.h"
+#include "core/simd/texture_inputs-inl.h"
 
 namespace pathlab::width1 {
 
@@ -38,6 +40,16 @@ using D3 = generic::Vec3<D1>;
 inline constexpr lane1::One<double> kScalarD{};
 inline D3 lanes(const dvec3& v) { return {{v.x}, {v.y}, {v.z}}; }
 inline dvec3 scalars(const D3& v) { return dvec3(v.x.raw, v.y.raw, v.z.raw); }
+
+// The texture coordinates of triangle t's corners (TriangleMesh::uvs) as
+// the generic texture inputs read them (core/simd/texture_inputs-inl.h); 0
+// on a mesh without them, which those ignore.
+inline generic::CornerUvs<F> corner_uvs(const TriangleMesh& mesh, std::uint32_t t) {
+  if (!mesh.has_uvs()) return {{F{0.0f}, F{0.0f}, F{0.0f}}, {F{0.0f}, F{0.0f}, F{0.0f}}};
+  const glm::uvec3 v = mesh.triangles[t];
+  const vec2 a = mesh.uvs[v.x], b = mesh.uvs[v.y], c = mesh.uvs[v.z];
+  return {{F{a.x}, F{b.x}, F{c.x}}, {F{a.y}, F{b.y}, F{c.y}}};
+}
 
 // Entry i (a whole float) of a cdf in a lane of m, as the generic samplers
 // read it (core/simd/lights-inl.h); 0 off the mask, as a masked gather reads.
