@@ -306,6 +306,46 @@ std::size_t LightSampler::pick(const std::vector<float>& cdf, float u) {
   return static_cast<std::size_t>(generic::pick_cdf(kScalar, lane1::M{true}, cdf.size(), F{u}, cdf_at).raw);
 }
 
+// The sky as this sampler holds it; `entry` is the sun disk sky_sample draws for.
+struct LightSampler::SkyView {
+  using F = width1::F;
+  using F3 = width1::F3;
+  const LightSampler& sampler;
+  std::size_t entry = 0;
+  bool image() const { return sampler.scene_->environment_map != nullptr; }
+  lane1::M sample_image(lane1::M, F ux, F uy, F3& wi, F3& Le, F& pdf) const {
+    const std::optional<EnvironmentMap::Sample> es = sampler.scene_->environment_map->sample(vec2(ux.raw, uy.raw));
+    if (!es) return lane1::M{false};
+    wi = width1::lanes(es->wi);
+    Le = width1::lanes(es->radiance);
+    pdf = F{es->pdf};
+    return lane1::M{true};
+  }
+  void lookup(lane1::M, const F3& dir, F3& Le, F& pdf) const {
+    const EnvironmentMap::Lookup m = sampler.scene_->environment_map->lookup(width1::scalars(dir));
+    Le = width1::lanes(m.radiance);
+    pdf = F{m.pdf};
+  }
+  F3 radiance() const { return width1::lanes(sampler.scene_->environment.value_or(Spectrum(0.0f))); }
+  F env_pmf() const {
+    return F{sampler.env_index_ >= 0 ? sampler.pmf_[static_cast<std::size_t>(sampler.env_index_)] : 0.0f};
+  }
+  void add_suns(const F3& dir, F3& Le, F& pdf) const {
+    vec3 L = width1::scalars(Le);
+    sampler.add_suns(width1::scalars(dir), &L, &pdf.raw);
+    Le = width1::lanes(L);
+  }
+  void along(lane1::M m, const F3& dir, F3& Le, F& pdf) const {
+    width1::generic::sky_along(width1::kScalar, m, dir, *this, Le, pdf);
+  }
+  void sun_directions(lane1::M, F ux, F uy, F3& wi) const {
+    const SunDisk& sun = sampler.suns_[entry - static_cast<std::size_t>(sampler.suns_.front().entry)];
+    const Frame& f = sun.frame;
+    wi = width1::generic::sun_direction(width1::kScalar, width1::lanes(f.s), width1::lanes(f.t), width1::lanes(f.n),
+                                        F{sun.one_minus_cos}, ux, uy);
+  }
+};
+
 std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u_choice, vec2 u) const {
   const std::optional<Pick> picked = pick(query, u_choice);
   if (!picked) return std::nullopt;
@@ -318,42 +358,10 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
   const bool env = static_cast<std::int64_t>(i) == env_index_;
   if (env || (!suns_.empty() && static_cast<std::int64_t>(i) >= suns_.front().entry)) {
     // The environment or a sun disk (the last entries, in order):
-    // core/simd/lights-inl.h's sky_sample at width 1, reading the sky as
-    // this sampler holds it.
-    struct SkyView {
-      const LightSampler& sampler;
-      std::size_t entry;
-      float pmf;
-      bool image() const { return sampler.scene_->environment_map != nullptr; }
-      lane1::M sample_image(lane1::M, F ux, F uy, F3& wi, F3& Le, F& pdf) const {
-        const std::optional<EnvironmentMap::Sample> es = sampler.scene_->environment_map->sample(vec2(ux.raw, uy.raw));
-        if (!es) return lane1::M{false};
-        wi = lanes(es->wi);
-        Le = lanes(es->radiance);
-        pdf = F{es->pdf};
-        return lane1::M{true};
-      }
-      F env_pmf() const { return F{pmf}; }
-      void add_suns(const F3& dir, F3& Le, F& pdf) const {
-        vec3 L = scalars(Le);
-        sampler.add_suns(scalars(dir), &L, &pdf.raw);
-        Le = lanes(L);
-      }
-      void along(lane1::M, const F3& dir, F3& Le, F& pdf) const {
-        const Sky there = sampler.sky(scalars(dir));
-        Le = lanes(there.Le);
-        pdf = F{there.pdf};
-      }
-      void sun_directions(lane1::M, F ux, F uy, F3& wi) const {
-        const SunDisk& sun = sampler.suns_[entry - static_cast<std::size_t>(sampler.suns_.front().entry)];
-        const Frame& f = sun.frame;
-        wi = generic::sun_direction(kScalar, lanes(f.s), lanes(f.t), lanes(f.n), F{sun.one_minus_cos}, ux, uy);
-      }
-    };
+    // core/simd/lights-inl.h's sky_sample at width 1.
     F3 wi, Le;
     F pdf;
-    if (!generic::sky_sample(kScalar, lane1::M{true}, lane1::M{env}, F{u.x}, F{u.y}, SkyView{*this, i, pmf}, wi, Le,
-                             pdf)
+    if (!generic::sky_sample(kScalar, lane1::M{true}, lane1::M{env}, F{u.x}, F{u.y}, SkyView{*this, i}, wi, Le, pdf)
              .raw)
       return std::nullopt;  // the image drew nothing, or a sun's direction rounded out of its cone
     ls.wi = scalars(wi);
@@ -422,18 +430,11 @@ void LightSampler::add_suns(const vec3& dir, Spectrum* Le, float* pdf) const {
 }
 
 LightSampler::Sky LightSampler::sky(const vec3& dir) const {
-  Sky out;
-  const float pmf = env_index_ >= 0 ? pmf_[static_cast<std::size_t>(env_index_)] : 0.0f;
-  if (scene_->environment_map) {
-    const EnvironmentMap::Lookup m = scene_->environment_map->lookup(dir);
-    out.Le = m.radiance;
-    out.pdf = pmf * m.pdf;
-  } else {
-    out.Le = scene_->environment.value_or(Spectrum(0.0f));
-    out.pdf = pmf * kInv4Pi;
-  }
-  if (!suns_.empty()) add_suns(dir, &out.Le, &out.pdf);
-  return out;
+  using namespace width1;
+  F3 Le;
+  F pdf;
+  generic::sky_along(kScalar, lane1::M{true}, lanes(dir), SkyView{*this}, Le, pdf);
+  return {scalars(Le), pdf.raw};
 }
 
 std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_choice) const {

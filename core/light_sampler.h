@@ -259,6 +259,9 @@ class LightSampler {
   // pick sky entry j; the tree takes [0, sky_start_[0]).
   void build_bvh(const std::vector<double>& power);
 
+  // The sky as core/simd/lights-inl.h's sky_sample and sky_along read it at
+  // width 1 (core/light_sampler.cpp).
+  struct SkyView;
   // Adds the radiance and density (with its pick probability) of every sun
   // disk whose cone holds `dir`.
   void add_suns(const vec3& dir, Spectrum* Le, float* pdf) const;

@@ -899,21 +899,38 @@ void add_suns(const Sky& s, const V3& dir, V3& Le, VF& pdf) {
   }
 }
 
-// LightSampler::sky along dir in the lanes of m: the environment's
-// radiance and density (an image's texel, or the one radiance), then each
-// sun disk's that dir is in.
-void sky_along(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) {
-  const DF df;
-  if (s.image) {
-    VF map_pdf;
-    env_lookup(s, m, dir, Le, map_pdf);
-    pdf = k(s.pmf) * map_pdf;
-  } else {
-    Le = zero_unless(m, splat3(df, s.Le[0], s.Le[1], s.Le[2]));
-    pdf = hn::IfThenElseZero(m, k(s.pmf * kInv4Pi));
+// The sky as core/simd/lights-inl.h's sky_sample and sky_along read it:
+// Sky's tables, and each lane's light entry (for sky_sample's sun disks).
+struct SkyView {
+  const Sky& s;
+  VI light;
+  bool image() const { return s.image != nullptr; }
+  M sample_image(M m, VF ux, VF uy, V3& wi, V3& Le, VF& pdf) const {
+    M drawn = m;
+    env_sample(s, ux, uy, drawn, wi, Le, pdf);
+    return drawn;
   }
-  add_suns(s, dir, Le, pdf);
-}
+  void lookup(M m, const V3& dir, V3& Le, VF& pdf) const { env_lookup(s, m, dir, Le, pdf); }
+  V3 radiance() const { return splat3(DF(), s.Le[0], s.Le[1], s.Le[2]); }
+  VF env_pmf() const { return k(s.pmf); }
+  void add_suns(const V3& dir, V3& Le, VF& pdf) const { vector_stages::HWY_NAMESPACE::add_suns(s, dir, Le, pdf); }
+  void along(M m, const V3& dir, V3& Le, VF& pdf) const {
+    pathlab::HWY_NAMESPACE::sky_along(DF(), m, dir, *this, Le, pdf);
+  }
+  void sun_directions(M m, VF ux, VF uy, V3& wi) const {
+    const DF d;
+    for (std::size_t j = 0; j < s.suns; ++j) {
+      const float* sun = s.sun + j * kSunFields;
+      const M at_sun = hn::And(m, hn::RebindMask(d, light == hn::Set(DI(), static_cast<std::int32_t>(sun[kSunEntry]))));
+      if (hn::AllFalse(d, at_sun)) continue;
+      const auto at = [&](int f) { return splat3(d, sun[f], sun[f + 1], sun[f + 2]); };
+      wi = select(at_sun, sun_direction(d, at(kSunS), at(kSunT), at(kSunN), k(sun[kSunOneMinusCos]), ux, uy), wi);
+    }
+  }
+};
+
+// LightSampler::sky along dir in the lanes of m (sky_along).
+void sky_along(const Sky& s, M m, const V3& dir, V3& Le, VF& pdf) { SkyView{s, hn::Zero(DI())}.along(m, dir, Le, pdf); }
 
 void add_emission(const Scene& sc, const Wave& w) {
   const DF df;
@@ -1111,30 +1128,6 @@ LightLanes sky_light(const Scene& sc, const Wave& w, std::size_t i0, VI light, V
                      M& ok) {
   const DF df;
   const Sky& s = sc.skies;
-  // The sky as sky_sample reads it: Sky's tables, each lane's entry.
-  struct SkyView {
-    const Sky& s;
-    VI light;
-    bool image() const { return s.image != nullptr; }
-    M sample_image(M m, VF ux, VF uy, V3& wi, V3& Le, VF& pdf) const {
-      M drawn = m;
-      env_sample(s, ux, uy, drawn, wi, Le, pdf);
-      return drawn;
-    }
-    VF env_pmf() const { return k(s.pmf); }
-    void add_suns(const V3& dir, V3& Le, VF& pdf) const { vector_stages::HWY_NAMESPACE::add_suns(s, dir, Le, pdf); }
-    void along(M m, const V3& dir, V3& Le, VF& pdf) const { sky_along(s, m, dir, Le, pdf); }
-    void sun_directions(M m, VF ux, VF uy, V3& wi) const {
-      const DF d;
-      for (std::size_t j = 0; j < s.suns; ++j) {
-        const float* sun = s.sun + j * kSunFields;
-        const M at_sun = hn::And(m, hn::RebindMask(d, light == hn::Set(DI(), static_cast<std::int32_t>(sun[kSunEntry]))));
-        if (hn::AllFalse(d, at_sun)) continue;
-        const auto at = [&](int f) { return splat3(d, sun[f], sun[f + 1], sun[f + 2]); };
-        wi = select(at_sun, sun_direction(d, at(kSunS), at(kSunT), at(kSunN), k(sun[kSunOneMinusCos]), ux, uy), wi);
-      }
-    }
-  };
   // The environment's lanes (none where it is not sampled: its entry is -1).
   const M env = hn::RebindMask(df, light == hn::Set(DI(), static_cast<std::int32_t>(s.environment)));
   LightLanes ls;

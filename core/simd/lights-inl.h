@@ -279,6 +279,25 @@ HWY_INLINE void add_sun(D d, const Vec3<V>& dir, const Vec3<V>& n, V sin2, const
   pdf = IfThenElse(in, pdf + pdf_sun, pdf);
 }
 
+// LightSampler::sky along dir in the lanes of m: the environment's radiance
+// and density (an image's texel and its density, or the one radiance and
+// 1 / 4 pi, times the environment's pick probability), then each sun disk's
+// that dir is in. The caller's sky, as sky_sample's, also has
+//   void lookup(m, dir, Le, pdf)                  EnvironmentMap::lookup (pdf without the pick)
+//   Vec3<V> radiance()                            a uniform environment's (0 without one)
+template <class D, class M, class Sky, class V = VecOf<D>>
+HWY_INLINE void sky_along(D d, M m, const Vec3<V>& dir, const Sky& sky, Vec3<V>& Le, V& pdf) {
+  if (sky.image()) {
+    V map_pdf;
+    sky.lookup(m, dir, Le, map_pdf);
+    pdf = sky.env_pmf() * map_pdf;
+  } else {
+    Le = zero_unless(m, sky.radiance());
+    pdf = IfThenElseZero(m, sky.env_pmf() * Set(d, kInv4Pi));
+  }
+  sky.add_suns(dir, Le, pdf);
+}
+
 // LightSampler::sample of the sky's entries in the lanes of ok, `env` those
 // that picked the environment, the rest a sun disk: a direction (one drawn
 // from the environment image, uniform on the sphere for one radiance, or
@@ -293,7 +312,7 @@ HWY_INLINE void add_sun(D d, const Vec3<V>& dir, const Vec3<V>& n, V sin2, const
 //   M sample_image(m, ux, uy, wi, Le, pdf)        EnvironmentMap::sample (pdf without the pick)
 //   V env_pmf()                                   the environment's pick probability
 //   void add_suns(dir, Le, pdf)                   LightSampler::add_suns
-//   void along(m, dir, Le, pdf)                   LightSampler::sky
+//   void along(m, dir, Le, pdf)                   LightSampler::sky (sky_along above)
 //   void sun_directions(m, ux, uy, wi)            wi of the lanes of m: their sun's sun_direction
 template <class D, class M, class Sky, class V = VecOf<D>>
 HWY_INLINE M sky_sample(D d, M ok, M env, V ux, V uy, const Sky& sky, Vec3<V>& wi, Vec3<V>& Le, V& pdf) {
