@@ -50,10 +50,4 @@ SphereCone sphere_cone(const dvec3& ref, const dvec3& center, double radius) {
   return c;
 }
 
-dvec3 sample_sphere_cone_normal(const SphereCone& cone, vec2 u) {
-  using namespace width1;
-  return scalars(generic::sample_sphere_cone_normal(kScalarD, lanes(cone.axis), D1{cone.d}, D1{cone.sin2_max},
-                                                    D1{cone.one_minus_cos_max}, D1{double(u.x)}, D1{double(u.y)}));
-}
-
 }  // namespace pathlab

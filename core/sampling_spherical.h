@@ -76,10 +76,5 @@ struct SphereCone {
 // The scalar functions here are core/simd/spherical-inl.h's generic code at
 // width 1 (the wavefront's lanes run the same source).
 SphereCone sphere_cone(const dvec3& ref, const dvec3& center, double radius);
-// A direction uniform in the cone (1 - cos theta = u.x (1 - cos theta_max),
-// phi = 2 pi u.y about `axis`), returned as the unit normal of the sphere at
-// the nearest point where that direction meets it: the point is
-// centre + r * normal, exactly on the sphere, with no ray intersection.
-dvec3 sample_sphere_cone_normal(const SphereCone& cone, vec2 u);
 
 }  // namespace pathlab

@@ -58,7 +58,15 @@ std::optional<float> constant_emitters_peak(const Scene& scene) {
   std::optional<float> peak;
   const auto take = [&](const Spectrum& L) { peak = std::max(peak.value_or(0.0f), max_component(glm::abs(L))); };
   if (scene.environment && !is_black(*scene.environment)) take(*scene.environment);
-  for (const Shape& shape : scene.shapes) {
+  // A group's shapes are in the image only if an instance places the group.
+  std::vector<bool> placed(scene.shapes.size(), true);
+  for (const ShapeGroup& g : scene.groups)
+    for (const std::uint32_t i : g.shapes) placed[i] = false;
+  for (const Instance& inst : scene.instances)
+    for (const std::uint32_t i : scene.groups[inst.group].shapes) placed[i] = true;
+  for (std::size_t i = 0; i < scene.shapes.size(); ++i) {
+    if (!placed[i]) continue;
+    const Shape& shape = scene.shapes[i];
     const Material& m = scene.materials[shape.material];
     if (m.emission_textured) return std::nullopt;
     if (m.emits()) take(m.emission);

@@ -226,8 +226,7 @@ std::optional<BsdfSample> Surfel::scatter_in_frame(const vec3& wo, float u_lobe,
 }
 
 std::optional<BsdfSample> Surfel::scatter_cosine(const vec3& wo, vec2 u) const {
-  if (material->is_pure_impulse()) return std::nullopt;
-  if (material->one_sided && !on_front(wo)) return std::nullopt;
+  if (material->is_pure_impulse() || !scatter_ok(*this, wo)) return std::nullopt;
   const float side = upper_side(glm::dot(wo, frame.n));
   vec3 wi_local = square_to_cosine_hemisphere(u);
   const float pdf = cosine_hemisphere_pdf(wi_local);

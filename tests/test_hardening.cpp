@@ -10,6 +10,7 @@
 #include "apps/cli/interrupt.h"
 #include "core/embree_accel.h"
 #include "core/messages.h"
+#include "core/scene.h"
 #include "core/scene_limits.h"
 #include "core/temp_files.h"
 
@@ -212,6 +213,31 @@ TEST_F(Hardening, EmittersTooFaintForTheFilmAreWarnedAbout) {
   const ProcessResult dim = with_lamp("dim.json", "1e-12");
   EXPECT_EQ(dim.code, 0) << dim.err;
   EXPECT_EQ(dim.err.find("brightest emitter"), std::string::npos) << dim.err;
+}
+
+// The bound counts only emitters in the image: a group's lamp no instance
+// places neither hides a faint scene nor raises a false alarm; other lights
+// cannot be bounded.
+TEST(HardeningFaintEmitters, ThePeakCountsOnlyPlacedConstantEmitters) {
+  Scene scene;
+  Material lamp;
+  lamp.type = MaterialType::Emissive;
+  lamp.emission = Spectrum(1e-18f);
+  Material bright = lamp;
+  bright.emission = Spectrum(2.0f);
+  scene.materials = {lamp, bright};
+  Shape faint_lamp, grouped_lamp;
+  faint_lamp.material = 0;
+  grouped_lamp.material = 1;
+  grouped_lamp.in_group = true;
+  scene.shapes = {faint_lamp, grouped_lamp};
+  scene.groups = {ShapeGroup{"g", {1}}};
+  ASSERT_TRUE(constant_emitters_peak(scene));
+  EXPECT_EQ(*constant_emitters_peak(scene), 1e-18f);
+  scene.instances = {Instance{0, mat4(1.0f), "instances[0]"}};
+  EXPECT_EQ(*constant_emitters_peak(scene), 2.0f);
+  scene.delta_lights.push_back(DeltaLight{});
+  EXPECT_FALSE(constant_emitters_peak(scene));
 }
 
 // A ray Embree would abort on never reaches it, through any of the accel's

@@ -117,7 +117,6 @@ using pathlab::HWY_NAMESPACE::affine_point;
 using pathlab::HWY_NAMESPACE::area_light_sample;
 using pathlab::HWY_NAMESPACE::AreaLight;
 using pathlab::HWY_NAMESPACE::AreaLightSample;
-using pathlab::HWY_NAMESPACE::area_light_pdf_at;
 using pathlab::HWY_NAMESPACE::emitter_hit_pdf;
 using pathlab::HWY_NAMESPACE::blend_normals;
 using pathlab::HWY_NAMESPACE::bvh_pick;
@@ -153,7 +152,6 @@ using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::NoEnergy;
 using pathlab::HWY_NAMESPACE::normal_map_frame;
-using pathlab::HWY_NAMESPACE::normalize;
 using pathlab::HWY_NAMESPACE::light_grid_point;
 using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::sky_entry_of;
@@ -179,7 +177,6 @@ using pathlab::HWY_NAMESPACE::TextureInputs;
 using pathlab::HWY_NAMESPACE::transform_point;
 using pathlab::HWY_NAMESPACE::triangle_texture_inputs;
 using pathlab::HWY_NAMESPACE::triangle_point;
-using pathlab::HWY_NAMESPACE::uniform_sphere;
 using pathlab::HWY_NAMESPACE::CospowLobes;
 using pathlab::HWY_NAMESPACE::VndfLobes;
 using pathlab::HWY_NAMESPACE::zero_unless;
@@ -762,6 +759,8 @@ void resolve(const Scene& sc, const Wave& w) {
 // double halves of the registers and carried to floats, as LightSampler's
 // sample() and pdf() carry it; with u (lu, lv) given, the point drawn.
 using SolidAngleLanes = SolidAngleDraw<VF, M>;
+// Under light_sampling area: no lane in solid angle.
+SolidAngleLanes no_solid_angle() { return {hn::FirstN(DF(), 0), k(0.0f), k(0.0f), k(0.0f), zero3()}; }
 SolidAngleLanes solid_angle_lanes(M m, M sphere, const V3& ref, const V3& p0, const V3& p1, const V3& p2,
                                   const VF* lu = nullptr, const VF* lv = nullptr) {
   const DD dd;
@@ -825,7 +824,7 @@ VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI 
   // solid-angle rule in the registers' double halves.
   const V3 prev = load3(w, kPrevX, i0, light);
   const auto solid_angle = [&](M m) {
-    if (!sc.solid_angle) return SolidAngleLanes{hn::FirstN(df, 0), k(0.0f), k(0.0f), k(0.0f), zero3()};
+    if (!sc.solid_angle) return no_solid_angle();
     return solid_angle_lanes(m, sphere_lights(m, sc.lights, entry), prev, light_value3(m, sc.lights, entry, kLightP0),
                              light_value3(m, sc.lights, entry, kLightP1), light_value3(m, sc.lights, entry, kLightP2));
   };
@@ -1080,12 +1079,12 @@ LightLanes triangle_light(const Scene& sc, const Wave& w, std::size_t i0, VI lig
   e.p2 = light_value3(ok, lights, light, kLightP2);
   e.n = light_value3(ok, lights, light, kLightNormal);
   e.sphere = sphere_lights(ok, lights, light);
-  e.flip = e.p1.y != k(0.0f);  // a sphere's; its p1 is (radius, flip, 0)
+  e.flip = hn::And(e.sphere, e.p1.y != k(0.0f));  // a sphere's p1 is (radius, flip, 0)
   e.two_sided = light_value(ok, lights, light, kLightTwoSided) != k(0.0f);
   e.inv_area = light_value(ok, lights, light, kLightInvArea);
   const auto solid_angle = [&](M m) {
     if (sc.solid_angle) return solid_angle_lanes(m, e.sphere, sp, e.p0, e.p1, e.p2, &lu, &lv);
-    return SolidAngleLanes{hn::FirstN(df, 0), k(0.0f), k(0.0f), k(0.0f), zero3()};
+    return no_solid_angle();
   };
   AreaLightSample<VF> s;
   ok = area_light_sample(df, ok, sp, e, pmf, lu, lv, solid_angle, false, s);
@@ -1622,7 +1621,7 @@ void scatter(const Scene& sc, const Wave& w) {
     }
     // Surfel::scatter's rule after the draw (scattered_side_ok): under a
     // shading normal, wi on wo's geometric side, or across it if transmitted.
-    if (const M lobes = hn::AndNot(g, hn::And(ok, shading_normal)); !hn::AllFalse(df, lobes))
+    if (const M lobes = hn::And(ok, shading_normal); !hn::AllFalse(df, lobes))
       ok = hn::And(ok, scattered_side_ok(df, lobes, transmitted, wo_z, dot(wi, n)));
     if (!hn::AllFalse(df, g)) {
       // Any other material: Surfel::scatter, path by path.

@@ -249,9 +249,9 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
         << "sampling; only rays that hit them count their light\n";
   if (const std::optional<float> peak = constant_emitters_peak(sc); peak && *peak < kFilmFaintRadiance && chatty)
     err << "pathlab: warning: the brightest emitter's radiance is " << *peak
-        << ": the film sums samples to 2^-65 (2.7e-20) each, so below 2^-55 (2.8e-17) the image loses more than "
-           "0.1 % of its light to rounding and below 2.7e-20 goes black (docs/overnight.md); choose a smaller unit "
-           "of radiance (scale the emission up)\n";
+        << ": the film rounds each sample to a multiple of 2^-64 (an error of up to 2^-65, 2.7e-20), so below 2^-55 "
+           "(2.8e-17) the image can lose about 0.1 % of its light or more to rounding, and below 2.7e-20 goes black "
+           "(docs/overnight.md); choose a smaller unit of radiance (scale the emission up)\n";
   if (const LightBvh* bvh = compiled.lights().bvh(); bvh && chatty && !quiet && !bvh->empty())
     err << "pathlab: light BVH: " << (bvh->node_count() + 1) / 2 << " lights, " << bvh->node_count()
         << " nodes, depth " << bvh->depth() << "\n";

@@ -252,7 +252,7 @@ HWY_INLINE auto opposite_sides(D d, V a, V b) {
   const auto below_a = a < Zero(d), below_b = b < Zero(d);
   return Or(And(below_a, Not(below_b)), And(below_b, Not(below_a)));
 }
-// geometric_side_ok (core/surfel.cpp): under a shading normal, a reflection
+// Surfel's shading-normal rule (surface_eval_ok, scattered_side_ok below): under a shading normal, a reflection
 // needs wi and wo on one side of the geometric surface (wi_z wo_z > 0), a
 // transmission opposite sides, neither in it (wi_z, wo_z: their dot products
 // with the geometric normal).
@@ -273,8 +273,8 @@ HWY_INLINE M geometric_side_ok(D d, M transmission, V wi_z, V wo_z) {
 template <class D, class M, class V = VecOf<D>>
 HWY_INLINE M surface_eval_ok(D d, M one_sided, M shading_normal, V wo_z, V wi_z) {
   const M front = And(wo_z > Zero(d), wi_z > Zero(d));
-  const M reflection = AndNot(shading_normal, shading_normal);
-  return And(Or(Not(one_sided), front), Or(Not(shading_normal), geometric_side_ok(d, reflection, wi_z, wo_z)));
+  const M no_transmission = AndNot(shading_normal, shading_normal);
+  return And(Or(Not(one_sided), front), Or(Not(shading_normal), geometric_side_ok(d, no_transmission, wi_z, wo_z)));
 }
 // Surfel::scatter before the BSDF draws: nothing from the back of a
 // one-sided surface, nor from a dielectric under a shading normal where wo
@@ -623,7 +623,7 @@ HWY_INLINE void spawn_to(D d, const Vec3<V>& p, const Vec3<V>& error, const Vec3
 // n) towards a light sample in the lanes of m: escaping along wi (tmax
 // infinite) where `infinite` (the sky, a directional light), else to the
 // light's point lp (its error bound and normal: an area light's, or a point
-// light's own with no error and the normal -wi). Zero off m.
+// light's own with no error and the normal -wi). Unspecified off m.
 template <class D, class M, class V = VecOf<D>>
 HWY_INLINE void shadow_ray(D d, M m, M infinite, const Vec3<V>& p, const Vec3<V>& error, const Vec3<V>& n,
                            const Vec3<V>& wi, const Vec3<V>& lp, const Vec3<V>& lp_error, const Vec3<V>& ln,
