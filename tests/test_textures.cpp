@@ -301,6 +301,28 @@ TEST_F(TexturesTest, ConeFootprintAtAPlaneIsTheClosedForm) {
   }
 }
 
+// The hits through the camera at `pixels` of a textured surface placed in
+// world space and of the same surface placed by an instance: the same uv and
+// the same filtered texel (the footprint, of the placed geometry, large
+// enough that the finest level would read something else).
+void expect_placed_reads_as_world(const CompiledScene& world, const CompiledScene& placed,
+                                  std::initializer_list<vec2> pixels) {
+  const TextureRef& ref = world.scene().materials[0].textured.at(0).texture;
+  for (const vec2 pixel : pixels) {
+    const Ray ray = world.camera().generate_ray(pixel, vec2(0.5f));
+    Surfel a, b;
+    SurfaceParams pa, pb;
+    ASSERT_TRUE(world.intersect(ray, &a, world.camera_cone(TextureFilter::Cone), &pa));
+    ASSERT_TRUE(placed.intersect(ray, &b, placed.camera_cone(TextureFilter::Cone), &pb));
+    ASSERT_NE(b.instance, kNoInstance);
+    EXPECT_NEAR(a.uv.x, b.uv.x, 1e-5f);
+    EXPECT_NEAR(a.uv.y, b.uv.y, 1e-5f);
+    expect_near(pb.albedo, pa.albedo, 2e-4f, "placed against world");
+    EXPECT_GT(glm::length(world.textures()->color(ref, {a.uv, 0.0f}) - pa.albedo), 1e-2f)
+        << "the footprint is too small to test";
+  }
+}
+
 // A textured sphere placed by an instance reads the texture over the same
 // footprint as the sphere it becomes in world space: a unit sphere scaled
 // 2.5 times against a sphere of radius 2.5, seen from the side (on the
@@ -322,20 +344,7 @@ TEST_F(TexturesTest, PlacedSphereFiltersAsTheSphereItBecomes) {
   const CompiledScene placed{scene(R"("shapes": [],
       "groups": {"ball": [{"type": "sphere", "material": "m", "center": [0, 0, 0], "radius": 1}]},
       "instances": [{"group": "ball", "transform": [{"scale": 2.5}]}])")};
-  const TextureRef& ref = world.scene().materials[0].textured.at(0).texture;
-  for (const vec2 pixel : {vec2(32.3f, 31.8f), vec2(27.5f, 36.2f), vec2(40.1f, 30.4f)}) {
-    const Ray ray = world.camera().generate_ray(pixel, vec2(0.5f));
-    Surfel a, b;
-    SurfaceParams pa, pb;
-    ASSERT_TRUE(world.intersect(ray, &a, world.camera_cone(TextureFilter::Cone), &pa));
-    ASSERT_TRUE(placed.intersect(ray, &b, placed.camera_cone(TextureFilter::Cone), &pb));
-    ASSERT_NE(b.instance, kNoInstance);
-    EXPECT_NEAR(a.uv.x, b.uv.x, 1e-5f);
-    EXPECT_NEAR(a.uv.y, b.uv.y, 1e-5f);
-    expect_near(pb.albedo, pa.albedo, 2e-4f, "placed against world");
-    // The filter matters here: the finest level reads something else.
-    EXPECT_GT(glm::length(world.textures()->color(ref, {a.uv, 0.0f}) - pa.albedo), 1e-2f) << "the footprint is too small to test";
-  }
+  expect_placed_reads_as_world(world, placed, {vec2(32.3f, 31.8f), vec2(27.5f, 36.2f), vec2(40.1f, 30.4f)});
 }
 
 // The same for a textured rectangle (a mesh with texture coordinates)
@@ -360,21 +369,7 @@ TEST_F(TexturesTest, PlacedMeshFiltersAsTheMeshItBecomes) {
   const CompiledScene placed{scene(R"("shapes": [],
       "groups": {"quad": [{"type": "rectangle", "material": "m"}]},
       "instances": [{"group": "quad", "transform": )" + place + "}]")};
-  const TextureRef& ref = world.scene().materials[0].textured.at(0).texture;
-  for (const vec2 pixel : {vec2(32.3f, 31.8f), vec2(24.5f, 36.2f), vec2(40.1f, 28.4f)}) {
-    const Ray ray = world.camera().generate_ray(pixel, vec2(0.5f));
-    Surfel a, b;
-    SurfaceParams pa, pb;
-    ASSERT_TRUE(world.intersect(ray, &a, world.camera_cone(TextureFilter::Cone), &pa));
-    ASSERT_TRUE(placed.intersect(ray, &b, placed.camera_cone(TextureFilter::Cone), &pb));
-    ASSERT_NE(b.instance, kNoInstance);
-    EXPECT_NEAR(a.uv.x, b.uv.x, 1e-5f);
-    EXPECT_NEAR(a.uv.y, b.uv.y, 1e-5f);
-    expect_near(pb.albedo, pa.albedo, 2e-4f, "placed against world");
-    // The filter matters here: the finest level reads something else.
-    EXPECT_GT(glm::length(world.textures()->color(ref, {a.uv, 0.0f}) - pa.albedo), 1e-2f)
-        << "the footprint is too small to test";
-  }
+  expect_placed_reads_as_world(world, placed, {vec2(32.3f, 31.8f), vec2(24.5f, 36.2f), vec2(40.1f, 28.4f)});
 }
 
 // ------------------------------------------------------------ normal maps
