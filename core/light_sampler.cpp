@@ -46,7 +46,7 @@ constexpr std::uint32_t kGrid = 1u << 24;  // LightChoice numbers are multiples 
 
 // Entry e (a triangle or sphere) as core/simd/lights-inl.h's area_light_sample
 // reads it, as the wavefront's lanes gather it from their light table.
-width1::generic::AreaLight<width1::F, lane1::M> area_light(const Scene& scene, const LightSampler::Entry& e) {
+HWY_INLINE width1::generic::AreaLight<width1::F, lane1::M> area_light(const Scene& scene, const LightSampler::Entry& e) {
   using namespace width1;
   const Shape& shape = scene.shapes[e.shape];
   const bool sphere = shape.kind == Shape::Kind::Sphere;
@@ -67,7 +67,7 @@ width1::generic::AreaLight<width1::F, lane1::M> area_light(const Scene& scene, c
 // `draw` the point drawn there with u: core/simd/spherical-inl.h's
 // solid_angle_draw at width 1, carried to floats as the lanes carry it.
 // sample() and pdf() both ask this, so they cannot apply different rules.
-width1::generic::SolidAngleDraw<width1::F, lane1::M> solid_angle_draw(const Scene& scene, LightSampling sampling,
+HWY_INLINE width1::generic::SolidAngleDraw<width1::F, lane1::M> solid_angle_draw(const Scene& scene, LightSampling sampling,
                                                               const LightSampler::Entry& e, const vec3& ref,
                                                               lane1::M m, bool draw, vec2 u) {
   using namespace width1;
