@@ -62,18 +62,24 @@ HWY_INLINE width1::generic::AreaLight<width1::F, lane1::M> area_light(const Scen
   return light;
 }
 
-// Whether entry e is sampled in solid angle from ref under `sampling` (the
-// fallback rule of core/sampling_spherical.h), with which density, and with
-// `draw` the point drawn there with u: core/simd/spherical-inl.h's
-// solid_angle_draw at width 1, carried to floats as the lanes carry it.
-// sample() and pdf() both ask this, so they cannot apply different rules.
-HWY_INLINE width1::generic::SolidAngleDraw<width1::F, lane1::M> solid_angle_draw(const Scene& scene, LightSampling sampling,
-                                                              const LightSampler::Entry& e, const vec3& ref,
-                                                              lane1::M m, bool draw, vec2 u) {
+// No light sampled in solid angle (under light_sampling area).
+width1::generic::SolidAngleDraw<width1::F, lane1::M> no_solid_angle() {
   using namespace width1;
-  generic::SolidAngleDraw<F, lane1::M> out{lane1::M{false}, F{0.0f}, F{0.0f}, F{0.0f}, lanes(vec3(0.0f))};
+  return {lane1::M{false}, F{0.0f}, F{0.0f}, F{0.0f}, lanes(vec3(0.0f))};
+}
+
+// Whether the area light `light` (area_light) is sampled in solid angle from
+// ref under `sampling` (the fallback rule of core/sampling_spherical.h), with
+// which density, and with `draw` the point drawn there with u:
+// core/simd/spherical-inl.h's solid_angle_draw at width 1, carried to floats
+// as the lanes carry it. sample() and pdf() both ask this, so they cannot
+// apply different rules.
+HWY_INLINE width1::generic::SolidAngleDraw<width1::F, lane1::M> solid_angle_draw(
+    const width1::generic::AreaLight<width1::F, lane1::M>& light, LightSampling sampling, const vec3& ref, lane1::M m,
+    bool draw, vec2 u) {
+  using namespace width1;
+  generic::SolidAngleDraw<F, lane1::M> out = no_solid_angle();
   if (sampling != LightSampling::SolidAngle || !m.raw) return out;
-  const generic::AreaLight<F, lane1::M> light = area_light(scene, e);
   const auto in_double = [](const F3& v) { return lanes(dvec3(scalars(v))); };
   const generic::SolidAngleDraw<D1, lane1::M> view =
       generic::solid_angle_draw(kScalarD, m, light.sphere, lanes(dvec3(ref)), in_double(light.p0),
@@ -373,10 +379,10 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
   }
   // A triangle or a sphere: core/simd/lights-inl.h's area_light_sample at width 1.
   const Entry& e = entries_[i];
-  const lane1::M one{true};
-  const auto solid_angle = [&](lane1::M m) { return solid_angle_draw(*scene_, light_sampling_, e, ref, m, true, u); };
+  const generic::AreaLight<F, lane1::M> light = area_light(*scene_, e);
+  const auto solid_angle = [&](lane1::M m) { return solid_angle_draw(light, light_sampling_, ref, m, true, u); };
   generic::AreaLightSample<F> s;
-  if (!generic::area_light_sample(kScalar, one, lanes(ref), area_light(*scene_, e), F{pmf}, F{u.x}, F{u.y}, solid_angle,
+  if (!generic::area_light_sample(kScalar, lane1::M{true}, lanes(ref), light, F{pmf}, F{u.x}, F{u.y}, solid_angle,
                                   PATHLAB_FAULT(LightPdfWithoutDistance), s)
            .raw)
     return std::nullopt;  // no distance, the back of a one-sided emitter, or seen edge-on
@@ -410,7 +416,8 @@ float LightSampler::pdf(const LightQuery& query, const Surfel& hit) const {
   // core/simd/lights-inl.h's emitter_hit_pdf at width 1, as the lanes take it.
   using namespace width1;
   const auto solid_angle = [&](lane1::M m) {
-    return solid_angle_draw(*scene_, light_sampling_, entries_[i], ref, m, false, vec2(0.0f));
+    if (light_sampling_ != LightSampling::SolidAngle) return no_solid_angle();  // area_light only when needed
+    return solid_angle_draw(area_light(*scene_, entries_[i]), light_sampling_, ref, m, false, vec2(0.0f));
   };
   const bool zero_unpicked = kind_ == LightSamplerKind::Bvh || light_sampling_ == LightSampling::SolidAngle;
   return generic::emitter_hit_pdf(kScalar, lane1::M{true}, lanes(ref), lanes(hit.p), lanes(hit.n), F{pmf},
