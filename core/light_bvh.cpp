@@ -90,7 +90,6 @@ LightBounds merge(const LightBounds& a, const LightBounds& b) {
 }
 
 namespace {
-constexpr lane1::One<std::int64_t> kIndex{};     // a node's index
 constexpr lane1::One<std::uint64_t> kTrail{};    // a light's trail
 
 width1::generic::BvhBounds<width1::D1, lane1::M> bounds_of(const LightBounds& b) {

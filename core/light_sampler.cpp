@@ -274,24 +274,31 @@ std::optional<LightSampler::Pick> LightSampler::pick(const LightQuery& ref, floa
     const std::size_t i = pick(cdf_, u_choice);
     return Pick{i, pmf_[i]};
   }
-  // The grid point of u and, past the tree's, the sky's entry that holds
-  // it: core/simd/lights-inl.h's light_grid_point and sky_entry_of at
-  // width 1, as the wavefront's lanes pick.
+  // The grid point of u, then the tree's walk below the tree's grid points
+  // and the sky's entry past them: core/simd/lights-inl.h's light_grid_point
+  // and tree_or_sky_pick at width 1, as the wavefront's lanes pick.
   using namespace width1;
-  const std::uint32_t k =
-      static_cast<std::uint32_t>(generic::light_grid_point(kScalarD, D1{static_cast<double>(u_choice)}).raw);
-  const std::uint32_t tree_count = sky_start_[0];
-  if (k < tree_count) {
-    const std::optional<LightBvh::Pick> p = bvh_->pick(ref, k, tree_count);
-    if (!p) return std::nullopt;
-    return Pick{tree_entry_[p->light], static_cast<float>(p->share) * 0x1p-24f};
-  }
+  const F k{static_cast<float>(generic::light_grid_point(kScalarD, D1{static_cast<double>(u_choice)}).raw)};
+  const std::uint32_t tree_count = bvh_->empty() ? 0 : sky_start_[0];
+  const auto walk = [&](lane1::M, F& share) {
+    const std::optional<LightBvh::Pick> p = bvh_->pick(ref, static_cast<std::uint32_t>(k.raw), tree_count);
+    share = F{p ? static_cast<float>(p->share) : 0.0f};
+    return Index{p ? static_cast<std::int64_t>(tree_entry_[p->light]) : 0};
+  };
   const auto starts = [this](lane1::M m, F i) {
     return F{m.raw ? static_cast<float>(sky_start_[static_cast<std::size_t>(i.raw)]) : 0.0f};
   };
-  const auto j = static_cast<std::size_t>(
-      generic::sky_entry_of(kScalar, lane1::M{true}, sky_entry_.size(), F{static_cast<float>(k)}, starts).raw);
-  return Pick{sky_entry_[j], pmf_[sky_entry_[j]]};
+  const auto sky_entry = [this](lane1::M, F j) {
+    return Index{static_cast<std::int64_t>(sky_entry_[static_cast<std::size_t>(j.raw)])};
+  };
+  const auto pmf_of = [this](lane1::M, Index entry) { return F{pmf_[static_cast<std::size_t>(entry.raw)]}; };
+  Index light;
+  F pmf;
+  if (!generic::tree_or_sky_pick(kScalar, kIndex, lane1::M{true}, k, F{static_cast<float>(tree_count)},
+                                 sky_entry_.size(), walk, starts, sky_entry, pmf_of, light, pmf)
+           .raw)
+    return std::nullopt;
+  return Pick{static_cast<std::size_t>(light.raw), pmf.raw};
 }
 
 float LightSampler::pick_pmf(const LightQuery& ref, std::size_t entry) const {
@@ -446,29 +453,41 @@ LightSampler::Sky LightSampler::sky(const vec3& dir) const {
 
 std::optional<LightSample> LightSampler::sample_delta(const vec3& ref, float u_choice) const {
   if (deltas_.empty()) return std::nullopt;
-  const std::size_t i = pick(delta_cdf_, u_choice);
-  const DeltaLight& light = deltas_[i];
-  LightSample ls;
-  ls.light = static_cast<std::uint32_t>(i);
-  ls.pdf = delta_pmf_[i];
+  // core/simd/lights-inl.h's delta_light_sample at width 1, as the
+  // wavefront's lanes sample.
   using namespace width1;
-  const bool directional = light.kind == DeltaLight::Kind::Directional;
+  const auto pick_delta = [this](lane1::M, F u) { return Index{static_cast<std::int64_t>(pick(delta_cdf_, u.raw))}; };
+  const auto light_of = [this](lane1::M, Index i) {
+    const DeltaLight& light = deltas_[static_cast<std::size_t>(i.raw)];
+    return generic::DeltaLightLanes<F, lane1::M>{lane1::M{light.kind == DeltaLight::Kind::Directional},
+                                                 lane1::M{light.kind == DeltaLight::Kind::Spot},
+                                                 lanes(light.position),
+                                                 lanes(light.direction),
+                                                 lanes(light.intensity),
+                                                 F{light.cos_outer},
+                                                 F{light.cos_inner},
+                                                 F{delta_pmf_[static_cast<std::size_t>(i.raw)]}};
+  };
+  lane1::M seen{true};
+  generic::DeltaLightLanes<F, lane1::M> light;
   F3 wi, Le;
   F dist;
-  if (!generic::delta_light_seen(kScalar, lane1::M{directional}, lane1::M{light.kind == DeltaLight::Kind::Spot}, lanes(ref),
-                                 lanes(light.position), lanes(light.direction), lanes(light.intensity),
-                                 F{light.cos_outer}, F{light.cos_inner}, wi, dist, Le)
-           .raw)
-    return std::nullopt;  // at the point itself, or outside the spot's cone
+  const Index i = generic::delta_light_sample(kScalar, seen, F{u_choice}, lanes(ref), pick_delta, light_of, light, wi,
+                                              dist, Le);
+  if (!seen.raw) return std::nullopt;  // at the point itself, or outside the spot's cone
+  LightSample ls;
+  ls.light = static_cast<std::uint32_t>(i.raw);
+  ls.pdf = light.pmf.raw;
   ls.wi = scalars(wi);
   ls.dist = dist.raw;
   ls.Le = scalars(Le);
+  const bool directional = light.directional.raw;
   // A directional light's shadow ray escapes (infinite): nothing may block
   // it anywhere. A point has no surface: its ray ends as if at one facing
   // the shading point.
   ls.infinite = directional;
   if (!directional) {
-    ls.p = light.position;
+    ls.p = scalars(light.position);
     ls.n = -ls.wi;
   }
   return ls;

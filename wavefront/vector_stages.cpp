@@ -126,7 +126,8 @@ using pathlab::HWY_NAMESPACE::camera_direction;
 using pathlab::HWY_NAMESPACE::CameraPlane;
 using pathlab::HWY_NAMESPACE::concentric_disk;
 using pathlab::HWY_NAMESPACE::CornerUvs;
-using pathlab::HWY_NAMESPACE::delta_light_seen;
+using pathlab::HWY_NAMESPACE::delta_light_sample;
+using pathlab::HWY_NAMESPACE::DeltaLightLanes;
 using pathlab::HWY_NAMESPACE::env_sample_direction;
 using pathlab::HWY_NAMESPACE::ClosureLanes;
 using pathlab::HWY_NAMESPACE::dielectric_sample;
@@ -154,7 +155,7 @@ using pathlab::HWY_NAMESPACE::NoEnergy;
 using pathlab::HWY_NAMESPACE::normal_map_frame;
 using pathlab::HWY_NAMESPACE::light_grid_point;
 using pathlab::HWY_NAMESPACE::pick_cdf;
-using pathlab::HWY_NAMESPACE::sky_entry_of;
+using pathlab::HWY_NAMESPACE::tree_or_sky_pick;
 using pathlab::HWY_NAMESPACE::sky_sample;
 using pathlab::HWY_NAMESPACE::place_normal;
 using pathlab::HWY_NAMESPACE::select;
@@ -1028,40 +1029,31 @@ VI pick_light(const Scene& sc, VF u_choice, const V3& sp, const V3& n, const V3&
     pmf = light_value(ok, lights, light, kLightPmf);
     return light;
   }
-  // Under bvh: the grid point k of u_choice walks the tree from
-  // light_query(s, wo) below bvh_grid, else picks the sky's entry j with
-  // k in [starts[j], starts[j + 1]).
+  // Under bvh: the grid point k of u_choice (in the registers' double
+  // halves), then core/simd/lights-inl.h's tree_or_sky_pick: the tree's walk
+  // from light_query(s, wo) below bvh_grid (in the double halves too), else
+  // the sky's entry.
   VD grid_k[2];
   for (int h = 0; h < 2; ++h) grid_k[h] = light_grid_point(DD(), half_d(u_choice, h));
-  const VF grid_point = join_f(grid_k[0], grid_k[1]);  // exact: below 2^24
-  const M tree = lights.bvh_nodes ? hn::And(ok, grid_point < k(static_cast<float>(lights.bvh_grid))) : hn::FirstN(df, 0);
-  // Without a sky the grid is the tree's (an empty tree picks nothing, as LightBvh::pick).
-  const M sky = sc.skies.count != 0 ? hn::AndNot(tree, ok) : hn::FirstN(df, 0);
-  VI light = hn::Zero(DI());
-  pmf = hn::Zero(df);
-  M picked = sky;
-  if (!hn::AllFalse(df, tree)) {
+  const auto walk = [&](M tree, VF& share) {
     const V3 qn = facing_normal(df, n, wo);  // light_query's
-    VD share[2], tree_light[2];
+    VD shares[2], tree_light[2];
     for (int h = 0; h < 2; ++h)
       bvh_pick(DD(), DDI(), BvhTable<DD, DDI>{DD(), DDI(), lights.bvh_nodes}, half_d(sp, h), half_d(qn, h), grid_k[h],
-               hn::Set(DD(), static_cast<double>(lights.bvh_grid)), half_mask(tree, h), tree_light[h], share[h]);
-    const VF shares = join_f(share[0], share[1]);
-    const M tree_ok = hn::And(tree, shares > k(0.0f));
-    picked = hn::Or(picked, tree_ok);
-    pmf = hn::IfThenElseZero(tree_ok, shares * k(0x1p-24f));
-    const VI tl = hn::IfThenElseZero(hn::RebindMask(DI(), tree_ok), hn::ConvertTo(DI(), join_f(tree_light[0], tree_light[1])));
-    light = hn::IfThenElseZero(hn::RebindMask(DI(), tree_ok), hn::GatherIndex(DI(), lights.bvh_entry, tl));
-  }
-  if (!hn::AllFalse(df, sky)) {
-    const Sky& s = sc.skies;
-    const auto starts = [&](M valid, VF i) { return gather(valid, s.starts, hn::ConvertTo(DI(), i), 1, 0); };
-    const VI j = hn::ConvertTo(DI(), sky_entry_of(df, sky, s.count, grid_point, starts));
-    const VF entry = gather(sky, s.entries, j, 1, 0);
-    light = hn::IfThenElse(hn::RebindMask(DI(), sky), hn::ConvertTo(DI(), entry), light);
-    pmf = hn::IfThenElse(sky, light_value(sky, lights, light, kLightPmf), pmf);
-  }
-  ok = picked;
+               hn::Set(DD(), static_cast<double>(lights.bvh_grid)), half_mask(tree, h), tree_light[h], shares[h]);
+    share = join_f(shares[0], shares[1]);
+    const M ok_tree = hn::And(tree, share > k(0.0f));
+    const VI tl = hn::IfThenElseZero(hn::RebindMask(DI(), ok_tree), hn::ConvertTo(DI(), join_f(tree_light[0], tree_light[1])));
+    return hn::IfThenElseZero(hn::RebindMask(DI(), ok_tree), hn::GatherIndex(DI(), lights.bvh_entry, tl));
+  };
+  const Sky& s = sc.skies;
+  const auto starts = [&](M valid, VF i) { return gather(valid, s.starts, hn::ConvertTo(DI(), i), 1, 0); };
+  const auto sky_entry = [&](M valid, VF j) { return hn::ConvertTo(DI(), gather(valid, s.entries, hn::ConvertTo(DI(), j), 1, 0)); };
+  const auto pmf_of = [&](M valid, VI light) { return light_value(valid, lights, light, kLightPmf); };
+  VI light;
+  ok = tree_or_sky_pick(df, DI(), ok, join_f(grid_k[0], grid_k[1]),  // exact: below 2^24
+                        k(lights.bvh_nodes ? static_cast<float>(lights.bvh_grid) : 0.0f), s.count, walk, starts,
+                        sky_entry, pmf_of, light, pmf);
   return light;
 }
 
@@ -1178,22 +1170,34 @@ LightLanes delta_light(const Scene& sc, const Wave& w, std::size_t i0, const Str
                        M& ok) {
   const DF df;
   const DeltaLights& d = sc.deltas;
-  const auto cdf_at = [&](M valid, VF i) { return gather(valid, d.cdf, hn::ConvertTo(DI(), i), 1, 0); };
-  const VI light = hn::ConvertTo(DI(), pick_cdf(df, ok, d.count, rng.u(Dim::DeltaLightChoice), cdf_at));
-  const auto field3 = [&](int f) { return gather3(ok, d.table, light, kDeltaFields, f); };
-  const VF kind = gather(ok, d.table, light, kDeltaFields, kDeltaKind);
-  const M directional = kind == k(static_cast<float>(kDeltaDirectional)), spot = kind == k(static_cast<float>(kDeltaSpot));
-  const V3 position = field3(kDeltaPosition);
+  // core/simd/lights-inl.h's delta_light_sample, over the delta lights' table.
+  const auto pick_delta = [&](M m, VF u) {
+    const auto cdf_at = [&](M valid, VF i) { return gather(valid, d.cdf, hn::ConvertTo(DI(), i), 1, 0); };
+    return hn::ConvertTo(DI(), pick_cdf(df, m, d.count, u, cdf_at));
+  };
+  const auto light_of = [&](M m, VI light) {
+    const auto field = [&](int f) { return gather(m, d.table, light, kDeltaFields, f); };
+    const auto field3 = [&](int f) { return gather3(m, d.table, light, kDeltaFields, f); };
+    const VF kind = field(kDeltaKind);
+    return DeltaLightLanes<VF, M>{kind == k(static_cast<float>(kDeltaDirectional)),
+                                  kind == k(static_cast<float>(kDeltaSpot)),
+                                  field3(kDeltaPosition),
+                                  field3(kDeltaDirection),
+                                  field3(kDeltaIntensity),
+                                  field(kDeltaCosOuter),
+                                  field(kDeltaCosInner),
+                                  field(kDeltaPmf)};
+  };
   LightLanes ls;
   VF dist;
-  ok = hn::And(ok, delta_light_seen(df, directional, spot, sp, position, field3(kDeltaDirection), field3(kDeltaIntensity),
-                                    gather(ok, d.table, light, kDeltaFields, kDeltaCosOuter),
-                                    gather(ok, d.table, light, kDeltaFields, kDeltaCosInner), ls.wi, dist, ls.Le));
-  ls.pdf = gather(ok, d.table, light, kDeltaFields, kDeltaPmf);
+  DeltaLightLanes<VF, M> light;
+  delta_light_sample(df, ok, rng.u(Dim::DeltaLightChoice), sp, pick_delta, light_of, light, ls.wi, dist, ls.Le);
+  ls.pdf = light.pmf;
   // To a point's or spot's position (no error, its normal -wi), or escaping along a directional light's wi.
   V3 origin, dir;
   VF len;
-  shadow_ray(df, ok, directional, sp, load3(w, kErrX, i0, ok), n, ls.wi, position, zero3(), -ls.wi, origin, dir, len);
+  shadow_ray(df, ok, light.directional, sp, load3(w, kErrX, i0, ok), n, ls.wi, light.position, zero3(), -ls.wi, origin,
+             dir, len);
   const VF ray[7] = {origin.x, origin.y, origin.z, dir.x, dir.y, dir.z, len};
   std::copy(std::begin(ray), std::end(ray), ls.ray);
   return ls;

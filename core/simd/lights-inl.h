@@ -62,6 +62,43 @@ HWY_INLINE V sky_entry_of(D d, M m, std::size_t count, V k, const Lookup& starts
   return pick_cdf(d, m, count, k, [&](M valid, V i) { return starts(valid, i + Set(d, 1.0f)); });
 }
 
+// LightSampler::pick under the light BVH, once the grid point k of each
+// lane of m is known (light_grid_point, a whole float): below tree_count
+// (the tree's grid points; 0 for an empty tree) the tree's walk from the
+// shading point, walk(tree, share), which returns the entry of the tree's
+// light and sets its share of the 2^24 grid points (0 where the tree gives
+// the lane nothing); at or past it the entry of the sky's grid points that
+// hold k (sky_entry_of over sky_count entries, starts(m, i); the entry
+// sky_entry(m, j)), whose probability is pmf_of(m, entry). Without a sky
+// the grid is the tree's. Returns the lanes it picks a light for, with the
+// light's entry (lanes of DI: int32 in the vector stages, int64 at width 1)
+// and its probability; 0 in the others.
+template <class D, class DI, class M, class Walk, class Starts, class SkyEntry, class PmfOf, class V = VecOf<D>,
+          class VI = VecOf<DI>>
+HWY_INLINE M tree_or_sky_pick(D d, DI di, M m, V k, V tree_count, std::size_t sky_count, const Walk& walk,
+                              const Starts& starts, const SkyEntry& sky_entry, const PmfOf& pmf_of, VI& light,
+                              V& pmf) {
+  const M tree = And(m, k < tree_count);
+  const M sky = sky_count != 0 ? AndNot(tree, m) : AndNot(m, m);
+  light = Zero(di);
+  pmf = Zero(d);
+  M picked = sky;
+  if (!AllFalse(d, tree)) {
+    V share;
+    const VI entry = walk(tree, share);
+    const M tree_ok = And(tree, share > Zero(d));
+    picked = Or(picked, tree_ok);
+    pmf = IfThenElseZero(tree_ok, share * Set(d, 0x1p-24f));
+    light = IfThenElseZero(RebindMask(di, tree_ok), entry);
+  }
+  if (!AllFalse(d, sky)) {
+    const V j = sky_entry_of(d, sky, sky_count, k, starts);
+    light = IfThenElse(RebindMask(di, sky), sky_entry(sky, j), light);
+    pmf = IfThenElse(sky, pmf_of(sky, light), pmf);
+  }
+  return picked;
+}
+
 // A piecewise-constant density's cdf (Distribution1D, core/sampling.h): count
 // cells, count + 1 entries from 0 to 1, entry i read by cdf_entry(m, i) (i a
 // whole float; the caller's table lookup).
@@ -245,6 +282,28 @@ HWY_INLINE M delta_light_seen(D d, M directional, M spot, const Vec3<V>& ref, co
   dist = IfThenElse(directional, Set(d, HUGE_VALF), r);
   Le = select(directional, intensity, select(spot, profile * falloff, falloff));
   return Or(directional, And(dist2 > Zero(d), Or(Not(spot), profile > Zero(d))));
+}
+
+// A delta light as delta_light_sample reads it (LightSampler's DeltaLight and
+// its probability of being picked).
+template <class V, class M>
+struct DeltaLightLanes {
+  M directional, spot;
+  Vec3<V> position, direction, intensity;
+  V cos_outer, cos_inner, pmf;
+};
+// LightSampler::sample_delta in the lanes of m: the delta light that
+// pick(m, u) chooses (an index lane: the caller's search of the delta
+// lights' cdf), read by light_of(m, index) into `light`, seen from ref
+// (delta_light_seen). Returns the lanes it gives a sample, with the index.
+template <class D, class M, class Pick, class LightOf, class V = VecOf<D>>
+HWY_INLINE auto delta_light_sample(D d, M& m, V u, const Vec3<V>& ref, const Pick& pick, const LightOf& light_of,
+                                   DeltaLightLanes<V, M>& light, Vec3<V>& wi, V& dist, Vec3<V>& Le) {
+  const auto index = pick(m, u);
+  light = light_of(m, index);
+  m = And(m, delta_light_seen(d, light.directional, light.spot, ref, light.position, light.direction, light.intensity,
+                              light.cos_outer, light.cos_inner, wi, dist, Le));
+  return index;
 }
 
 // Sun disks (LightSampler's SunDisk): a cone of directions of half-angle

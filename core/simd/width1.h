@@ -41,6 +41,10 @@ inline constexpr lane1::One<double> kScalarD{};
 inline D3 lanes(const dvec3& v) { return {{v.x}, {v.y}, {v.z}}; }
 inline dvec3 scalars(const D3& v) { return dvec3(v.x.raw, v.y.raw, v.z.raw); }
 
+// One index into a table (a light's entry, a node of the light BVH).
+using Index = lane1::I64;
+inline constexpr lane1::One<std::int64_t> kIndex{};
+
 // The texture coordinates of triangle t's corners (TriangleMesh::uvs) as
 // the generic texture inputs read them (core/simd/texture_inputs-inl.h); 0
 // on a mesh without them, which those ignore.
