@@ -23,4 +23,19 @@ float roulette_survival(const Spectrum& throughput) {
   return generic::roulette_survival(kScalar, lanes(throughput)).raw;
 }
 
+bool survives_roulette(const Spectrum& beta, float u, Spectrum* weight, float* survival) {
+  using namespace width1;
+  F3 w = lanes(*weight);
+  F s;
+  const bool survives = generic::roulette(kScalar, lane1::M{true}, lanes(beta), F{u}, w, s).raw;
+  *weight = scalars(w);
+  *survival = s.raw;
+  return survives;
+}
+
+bool chooses_light_technique(float u_technique) {
+  using namespace width1;
+  return generic::chooses_light_technique(kScalar, F{u_technique}).raw;
+}
+
 }  // namespace pathlab

@@ -40,6 +40,14 @@ float light_sample_weight(Strategy strategy, float light_pdf, float bsdf_pdf);
 // which carry little end early (dividing the survivors by it keeps the
 // estimate unbiased).
 float roulette_survival(const Spectrum& throughput);
+// Russian roulette after a scatter at a vertex past rr_depth (u its
+// Dim::Roulette number): false where the path ends; where it goes on,
+// *weight is divided by *survival = roulette_survival(beta * *weight).
+bool survives_roulette(const Spectrum& beta, float u, Spectrum* weight, float* survival);
+
+// Whether a light+bsdf vertex whose Dim::Technique number is u_technique
+// samples a light (else the BSDF): u_technique < 1/2.
+bool chooses_light_technique(float u_technique);
 
 // The continuation `strategy` samples at s towards wo: cosine-weighted
 // (Surfel::scatter_cosine) for every surface but a pure impulse under
@@ -56,7 +64,13 @@ inline std::optional<BsdfSample> scatter_for(Strategy strategy, const Surfel& s,
 // `u_technique` is its Dim::Technique number.
 inline bool samples_area_lights(Strategy strategy, float u_technique) {
   return strategy == Strategy::Light || strategy == Strategy::Mis ||
-         (strategy == Strategy::LightBsdf && u_technique < 0.5f);
+         (strategy == Strategy::LightBsdf && chooses_light_technique(u_technique));
+}
+// Whether that vertex's continuation counts as BSDF sampling for the
+// emitter it finds (PreviousVertex::bsdf_technique): always but where
+// light+bsdf chose light sampling.
+inline bool chose_bsdf_technique(Strategy strategy, float u_technique) {
+  return !(strategy == Strategy::LightBsdf && chooses_light_technique(u_technique));
 }
 
 }  // namespace pathlab

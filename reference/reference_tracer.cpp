@@ -88,18 +88,18 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
   }
   Spectrum weight = bs->weight;
   float survival = 1.0f;
+  // Russian roulette: survive in proportion to the throughput, so that paths
+  // which carry little end early; the survivors' weight is divided by the
+  // probability, which keeps the estimate unbiased.
   if (vertex > settings_.rr_depth) {
-    // Survive in proportion to the throughput, so that paths which carry
-    // little end early; dividing by the probability keeps the estimate unbiased.
-    survival = roulette_survival(beta * weight);
-    if (!(path.u(vertex, Dim::Roulette) < survival)) {
+    if (!survives_roulette(beta, path.u(vertex, Dim::Roulette), &weight, &survival)) {
       if (path.observer) {
         path.observer->on_scatter({vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, Spectrum(0.0f)});
         path.observer->on_end({vertex, PathEnd::Roulette});
       }
       return L;
     }
-    if (!PATHLAB_FAULT(RouletteNotReweighted)) weight /= survival;
+    if (PATHLAB_FAULT(RouletteNotReweighted)) weight = bs->weight;
   }
   const Spectrum beta_next = beta * weight;
   Ray next_ray = s.spawn(bs->wi);
@@ -108,7 +108,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
     path.observer->on_scatter(
         {vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, beta_next, next_ray});
 
-  const PreviousVertex next{light_query(s, wo), bs->pdf, bs->impulse, !(strategy == Strategy::LightBsdf && u_technique < 0.5f)};
+  const PreviousVertex next{light_query(s, wo), bs->pdf, bs->impulse, chose_bsdf_technique(strategy, u_technique)};
   if (path.params)
     path.cone = scattered_cone(path.cone, glm::length(s.p - ray.origin), bs->impulse, bs->pdf, settings_.texture_filter);
   return L + weight * Li(next_ray, vertex + 1, next, beta_next, path);

@@ -124,6 +124,7 @@ using pathlab::HWY_NAMESPACE::BvhTable;
 using pathlab::HWY_NAMESPACE::bvh_share;
 using pathlab::HWY_NAMESPACE::camera_direction;
 using pathlab::HWY_NAMESPACE::CameraPlane;
+using pathlab::HWY_NAMESPACE::chooses_light_technique;
 using pathlab::HWY_NAMESPACE::concentric_disk;
 using pathlab::HWY_NAMESPACE::CornerUvs;
 using pathlab::HWY_NAMESPACE::delta_light_sample;
@@ -158,6 +159,7 @@ using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::tree_or_sky_pick;
 using pathlab::HWY_NAMESPACE::sky_sample;
 using pathlab::HWY_NAMESPACE::place_normal;
+using pathlab::HWY_NAMESPACE::roulette;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::shading_normal;
 using pathlab::HWY_NAMESPACE::shadow_ray;
@@ -1489,7 +1491,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     M& ok = area.ok;
     if (sc.strategy == Strategy::Bsdf || sc.strategy == Strategy::Cosine || (sc.lights.count == 0 && !sc.general_lights))
       ok = hn::FirstN(df, 0);
-    if (sc.strategy == Strategy::LightBsdf) ok = hn::And(ok, rng.u(Dim::Technique) < k(0.5f));
+    if (sc.strategy == Strategy::LightBsdf) ok = hn::And(ok, chooses_light_technique(df, rng.u(Dim::Technique)));
     if (!hn::AllFalse(df, ok)) {
       const LightLanes ls =
           sc.general_lights ? other_light(sc, w, i0, rng, ok) : area_or_sky_light(sc, w, i0, rng, sp, wo, n, ok);
@@ -1657,10 +1659,9 @@ void scatter(const Scene& sc, const Wave& w) {
     const V3 beta = load3(w, kBetaR, i0, ok);
     const M rr = hn::And(ok, fmask(vertex > hn::Set(DI(), sc.rr_depth)));
     if (!hn::AllFalse(df, rr)) {
-      const V3 bw = beta * weight;
-      const VF survival = pathlab::HWY_NAMESPACE::roulette_survival(df, bw);
-      ok = hn::AndNot(hn::AndNot(rng.u(Dim::Roulette) < survival, rr), ok);
-      weight = select(rr, weight / survival, weight);
+      VF survival;
+      const M survives = roulette(df, rr, beta, rng.u(Dim::Roulette), weight, survival);
+      ok = hn::Or(hn::AndNot(rr, ok), survives);
     }
     store3(w, kBetaR, i0, ok, beta * weight);
 
@@ -1671,7 +1672,7 @@ void scatter(const Scene& sc, const Wave& w) {
     store(w, kPrevPdf, i0, ok, pdf);
     store_mask(w, kPrevImpulse, i0, ok, impulse);
     M bsdf_technique = hn::FirstN(df, lanes());
-    if (sc.strategy == Strategy::LightBsdf) bsdf_technique = hn::Not(rng.u(Dim::Technique) < k(0.5f));
+    if (sc.strategy == Strategy::LightBsdf) bsdf_technique = hn::Not(chooses_light_technique(df, rng.u(Dim::Technique)));
     store_mask(w, kPrevBsdfTechnique, i0, ok, bsdf_technique);
 
     if (sc.textured && !hn::AllFalse(df, ok)) {

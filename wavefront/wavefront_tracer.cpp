@@ -879,8 +879,7 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
     Spectrum weight = bs->weight;
     float survival = 1.0f;
     if (v > settings_.rr_depth) {
-      survival = roulette_survival(w.beta[i] * weight);
-      if (!(w.u(i, Dim::Roulette) < survival)) {
+      if (!survives_roulette(w.beta[i], w.u(i, Dim::Roulette), &weight, &survival)) {
         if (obs) {
           obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, Spectrum(0.0f)});
           obs->on_end({v, PathEnd::Roulette});
@@ -888,14 +887,13 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
         w.alive[i] = 0;
         continue;
       }
-      weight /= survival;
     }
     w.beta[i] *= weight;
     Ray next = s.spawn(bs->wi);
     next.alpha_key = scene_.alpha_key(w.rng[i], v);
     if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i], next});
     w.prev[i] = PreviousVertex{light_query(s, wo), bs->pdf, bs->impulse,
-                               !(strategy == Strategy::LightBsdf && w.u(i, Dim::Technique) < 0.5f)};
+                               chose_bsdf_technique(strategy, w.u(i, Dim::Technique))};
     if (textured)
       w.cone[i] = scattered_cone(w.cone[i], glm::length(s.p - w.ray[i].origin), bs->impulse, bs->pdf,
                                  settings_.texture_filter);

@@ -354,6 +354,27 @@ template <class D, class V = VecOf<D>>
 HWY_INLINE V roulette_survival(D d, const Vec3<V>& throughput) {
   return Min(Max(Max(throughput.z, throughput.y), throughput.x), Set(d, 1.0f));
 }
+// Russian roulette after a scatter, in the lanes of m where it applies (the
+// path is past rr_depth; the caller draws u, Dim::Roulette, only there): a
+// path whose throughput would become beta weight goes on where
+// u < survival = roulette_survival(beta weight), and a survivor's weight is
+// divided by survival, which keeps the estimate unbiased. Returns the lanes
+// of m that go on; the others keep their weight (the observers report it).
+template <class D, class M, class V = VecOf<D>>
+HWY_INLINE M roulette(D d, M m, const Vec3<V>& beta, V u, Vec3<V>& weight, V& survival) {
+  survival = roulette_survival(d, beta * weight);
+  const M survives = And(m, u < survival);
+  weight = select(survives, weight / survival, weight);
+  return survives;
+}
+
+// Light+bsdf's one-sample choice of technique at a vertex, by its
+// Dim::Technique number u: light sampling where u < 1/2, BSDF sampling
+// elsewhere (the weights above take c = 1/2).
+template <class D, class V = VecOf<D>>
+HWY_INLINE auto chooses_light_technique(D d, V u) {
+  return u < Set(d, 0.5f);
+}
 
 // area_to_solid_angle (core/sampling.h): pdf_area d^2 / |cos|, 0 edge-on.
 template <class D, class V = VecOf<D>>
