@@ -1,6 +1,5 @@
 #include "core/camera.h"
 
-#include "core/sampling.h"
 #include "core/simd/width1.h"
 
 namespace pathlab {
@@ -20,11 +19,13 @@ Ray Camera::generate_ray(vec2 film, vec2 u_lens) const {
   using namespace width1;
   const generic::CameraPlane<F> plane{lanes(desc_.position), lanes(forward_), lanes(right_), lanes(up_),
                                       F{tan_half_fov_}, F{aspect_}, F{inv_width_}, F{inv_height_}};
-  const F3 d = generic::camera_direction(kScalar, plane, F{film.x}, F{film.y});
-  if (desc_.aperture_radius <= 0.0f) return Ray{desc_.position, scalars(d)};
-  const vec2 lens = desc_.aperture_radius * square_to_concentric_disk(u_lens);
+  const auto lens_u = [&](F& lu, F& lv) {
+    lu = F{u_lens.x};
+    lv = F{u_lens.y};
+  };
   F3 origin, dir;
-  generic::thin_lens(kScalar, plane, F{desc_.focus_distance}, d, F{lens.x}, F{lens.y}, origin, dir);
+  generic::camera_ray(kScalar, plane, desc_.aperture_radius, desc_.focus_distance, F{film.x}, F{film.y}, lens_u, origin,
+                      dir);
   return Ray{scalars(origin), scalars(dir)};
 }
 

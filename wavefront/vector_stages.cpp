@@ -122,10 +122,9 @@ using pathlab::HWY_NAMESPACE::blend_normals;
 using pathlab::HWY_NAMESPACE::bvh_pick;
 using pathlab::HWY_NAMESPACE::BvhTable;
 using pathlab::HWY_NAMESPACE::bvh_share;
-using pathlab::HWY_NAMESPACE::camera_direction;
+using pathlab::HWY_NAMESPACE::camera_ray;
 using pathlab::HWY_NAMESPACE::CameraPlane;
 using pathlab::HWY_NAMESPACE::chooses_light_technique;
-using pathlab::HWY_NAMESPACE::concentric_disk;
 using pathlab::HWY_NAMESPACE::CornerUvs;
 using pathlab::HWY_NAMESPACE::delta_light_sample;
 using pathlab::HWY_NAMESPACE::DeltaLightLanes;
@@ -172,7 +171,6 @@ using pathlab::HWY_NAMESPACE::sphere_texture_inputs;
 using pathlab::HWY_NAMESPACE::sun_direction;
 using pathlab::HWY_NAMESPACE::splat3;
 using pathlab::HWY_NAMESPACE::tangent_frame;
-using pathlab::HWY_NAMESPACE::thin_lens;
 using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
@@ -459,20 +457,11 @@ void generate_camera_rays(const Scene& sc, const Camera& c, const Wave& w) {
     store(w, kFilmX, i0, in, fx);
     store(w, kFilmY, i0, in, fy);
     // Camera::generate_ray.
-    const V3 d = camera_direction(df, plane, fx, fy);
-    if (c.aperture_radius <= 0.0f) {
-      store3(w, kOx, i0, in, plane.position);
-      store3(w, kDx, i0, in, d);
-    } else {
-      VF lx, ly;
-      VF lu, lv;
-      rng.u2(Dim::LensX, lu, lv);
-      concentric_disk(df, lu, lv, lx, ly);
-      V3 origin, dir;
-      thin_lens(df, plane, k(c.focus_distance), d, k(c.aperture_radius) * lx, k(c.aperture_radius) * ly, origin, dir);
-      store3(w, kOx, i0, in, origin);
-      store3(w, kDx, i0, in, dir);
-    }
+    V3 origin, dir;
+    camera_ray(df, plane, c.aperture_radius, c.focus_distance, fx, fy,
+               [&](VF& lu, VF& lv) { rng.u2(Dim::LensX, lu, lv); }, origin, dir);
+    store3(w, kOx, i0, in, origin);
+    store3(w, kDx, i0, in, dir);
     store(w, kTmax, i0, in, k(std::numeric_limits<float>::infinity()));
     if (sc.alpha) store(w, kAlphaKey, i0, in, hn::BitCast(DI(), rng.bits_high(Dim::Alpha)));
     if (sc.textured) {

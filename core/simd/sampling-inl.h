@@ -267,6 +267,28 @@ HWY_INLINE void concentric_disk(D d, V ux, V uy, V& x, V& y) {
   y = IfThenZeroElse(centre, r * IfThenElse(wide, s, c));
 }
 
+// Camera::generate_ray: the ray through film position (fx, fy) in pixels
+// (camera_direction) from a pinhole at the plane's position where
+// aperture_radius <= 0, else from a thin lens of that radius focused at
+// focus_distance, through its point aperture_radius concentric_disk(lu, lv)
+// (thin_lens). lens_u(lu, lv) draws the lens pair (LensX, LensY): called
+// only for a lens.
+template <class D, class LensU, class V = VecOf<D>>
+HWY_INLINE void camera_ray(D d, const CameraPlane<V>& plane, float aperture_radius, float focus_distance, V fx, V fy,
+                           const LensU& lens_u, Vec3<V>& origin, Vec3<V>& dir) {
+  const Vec3<V> through = camera_direction(d, plane, fx, fy);
+  if (aperture_radius <= 0.0f) {
+    origin = plane.position;
+    dir = through;
+    return;
+  }
+  V lu, lv, lx, ly;
+  lens_u(lu, lv);
+  concentric_disk(d, lu, lv, lx, ly);
+  const V radius = Set(d, aperture_radius);
+  thin_lens(d, plane, Set(d, focus_distance), through, radius * lx, radius * ly, origin, dir);
+}
+
 // Cosine-weighted direction about +z (Malley's method): the disk point
 // lifted to the hemisphere, z = sqrt(max(0, (1 - x x) - y y)). Max(v, 0)
 // in that order: x86's max returns its second operand for a NaN or for
