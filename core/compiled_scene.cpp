@@ -5,7 +5,6 @@
 #include "core/parallel.h"
 #include "core/scene_limits.h"
 #include "core/simd/width1.h"
-#include "core/tangents.h"
 
 #include <algorithm>
 #include <cmath>
@@ -38,9 +37,16 @@ vec3 place_normal(const mat3& to_normal, const vec3& n) {
   return scalars(generic::place_normal(kScalar, lanes(to_normal[0]), lanes(to_normal[1]), lanes(to_normal[2]), lanes(n)));
 }
 
-// An instance's placement as the generic texture inputs read it
-// (core/simd/texture_inputs-inl.h): its columns, at width 1 (null in world
-// space, where none is asked for).
+// The texture coordinates at a hit: a mesh's blended by TriangleMesh::uv_at
+// where it has them, else the barycentrics (a sphere's: its hit's).
+vec2 hit_uv(const Shape& shape, const RayHit& hit) {
+  return shape.kind == Shape::Kind::Triangles && shape.mesh.has_uvs() ? shape.mesh.uv_at(hit.prim, hit.uv) : hit.uv;
+}
+
+// An instance's placement as the generic texture inputs and shading frame
+// read it (core/simd/texture_inputs-inl.h, shading_frame-inl.h): its
+// columns and whether it mirrors, at width 1 (null in world space, where
+// none is asked for).
 struct PlacementColumns {
   const CompiledScene::Placement* place;
   void linear(lane1::M, width1::F3 (&c)[3]) const {
@@ -52,6 +58,7 @@ struct PlacementColumns {
   void to_normal(lane1::M, width1::F3 (&c)[3]) const {
     for (int k = 0; k < 3; ++k) c[k] = width1::lanes(place->to_normal[k]);
   }
+  lane1::M mirrors(lane1::M) const { return {place->mirrors}; }
 };
 
 // The loaders check what a file says; a scene built in code gets the same
@@ -104,7 +111,8 @@ CompiledScene::CompiledScene(Scene scene)
   }
   for (const Instance& inst : scene_.instances) {
     box.add(placed(group_boxes[inst.group], inst.to_world));
-    placements_.push_back({inst.to_world, glm::inverse(inst.to_world), glm::transpose(glm::inverse(mat3(inst.to_world)))});
+    placements_.push_back({inst.to_world, glm::inverse(inst.to_world), glm::transpose(glm::inverse(mat3(inst.to_world))),
+                           glm::determinant(mat3(inst.to_world)) < 0.0f});
   }
   if (!box.empty()) {
     bounds_center_ = 0.5f * (box.lo + box.hi);
@@ -149,82 +157,74 @@ bool CompiledScene::intersect(const Ray& ray, Surfel* s, const RayCone& cone, Su
   return true;
 }
 
-void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, const mat3* to_normal,
-                                  Surfel* s, vec3* ns_sum) const {
+void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, Surfel* s) const {
   const SurfacePoint sp = shape.kind == Shape::Kind::Sphere
                               ? sphere_point(shape, p_approx)
                               : triangle_point(triangles_[first_triangle_[hit.shape] + hit.prim], hit.uv);
   s->p = sp.p;
   s->p_error = sp.p_error;
   s->n = sp.n;
-  local_shading(shape, hit, to_normal, s, ns_sum);
-}
-
-void CompiledScene::local_shading(const Shape& shape, const RayHit& hit, const mat3* to_normal, Surfel* s,
-                                  vec3* ns_sum) const {
-  s->uv = hit.uv;
-  *ns_sum = s->n;
-  if (shape.kind == Shape::Kind::Triangles && (shape.mesh.has_normals() || shape.mesh.has_uvs())) {
-    const glm::uvec3 v = shape.mesh.triangles[hit.prim];
-    s->uv = shape.mesh.uv_at(hit.prim, hit.uv);
-    if (shape.mesh.has_normals()) {
-      const std::vector<vec3>& n = shape.mesh.normals;
-      if (to_normal == nullptr) {
-        *ns_sum = blend_normals(hit.uv, n[v.x], n[v.y], n[v.z]);
-      } else {
-        // The vertex normals placed first, then blended, as a copy of the
-        // mesh placed by transform_mesh would blend them: under a
-        // non-uniform scale, blending first and placing the sum points
-        // elsewhere.
-        const auto placed = [&](std::uint32_t i) { return place_normal(*to_normal, n[i]); };
-        *ns_sum = blend_normals(hit.uv, placed(v.x), placed(v.y), placed(v.z));
-      }
-    }
-  }
+  s->uv = hit_uv(shape, hit);
 }
 
 void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s, const RayCone& cone,
                             SurfaceParams* params) const {
   const Shape& shape = scene_.shapes[hit.shape];
-  vec3 ns_sum;  // read only for a mesh with vertex normals
   if (hit.instance == kNoInstance) {
-    resolve_local(shape, hit, ray.origin + hit.t * ray.dir, nullptr, s, &ns_sum);
+    resolve_local(shape, hit, ray.origin + hit.t * ray.dir, s);
   } else {
     // Embree intersected the group in its own space; the hit distance is the
     // same along the world ray.
     const Placement& place = placements_[hit.instance];
     const vec3 p_world = ray.origin + hit.t * ray.dir;
-    resolve_local(shape, hit, affine_point(place.to_local, p_world), &place.to_normal, s, &ns_sum);
+    resolve_local(shape, hit, affine_point(place.to_local, p_world), s);
     transform_point(place.to_world, &s->p, &s->p_error);
     // Normals by the inverse transpose keep pointing to the image of their
     // side, so the front stays the front under a mirroring placement too.
     s->n = place_normal(place.to_normal, s->n);
   }
-  shading_frame(shape, hit, ns_sum, s);
+  shading_frame(shape, hit, s);
   if (textures_ && s->material->reads_textures_at_hits()) read_textures(shape, ray, hit, cone, params, s);
 }
 
 void CompiledScene::resolve_shading(const RayHit& hit, Surfel* s) const {
   const Shape& shape = scene_.shapes[hit.shape];
-  vec3 ns_sum;
-  local_shading(shape, hit, nullptr, s, &ns_sum);
-  shading_frame(shape, hit, ns_sum, s);
+  s->uv = hit_uv(shape, hit);
+  shading_frame(shape, hit, s);
 }
 
-void CompiledScene::shading_frame(const Shape& shape, const RayHit& hit, const vec3& ns_sum, Surfel* s) const {
-  const bool interpolated = shape.kind == Shape::Kind::Triangles && shape.mesh.has_normals();
-  const vec3 ns = interpolated ? shading_normal(s->n, ns_sum) : s->n;
-  s->shading_normal = ns != s->n;
-  if (shape.kind == Shape::Kind::Triangles && !shape.mesh.tangents.empty()) {
-    // The mesh's tangents orient the frame (anisotropic lobes stretch along
-    // s). Their handedness refers to the mesh's own normal: the interpolated
-    // one, or the winding normal of a flat mesh (before flip_normals).
-    const mat3 to_world = hit.instance == kNoInstance ? mat3(1.0f) : mat3(placements_[hit.instance].to_world);
-    const vec3 n_mesh = interpolated ? ns_sum : (shape.flip_normals ? -s->n : s->n);
-    s->frame = mesh_tangent_frame(shape.mesh, hit.prim, hit.uv, to_world, n_mesh, ns);
-  } else {
-    s->frame = Frame(ns);
-  }
+void CompiledScene::shading_frame(const Shape& shape, const RayHit& hit, Surfel* s) const {
+  // The generic steps at width 1 (core/simd/shading_frame-inl.h's
+  // surface_frame), which the wavefront's lanes take too: the vertex normals
+  // (placed by the instance first) blended into the shading normal, the
+  // frame about it of Frame(ns) or of the mesh's tangents.
+  using namespace width1;
+  const TriangleMesh& mesh = shape.mesh;
+  const bool triangles = shape.kind == Shape::Kind::Triangles;
+  const bool placed = hit.instance != kNoInstance;
+  const PlacementColumns place{placed ? &placements_[hit.instance] : nullptr};
+  const auto normals = [&](lane1::M, F3 (&n)[3]) {
+    const glm::uvec3 v = mesh.triangles[hit.prim];
+    for (int k = 0; k < 3; ++k) n[k] = lanes(mesh.normals[v[k]]);
+  };
+  const auto tangents = [&](lane1::M, F3 (&t)[3], F (&w)[3]) {
+    const glm::uvec3 v = mesh.triangles[hit.prim];
+    for (int k = 0; k < 3; ++k) {
+      const vec4& tk = mesh.tangents[v[k]];
+      t[k] = lanes(vec3(tk));
+      w[k] = F{tk.w};
+    }
+  };
+  const auto flipped = [&](lane1::M) { return lane1::M{shape.flip_normals}; };
+  F3 fs, ft, ns;
+  s->shading_normal = generic::surface_frame(kScalar, F{hit.uv.x}, F{hit.uv.y}, lanes(s->n),
+                                             lane1::M{triangles && mesh.has_normals()}, normals,
+                                             lane1::M{triangles && !mesh.tangents.empty()}, tangents, flipped,
+                                             lane1::M{placed}, place, fs, ft, ns)
+                          .raw;
+  s->frame.s = scalars(fs);
+  s->frame.t = scalars(ft);
+  s->frame.n = scalars(ns);
   s->material = &scene_.materials[shape.material];
   s->params = nullptr;
   s->shape = hit.shape;
@@ -258,14 +258,15 @@ void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayH
   if (m.normal_map) {
     // Tangent space as glTF has it: x along the tangent (dP/du), y along the
     // bitangent (dP/dv, "+y up"), z the shading normal (generic code, which
-    // the wavefront's lanes run too: lanes-inl.h normal_map_frame).
+    // the wavefront's lanes run too: shading_frame-inl.h normal_mapped_frame).
     const vec3 c = vec3(textures_->color(m.normal_map->texture, at));
     F3 fs = lanes(s->frame.s), ft = lanes(s->frame.t), fn = lanes(s->frame.n);
-    if (generic::normal_map_frame(kScalar, lanes(c), F{m.normal_map->scale}, lanes(s->n), fs, ft, fn).raw) {
+    lane1::M shading{s->shading_normal};
+    if (generic::normal_mapped_frame(kScalar, lanes(c), F{m.normal_map->scale}, lanes(s->n), fs, ft, fn, shading).raw) {
       s->frame.s = scalars(fs);
       s->frame.t = scalars(ft);
       s->frame.n = scalars(fn);
-      s->shading_normal = s->frame.n != s->n;
+      s->shading_normal = shading.raw;
     }
   }
   if (m.is_textured() && params != nullptr) {

@@ -118,6 +118,7 @@ class CompiledScene {
     mat4 to_world;
     mat4 to_local;     // its inverse
     mat3 to_normal;    // the inverse transpose of to_world's linear part
+    bool mirrors;      // to_world's linear part has a negative determinant (a mesh's tangents' handedness turns)
   };
   // Per instance (Scene::instances), in order.
   std::span<const Placement> placements() const { return placements_; }
@@ -125,17 +126,12 @@ class CompiledScene {
  private:
   // The point, front normal and texture coordinates of a hit on `shape`, in
   // the shape's own space (`p_approx` is the hit point there: spheres
-  // reproject it), and the unnormalised interpolated shading normal - in
-  // world space: its vertex normals are placed by `to_normal` (an instance's
-  // inverse transpose; null for a shape placed in world space) first.
-  void resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, const mat3* to_normal, Surfel* s,
-                     vec3* ns_sum) const;
-  // resolve_local()'s texture coordinates and unnormalised interpolated
-  // shading normal, from s->n (the shape's own normal at the hit).
-  void local_shading(const Shape& shape, const RayHit& hit, const mat3* to_normal, Surfel* s, vec3* ns_sum) const;
+  // reproject it).
+  void resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, Surfel* s) const;
   // The shading frame, shading_normal, material and hit identity of a Surfel
-  // whose point and geometric normal are placed in world space.
-  void shading_frame(const Shape& shape, const RayHit& hit, const vec3& ns_sum, Surfel* s) const;
+  // whose point and geometric normal are placed in world space (the generic
+  // surface_frame, core/simd/shading_frame-inl.h, at width 1).
+  void shading_frame(const Shape& shape, const RayHit& hit, Surfel* s) const;
   // resolve()'s texture reads for a material with textures or a normal map.
   void read_textures(const Shape& shape, const Ray& ray, const RayHit& hit, const RayCone& cone,
                      SurfaceParams* params, Surfel* s) const;

@@ -3,7 +3,6 @@
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/material.h"
-#include "core/simd/width1.h"
 
 #include <cmath>
 
@@ -66,30 +65,6 @@ bool needs_tangents(const Shape& shape, const Material& material) {
 void add_needed_tangents(Scene* scene) {
   for (Shape& shape : scene->shapes)
     if (needs_tangents(shape, scene->materials[shape.material])) shape.mesh.tangents = compute_tangents(shape.mesh);
-}
-
-Frame mesh_tangent_frame(const TriangleMesh& mesh, std::uint32_t tri, vec2 b, const mat3& to_world,
-                         const vec3& n_mesh, const vec3& ns) {
-  const glm::uvec3 v = mesh.triangles[tri];
-  const vec4& t0 = mesh.tangents[v.x];
-  const vec4& t1 = mesh.tangents[v.y];
-  const vec4& t2 = mesh.tangents[v.z];
-  // The generic steps (core/simd/lanes-inl.h tangent_frame), which the
-  // wavefront's lanes take too: the vertices' tangents blended, placed, made
-  // perpendicular to ns, the handedness turned by a mirroring placement and
-  // a normal that turned.
-  using namespace width1;
-  const F3 tangents[3] = {lanes(vec3(t0)), lanes(vec3(t1)), lanes(vec3(t2))};
-  const F w[3] = {F{t0.w}, F{t1.w}, F{t2.w}};
-  F3 fs, ft;
-  generic::tangent_frame(kScalar, F{b.x}, F{b.y}, tangents, w, lanes(to_world[0]), lanes(to_world[1]),
-                         lanes(to_world[2]), lane1::M{glm::determinant(to_world) < 0.0f}, lanes(n_mesh), lanes(ns), fs,
-                         ft);
-  Frame f;
-  f.s = scalars(fs);
-  f.t = scalars(ft);
-  f.n = ns;
-  return f;
 }
 
 }  // namespace pathlab

@@ -63,18 +63,4 @@ bool needs_tangents(const Shape& shape, const Material& material);
 // scene loader calls it once every shape is read.
 void add_needed_tangents(Scene* scene);
 
-// The shading frame at barycentrics `b` (b1, b2) of triangle `tri` of a mesh
-// with tangents, for the shading normal `ns` (world space, unit):
-// s = the interpolated tangent, placed by `to_world` (the linear part of an
-// instance's placement, identity otherwise; tangents are directions in the
-// surface, so they move with it) and orthogonalised against ns;
-// t = w * cross(ns, s), with w the interpolated handedness corrected so that
-// t is the mesh's bitangent (dP/dv) whatever side ns faces: flipped by a
-// mirroring placement and when ns is opposite `n_mesh`, the normal the
-// handedness refers to (the interpolated vertex normal, or the winding
-// normal of a flat mesh, placed like ns). Falls back to Frame(ns) when the
-// tangent vanishes, is not finite or lies along ns.
-Frame mesh_tangent_frame(const TriangleMesh& mesh, std::uint32_t tri, vec2 b, const mat3& to_world,
-                         const vec3& n_mesh, const vec3& ns);
-
 }  // namespace pathlab

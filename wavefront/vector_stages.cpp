@@ -31,6 +31,7 @@
 #include "core/simd/light_bvh-inl.h"
 #include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"
+#include "core/simd/shading_frame-inl.h"
 #include "core/simd/sobol-inl.h"
 #include "core/simd/spherical-inl.h"
 #include "core/simd/texture_inputs-inl.h"
@@ -118,7 +119,6 @@ using pathlab::HWY_NAMESPACE::area_light_sample;
 using pathlab::HWY_NAMESPACE::AreaLight;
 using pathlab::HWY_NAMESPACE::AreaLightSample;
 using pathlab::HWY_NAMESPACE::emitter_hit_pdf;
-using pathlab::HWY_NAMESPACE::blend_normals;
 using pathlab::HWY_NAMESPACE::bvh_pick;
 using pathlab::HWY_NAMESPACE::BvhTable;
 using pathlab::HWY_NAMESPACE::bvh_share;
@@ -152,15 +152,15 @@ using pathlab::HWY_NAMESPACE::mirror_sample;
 using pathlab::HWY_NAMESPACE::mix64;
 using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::NoEnergy;
-using pathlab::HWY_NAMESPACE::normal_map_frame;
+using pathlab::HWY_NAMESPACE::normal_mapped_frame;
 using pathlab::HWY_NAMESPACE::light_grid_point;
 using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::tree_or_sky_pick;
 using pathlab::HWY_NAMESPACE::sky_sample;
 using pathlab::HWY_NAMESPACE::place_normal;
 using pathlab::HWY_NAMESPACE::roulette;
+using pathlab::HWY_NAMESPACE::surface_frame;
 using pathlab::HWY_NAMESPACE::select;
-using pathlab::HWY_NAMESPACE::shading_normal;
 using pathlab::HWY_NAMESPACE::shadow_ray;
 using pathlab::HWY_NAMESPACE::spawn_origin;
 using pathlab::HWY_NAMESPACE::scattered_cone;
@@ -170,7 +170,6 @@ using pathlab::HWY_NAMESPACE::sphere_point;
 using pathlab::HWY_NAMESPACE::sphere_texture_inputs;
 using pathlab::HWY_NAMESPACE::sun_direction;
 using pathlab::HWY_NAMESPACE::splat3;
-using pathlab::HWY_NAMESPACE::tangent_frame;
 using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
@@ -513,21 +512,26 @@ void prefetch_hits(const Scene& sc, const Wave& w) {
   }
 }
 
-// An instance's placement as core/simd/texture_inputs-inl.h reads it:
-// column(m, field) gathers a column of Scene::placements (PlacementField)
-// for the lanes of m.
-template <class Column>
+// An instance's placement as core/simd/texture_inputs-inl.h and
+// shading_frame-inl.h read it: the columns of Scene::placements
+// (PlacementField) gathered for the lanes of m, but the inverse transpose's,
+// which resolve() gathered already for every placed lane (`normal`), and
+// whether it mirrors (kMirrors).
 struct PlacementLanes {
-  const Column& column;
+  const Scene& sc;
+  VI instance;
+  const V3 (&normal)[3];
+  V3 column(M m, int field) const { return gather3(m, sc.placements, instance, kPlacementFloats, field); }
   void linear(M m, V3 (&c)[3]) const {
     for (int k = 0; k < 3; ++k) c[k] = column(m, kToWorld + 3 * k);
   }
   void to_local(M m, V3 (&c)[4]) const {
     for (int k = 0; k < 4; ++k) c[k] = column(m, kToLocal + 3 * k);
   }
-  void to_normal(M m, V3 (&c)[3]) const {
-    for (int k = 0; k < 3; ++k) c[k] = column(m, kToNormal + 3 * k);
+  void to_normal(M, V3 (&c)[3]) const {
+    for (int k = 0; k < 3; ++k) c[k] = normal[k];
   }
+  M mirrors(M m) const { return hn::And(m, gather(m, sc.placements, instance, kPlacementFloats, kMirrors) > k(0.0f)); }
 };
 
 void resolve(const Scene& sc, const Wave& w) {
@@ -549,7 +553,6 @@ void resolve(const Scene& sc, const Wave& w) {
       placed = hn::And(found, fmask(instance != hn::Set(DI(), -1)));
     }
     const auto placement = [&](M m, int field) { return gather3(m, sc.placements, instance, kPlacementFloats, field); };
-    const PlacementLanes<decltype(placement)> place{placement};
     V3 p = zero3(), error = zero3(), n = zero3();
     if (!hn::AllFalse(df, mesh)) {
       // triangle_point (core/geometry.cpp) of the shape's triangle prim.
@@ -588,6 +591,7 @@ void resolve(const Scene& sc, const Wave& w) {
       error = select(placed, pe, error);
       n = select(placed, place_normal(df, to_normal[0], to_normal[1], to_normal[2], n), n);
     }
+    const PlacementLanes place{sc, instance, to_normal};
     store3(w, kPx, i0, found, p);
     store3(w, kErrX, i0, found, error);
     store3(w, kNx, i0, found, n);
@@ -637,51 +641,27 @@ void resolve(const Scene& sc, const Wave& w) {
       const M textured = sc.textured_hits ? shape_flag(framed, sc, shape, kTexturedHits) : hn::FirstN(df, 0);
       by_core = hn::Or(by_core, hn::AndNot(hn::Or(here, textured), framed));
       if (!hn::AllFalse(df, here)) {
-        const VF b1 = load(w, kHitU, i0, here), b2 = load(w, kHitV, i0, here);
-        // The shading normal of the vertex normals (CompiledScene::local_shading's sum, each placed first on an
-        // instance; shading_normal), else the geometric normal.
-        V3 sum = n, ns = n;
-        if (!hn::AllFalse(df, smooth)) {
-          const VI tri = normals_at + load(w, kPrim, i0, smooth);
-          V3 vn[3];
-          for (int k = 0; k < 3; ++k) vn[k] = gather3(smooth, sc.vertex_normals, tri, 9, 3 * k);
-          if (const M on = hn::And(smooth, placed); !hn::AllFalse(df, on))
-            for (V3& v : vn) v = select(on, place_normal(df, to_normal[0], to_normal[1], to_normal[2], v), v);
-          sum = select(smooth, blend_normals(df, b1, b2, vn[0], vn[1], vn[2]), n);
-          ns = select(smooth, shading_normal(df, n, sum), n);
-        }
-        V3 fs, ft;
-        frame(df, ns, fs, ft);
-        if (!hn::AllFalse(df, tangents)) {
-          // mesh_tangent_frame: the tangents blended, placed (by the identity in world space, as core), made
-          // perpendicular to ns, about the mesh's own normal (the vertex normals' sum, or the geometric normal
-          // before flip_normals).
-          const VI tri = tangents_at + load(w, kPrim, i0, tangents);
-          V3 t[3];
-          VF tw[3];
+        // CompiledScene::shading_frame (core/simd/shading_frame-inl.h): the vertex normals' shading normal, the
+        // frame about it of Frame(ns) or of the tangents, read from their per-triangle arrays.
+        const auto normals = [&](M m, V3 (&vn)[3]) {
+          const VI tri = normals_at + load(w, kPrim, i0, m);
+          for (int k = 0; k < 3; ++k) vn[k] = gather3(m, sc.vertex_normals, tri, 9, 3 * k);
+        };
+        const auto vertex_tangents = [&](M m, V3 (&t)[3], VF (&tw)[3]) {
+          const VI tri = tangents_at + load(w, kPrim, i0, m);
           for (int k = 0; k < 3; ++k) {
-            t[k] = gather3(tangents, sc.vertex_tangents, tri, 12, 4 * k);
-            tw[k] = gather(tangents, sc.vertex_tangents, tri, 12, 4 * k + 3);
+            t[k] = gather3(m, sc.vertex_tangents, tri, 12, 4 * k);
+            tw[k] = gather(m, sc.vertex_tangents, tri, 12, 4 * k + 3);
           }
-          V3 c0 = splat3(df, 1.0f, 0.0f, 0.0f), c1 = splat3(df, 0.0f, 1.0f, 0.0f), c2 = splat3(df, 0.0f, 0.0f, 1.0f);
-          M mirrors = hn::FirstN(df, 0);
-          if (const M on = hn::And(tangents, placed); !hn::AllFalse(df, on)) {
-            c0 = select(on, placement(on, kToWorld), c0);
-            c1 = select(on, placement(on, kToWorld + 3), c1);
-            c2 = select(on, placement(on, kToWorld + 6), c2);
-            mirrors = hn::And(on, gather(on, sc.placements, instance, kPlacementFloats, kMirrors) > k(0.0f));
-          }
-          const V3 n_mesh = select(smooth, sum, select(shape_flag(tangents, sc, shape, kFlipped), -n, n));
-          V3 tfs, tft;
-          tangent_frame(df, b1, b2, t, tw, c0, c1, c2, mirrors, n_mesh, ns, tfs, tft);
-          fs = select(tangents, tfs, fs);
-          ft = select(tangents, tft, ft);
-        }
+        };
+        const auto flipped = [&](M m) { return shape_flag(m, sc, shape, kFlipped); };
+        V3 fs, ft, ns;
+        const M shading = surface_frame(df, load(w, kHitU, i0, here), load(w, kHitV, i0, here), n, smooth, normals,
+                                        tangents, vertex_tangents, flipped, placed, place, fs, ft, ns);
         store3(w, kFsX, i0, here, fs);
         store3(w, kFtX, i0, here, ft);
         store3(w, kFnX, i0, here, ns);
-        // Surfel::shading_normal: ns != n.
-        store_mask(w, kShadingNormal, i0, here, hn::Or(ns.x != n.x, hn::Or(ns.y != n.y, ns.z != n.z)));
+        store_mask(w, kShadingNormal, i0, here, shading);
         store_mask(w, kHasParams, i0, here, hn::FirstN(df, 0));
       }
       if (!hn::AllFalse(df, textured)) {
@@ -728,16 +708,17 @@ void resolve(const Scene& sc, const Wave& w) {
         store_mask(w, kHasParams, i0, textured, shape_flag(textured, sc, shape, kTexturedParams));
         // The texels: OpenImageIO's lookups, by core, path by path, into the slot's SurfaceParams and kMapR...
         for_each_lane(textured, i0, [&](std::size_t i, std::size_t) { general_texels(sc, w, i); });
-        // A normal map tilts the frame (CompiledScene::read_textures: normal_map_frame).
+        // A normal map tilts the frame (CompiledScene::read_textures: normal_mapped_frame).
         if (const M mapped = shape_flag(textured, sc, shape, kNormalMapped); !hn::AllFalse(df, mapped)) {
           V3 fs = load3(w, kFsX, i0, mapped), ft = load3(w, kFtX, i0, mapped), fn = load3(w, kFnX, i0, mapped);
-          const M tilted = hn::And(mapped, normal_map_frame(df, load3(w, kMapR, i0, mapped),
-                                                            shape_value(mapped, sc, shape, kNormalMapScale), n, fs,
-                                                            ft, fn));
+          M shading;
+          const M tilted = hn::And(mapped, normal_mapped_frame(df, load3(w, kMapR, i0, mapped),
+                                                               shape_value(mapped, sc, shape, kNormalMapScale), n, fs,
+                                                               ft, fn, shading));
           store3(w, kFsX, i0, tilted, fs);
           store3(w, kFtX, i0, tilted, ft);
           store3(w, kFnX, i0, tilted, fn);
-          store_mask(w, kShadingNormal, i0, tilted, hn::Or(fn.x != n.x, hn::Or(fn.y != n.y, fn.z != n.z)));
+          store_mask(w, kShadingNormal, i0, tilted, shading);
         }
       }
     }

@@ -240,8 +240,8 @@ struct WavefrontTracer::VectorStages {
         for (int c = 0; c < 4; ++c) column(pl.to_world[c]);
         for (int c = 0; c < 4; ++c) column(pl.to_local[c]);
         for (int c = 0; c < 3; ++c) column(pl.to_normal[c]);
-        // Whether it mirrors (mesh_tangent_frame's handedness), decided as core decides it.
-        v->placements.push_back(glm::determinant(mat3(pl.to_world)) < 0.0f ? 1.0f : 0.0f);
+        // Whether it mirrors (the tangent frame's handedness), as core decided it (Placement::mirrors).
+        v->placements.push_back(pl.mirrors ? 1.0f : 0.0f);
       }
       static_assert(vs::kToLocal == 12 && vs::kToNormal == 24 && vs::kMirrors == 33 && vs::kPlacementFloats == 34);
       sc.placements = v->placements.data();

@@ -468,8 +468,8 @@ HWY_INLINE void sphere_point(D d, const Vec3<V>& center, V radius, M flip, const
 }
 
 // A mesh's vertex normals n0, n1, n2 blended by the barycentrics
-// (b0, b1, b2) of a hit, b0 = (1 - b1) - b2 (CompiledScene::local_shading):
-// (b0 n0 + b1 n1) + b2 n2, not normalised.
+// (b0, b1, b2) of a hit, b0 = (1 - b1) - b2 (shading_frame-inl.h's
+// surface_frame): (b0 n0 + b1 n1) + b2 n2, not normalised.
 template <class D, class V = VecOf<D>>
 HWY_INLINE Vec3<V> blend_normals(D d, V b1, V b2, const Vec3<V>& n0, const Vec3<V>& n1, const Vec3<V>& n2) {
   const V b0 = Set(d, 1.0f) - b1 - b2;
@@ -505,8 +505,8 @@ HWY_INLINE void frame_along(D d, const Vec3<V>& ns, const Vec3<V>& perp, V lengt
   ft = select(usable, handed * cross(ns, s), dt);
 }
 
-// mesh_tangent_frame (core/tangents.cpp): the shading frame of a mesh with
-// tangents at a hit. tangents[k] and w[k] are the triangle's vertices'
+// The shading frame of a mesh with tangents at a hit (shading_frame-inl.h's
+// surface_frame, for CompiledScene::shading_frame). tangents[k] and w[k] are the triangle's vertices'
 // tangents (xyz; handedness w), blended here by the barycentrics (b1, b2) in
 // blend_normals' order, the sum placed by the linear part c0 c1 c2 of the
 // instance's placement (the identity's columns in world space: core

@@ -21,6 +21,7 @@
 #include "core/simd/light_bvh-inl.h"
 #include "core/simd/lights-inl.h"
 #include "core/simd/sampling-inl.h"
+#include "core/simd/shading_frame-inl.h"
 #include "core/simd/spherical-inl.h"
 #include "core/simd/texture_inputs-inl.h"
 
