@@ -53,25 +53,46 @@ std::optional<Intersection> parse_intersection(std::string_view name) {
   return std::nullopt;
 }
 
-std::optional<float> constant_emitters_peak(const Scene& scene) {
-  if (scene.environment_map || !scene.delta_lights.empty()) return std::nullopt;
-  std::optional<float> peak;
-  const auto take = [&](const Spectrum& L) { peak = std::max(peak.value_or(0.0f), max_component(glm::abs(L))); };
-  if (scene.environment && !is_black(*scene.environment)) take(*scene.environment);
-  // A group's shapes are in the image only if an instance places the group.
+namespace {
+
+// Whether each shape is in the image: a group's shapes are only if an
+// instance places the group.
+std::vector<bool> placed_shapes(const Scene& scene) {
   std::vector<bool> placed(scene.shapes.size(), true);
   for (const ShapeGroup& g : scene.groups)
     for (const std::uint32_t i : g.shapes) placed[i] = false;
   for (const Instance& inst : scene.instances)
     for (const std::uint32_t i : scene.groups[inst.group].shapes) placed[i] = true;
+  return placed;
+}
+
+}  // namespace
+
+std::optional<EmitterPeak> brightest_constant_emitter(const Scene& scene) {
+  std::optional<EmitterPeak> peak;
+  const auto take = [&](const Spectrum& L, const auto& source) {
+    const float radiance = max_component(glm::abs(L));
+    if (!peak || radiance > peak->radiance) peak = EmitterPeak{radiance, source()};
+  };
+  if (scene.environment && !is_black(*scene.environment))
+    take(*scene.environment, [] { return std::string("the environment"); });
+  const std::vector<bool> placed = placed_shapes(scene);
   for (std::size_t i = 0; i < scene.shapes.size(); ++i) {
-    if (!placed[i]) continue;
-    const Shape& shape = scene.shapes[i];
-    const Material& m = scene.materials[shape.material];
-    if (m.emission_textured) return std::nullopt;
-    if (m.emits()) take(m.emission);
+    const Material& m = scene.materials[scene.shapes[i].material];
+    if (placed[i] && m.emits() && !m.emission_textured)
+      take(m.emission, [&] { return "material '" + m.name + "'"; });
   }
   return peak;
+}
+
+std::optional<float> constant_emitters_peak(const Scene& scene) {
+  if (scene.environment_map || !scene.delta_lights.empty()) return std::nullopt;
+  const std::vector<bool> placed = placed_shapes(scene);
+  for (std::size_t i = 0; i < scene.shapes.size(); ++i)
+    if (placed[i] && scene.materials[scene.shapes[i].material].emission_textured) return std::nullopt;
+  const std::optional<EmitterPeak> peak = brightest_constant_emitter(scene);
+  if (!peak) return std::nullopt;
+  return peak->radiance;
 }
 
 }  // namespace pathlab

@@ -180,6 +180,15 @@ struct DeltaLight {
 // emission texture, an environment image, point, spot or directional lights,
 // sun disks), whose brightest sample this cannot bound.
 std::optional<float> constant_emitters_peak(const Scene& scene);
+// The brightest of the scene's constant emitters the image can see (placed
+// shapes' materials without an emission texture, a uniform environment),
+// whatever other lights it has: its largest radiance component, and what
+// it is ("material 'lamp'", "the environment"); nullopt if there is none.
+struct EmitterPeak {
+  float radiance = 0.0f;
+  std::string source;
+};
+std::optional<EmitterPeak> brightest_constant_emitter(const Scene& scene);
 // The spot profile: 1 for cos_theta >= cos_inner, 0 for cos_theta <= cos_outer,
 // a smoothstep in cos theta between.
 float spot_profile(float cos_theta, float cos_outer, float cos_inner);

@@ -215,6 +215,27 @@ TEST_F(Hardening, EmittersTooFaintForTheFilmAreWarnedAbout) {
   EXPECT_EQ(dim.err.find("brightest emitter"), std::string::npos) << dim.err;
 }
 
+// An emitter at or beyond the film's range (2^32) is named up front: every
+// sample that sees it would be left out as bad, the lamp black in the image.
+// A lamp of 1e9 (within range) does not warn.
+TEST_F(Hardening, EmittersBeyondTheFilmsRangeAreWarnedAbout) {
+  const auto with_lamp = [&](const std::string& name, const std::string& radiance) {
+    std::string text = scene_text(kCamera, kSphere + ",\n" + kLamp);
+    const std::string from = "\"radiance\": 2";
+    text.replace(text.find(from), from.size(), "\"radiance\": " + radiance);
+    return render(file(name, text));
+  };
+  for (const char* bright : {"4294967296", "1e30"}) {
+    const ProcessResult r = with_lamp(std::string("bright") + bright + ".json", bright);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.err.find("pathlab: warning: material 'lamp' emits radiance "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("choose a larger unit of radiance"), std::string::npos) << r.err;
+  }
+  const ProcessResult within = with_lamp("within.json", "1e9");
+  EXPECT_EQ(within.code, 0) << within.err;
+  EXPECT_EQ(within.err.find("beyond the film's range"), std::string::npos) << within.err;
+}
+
 // The bound counts only emitters in the image: a group's lamp no instance
 // places neither hides a faint scene nor raises a false alarm; other lights
 // cannot be bounded.
@@ -238,6 +259,12 @@ TEST(HardeningFaintEmitters, ThePeakCountsOnlyPlacedConstantEmitters) {
   EXPECT_EQ(*constant_emitters_peak(scene), 2.0f);
   scene.delta_lights.push_back(DeltaLight{});
   EXPECT_FALSE(constant_emitters_peak(scene));
+  // The brightest constant emitter stays known beside other lights (a lower
+  // bound of the brightest sample, which is all the bright warning needs).
+  scene.materials[1].name = "bright";
+  ASSERT_TRUE(brightest_constant_emitter(scene));
+  EXPECT_EQ(brightest_constant_emitter(scene)->radiance, 2.0f);
+  EXPECT_EQ(brightest_constant_emitter(scene)->source, "material 'bright'");
 }
 
 // A ray Embree would abort on never reaches it, through any of the accel's

@@ -252,6 +252,11 @@ int RenderCommand::run(std::ostream& /*out*/, std::ostream& err) const {
         << ": the film rounds each sample to a multiple of 2^-64 (an error of up to 2^-65, 2.7e-20), so below 2^-55 "
            "(2.8e-17) the image can lose about 0.1 % of its light or more to rounding, and below 2.7e-20 goes black "
            "(docs/overnight.md); choose a smaller unit of radiance (scale the emission up)\n";
+  if (const std::optional<EmitterPeak> peak = brightest_constant_emitter(sc);
+      peak && !(peak->radiance < kFilmRadianceLimit) && chatty)
+    err << "pathlab: warning: " << peak->source << " emits radiance " << peak->radiance
+        << ", beyond the film's range (below 2^32, 4.3e9): every sample that sees it is left out of the image and "
+           "counted as bad (docs/overnight.md); choose a larger unit of radiance (scale the emission down)\n";
   if (const LightBvh* bvh = compiled.lights().bvh(); bvh && chatty && !quiet && !bvh->empty())
     err << "pathlab: light BVH: " << (bvh->node_count() + 1) / 2 << " lights, " << bvh->node_count()
         << " nodes, depth " << bvh->depth() << "\n";
