@@ -147,7 +147,7 @@ class Reader {
   void read(void* data, std::size_t n) {
     if (position_ + n > size_) fail("truncated (it ends inside its data)");
     in_.read(static_cast<char*>(data), static_cast<std::streamsize>(n));
-    if (!in_) fail("read failed");
+    if (!in_) fail("reading it failed at byte " + std::to_string(position_) + " (an input/output error)");
     XXH3_128bits_update(state_.get(), data, n);
     position_ += n;
   }
@@ -164,7 +164,7 @@ class Reader {
     if (position_ + 16 != size_) fail(position_ + 16 > size_ ? "truncated (its checksum is missing)" : "has bytes after its checksum");
     unsigned char b[16];
     in_.read(reinterpret_cast<char*>(b), 16);
-    if (!in_) fail("read failed");
+    if (!in_) fail("reading it failed at byte " + std::to_string(position_) + " (an input/output error)");
     return hex128(hash_from_bytes(b));
   }
   [[noreturn]] void fail(const std::string& why) const {
@@ -175,8 +175,7 @@ class Reader {
   // which a flipped bit in its length or a digit of its resolution must
   // not pass for a truncated file.
   [[noreturn]] void header_fail(const std::string& why) const {
-    if (intact())
-      fail(why + ": not a partial film of this pathlab version (format version " + std::to_string(kFormatVersion) + ")");
+    if (intact()) fail(why + ": not a partial film of this pathlab version");
     fail("its header is corrupt: " + why + " (its checksum does not match its content)");
   }
   // True if a complete JSON value starts after the length field and more
