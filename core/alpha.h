@@ -27,9 +27,11 @@
 
 namespace pathlab {
 
-// The key of the rays leaving `vertex` of the sample `rng` draws for.
+// The key of the rays leaving `vertex` of the sample `rng` draws for: the
+// high 32 bits of its Alpha hash (core/simd/stream-generic.h's
+// stream_alpha_key, which the wavefront's lanes run too).
 constexpr std::uint32_t alpha_key(const SampleStream& rng, std::uint32_t vertex) {
-  return static_cast<std::uint32_t>(rng.bits(vertex, Dim::Alpha) >> 32);
+  return static_cast<std::uint32_t>(sobol::width1::stream_alpha_key(sobol::detail::kLane, rng.at(vertex)).raw);
 }
 
 // The uniform that decides whether a ray of key `key` stops at triangle

@@ -19,9 +19,10 @@ namespace pathlab {
 constexpr std::uint64_t mix64(std::uint64_t z) { return sobol::mix(z); }
 
 // Top 24 bits of a hash as a float in [0, 1): every value is exactly
-// representable, and 1 - 2^-24 is the largest, so u < 1 always holds.
+// representable, and 1 - 2^-24 is the largest, so u < 1 always holds
+// (sobol::top24_to_float, which a stream's numbers take, core/simd/stream-generic.h).
 constexpr float to_unit_float(std::uint64_t h) {
-  return static_cast<float>(h >> 40) * 0x1p-24f;
+  return sobol::top24_to_float(static_cast<std::uint32_t>(h >> 40));
 }
 
 // Where the numbers of get() come from (RenderSettings::sampler, the scene
@@ -71,39 +72,64 @@ constexpr SobolSlot sobol_slot(Dim dim) {
   return {kSobolSlotsPerVertex, 0};
 }
 
+// Whether the zsobol sampler draws dim from its points (else dim is the
+// hash, as under the independent sampler: Alpha, whose key bits() takes).
+constexpr bool zsobol_draws(Dim dim) { return sobol_slot(dim).entity < kSobolSlotsPerVertex; }
+// The dimension after x: a pair's second (FilmY after FilmX).
+constexpr Dim next_dim(Dim x) { return static_cast<Dim>(static_cast<std::uint32_t>(x) + 1); }
+// Whether x and next_dim(x) are a 2D slot's axes 0 and 1, drawn by zsobol
+// from one point (get2 permutes its index once): FilmX, LensX, LightX and
+// DirectionX.
+constexpr bool zsobol_pair(Dim x) {
+  return zsobol_draws(x) && sobol_slot(x).axis == 0 && sobol_slot(next_dim(x)).entity == sobol_slot(x).entity;
+}
+// A stream's zsobol bits when it is not zsobol's: every number the hash.
+inline constexpr std::uint32_t kNoZSobol = 0xffffffffu;
+
+// How a stream composes the hashes into its numbers, written once for every
+// width (core/simd/stream-generic.h), here over lane1's one plain uint64;
+// the wavefront's lanes compile the same text over Highway's vectors
+// (core/simd/sobol-inl.h).
+namespace sobol::width1 {
+#include "core/simd/stream-generic.h"
+}  // namespace sobol::width1
+
 // The random numbers of one pixel sample. The key is hashed in a chain,
 // each link injecting 64 bits of key into a fully mixed state:
 //   h1 = mix(mix(seed + golden) ^ (pixel << 32 | sample))
 //   u  = mix(h1 ^ (bounce << 32 | dim))
 // Under the zsobol sampler (made by SamplerSetup::stream) get() is instead
 // point `index` of a 2D Sobol' sequence, its index's digits permuted and its
-// value scrambled per slot (see SamplerSetup); bits() stays the hash.
+// value scrambled per slot (see SamplerSetup); bits() stays the hash. Each
+// number is core/simd/stream-generic.h's at width 1 (sobol::width1), the
+// text the wavefront's vectorised stages draw their lanes' numbers by.
 class SampleStream {
  public:
   constexpr SampleStream(std::uint64_t seed, std::uint32_t pixel, std::uint32_t sample)
-      : key_(mix64(seed_key(seed) ^ ((static_cast<std::uint64_t>(pixel) << 32) | sample))) {}
+      : key_(sobol::width1::stream_key(sobol::detail::kLane, sobol::detail::lane(seed_key(seed)),
+                                       sobol::detail::lane(pixel_sample(pixel, sample)))
+                 .raw) {}
 
-  // key() is mix64(seed_key(seed) ^ (pixel << 32 | sample)).
+  // key() is mix64(seed_key(seed) ^ pixel_sample(pixel, sample)).
   static constexpr std::uint64_t seed_key(std::uint64_t seed) { return mix64(seed + 0x9e3779b97f4a7c15ull); }
+  static constexpr std::uint64_t pixel_sample(std::uint32_t pixel, std::uint32_t sample) {
+    return (static_cast<std::uint64_t>(pixel) << 32) | sample;
+  }
 
   constexpr float get(std::uint32_t bounce, Dim dim) const {
-    if (index_bits_ != kHash) {
-      const SobolSlot s = sobol_slot(dim);
-      if (s.entity < kSobolSlotsPerVertex) return zsobol(bounce * kSobolSlotsPerVertex + s.entity, s.axis);
-    }
-    return to_unit_float(bits(bounce, dim));
+    return unit(sobol::width1::stream_top24(sobol::detail::kLane, at(bounce), index_bits_, dim));
   }
   // The whole 64-bit hash get() takes its top 24 bits from, for a decision
   // that needs more than one float's worth (a ray's alpha key, core/alpha.h).
   constexpr std::uint64_t bits(std::uint32_t bounce, Dim dim) const {
-    return mix64(key_ ^ ((static_cast<std::uint64_t>(bounce) << 32) | static_cast<std::uint32_t>(dim)));
+    return sobol::width1::stream_bits(sobol::detail::kLane, at(bounce), dim).raw;
   }
   // The hashed (seed, pixel, sample): under the independent sampler get() is
   // to_unit_float(mix64(key() ^ (bounce << 32 | dim))), for code that draws
   // many streams' numbers at once.
   constexpr std::uint64_t key() const { return key_; }
   // False under zsobol: get() is then no function of key() alone.
-  constexpr bool independent() const { return index_bits_ == kHash; }
+  constexpr bool independent() const { return index_bits_ == kNoZSobol; }
 
   // The two numbers of a 2D pair: {get(bounce, x), get(bounce, x + 1)} bit
   // for bit, for x = FilmX, LensX, LightX or DirectionX. Under zsobol the
@@ -112,32 +138,26 @@ class SampleStream {
     float x, y;
   };
   constexpr Pair get2(std::uint32_t bounce, Dim x) const {
-    const Dim y = static_cast<Dim>(static_cast<std::uint32_t>(x) + 1);
-    if (index_bits_ != kHash) {
-      const SobolSlot s = sobol_slot(x);
-      if (s.entity < kSobolSlotsPerVertex && s.axis == 0 && sobol_slot(y).entity == s.entity) {
-        std::uint32_t second = 0;
-        const std::uint32_t first =
-            sobol::zsobol_top24(index_, sobol_key_, index_bits_, bounce * kSobolSlotsPerVertex + s.entity, 0, &second);
-        return {sobol::top24_to_float(first), sobol::top24_to_float(second)};
-      }
-    }
-    return {get(bounce, x), get(bounce, y)};
+    lane1::U64 second{};
+    const lane1::U64 first = sobol::width1::stream_top24_pair(sobol::detail::kLane, at(bounce), index_bits_, x, second);
+    return {unit(first), unit(second)};
   }
 
-  // Point `slot` of the zsobol sequence in Sobol' dimension `axis`, as get()
-  // draws it (public for the tests of its parts).
-  constexpr float zsobol(std::uint32_t slot, int axis) const {
-    return sobol::top24_to_float(sobol::zsobol_top24(index_, sobol_key_, index_bits_, slot, axis, nullptr));
+  // The stream at vertex `bounce` as core/simd/stream-generic.h takes it,
+  // one lane (core/alpha.h's alpha_key draws through it).
+  constexpr sobol::width1::VertexStreams<lane1::U64> at(std::uint32_t bounce) const {
+    return sobol::width1::vertex_streams(sobol::detail::kLane, sobol::detail::lane(key_), sobol::detail::lane(bounce),
+                                         sobol::detail::lane(index_), sobol::detail::lane(sobol_key_));
   }
 
  private:
   friend class SamplerSetup;
-  static constexpr std::uint32_t kHash = 0xffffffffu;
+  // A 24-bit number (stream_top24's) as the float in [0, 1) it stands for.
+  static constexpr float unit(lane1::U64 top24) { return sobol::top24_to_float(static_cast<std::uint32_t>(top24.raw)); }
   std::uint64_t key_;
   std::uint64_t index_ = 0;       // zsobol: morton(x, y) << log2_spp | sample mod 2^log2_spp
   std::uint64_t sobol_key_ = 0;   // zsobol: a hash of the seed and the sample's replicate
-  std::uint32_t index_bits_ = kHash;  // zsobol: the bits of index_ that are permuted; kHash: independent
+  std::uint32_t index_bits_ = kNoZSobol;  // zsobol: the bits of index_ that are permuted; kNoZSobol: independent
 };
 
 // What a sampler needs to know of the render to make the streams of its

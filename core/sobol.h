@@ -164,7 +164,7 @@ constexpr std::uint32_t zsobol_top24(std::uint64_t index, std::uint64_t key, uns
   return static_cast<std::uint32_t>(top.raw);
 }
 // A 32-bit fixed-point value's top 24 bits (zsobol_top24's) as a float in
-// [0, 1), as to_unit_float (core/rng.h) takes the hash's.
+// [0, 1); to_unit_float (core/rng.h) takes the hash's top 24 bits through it.
 constexpr float top24_to_float(std::uint32_t top) { return static_cast<float>(top) * 0x1p-24f; }
 
 }  // namespace pathlab::sobol

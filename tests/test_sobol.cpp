@@ -566,5 +566,43 @@ TEST(ZSobolTracers, ImagesAreTheSameBitsForAnyThreadCountAndWaveSize) {
   }
 }
 
+// What the tracers draw, against the nets, not against each other: each
+// pixel's film samples of an 8-spp render (the FilmX/FilmY pair, drawn by
+// get2 in the reference and the scalar stages, by the lanes' u2 in the
+// vectorised ones: one text, core/simd/stream-generic.h) are a
+// (0, 3, 2)-net, their fractions in the pixel as fixed point. A bug in the
+// shared text reaches every tracer alike, where BothTracersFollowTheSamePaths
+// and VectorStages cannot see it.
+TEST(ZSobolTracers, EachPixelsFilmSamplesAreANetInEveryTracer) {
+  constexpr std::uint32_t spp = 8;
+  Scene scene = small_scene("", static_cast<int>(spp));
+  const RenderSettings settings = scene.render;
+  const CompiledScene compiled(std::move(scene));
+  const std::uint32_t w = static_cast<std::uint32_t>(compiled.scene().film.width);
+  const std::uint32_t h = static_cast<std::uint32_t>(compiled.scene().film.height);
+  const ReferenceTracer reference(compiled, settings);
+  const WavefrontTracer lanes(compiled, settings, 97, {}, WavefrontStages::Auto);
+  const WavefrontTracer scalar(compiled, settings, 97, {}, WavefrontStages::Scalar);
+  for (const Tracer* t : {static_cast<const Tracer*>(&reference), static_cast<const Tracer*>(&lanes),
+                          static_cast<const Tracer*>(&scalar)}) {
+    std::vector<FilmSample> batch(static_cast<std::size_t>(w) * h * spp);
+    t->render_batch(0, spp, batch);
+    int failures = 0;
+    for (std::uint32_t p = 0; p < w * h; ++p) {
+      std::vector<float> u, v;
+      for (std::uint32_t j = 0; j < spp; ++j) {
+        const vec2 film = batch[p * spp + j].film;  // (x, y) + the pair: its fraction exact to 2^-19 here
+        u.push_back(film.x - static_cast<float>(p % w));
+        v.push_back(film.y - static_cast<float>(p / w));
+      }
+      const std::string failure = float_net_failure(u, v, 3);
+      if (!failure.empty() && failures++ < 3)
+        ADD_FAILURE() << t->name() << (t == &scalar ? " (scalar stages)" : "") << ", pixel " << p % w << ","
+                      << p / w << ": " << failure;
+    }
+    EXPECT_EQ(failures, 0) << t->name() << (t == &scalar ? " (scalar stages)" : "") << ": of " << w * h << " pixels";
+  }
+}
+
 }  // namespace
 }  // namespace pathlab

@@ -145,12 +145,12 @@ using pathlab::HWY_NAMESPACE::surface_eval_ok;
 using pathlab::HWY_NAMESPACE::surface_scatter_ok;
 using pathlab::HWY_NAMESPACE::upper_side;
 using pathlab::HWY_NAMESPACE::usable_bsdf_pdf;
+using pathlab::HWY_NAMESPACE::vertex_streams;
+using pathlab::HWY_NAMESPACE::VertexStreams;
 using pathlab::HWY_NAMESPACE::is_black;
 using pathlab::HWY_NAMESPACE::lambert_eval;
 using pathlab::HWY_NAMESPACE::lambert_sample;
 using pathlab::HWY_NAMESPACE::mirror_sample;
-using pathlab::HWY_NAMESPACE::mix64;
-using pathlab::HWY_NAMESPACE::mul64;
 using pathlab::HWY_NAMESPACE::NoEnergy;
 using pathlab::HWY_NAMESPACE::normal_mapped_frame;
 using pathlab::HWY_NAMESPACE::light_grid_point;
@@ -168,6 +168,10 @@ using pathlab::HWY_NAMESPACE::solid_angle_draw;
 using pathlab::HWY_NAMESPACE::SolidAngleDraw;
 using pathlab::HWY_NAMESPACE::sphere_point;
 using pathlab::HWY_NAMESPACE::sphere_texture_inputs;
+using pathlab::HWY_NAMESPACE::stream_alpha_key;
+using pathlab::HWY_NAMESPACE::stream_key;
+using pathlab::HWY_NAMESPACE::stream_top24;
+using pathlab::HWY_NAMESPACE::stream_top24_pair;
 using pathlab::HWY_NAMESPACE::sun_direction;
 using pathlab::HWY_NAMESPACE::splat3;
 using pathlab::HWY_NAMESPACE::to_local;
@@ -180,7 +184,6 @@ using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::CospowLobes;
 using pathlab::HWY_NAMESPACE::VndfLobes;
 using pathlab::HWY_NAMESPACE::zero_unless;
-using pathlab::HWY_NAMESPACE::zsobol_top24;
 
 using DF = hn::ScalableTag<float>;
 using DI = hn::RebindToSigned<DF>;
@@ -323,66 +326,40 @@ struct Packer {
   VI packed(VI v) const { return hn::BitCast(DI(), hn::TableLookupLanes(hn::BitCast(DF(), v), order)); }
 };
 
-// SampleStream::get for the block's paths at their current vertex, each
-// half of the block in 64-bit lanes: under the independent sampler the
-// hash of each path's key with the vertex xored into its high half, under
-// zsobol the point of the dimension's slot (core/simd/sobol-inl.h).
+// SampleStream's numbers for the block's paths at their current vertex:
+// core/simd/stream-generic.h's, the text SampleStream draws by at width 1,
+// on each half of the block in 64-bit lanes (core/simd/sobol-inl.h). unit()
+// is the stages' own: it packs the halves into the block's floats.
 struct Streams {
-  V64 lo, hi;  // key ^ vertex << 32
-  const Scene* scene;
-  V64 zindex_lo, zindex_hi, zkey_lo, zkey_hi, slot_lo, slot_hi;  // zsobol; slot: vertex * slots per vertex
+  VertexStreams<V64> lo, hi;  // the block's halves
+  unsigned zsobol_bits;       // SampleStream's: Scene::zsobol_bits, or kNoZSobol
 
   VF u(Dim dim) const {
-    if (scene->zsobol) {
-      const SobolSlot s = sobol_slot(dim);
-      if (s.entity < kSobolSlotsPerVertex) return zsobol(s, nullptr);
-    }
     const D64 d64;
-    const V64 d = hn::Set(d64, static_cast<std::uint64_t>(dim));
-    // to_unit_float: the top 24 bits, exactly a float, times 2^-24.
-    return unit(hn::ShiftRight<40>(mix64(d64, hn::Xor(lo, d))), hn::ShiftRight<40>(mix64(d64, hn::Xor(hi, d))));
-  }
-  // SampleStream::bits(vertex, dim) >> 32 (under either sampler): a ray's
-  // alpha key (core/alpha.h) for dim Alpha.
-  VU bits_high(Dim dim) const {
-    const D64 d64;
-    const V64 d = hn::Set(d64, static_cast<std::uint64_t>(dim));
-    const V64 a = hn::ShiftRight<32>(mix64(d64, hn::Xor(lo, d))), b = hn::ShiftRight<32>(mix64(d64, hn::Xor(hi, d)));
-    return hn::ConcatEven(DU(), hn::BitCast(DU(), b), hn::BitCast(DU(), a));  // the low words, in order
+    return unit(stream_top24(d64, lo, zsobol_bits, dim), stream_top24(d64, hi, zsobol_bits, dim));
   }
   // SampleStream::get2: {u(x), u(x + 1)}, the pair's point made once under zsobol.
   void u2(Dim x, VF& a, VF& b) const {
-    const Dim y = static_cast<Dim>(static_cast<std::uint32_t>(x) + 1);
-    if (scene->zsobol) {
-      const SobolSlot s = sobol_slot(x);
-      if (s.entity < kSobolSlotsPerVertex && s.axis == 0 && sobol_slot(y).entity == s.entity) {
-        a = zsobol(s, &b);
-        return;
-      }
-    }
-    a = u(x);
-    b = u(y);
+    const D64 d64;
+    V64 lo2, hi2;
+    const V64 lo1 = stream_top24_pair(d64, lo, zsobol_bits, x, lo2);
+    const V64 hi1 = stream_top24_pair(d64, hi, zsobol_bits, x, hi2);
+    a = unit(lo1, hi1);
+    b = unit(lo2, hi2);
+  }
+  // alpha_key (core/alpha.h) of the rays leaving the vertex.
+  VU alpha_key() const {
+    const D64 d64;
+    const V64 a = stream_alpha_key(d64, lo), b = stream_alpha_key(d64, hi);
+    return hn::ConcatEven(DU(), hn::BitCast(DU(), b), hn::BitCast(DU(), a));  // the low words, in order
   }
 
  private:
-  // Two halves of 24-bit integers as the floats of the block, times 2^-24.
+  // Two halves of 24-bit integers as the floats of the block, times 2^-24
+  // (sobol::top24_to_float's product).
   static VF unit(V64 a, V64 b) {
     const VU bits = hn::ConcatEven(DU(), hn::BitCast(DU(), b), hn::BitCast(DU(), a));  // the low words, in order
     return hn::ConvertTo(DF(), hn::BitCast(DI(), bits)) * hn::Set(DF(), 0x1p-24f);
-  }
-  // The slot's axis (and axis 1 into *second when not null).
-  VF zsobol(SobolSlot s, VF* second) const {
-    const D64 d64;
-    const V64 entity = hn::Set(d64, s.entity);
-    const unsigned bits = scene->zsobol_bits;
-    V64 lo2, hi2;
-    const V64 low32 = hn::Set(d64, 0xffffffffull);
-    const V64 a = zsobol_top24(d64, zindex_lo, zkey_lo, bits, hn::And(slot_lo + entity, low32), s.axis,
-                               second ? &lo2 : nullptr);
-    const V64 b = zsobol_top24(d64, zindex_hi, zkey_hi, bits, hn::And(slot_hi + entity, low32), s.axis,
-                               second ? &hi2 : nullptr);
-    if (second) *second = unit(lo2, hi2);
-    return unit(a, b);
   }
 };
 Streams streams(const Scene& sc, const Wave& w, std::size_t i0, VI vertex) {
@@ -391,20 +368,12 @@ Streams streams(const Scene& sc, const Wave& w, std::size_t i0, VI vertex) {
   const std::size_t half = hn::Lanes(d64);
   const VU v = hn::BitCast(DU(), vertex);
   const V64 vertex_lo = hn::PromoteTo(d64, hn::LowerHalf(dh, v)), vertex_hi = hn::PromoteTo(d64, hn::UpperHalf(dh, v));
-  Streams s{hn::Xor(hn::LoadU(d64, w.rng + i0), hn::ShiftLeft<32>(vertex_lo)),
-            hn::Xor(hn::LoadU(d64, w.rng + i0 + half), hn::ShiftLeft<32>(vertex_hi)),
-            &sc,
-            hn::Zero(d64), hn::Zero(d64), hn::Zero(d64), hn::Zero(d64), hn::Zero(d64), hn::Zero(d64)};
-  if (sc.zsobol) {
-    s.zindex_lo = hn::LoadU(d64, w.zindex + i0);
-    s.zindex_hi = hn::LoadU(d64, w.zindex + i0 + half);
-    s.zkey_lo = hn::LoadU(d64, w.zkey + i0);
-    s.zkey_hi = hn::LoadU(d64, w.zkey + i0 + half);
-    // vertex * slots per vertex (+ entity, in zsobol()) wraps at 2^32 as SampleStream's uint32 does.
-    s.slot_lo = mul64(d64, vertex_lo, kSobolSlotsPerVertex);
-    s.slot_hi = mul64(d64, vertex_hi, kSobolSlotsPerVertex);
-  }
-  return s;
+  const V64 key_lo = hn::LoadU(d64, w.rng + i0), key_hi = hn::LoadU(d64, w.rng + i0 + half);
+  if (!sc.zsobol) return {vertex_streams(d64, key_lo, vertex_lo), vertex_streams(d64, key_hi, vertex_hi), kNoZSobol};
+  return {vertex_streams(d64, key_lo, vertex_lo, hn::LoadU(d64, w.zindex + i0), hn::LoadU(d64, w.zkey + i0)),
+          vertex_streams(d64, key_hi, vertex_hi, hn::LoadU(d64, w.zindex + i0 + half),
+                         hn::LoadU(d64, w.zkey + i0 + half)),
+          sc.zsobol_bits};
 }
 
 // LightSampler::pick (pick_cdf) over the lights' cdf.
@@ -462,7 +431,7 @@ void generate_camera_rays(const Scene& sc, const Camera& c, const Wave& w) {
     store3(w, kOx, i0, in, origin);
     store3(w, kDx, i0, in, dir);
     store(w, kTmax, i0, in, k(std::numeric_limits<float>::infinity()));
-    if (sc.alpha) store(w, kAlphaKey, i0, in, hn::BitCast(DI(), rng.bits_high(Dim::Alpha)));
+    if (sc.alpha) store(w, kAlphaKey, i0, in, hn::BitCast(DI(), rng.alpha_key()));
     if (sc.textured) {
       store(w, kConeWidth, i0, in, k(sc.camera_cone_width));
       store(w, kConeSpread, i0, in, k(sc.camera_cone_spread));
@@ -1477,7 +1446,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
     // The shadow rays, packed behind the previous ones with the slot of the
     // path each belongs to (add_light); each counts as one of its path's rays.
     // A vertex's shadow rays share its alpha key (core/alpha.h).
-    const VU alpha_keys = sc.alpha ? rng.bits_high(Dim::Alpha) : hn::Zero(DU());
+    const VU alpha_keys = sc.alpha ? rng.alpha_key() : hn::Zero(DU());
     queries += pack_shadow_rays(w, i0, queries, sc.deltas.count != 0 ? &delta : nullptr, area, sc.alpha ? &alpha_keys : nullptr);
     const VI rays = load(w, kRays, i0, alive);
     store(w, kRays, i0, alive,
@@ -1662,7 +1631,7 @@ void scatter(const Scene& sc, const Wave& w) {
     store3(w, kOx, i0, ok, spawn_origin(df, sp, err, n, wi));
     store3(w, kDx, i0, ok, wi);
     store(w, kTmax, i0, ok, k(std::numeric_limits<float>::infinity()));
-    if (sc.alpha) store(w, kAlphaKey, i0, ok, hn::BitCast(DI(), rng.bits_high(Dim::Alpha)));
+    if (sc.alpha) store(w, kAlphaKey, i0, ok, hn::BitCast(DI(), rng.alpha_key()));
     vertex = vertex + hn::Set(DI(), 1);
     store(w, kVertex, i0, ok, vertex);
     store_mask(w, kAlive, i0, in, ok);
@@ -1673,7 +1642,7 @@ void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key) {
   const D64 d64;
   const V64 seed = hn::Set(d64, seed_key);
   for (std::size_t i0 = 0; i0 < n; i0 += hn::Lanes(d64))
-    hn::StoreU(mix64(d64, hn::Xor(seed, hn::LoadU(d64, keys + i0))), d64, keys + i0);
+    hn::StoreU(stream_key(d64, seed, hn::LoadU(d64, keys + i0)), d64, keys + i0);
 }
 
 std::size_t compact(const Scene& sc, const Wave& w, void* samples, std::uint32_t first_slot) {

@@ -433,8 +433,9 @@ std::size_t lanes();
 // to a whole block of the widest target: a block is loaded whole.
 constexpr std::size_t kPadding = 32;
 
-// SampleStream keys for a wave: each of keys[0, n) holds pixel << 32 |
-// sample and becomes mix64(seed_key ^ that), SampleStream::key().
+// SampleStream keys for a wave: each of keys[0, n) holds
+// SampleStream::pixel_sample(pixel, sample) and becomes SampleStream::key()
+// (core/simd/stream-generic.h's stream_key, seed_key SampleStream::seed_key).
 void hash_keys(std::uint64_t* keys, std::size_t n, std::uint64_t seed_key);
 
 // The stages, in the order a bounce runs them (wavefront_tracer.cpp has the

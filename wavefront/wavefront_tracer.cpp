@@ -1106,7 +1106,7 @@ void WavefrontTracer::render_waves(std::uint32_t first, std::uint32_t count, std
                lanes.u[vs::kOutIndex][i] = slot;
                lanes.u[vs::kPixelX][i] = x;
                lanes.u[vs::kPixelY][i] = y;
-               lanes.rng[i] = (std::uint64_t{pixel} << 32) | sample;  // hashed into the key below
+               lanes.rng[i] = SampleStream::pixel_sample(pixel, sample);  // hashed into the key below
                if (zsobol) {
                  lanes.zindex[i] = sampler().zsobol_index(x, y, sample);
                  lanes.zkey[i] = sampler().zsobol_key(sample);
