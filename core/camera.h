@@ -31,6 +31,10 @@ class Camera {
   // y down, (0,0) the top-left corner of the image) and aperture sample
   // `u_lens` in [0,1)^2 (ignored by a pinhole).
   Ray generate_ray(vec2 film, vec2 u_lens) const;
+  // Whether generate_ray reads u_lens (a thin lens): the callers draw the
+  // lens pair (Dim::LensX) only then (under zsobol a draw costs a
+  // permutation of the Sobol' index).
+  bool has_lens() const { return desc_.aperture_radius > 0.0f; }
 
   const CameraDesc& desc() const { return desc_; }
   // The image plane as generate_ray() computes it, for code that makes rays

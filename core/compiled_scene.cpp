@@ -47,18 +47,19 @@ vec2 hit_uv(const Shape& shape, const RayHit& hit) {
 // read it (core/simd/texture_inputs-inl.h, shading_frame-inl.h): its
 // columns and whether it mirrors, at width 1 (null in world space, where
 // none is asked for).
+// Asked off the mask (m false), each gives what a masked gather gives: 0.
 struct PlacementColumns {
   const CompiledScene::Placement* place;
-  void linear(lane1::M, width1::F3 (&c)[3]) const {
-    for (int k = 0; k < 3; ++k) c[k] = width1::lanes(vec3(place->to_world[k]));
+  void linear(lane1::M m, width1::F3 (&c)[3]) const {
+    for (int k = 0; k < 3; ++k) c[k] = width1::lanes(m.raw ? vec3(place->to_world[k]) : vec3(0.0f));
   }
-  void to_local(lane1::M, width1::F3 (&c)[4]) const {
-    for (int k = 0; k < 4; ++k) c[k] = width1::lanes(vec3(place->to_local[k]));
+  void to_local(lane1::M m, width1::F3 (&c)[4]) const {
+    for (int k = 0; k < 4; ++k) c[k] = width1::lanes(m.raw ? vec3(place->to_local[k]) : vec3(0.0f));
   }
-  void to_normal(lane1::M, width1::F3 (&c)[3]) const {
-    for (int k = 0; k < 3; ++k) c[k] = width1::lanes(place->to_normal[k]);
+  void to_normal(lane1::M m, width1::F3 (&c)[3]) const {
+    for (int k = 0; k < 3; ++k) c[k] = width1::lanes(m.raw ? place->to_normal[k] : vec3(0.0f));
   }
-  lane1::M mirrors(lane1::M) const { return {place->mirrors}; }
+  lane1::M mirrors(lane1::M m) const { return {m.raw && place->mirrors}; }
 };
 
 // The loaders check what a file says; a scene built in code gets the same
@@ -261,7 +262,7 @@ void CompiledScene::read_textures(const Shape& shape, const Ray& ray, const RayH
     // the wavefront's lanes run too: shading_frame-inl.h normal_mapped_frame).
     const vec3 c = vec3(textures_->color(m.normal_map->texture, at));
     F3 fs = lanes(s->frame.s), ft = lanes(s->frame.t), fn = lanes(s->frame.n);
-    lane1::M shading{s->shading_normal};
+    lane1::M shading;
     if (generic::normal_mapped_frame(kScalar, lanes(c), F{m.normal_map->scale}, lanes(s->n), fs, ft, fn, shading).raw) {
       s->frame.s = scalars(fs);
       s->frame.t = scalars(ft);

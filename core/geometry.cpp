@@ -239,11 +239,6 @@ vec3 shading_normal(const vec3& ng, const vec3& sum) {
   return scalars(generic::shading_normal(kScalar, lanes(ng), lanes(sum)));
 }
 
-vec3 blend_normals(vec2 b, const vec3& n0, const vec3& n1, const vec3& n2) {
-  using namespace width1;
-  return scalars(generic::blend_normals(kScalar, F{b.x}, F{b.y}, lanes(n0), lanes(n1), lanes(n2)));
-}
-
 SurfacePoint sample_triangle(const Triangle& t, vec2 u) { return triangle_point(t, square_to_uniform_triangle(u)); }
 
 SurfacePoint sample_triangle(const Shape& shape, std::uint32_t tri, vec2 u) {

@@ -101,11 +101,10 @@ float sphere_crossing(const vec3& origin, const vec3& dir, float tnear, float tf
 // not finite (opposite vertex normals) and when it lies within about 0.08
 // degrees of ng (1 - cos < 1e-6), so that a mesh whose normals are its face
 // normals shades exactly as the flat mesh.
+// (The generic shading_normal of core/simd/lanes-inl.h at width 1, which
+// core/simd/shading_frame-inl.h's surface_frame applies to the vertex
+// normals' blend.)
 vec3 shading_normal(const vec3& ng, const vec3& sum);
-// A mesh's vertex normals blended by a hit's barycentrics b = (b1, b2):
-// ((1 - b1 - b2) n0 + b1 n1) + b2 n2, the `sum` shading_normal takes. Both
-// are the generic functions of core/simd/lanes-inl.h at width 1.
-vec3 blend_normals(vec2 b, const vec3& n0, const vec3& n1, const vec3& n2);
 
 SurfacePoint sample_triangle(const Triangle& t, vec2 u);
 SurfacePoint sample_triangle(const Shape& shape, std::uint32_t tri, vec2 u);

@@ -72,6 +72,7 @@ std::optional<EmitterPeak> brightest_constant_emitter(const Scene& scene) {
   std::optional<EmitterPeak> peak;
   const auto take = [&](const Spectrum& L, const auto& source) {
     const float radiance = max_component(glm::abs(L));
+    if (std::isnan(radiance)) return;  // a scene built in code (the loaders refuse NaN)
     if (!peak || radiance > peak->radiance) peak = EmitterPeak{radiance, source()};
   };
   if (scene.environment && !is_black(*scene.environment))

@@ -18,11 +18,6 @@ float light_sample_weight(Strategy strategy, float light_pdf, float bsdf_pdf) {
   return generic::light_sample_weight(kScalar, strategy, F{light_pdf}, F{bsdf_pdf}).raw;
 }
 
-float roulette_survival(const Spectrum& throughput) {
-  using namespace width1;
-  return generic::roulette_survival(kScalar, lanes(throughput)).raw;
-}
-
 bool survives_roulette(const Spectrum& beta, float u, Spectrum* weight, float* survival) {
   using namespace width1;
   F3 w = lanes(*weight);

@@ -35,14 +35,11 @@ struct PreviousVertex {
 float emission_weight(Strategy strategy, const PreviousVertex& prev, float light_pdf);
 float light_sample_weight(Strategy strategy, float light_pdf, float bsdf_pdf);
 
-// The probability that Russian roulette lets a path go on whose throughput
-// would become `throughput`: min(1, its largest component), so that paths
-// which carry little end early (dividing the survivors by it keeps the
-// estimate unbiased).
-float roulette_survival(const Spectrum& throughput);
 // Russian roulette after a scatter at a vertex past rr_depth (u its
-// Dim::Roulette number): false where the path ends; where it goes on,
-// *weight is divided by *survival = roulette_survival(beta * *weight).
+// Dim::Roulette number): the path goes on with probability *survival =
+// min(1, the largest component of beta * *weight), so that paths which
+// carry little end early; false where it ends; where it goes on, *weight is
+// divided by *survival, which keeps the estimate unbiased.
 bool survives_roulette(const Spectrum& beta, float u, Spectrum* weight, float* survival);
 
 // Whether a light+bsdf vertex whose Dim::Technique number is u_technique
@@ -60,17 +57,21 @@ inline std::optional<BsdfSample> scatter_for(Strategy strategy, const Surfel& s,
   return by_cosine ? s.scatter_cosine(wo, u_dir) : s.scatter(wo, u_lobe, u_dir);
 }
 
-// Whether vertex `vertex` samples area lights (NEE) under `strategy`;
-// `u_technique` is its Dim::Technique number.
-inline bool samples_area_lights(Strategy strategy, float u_technique) {
+// Whether a vertex samples area lights (NEE) under `strategy`.
+// u_technique() draws the vertex's Dim::Technique number: asked only under
+// light+bsdf, the one strategy it decides anything for (under zsobol a draw
+// costs a permutation of the Sobol' index).
+template <class Draw>
+inline bool samples_area_lights(Strategy strategy, const Draw& u_technique) {
   return strategy == Strategy::Light || strategy == Strategy::Mis ||
-         (strategy == Strategy::LightBsdf && chooses_light_technique(u_technique));
+         (strategy == Strategy::LightBsdf && chooses_light_technique(u_technique()));
 }
 // Whether that vertex's continuation counts as BSDF sampling for the
 // emitter it finds (PreviousVertex::bsdf_technique): always but where
 // light+bsdf chose light sampling.
-inline bool chose_bsdf_technique(Strategy strategy, float u_technique) {
-  return !(strategy == Strategy::LightBsdf && chooses_light_technique(u_technique));
+template <class Draw>
+inline bool chose_bsdf_technique(Strategy strategy, const Draw& u_technique) {
+  return !(strategy == Strategy::LightBsdf && chooses_light_technique(u_technique()));
 }
 
 }  // namespace pathlab

@@ -75,7 +75,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
 
   // Light a ray can find, as the strategy says.
   const Strategy strategy = settings_.strategy;
-  const float u_technique = path.u(vertex, Dim::Technique);
+  const auto u_technique = [&] { return path.u(vertex, Dim::Technique); };
   if (samples_area_lights(strategy, u_technique)) L += direct_area(s, wo, vertex, beta, path);
 
   // Continue the path.
@@ -178,7 +178,8 @@ FilmSample ReferenceTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::
   }
   FilmSample fs;
   fs.film = vec2(static_cast<float>(x), static_cast<float>(y)) + path.u2(0, Dim::FilmX);
-  Ray ray = scene_.camera().generate_ray(fs.film, path.u2(0, Dim::LensX));
+  const Camera& camera = scene_.camera();
+  Ray ray = camera.generate_ray(fs.film, camera.has_lens() ? path.u2(0, Dim::LensX) : vec2(0.0f));
   ray.alpha_key = path.alpha_key(scene_, 0);
   if (observer) observer->on_camera({x, y, sample, fs.film, ray.origin, ray.dir});
   fs.L = Li(ray, 1, PreviousVertex{}, Spectrum(1.0f), path);

@@ -319,6 +319,7 @@ TEST_F(PartialFilmFile, AFlippedBitInTheHeaderIsReportedAsACorruptHeader) {
   EXPECT_NE(message.find("format version 2, this pathlab reads 1: not a partial film of this pathlab version"),
             std::string::npos)
       << message;
+  EXPECT_EQ(message.find("(format version"), std::string::npos) << message;  // the version named once
 }
 
 TEST_F(PartialFilmFile, MergeRefusesOverlapsGapsAndOtherRenders) {

@@ -305,7 +305,7 @@ enum ShapeField : int {
                            // tangents make its frame in the lanes (about its vertex normals' or geometric
                            // normal); -1 if it has none
   kNormalMapped = 53,      // 1 if a kTexturedHits shape's material has a normal map, which tilts its frame in
-                           // the lanes (normal_map_frame) from the texel core reads (kMapR...)
+                           // the lanes (normal_mapped_frame) from the texel core reads (kMapR...)
   kNormalMapScale = 54,    // its NormalMap::scale
   kTexturedParams = 55,    // 1 if a kTexturedHits shape's material has textured parameters (kHasParams), 0 if
                            // it reads only a normal map

@@ -792,7 +792,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
         }
       }
     }
-    if (samples_area_lights(strategy, w.u(i, Dim::Technique))) {
+    if (samples_area_lights(strategy, [&] { return w.u(i, Dim::Technique); })) {
       const auto ls = lights.sample(light_query(s, wo), w.u(i, Dim::LightChoice), w.u2(i, Dim::LightX));
       if (!ls) {
         if (obs && lights.has_area_lights()) w.shadow_state[2 * i + 1] = rejected_state(LightRejection::NoSample);
@@ -893,7 +893,7 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
     next.alpha_key = scene_.alpha_key(w.rng[i], v);
     if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i], next});
     w.prev[i] = PreviousVertex{light_query(s, wo), bs->pdf, bs->impulse,
-                               chose_bsdf_technique(strategy, w.u(i, Dim::Technique))};
+                               chose_bsdf_technique(strategy, [&] { return w.u(i, Dim::Technique); })};
     if (textured)
       w.cone[i] = scattered_cone(w.cone[i], glm::length(s.p - w.ray[i].origin), bs->impulse, bs->pdf,
                                  settings_.texture_filter);
@@ -932,7 +932,7 @@ void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
   for (std::size_t i = 0; i < w.n; ++i) {
     w.vertex[i] = 0;  // the camera's random numbers are those of vertex 0
     w.film[i] = vec2(static_cast<float>(w.x[i]), static_cast<float>(w.y[i])) + w.u2(i, Dim::FilmX);
-    w.ray[i] = camera.generate_ray(w.film[i], w.u2(i, Dim::LensX));
+    w.ray[i] = camera.generate_ray(w.film[i], camera.has_lens() ? w.u2(i, Dim::LensX) : vec2(0.0f));
     w.ray[i].alpha_key = scene_.alpha_key(w.rng[i], 0);
     w.beta[i] = Spectrum(1.0f);
     w.L[i] = Spectrum(0.0f);

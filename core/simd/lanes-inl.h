@@ -347,7 +347,7 @@ HWY_INLINE V light_sample_weight(D d, Strategy strategy, V light_pdf, V bsdf_pdf
   return Set(d, 1.0f);
 }
 
-// roulette_survival (core/strategy_weights.h): Russian roulette's survival
+// Russian roulette's survival (roulette, below; core/strategy_weights.h): the
 // probability for a path whose throughput would become `throughput`,
 // std::min(1, max_component(throughput)) in Min's and Max's order.
 template <class D, class V = VecOf<D>>
@@ -509,8 +509,8 @@ HWY_INLINE void frame_along(D d, const Vec3<V>& ns, const Vec3<V>& perp, V lengt
 // surface_frame, for CompiledScene::shading_frame). tangents[k] and w[k] are the triangle's vertices'
 // tangents (xyz; handedness w), blended here by the barycentrics (b1, b2) in
 // blend_normals' order, the sum placed by the linear part c0 c1 c2 of the
-// instance's placement (the identity's columns in world space: core
-// multiplies by mat3(1) too); `mirrors` where that placement's determinant
+// instance's placement (the identity's columns in world space); `mirrors`
+// where that placement's determinant
 // is negative. The placed tangent is made perpendicular to the shading
 // normal ns (Gram-Schmidt) and is the frame's s, with t = w' n x s, w' the
 // handedness turned where the placement mirrors and where ns faces away

@@ -295,7 +295,8 @@ struct DeltaLightLanes {
 // LightSampler::sample_delta in the lanes of m: the delta light that
 // pick(m, u) chooses (an index lane: the caller's search of the delta
 // lights' cdf), read by light_of(m, index) into `light`, seen from ref
-// (delta_light_seen). Returns the lanes it gives a sample, with the index.
+// (delta_light_seen). Returns the index; the lanes of m it gives no sample
+// (the point at ref, ref outside a spot's cone) leave m.
 template <class D, class M, class Pick, class LightOf, class V = VecOf<D>>
 HWY_INLINE auto delta_light_sample(D d, M& m, V u, const Vec3<V>& ref, const Pick& pick, const LightOf& light_of,
                                    DeltaLightLanes<V, M>& light, Vec3<V>& wi, V& dist, Vec3<V>& Le) {
