@@ -302,9 +302,14 @@ std::optional<LightSampler::Pick> LightSampler::pick(const LightQuery& ref, floa
 }
 
 float LightSampler::pick_pmf(const LightQuery& ref, std::size_t entry) const {
-  if (kind_ == LightSamplerKind::Power || entry_tree_[entry] < 0) return pmf_[entry];
-  const std::uint32_t light = static_cast<std::uint32_t>(entry_tree_[entry]);
-  return static_cast<float>(bvh_->share(ref, light, sky_start_[0])) * 0x1p-24f;
+  // core/simd/lights-inl.h's pick_pmf at width 1, as the wavefront's lanes.
+  using namespace width1;
+  const bool in_tree = kind_ == LightSamplerKind::Bvh && entry_tree_[entry] >= 0;
+  const auto share = [&](lane1::M) {
+    const auto light = static_cast<std::uint32_t>(entry_tree_[entry]);
+    return F{static_cast<float>(bvh_->share(ref, light, sky_start_[0]))};
+  };
+  return generic::pick_pmf(kScalar, lane1::M{in_tree}, F{pmf_[entry]}, share).raw;
 }
 
 std::size_t LightSampler::pick(const std::vector<float>& cdf, float u) {

@@ -155,6 +155,7 @@ using pathlab::HWY_NAMESPACE::NoEnergy;
 using pathlab::HWY_NAMESPACE::normal_mapped_frame;
 using pathlab::HWY_NAMESPACE::light_grid_point;
 using pathlab::HWY_NAMESPACE::pick_cdf;
+using pathlab::HWY_NAMESPACE::pick_pmf;
 using pathlab::HWY_NAMESPACE::tree_or_sky_pick;
 using pathlab::HWY_NAMESPACE::sky_sample;
 using pathlab::HWY_NAMESPACE::place_normal;
@@ -750,17 +751,18 @@ VF triangle_light_pdf(const Scene& sc, const Wave& w, std::size_t i0, M lit, VI 
     const VI safe_entry = hn::IfThenElseZero(hn::RebindMask(DI(), light), entry);
     const VI tree_light = hn::GatherIndex(DI(), sc.lights.bvh_light, safe_entry);
     const M in_tree = hn::And(light, fmask(hn::Not(tree_light < hn::Zero(DI()))));
-    if (!hn::AllFalse(df, in_tree)) {
-      const V3 qp = load3(w, kPrevX, i0, in_tree), qn = load3(w, kPrevNx, i0, in_tree);
-      const VF tl = hn::ConvertTo(df, hn::IfThenElseZero(hn::RebindMask(DI(), in_tree), tree_light));
+    // core/simd/lights-inl.h's pick_pmf, the tree's walk back in the registers' double halves.
+    const auto share_of = [&](M m) {
+      const V3 qp = load3(w, kPrevX, i0, m), qn = load3(w, kPrevNx, i0, m);
+      const VF tl = hn::ConvertTo(df, hn::IfThenElseZero(hn::RebindMask(DI(), m), tree_light));
       const VD grid = hn::Set(DD(), static_cast<double>(sc.lights.bvh_grid));
       VD share[2];
       for (int h = 0; h < 2; ++h)
         share[h] = bvh_share(DD(), DDI(), hn::RebindToUnsigned<DD>(), BvhTable<DD, DDI>{DD(), DDI(), sc.lights.bvh_nodes},
-                             sc.lights.bvh_trail,
-                             half_d(qp, h), half_d(qn, h), half_d(tl, h), grid, half_mask(in_tree, h));
-      pmf = hn::IfThenElse(in_tree, join_f(share[0], share[1]) * k(0x1p-24f), pmf);
-    }
+                             sc.lights.bvh_trail, half_d(qp, h), half_d(qn, h), half_d(tl, h), grid, half_mask(m, h));
+      return join_f(share[0], share[1]);
+    };
+    pmf = pick_pmf(df, in_tree, pmf, share_of);
   }
   // LightSampler::pdf's densities and zero rule (emitter_hit_pdf), the
   // solid-angle rule in the registers' double halves.

@@ -62,6 +62,13 @@ HWY_INLINE V sky_entry_of(D d, M m, std::size_t count, V k, const Lookup& starts
   return pick_cdf(d, m, count, k, [&](M valid, V i) { return starts(valid, i + Set(d, 1.0f)); });
 }
 
+// The probability of a light the light BVH's tree picks with a share of
+// `share` of the 2^24 grid points of LightChoice (each 2^-24 likely).
+template <class D, class V = VecOf<D>>
+HWY_INLINE V tree_share_pmf(D d, V share) {
+  return share * Set(d, 0x1p-24f);
+}
+
 // LightSampler::pick under the light BVH, once the grid point k of each
 // lane of m is known (light_grid_point, a whole float): below tree_count
 // (the tree's grid points; 0 for an empty tree) the tree's walk from the
@@ -88,7 +95,7 @@ HWY_INLINE M tree_or_sky_pick(D d, DI di, M m, V k, V tree_count, std::size_t sk
     const VI entry = walk(tree, share);
     const M tree_ok = And(tree, share > Zero(d));
     picked = Or(picked, tree_ok);
-    pmf = IfThenElseZero(tree_ok, share * Set(d, 0x1p-24f));
+    pmf = IfThenElseZero(tree_ok, tree_share_pmf(d, share));
     light = IfThenElseZero(RebindMask(di, tree_ok), entry);
   }
   if (!AllFalse(d, sky)) {
@@ -97,6 +104,17 @@ HWY_INLINE M tree_or_sky_pick(D d, DI di, M m, V k, V tree_count, std::size_t sk
     pmf = IfThenElse(sky, pmf_of(sky, light), pmf);
   }
   return picked;
+}
+
+// LightSampler::pick_pmf: the probability that the pick chose a light
+// entry from the shading point it was picked from: where the entry is the
+// tree's (in_tree), its share of the grid, share(m) in the lanes of m (the
+// tree's walk back from the light, bvh_share); elsewhere its pmf (power's,
+// or a sky entry's grid points).
+template <class D, class M, class Share, class V = VecOf<D>>
+HWY_INLINE V pick_pmf(D d, M in_tree, V pmf, const Share& share) {
+  if (AllFalse(d, in_tree)) return pmf;
+  return IfThenElse(in_tree, tree_share_pmf(d, share(in_tree)), pmf);
 }
 
 // A piecewise-constant density's cdf (Distribution1D, core/sampling.h): count
