@@ -128,6 +128,13 @@ class Hardening : public test::TempDirTest {
     args.insert(args.end(), extra.begin(), extra.end());
     return run_pathlab(args, env);
   }
+  // The sphere and lamp scene with the lamp's radiance `radiance`, rendered.
+  ProcessResult render_with_lamp(const std::string& name, const std::string& radiance) {
+    std::string text = scene_text(kCamera, kSphere + ",\n" + kLamp);
+    const std::string from = "\"radiance\": 2";
+    text.replace(text.find(from), from.size(), "\"radiance\": " + radiance);
+    return render(file(name, text));
+  }
   // No image, no temporary file: only what the test wrote.
   void expect_no_output() const {
     for (const fs::directory_entry& e : fs::directory_iterator(dir_)) {
@@ -197,20 +204,14 @@ TEST_F(Hardening, PositionsWithinTheRuleRender) {
 // (2^-65 per sample) says so: a lamp of 1e-18 once rendered 28 % dark and one
 // of 1e-20 black, without a word. A lamp of 1e-12 does not warn.
 TEST_F(Hardening, EmittersTooFaintForTheFilmAreWarnedAbout) {
-  const auto with_lamp = [&](const std::string& name, const std::string& radiance) {
-    std::string text = scene_text(kCamera, kSphere + ",\n" + kLamp);
-    const std::string from = "\"radiance\": 2";
-    text.replace(text.find(from), from.size(), "\"radiance\": " + radiance);
-    return render(file(name, text));
-  };
   for (const char* faint : {"1e-18", "1e-20"}) {
-    const ProcessResult r = with_lamp(std::string("faint") + faint + ".json", faint);
+    const ProcessResult r = render_with_lamp(std::string("faint") + faint + ".json", faint);
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find("pathlab: warning: the brightest emitter's radiance is " + std::string(faint)), std::string::npos)
         << r.err;
     EXPECT_NE(r.err.find("choose a smaller unit of radiance"), std::string::npos) << r.err;
   }
-  const ProcessResult dim = with_lamp("dim.json", "1e-12");
+  const ProcessResult dim = render_with_lamp("dim.json", "1e-12");
   EXPECT_EQ(dim.code, 0) << dim.err;
   EXPECT_EQ(dim.err.find("brightest emitter"), std::string::npos) << dim.err;
 }
@@ -219,19 +220,13 @@ TEST_F(Hardening, EmittersTooFaintForTheFilmAreWarnedAbout) {
 // sample that sees it would be left out as bad, the lamp black in the image.
 // A lamp of 1e9 (within range) does not warn.
 TEST_F(Hardening, EmittersBeyondTheFilmsRangeAreWarnedAbout) {
-  const auto with_lamp = [&](const std::string& name, const std::string& radiance) {
-    std::string text = scene_text(kCamera, kSphere + ",\n" + kLamp);
-    const std::string from = "\"radiance\": 2";
-    text.replace(text.find(from), from.size(), "\"radiance\": " + radiance);
-    return render(file(name, text));
-  };
   for (const char* bright : {"4294967296", "1e30"}) {
-    const ProcessResult r = with_lamp(std::string("bright") + bright + ".json", bright);
+    const ProcessResult r = render_with_lamp(std::string("bright") + bright + ".json", bright);
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_NE(r.err.find("pathlab: warning: material 'lamp' emits radiance "), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("choose a larger unit of radiance"), std::string::npos) << r.err;
   }
-  const ProcessResult within = with_lamp("within.json", "1e9");
+  const ProcessResult within = render_with_lamp("within.json", "1e9");
   EXPECT_EQ(within.code, 0) << within.err;
   EXPECT_EQ(within.err.find("beyond the film's range"), std::string::npos) << within.err;
 }
