@@ -18,6 +18,16 @@ float light_sample_weight(Strategy strategy, float light_pdf, float bsdf_pdf) {
   return generic::light_sample_weight(kScalar, strategy, F{light_pdf}, F{bsdf_pdf}).raw;
 }
 
+Spectrum delta_light_contribution(const Spectrum& f, const Spectrum& Le, float pdf) {
+  using namespace width1;
+  return scalars(generic::delta_light_contribution(lanes(f), lanes(Le), F{pdf}));
+}
+
+Spectrum light_contribution(const Spectrum& f, const Spectrum& Le, float weight, float pdf) {
+  using namespace width1;
+  return scalars(generic::light_contribution(lanes(f), lanes(Le), F{weight}, F{pdf}));
+}
+
 bool survives_roulette(const Spectrum& beta, float u, Spectrum* weight, float* survival) {
   using namespace width1;
   F3 w = lanes(*weight);

@@ -35,6 +35,11 @@ struct PreviousVertex {
 float emission_weight(Strategy strategy, const PreviousVertex& prev, float light_pdf);
 float light_sample_weight(Strategy strategy, float light_pdf, float bsdf_pdf);
 
+// What a light sample brings if its shadow ray arrives: a delta light's
+// f Le / pdf, an area light's f Le (w / pdf), w its light_sample_weight.
+Spectrum delta_light_contribution(const Spectrum& f, const Spectrum& Le, float pdf);
+Spectrum light_contribution(const Spectrum& f, const Spectrum& Le, float weight, float pdf);
+
 // Russian roulette after a scatter at a vertex past rr_depth (u its
 // Dim::Roulette number): the path goes on with probability *survival =
 // min(1, the largest component of beta * *weight), so that paths which

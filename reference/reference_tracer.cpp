@@ -133,7 +133,7 @@ Spectrum ReferenceTracer::direct_delta(const Surfel& s, const vec3& wo, int vert
   Ray shadow = shadow_ray(s, *ls);
   shadow.alpha_key = path.alpha_key(scene_, vertex);
   const bool visible = !scene_.occluded(shadow);
-  const Spectrum L = visible ? f * ls->Le / ls->pdf : Spectrum(0.0f);
+  const Spectrum L = visible ? delta_light_contribution(f, ls->Le, ls->pdf) : Spectrum(0.0f);
   if (path.observer)
     path.observer->on_light(
         {vertex, true, ls->infinite, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, 1.0f, beta * L, shadow});
@@ -160,7 +160,7 @@ Spectrum ReferenceTracer::direct_area(const Surfel& s, const vec3& wo, int verte
   Ray shadow = shadow_ray(s, *ls);
   shadow.alpha_key = path.alpha_key(scene_, vertex);
   const bool visible = !scene_.occluded(shadow);
-  const Spectrum L = visible ? f * ls->Le * (w / ls->pdf) : Spectrum(0.0f);
+  const Spectrum L = visible ? light_contribution(f, ls->Le, w, ls->pdf) : Spectrum(0.0f);
   if (path.observer)
     path.observer->on_light(
         {vertex, false, ls->infinite, ls->light, ls->p, ls->wi, ls->dist, ls->pdf, ls->Le, visible, w, beta * L, shadow});

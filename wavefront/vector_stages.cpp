@@ -126,6 +126,8 @@ using pathlab::HWY_NAMESPACE::camera_ray;
 using pathlab::HWY_NAMESPACE::CameraPlane;
 using pathlab::HWY_NAMESPACE::chooses_light_technique;
 using pathlab::HWY_NAMESPACE::CornerUvs;
+using pathlab::HWY_NAMESPACE::delta_light_contribution;
+using pathlab::HWY_NAMESPACE::light_contribution;
 using pathlab::HWY_NAMESPACE::delta_light_sample;
 using pathlab::HWY_NAMESPACE::DeltaLightLanes;
 using pathlab::HWY_NAMESPACE::env_sample_direction;
@@ -1423,7 +1425,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
       V3 f;
       VF pdf_bsdf;
       eval_bsdf(sc, w, i0, shape, wo, n, ls.wi, delta.ok, f, pdf_bsdf);
-      delta.unoccluded = (f * ls.Le) / ls.pdf;
+      delta.unoccluded = delta_light_contribution(f, ls.Le, ls.pdf);
       std::copy(std::begin(ls.ray), std::end(ls.ray), delta.ray);
     }
 
@@ -1440,7 +1442,7 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
       VF pdf_bsdf;
       eval_bsdf(sc, w, i0, shape, wo, n, ls.wi, ok, f, pdf_bsdf);
       const VF weight = pathlab::HWY_NAMESPACE::light_sample_weight(df, sc.strategy, ls.pdf, pdf_bsdf);
-      area.unoccluded = (weight / ls.pdf) * (f * ls.Le);
+      area.unoccluded = light_contribution(f, ls.Le, weight, ls.pdf);
       std::copy(std::begin(ls.ray), std::end(ls.ray), area.ray);
     }
     if (hn::AllFalse(df, hn::Or(delta.ok, ok))) continue;

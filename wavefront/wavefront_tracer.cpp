@@ -784,7 +784,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
         }
         if (!is_black(f)) {
           if (keep) w.light[2 * i] = *ls;  // only the observer and the stage records read it back
-          w.unoccluded[2 * i] = f * ls->Le / ls->pdf;
+          w.unoccluded[2 * i] = delta_light_contribution(f, ls->Le, ls->pdf);
           w.light_weight[2 * i] = 1.0f;
           w.shadow[2 * i] = shadow_ray(s, *ls);
           w.shadow[2 * i].alpha_key = scene_.alpha_key(w.rng[i], w.vertex[i]);
@@ -808,7 +808,7 @@ void WavefrontTracer::sample_lights(Wave& w, PathObserver* obs) const {
       }
       const float lw = light_sample_weight(strategy, ls->pdf, s.pdf(ls->wi, wo));
       if (keep) w.light[2 * i + 1] = *ls;
-      w.unoccluded[2 * i + 1] = f * ls->Le * (lw / ls->pdf);
+      w.unoccluded[2 * i + 1] = light_contribution(f, ls->Le, lw, ls->pdf);
       w.light_weight[2 * i + 1] = lw;
       w.shadow[2 * i + 1] = shadow_ray(s, *ls);
       w.shadow[2 * i + 1].alpha_key = scene_.alpha_key(w.rng[i], w.vertex[i]);

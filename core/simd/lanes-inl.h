@@ -347,6 +347,19 @@ HWY_INLINE V light_sample_weight(D d, Strategy strategy, V light_pdf, V bsdf_pdf
   return Set(d, 1.0f);
 }
 
+// What a light sample brings if its shadow ray arrives (next-event
+// estimation), from the BSDF value f and the radiance Le: a delta light's
+// f Le / pdf (pdf the pick's probability), an area light's f Le (w / pdf),
+// w the strategy's weight (light_sample_weight).
+template <class V>
+HWY_INLINE Vec3<V> delta_light_contribution(const Vec3<V>& f, const Vec3<V>& Le, V pdf) {
+  return (f * Le) / pdf;
+}
+template <class V>
+HWY_INLINE Vec3<V> light_contribution(const Vec3<V>& f, const Vec3<V>& Le, V weight, V pdf) {
+  return (weight / pdf) * (f * Le);
+}
+
 // Russian roulette's survival (roulette, below; core/strategy_weights.h): the
 // probability for a path whose throughput would become `throughput`,
 // std::min(1, max_component(throughput)) in Min's and Max's order.
