@@ -77,22 +77,23 @@ std::optional<EmitterPeak> brightest_constant_emitter(const Scene& scene) {
   };
   if (scene.environment && !is_black(*scene.environment))
     take(*scene.environment, [] { return std::string("the environment"); });
+  bool other_lights = scene.environment_map || !scene.delta_lights.empty();
   const std::vector<bool> placed = placed_shapes(scene);
   for (std::size_t i = 0; i < scene.shapes.size(); ++i) {
     const Material& m = scene.materials[scene.shapes[i].material];
-    if (placed[i] && m.emits() && !m.emission_textured)
+    if (!placed[i] || !m.emits()) continue;
+    if (m.emission_textured)
+      other_lights = true;
+    else
       take(m.emission, [&] { return "material '" + m.name + "'"; });
   }
+  if (peak) peak->bounds_every_light = !other_lights;
   return peak;
 }
 
 std::optional<float> constant_emitters_peak(const Scene& scene) {
-  if (scene.environment_map || !scene.delta_lights.empty()) return std::nullopt;
-  const std::vector<bool> placed = placed_shapes(scene);
-  for (std::size_t i = 0; i < scene.shapes.size(); ++i)
-    if (placed[i] && scene.materials[scene.shapes[i].material].emission_textured) return std::nullopt;
   const std::optional<EmitterPeak> peak = brightest_constant_emitter(scene);
-  if (!peak) return std::nullopt;
+  if (!peak || !peak->bounds_every_light) return std::nullopt;
   return peak->radiance;
 }
 

@@ -187,6 +187,10 @@ std::optional<float> constant_emitters_peak(const Scene& scene);
 struct EmitterPeak {
   float radiance = 0.0f;
   std::string source;
+  // Whether the scene has no other light (an emission texture, an
+  // environment image, point, spot or directional lights, sun disks), so
+  // that `radiance` bounds every emitter (constant_emitters_peak).
+  bool bounds_every_light = true;
 };
 std::optional<EmitterPeak> brightest_constant_emitter(const Scene& scene);
 // The spot profile: 1 for cos_theta >= cos_inner, 0 for cos_theta <= cos_outer,

@@ -75,7 +75,10 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
 
   // Light a ray can find, as the strategy says.
   const Strategy strategy = settings_.strategy;
-  const auto u_technique = [&] { return path.u(vertex, Dim::Technique); };
+  // The Technique number decides only under light+bsdf: drawn there, once,
+  // for both of the vertex's technique rules below.
+  const float u = strategy == Strategy::LightBsdf ? path.u(vertex, Dim::Technique) : 0.0f;
+  const auto u_technique = [u] { return u; };
   if (samples_area_lights(strategy, u_technique)) L += direct_area(s, wo, vertex, beta, path);
 
   // Continue the path.
