@@ -373,38 +373,47 @@ std::optional<LightSample> LightSampler::sample(const LightQuery& query, float u
   LightSample ls;
   ls.light = static_cast<std::uint32_t>(i);
   using namespace width1;
-  const bool env = static_cast<std::int64_t>(i) == env_index_;
-  if (env || (!suns_.empty() && static_cast<std::int64_t>(i) >= suns_.front().entry)) {
-    // The environment or a sun disk (the last entries, in order):
-    // core/simd/lights-inl.h's sky_sample at width 1.
+  // The environment or a sun disk: core/simd/lights-inl.h's sky_sample at
+  // width 1. Not where the image drew nothing, or a sun's direction rounded
+  // out of its cone.
+  const auto sample_sky = [&](lane1::M m) {
     F3 wi, Le;
     F pdf;
-    if (!generic::sky_sample(kScalar, lane1::M{true}, lane1::M{env}, F{u.x}, F{u.y}, SkyView{*this, i}, wi, Le, pdf)
-             .raw)
-      return std::nullopt;  // the image drew nothing, or a sun's direction rounded out of its cone
+    const lane1::M env{static_cast<std::int64_t>(i) == env_index_};
+    const lane1::M ok = generic::sky_sample(kScalar, m, env, F{u.x}, F{u.y}, SkyView{*this, i}, wi, Le, pdf);
     ls.wi = scalars(wi);
     ls.Le = scalars(Le);
     ls.pdf = pdf.raw;
     ls.dist = kInfinity;
     ls.infinite = true;
-    return ls;
-  }
-  // A triangle or a sphere: core/simd/lights-inl.h's area_light_sample at width 1.
-  const Entry& e = entries_[i];
-  const generic::AreaLight<F, lane1::M> light = area_light(*scene_, e);
-  const auto solid_angle = [&](lane1::M m) { return solid_angle_draw(light, light_sampling_, ref, m, true, u); };
-  generic::AreaLightSample<F> s;
-  if (!generic::area_light_sample(kScalar, lane1::M{true}, lanes(ref), light, F{pmf}, F{u.x}, F{u.y}, solid_angle,
-                                  PATHLAB_FAULT(LightPdfWithoutDistance), s)
+    return ok;
+  };
+  // A triangle or a sphere: area_light_sample at width 1. Not where the
+  // point is at no distance, on a one-sided emitter's back, or edge-on.
+  const auto sample_area = [&](lane1::M m) {
+    const Entry& e = entries_[i];
+    const generic::AreaLight<F, lane1::M> light = area_light(*scene_, e);
+    const auto solid_angle = [&](lane1::M mask) {
+      return solid_angle_draw(light, light_sampling_, ref, mask, true, u);
+    };
+    generic::AreaLightSample<F> s;
+    const lane1::M ok = generic::area_light_sample(kScalar, m, lanes(ref), light, F{pmf}, F{u.x}, F{u.y}, solid_angle,
+                                                   PATHLAB_FAULT(LightPdfWithoutDistance), s);
+    if (!ok.raw) return ok;
+    ls.p = scalars(s.p);
+    ls.p_error = scalars(s.error);
+    ls.n = scalars(s.n);
+    ls.wi = scalars(s.wi);
+    ls.dist = s.dist.raw;
+    ls.pdf = s.pdf.raw;
+    ls.Le = emission_at_point(i, vec2(s.b1.raw, s.b2.raw), ls.p);
+    return ok;
+  };
+  lane1::M sky;
+  if (!generic::sky_or_area_sample(kScalar, lane1::M{true}, Index{static_cast<std::int64_t>(i)},
+                                   Index{static_cast<std::int64_t>(first_sky_entry())}, sky, sample_sky, sample_area)
            .raw)
-    return std::nullopt;  // no distance, the back of a one-sided emitter, or seen edge-on
-  ls.p = scalars(s.p);
-  ls.p_error = scalars(s.error);
-  ls.n = scalars(s.n);
-  ls.wi = scalars(s.wi);
-  ls.dist = s.dist.raw;
-  ls.pdf = s.pdf.raw;
-  ls.Le = emission_at_point(i, vec2(s.b1.raw, s.b2.raw), ls.p);
+    return std::nullopt;
   return ls;
 }
 

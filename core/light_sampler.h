@@ -237,6 +237,13 @@ class LightSampler {
     std::int64_t entry = -1;     // its entry in entries_
   };
   std::int64_t environment_entry() const { return env_index_; }
+  // The first of the sky's entries, which are the last ones (the
+  // environment's, then the sun disks'); entries().size() without a sky.
+  std::size_t first_sky_entry() const {
+    return env_index_ >= 0  ? static_cast<std::size_t>(env_index_)
+           : suns_.empty() ? entries_.size()
+                           : static_cast<std::size_t>(suns_.front().entry);
+  }
   std::span<const SunDisk> sun_disks() const { return suns_; }
   float sun_pdf(const SunDisk& sun) const { return pmf_[static_cast<std::size_t>(sun.entry)] * sun.cone_pdf; }
   // Under `bvh`: the sky's entries (environment, then sun disks) and the

@@ -38,9 +38,22 @@ bool survives_roulette(const Spectrum& beta, float u, Spectrum* weight, float* s
   return survives;
 }
 
-bool chooses_light_technique(float u_technique) {
+bool samples_area_lights(Strategy strategy, LazyDraw u_technique) {
   using namespace width1;
-  return generic::chooses_light_technique(kScalar, F{u_technique}).raw;
+  return generic::samples_area_lights(kScalar, strategy, lane1::M{true}, [&] { return F{u_technique()}; }).raw;
+}
+
+bool chose_bsdf_technique(Strategy strategy, LazyDraw u_technique) {
+  using namespace width1;
+  return generic::chose_bsdf_technique(kScalar, strategy, lane1::M{true}, [&] { return F{u_technique()}; }).raw;
+}
+
+PreviousVertex previous_vertex(Strategy strategy, const Surfel& s, const vec3& wo, const BsdfSample& bs,
+                               LazyDraw u_technique) {
+  using namespace width1;
+  const auto v = generic::previous_vertex(kScalar, strategy, lane1::M{true}, lanes(s.p), lanes(s.n), lanes(wo),
+                                          F{bs.pdf}, lane1::M{bs.impulse}, [&] { return F{u_technique()}; });
+  return {{scalars(v.p), scalars(v.n)}, v.pdf.raw, v.impulse.raw, v.bsdf_technique.raw};
 }
 
 }  // namespace pathlab

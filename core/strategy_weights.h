@@ -47,10 +47,6 @@ Spectrum light_contribution(const Spectrum& f, const Spectrum& Le, float weight,
 // divided by *survival, which keeps the estimate unbiased.
 bool survives_roulette(const Spectrum& beta, float u, Spectrum* weight, float* survival);
 
-// Whether a light+bsdf vertex whose Dim::Technique number is u_technique
-// samples a light (else the BSDF): u_technique < 1/2.
-bool chooses_light_technique(float u_technique);
-
 // The continuation `strategy` samples at s towards wo: cosine-weighted
 // (Surfel::scatter_cosine) for every surface but a pure impulse under
 // `cosine`, the BSDF's own sampling (Surfel::scatter) otherwise. *cosine,
@@ -62,21 +58,36 @@ inline std::optional<BsdfSample> scatter_for(Strategy strategy, const Surfel& s,
   return by_cosine ? s.scatter_cosine(wo, u_dir) : s.scatter(wo, u_lobe, u_dir);
 }
 
-// Whether a vertex samples area lights (NEE) under `strategy`.
-// u_technique() draws the vertex's Dim::Technique number: asked only under
-// light+bsdf, the one strategy it decides anything for (under zsobol a draw
-// costs a permutation of the Sobol' index).
-template <class Draw>
-inline bool samples_area_lights(Strategy strategy, const Draw& u_technique) {
-  return strategy == Strategy::Light || strategy == Strategy::Mis ||
-         (strategy == Strategy::LightBsdf && chooses_light_technique(u_technique()));
-}
-// Whether that vertex's continuation counts as BSDF sampling for the
-// emitter it finds (PreviousVertex::bsdf_technique): always but where
-// light+bsdf chose light sampling.
-template <class Draw>
-inline bool chose_bsdf_technique(Strategy strategy, const Draw& u_technique) {
-  return !(strategy == Strategy::LightBsdf && chooses_light_technique(u_technique()));
-}
+// A vertex's number drawn only when asked (a callable returning float),
+// passed to the functions below without a copy or an allocation; it refers
+// to the callable, which must outlive the call (a lambda written in the
+// call's arguments does).
+class LazyDraw {
+ public:
+  template <class Draw>
+  LazyDraw(const Draw& draw)  // NOLINT(google-explicit-constructor): a lambda converts where it is passed
+      : draw_(&draw), call_([](const void* d) { return static_cast<float>((*static_cast<const Draw*>(d))()); }) {}
+  float operator()() const { return call_(draw_); }
+
+ private:
+  const void* draw_;
+  float (*call_)(const void*);
+};
+
+// The strategy's dispatch at a vertex (core/simd/lanes-inl.h's generic
+// functions at width 1, which the wavefront's lanes call too): whether it
+// samples area lights (next-event estimation), and whether its continuation
+// counts as BSDF sampling for the emitter it finds
+// (PreviousVertex::bsdf_technique). u_technique() draws the vertex's
+// Dim::Technique number, asked only under light+bsdf, the one strategy it
+// decides anything for (under zsobol a draw costs a permutation of the
+// Sobol' index).
+bool samples_area_lights(Strategy strategy, LazyDraw u_technique);
+bool chose_bsdf_technique(Strategy strategy, LazyDraw u_technique);
+
+// The vertex a scatter bs at s (wo towards the previous vertex) leaves for
+// the emitter its ray finds, under `strategy` (u_technique as above).
+PreviousVertex previous_vertex(Strategy strategy, const Surfel& s, const vec3& wo, const BsdfSample& bs,
+                               LazyDraw u_technique);
 
 }  // namespace pathlab

@@ -111,7 +111,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
     path.observer->on_scatter(
         {vertex, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, beta_next, next_ray});
 
-  const PreviousVertex next{light_query(s, wo), bs->pdf, bs->impulse, chose_bsdf_technique(strategy, u_technique)};
+  const PreviousVertex next = previous_vertex(strategy, s, wo, *bs, u_technique);
   if (path.params)
     path.cone = scattered_cone(path.cone, glm::length(s.p - ray.origin), bs->impulse, bs->pdf, settings_.texture_filter);
   return L + weight * Li(next_ray, vertex + 1, next, beta_next, path);

@@ -124,7 +124,10 @@ using pathlab::HWY_NAMESPACE::BvhTable;
 using pathlab::HWY_NAMESPACE::bvh_share;
 using pathlab::HWY_NAMESPACE::camera_ray;
 using pathlab::HWY_NAMESPACE::CameraPlane;
-using pathlab::HWY_NAMESPACE::chooses_light_technique;
+using pathlab::HWY_NAMESPACE::samples_area_lights;
+using pathlab::HWY_NAMESPACE::sky_or_area_sample;
+using pathlab::HWY_NAMESPACE::previous_vertex;
+using pathlab::HWY_NAMESPACE::PreviousVertexLanes;
 using pathlab::HWY_NAMESPACE::CornerUvs;
 using pathlab::HWY_NAMESPACE::delta_light_contribution;
 using pathlab::HWY_NAMESPACE::light_contribution;
@@ -1085,26 +1088,25 @@ LightLanes area_or_sky_light(const Scene& sc, const Wave& w, std::size_t i0, con
   const VI light = pick_light(sc, rng.u(Dim::LightChoice), sp, n, wo, ok, pmf);
   VF lu, lv;
   rng.u2(Dim::LightX, lu, lv);
-  if (sc.skies.first_entry >= sc.lights.count) return triangle_light(sc, w, i0, light, pmf, lu, lv, sp, n, ok);  // no sky
-  const M sky = hn::And(ok, hn::RebindMask(DF(), hn::Not(light < hn::Set(DI(), static_cast<std::int32_t>(sc.skies.first_entry)))));
-  M triangles = hn::AndNot(sky, ok);
-  if (hn::AllFalse(df, sky)) {
-    const LightLanes ls = triangle_light(sc, w, i0, light, pmf, lu, lv, sp, n, triangles);
-    ok = triangles;
-    return ls;
-  }
-  M skies = sky;
-  const LightLanes from_sky = sky_light(sc, w, i0, light, lu, lv, sp, n, skies);
-  if (hn::AllFalse(df, triangles)) {
-    ok = skies;
-    return from_sky;
-  }
-  LightLanes ls = triangle_light(sc, w, i0, light, pmf, lu, lv, sp, n, triangles);
+  // core/simd/lights-inl.h's sky_or_area_sample: the sky's lanes, the others.
+  LightLanes from_sky{}, from_area{};
+  M sky;
+  ok = sky_or_area_sample(
+      df, ok, light, hn::Set(DI(), static_cast<std::int32_t>(sc.skies.first_entry)), sky,
+      [&](M m) {
+        from_sky = sky_light(sc, w, i0, light, lu, lv, sp, n, m);
+        return m;
+      },
+      [&](M m) {
+        from_area = triangle_light(sc, w, i0, light, pmf, lu, lv, sp, n, m);
+        return m;
+      });
+  if (hn::AllFalse(df, sky)) return from_area;
+  LightLanes& ls = from_area;
   ls.wi = select(sky, from_sky.wi, ls.wi);
   ls.Le = select(sky, from_sky.Le, ls.Le);
   ls.pdf = hn::IfThenElse(sky, from_sky.pdf, ls.pdf);
   for (int a = 0; a < 7; ++a) ls.ray[a] = hn::IfThenElse(sky, from_sky.ray[a], ls.ray[a]);
-  ok = hn::Or(triangles, skies);
   return ls;
 }
 
@@ -1429,12 +1431,13 @@ std::size_t sample_lights(const Scene& sc, const Wave& w) {
       std::copy(std::begin(ls.ray), std::end(ls.ray), delta.ray);
     }
 
-    // An area light, as samples_area_lights says (core/strategy_weights.h).
+    // An area light, where the strategy samples them.
     ShadowLanes area{alive, zero3(), {}};
     M& ok = area.ok;
-    if (sc.strategy == Strategy::Bsdf || sc.strategy == Strategy::Cosine || (sc.lights.count == 0 && !sc.general_lights))
+    if (sc.lights.count == 0 && !sc.general_lights)
       ok = hn::FirstN(df, 0);
-    if (sc.strategy == Strategy::LightBsdf) ok = hn::And(ok, chooses_light_technique(df, rng.u(Dim::Technique)));
+    else
+      ok = samples_area_lights(df, sc.strategy, ok, [&] { return rng.u(Dim::Technique); });
     if (!hn::AllFalse(df, ok)) {
       const LightLanes ls =
           sc.general_lights ? other_light(sc, w, i0, rng, ok) : area_or_sky_light(sc, w, i0, rng, sp, wo, n, ok);
@@ -1608,15 +1611,15 @@ void scatter(const Scene& sc, const Wave& w) {
     }
     store3(w, kBetaR, i0, ok, beta * weight);
 
-    // PreviousVertex{s.p, pdf, impulse, bsdf_technique}.
+    // The PreviousVertex the scatter leaves.
     const V3 sp = load3(w, kPx, i0, ok);
-    store3(w, kPrevX, i0, ok, sp);
-    store3(w, kPrevNx, i0, ok, facing_normal(df, n, wo));  // light_query's
-    store(w, kPrevPdf, i0, ok, pdf);
-    store_mask(w, kPrevImpulse, i0, ok, impulse);
-    M bsdf_technique = hn::FirstN(df, lanes());
-    if (sc.strategy == Strategy::LightBsdf) bsdf_technique = hn::Not(chooses_light_technique(df, rng.u(Dim::Technique)));
-    store_mask(w, kPrevBsdfTechnique, i0, ok, bsdf_technique);
+    const PreviousVertexLanes<VF, M> prev =
+        previous_vertex(df, sc.strategy, ok, sp, n, wo, pdf, impulse, [&] { return rng.u(Dim::Technique); });
+    store3(w, kPrevX, i0, ok, prev.p);
+    store3(w, kPrevNx, i0, ok, prev.n);
+    store(w, kPrevPdf, i0, ok, prev.pdf);
+    store_mask(w, kPrevImpulse, i0, ok, prev.impulse);
+    store_mask(w, kPrevBsdfTechnique, i0, ok, prev.bsdf_technique);
 
     if (sc.textured && !hn::AllFalse(df, ok)) {
       // The ray cone after the scatter (scattered_cone, core/ray_cone.h; none under the point filter).

@@ -305,9 +305,7 @@ struct WavefrontTracer::VectorStages {
       vs::Sky& sky = sc.skies;
       const std::span<const LightSampler::SunDisk> suns = lights.sun_disks();
       const std::int64_t env = lights.environment_entry();
-      sky.first_entry = env >= 0 ? static_cast<std::size_t>(env)
-                        : suns.empty() ? lights.entries().size()
-                                       : static_cast<std::size_t>(suns.front().entry);
+      sky.first_entry = lights.first_sky_entry();
       sky.environment = env;
       const Spectrum env_Le = scene.environment.value_or(Spectrum(0.0f));
       for (int c = 0; c < 3; ++c) sky.Le[c] = env_Le[c];
@@ -892,8 +890,7 @@ void WavefrontTracer::scatter(Wave& w, PathObserver* obs) const {
     Ray next = s.spawn(bs->wi);
     next.alpha_key = scene_.alpha_key(w.rng[i], v);
     if (obs) obs->on_scatter({v, bs->lobe, bs->impulse, cosine, bs->wi, bs->pdf, weight, survival, w.beta[i], next});
-    w.prev[i] = PreviousVertex{light_query(s, wo), bs->pdf, bs->impulse,
-                               chose_bsdf_technique(strategy, [&] { return w.u(i, Dim::Technique); })};
+    w.prev[i] = previous_vertex(strategy, s, wo, *bs, [&] { return w.u(i, Dim::Technique); });
     if (textured)
       w.cone[i] = scattered_cone(w.cone[i], glm::length(s.p - w.ray[i].origin), bs->impulse, bs->pdf,
                                  settings_.texture_filter);

@@ -389,6 +389,35 @@ HWY_INLINE auto chooses_light_technique(D d, V u) {
   return u < Set(d, 0.5f);
 }
 
+// The strategy's dispatch at a vertex, in the lanes of m: the lanes that
+// sample area lights (next-event estimation), all of m under light and mis,
+// under light+bsdf those whose Dim::Technique number chooses light sampling,
+// none under bsdf and cosine. u_technique() draws that number; it is asked
+// only under light+bsdf, the one strategy it decides anything for (under
+// zsobol a draw costs a permutation of the Sobol' index).
+template <class D, class M, class Draw>
+HWY_INLINE M samples_area_lights(D d, Strategy strategy, M m, const Draw& u_technique) {
+  switch (strategy) {
+    case Strategy::Light:
+    case Strategy::Mis:
+      return m;
+    case Strategy::LightBsdf:
+      return And(m, chooses_light_technique(d, u_technique()));
+    case Strategy::Bsdf:
+    case Strategy::Cosine:
+      break;
+  }
+  return AndNot(m, m);
+}
+// The lanes of m whose continuation counts as BSDF sampling for the emitter
+// it finds (PreviousVertex::bsdf_technique, emission_weight): all of m but
+// where light+bsdf chose light sampling (u_technique() as above).
+template <class D, class M, class Draw>
+HWY_INLINE M chose_bsdf_technique(D d, Strategy strategy, M m, const Draw& u_technique) {
+  if (strategy != Strategy::LightBsdf) return m;
+  return AndNot(chooses_light_technique(d, u_technique()), m);
+}
+
 // area_to_solid_angle (core/sampling.h): pdf_area d^2 / |cos|, 0 edge-on.
 template <class D, class V = VecOf<D>>
 HWY_INLINE V area_to_solid_angle(D d, V pdf_area, V dist, V cos_light) {
@@ -627,6 +656,24 @@ template <class D, class V = VecOf<D>>
 HWY_INLINE Vec3<V> facing_normal(D d, const Vec3<V>& n, const Vec3<V>& wo) {
   const V c = dot(n, wo);
   return select(c > Zero(d), n, select(c < Zero(d), -n, splat3(d, 0.0f, 0.0f, 0.0f)));
+}
+
+// The vertex a scatter at p (normal n, wo towards the previous vertex)
+// leaves for the emitter its ray finds (PreviousVertex,
+// core/strategy_weights.h), in the lanes of m: the light query (light_query:
+// p and n turned to wo's side), the density pdf of the direction, whether it
+// was an impulse, and whether it counts as BSDF sampling
+// (chose_bsdf_technique, u_technique() drawn only under light+bsdf).
+template <class V, class M>
+struct PreviousVertexLanes {
+  Vec3<V> p, n;
+  V pdf;
+  M impulse, bsdf_technique;
+};
+template <class D, class M, class Draw, class V = VecOf<D>>
+HWY_INLINE PreviousVertexLanes<V, M> previous_vertex(D d, Strategy strategy, M m, const Vec3<V>& p, const Vec3<V>& n,
+                                                     const Vec3<V>& wo, V pdf, M impulse, const Draw& u_technique) {
+  return {p, facing_normal(d, n, wo), pdf, impulse, chose_bsdf_technique(d, strategy, m, u_technique)};
 }
 
 // Surfel::spawn (core/surfel.cpp): the origin of a ray leaving p (error

@@ -423,6 +423,24 @@ HWY_INLINE M sky_sample(D d, M ok, M env, V ux, V uy, const Sky& sky, Vec3<V>& w
   return AndNot(And(suns, Or(Not(pdf > Zero(d)), is_black(d, Le))), ok);
 }
 
+// LightSampler::sample after the pick, in the lanes of m whose picked entry
+// is `entry`: the sky's entries are the last ones, from first_sky on (the
+// environment, then the sun disks: LightSampler::first_sky_entry); their
+// lanes, `sky`, take sample_sky's sample (sky_sample above), the others
+// sample_area's (a triangle or a sphere: area_light_sample). Each is called
+// only if it has lanes, with those, and returns the lanes it gave a sample;
+// so does this. Where the two write their samples is the caller's.
+template <class D, class M, class VI, class SkyFn, class AreaFn>
+HWY_INLINE M sky_or_area_sample(D d, M m, VI entry, VI first_sky, M& sky, const SkyFn& sample_sky,
+                                const AreaFn& sample_area) {
+  sky = And(m, RebindMask(d, Not(entry < first_sky)));
+  const M area = AndNot(sky, m);
+  M sampled = AndNot(m, m);
+  if (!AllFalse(d, sky)) sampled = sample_sky(sky);
+  if (!AllFalse(d, area)) sampled = Or(sampled, sample_area(area));
+  return sampled;
+}
+
 }  // namespace pathlab::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
