@@ -74,17 +74,12 @@ template <unsigned F> float pdf_as(const MaterialView& m, const LocalDirs& d) {
 template <unsigned F>
 std::optional<BsdfSample> scatter_closure(const MaterialView& m, const Frame& frame, const vec3& wo_local, float side,
                                           float u_lobe, vec2 u) {
-  const std::optional<disney::DirectionSample> ds = disney::sample<F>(m.closure, wo_local, u_lobe, u, m.shading.sampling);
+  const std::optional<disney::Scatter> ds =
+      disney::scatter<F>(m.closure, wo_local, u_lobe, u, m.shading.sampling, m.shading.min_pdf);
   if (!ds) return std::nullopt;
-  // The weight is the true f cos over the mixture's density at the final
-  // direction, whatever lobe drew it.
-  const float pdf = disney::pdf<F>(m.closure, wo_local, ds->wi, m.shading.sampling);
-  if (!width1::generic::usable_bsdf_pdf(width1::kScalar, width1::F{pdf}, width1::F{m.shading.min_pdf}).raw)
-    return std::nullopt;
-  const Spectrum f = disney::eval<F>(m.closure, wo_local, ds->wi);
   vec3 wi = ds->wi;
   wi.z *= side;
-  return BsdfSample{frame.to_world(wi), f / pdf, pdf, ds->lobe, false};
+  return BsdfSample{frame.to_world(wi), ds->weight, ds->pdf, ds->lobe, false};
 }
 
 std::optional<BsdfSample> scatter_dielectric(const MaterialView& m, const Frame& frame, const vec3& wo, float u_lobe) {

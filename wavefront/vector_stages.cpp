@@ -139,7 +139,7 @@ using pathlab::HWY_NAMESPACE::dielectric_sample;
 using pathlab::HWY_NAMESPACE::distribution2d_sample;
 using pathlab::HWY_NAMESPACE::disney_eval;
 using pathlab::HWY_NAMESPACE::disney_pdf;
-using pathlab::HWY_NAMESPACE::disney_sample;
+using pathlab::HWY_NAMESPACE::disney_scatter;
 using pathlab::HWY_NAMESPACE::dot;
 using pathlab::HWY_NAMESPACE::emitted_towards;
 using pathlab::HWY_NAMESPACE::facing_normal;
@@ -149,7 +149,6 @@ using pathlab::HWY_NAMESPACE::scattered_side_ok;
 using pathlab::HWY_NAMESPACE::surface_eval_ok;
 using pathlab::HWY_NAMESPACE::surface_scatter_ok;
 using pathlab::HWY_NAMESPACE::upper_side;
-using pathlab::HWY_NAMESPACE::usable_bsdf_pdf;
 using pathlab::HWY_NAMESPACE::vertex_streams;
 using pathlab::HWY_NAMESPACE::VertexStreams;
 using pathlab::HWY_NAMESPACE::is_black;
@@ -1522,14 +1521,12 @@ void scatter(const Scene& sc, const Wave& w) {
       const V3 wo_up{wo_local.x, wo_local.y, wo_local.z * side};
       with_disney_model(dm, sc, shape, [&](auto lobes, const auto& energy, const auto& sampler) {
         constexpr unsigned F = decltype(lobes)::value;
-        V3 local_d;
-        VF family;
-        M drawn = disney_sample<F>(df, c, wo_up, u_lobe, du, dv, sampler, energy, local_d, family);
-        const VF pdf_d = disney_pdf<F>(df, c, wo_up, local_d, sampler, energy, {});
-        drawn = hn::And(drawn, usable_bsdf_pdf(df, pdf_d, k(sc.min_pdf)));
-        const V3 f = disney_eval<F>(df, c, wo_up, local_d, energy, {});
+        V3 local_d, weight_d;
+        VF pdf_d, family;
+        const M drawn = disney_scatter<F>(df, c, wo_up, u_lobe, du, dv, sampler, energy, k(sc.min_pdf), {}, local_d,
+                                          weight_d, pdf_d, family);
         wi = select(dm, to_world(fs, ft, fn, local_d.x, local_d.y, local_d.z * side), wi);
-        weight = select(dm, f / pdf_d, weight);
+        weight = select(dm, weight_d, weight);
         pdf = hn::IfThenElse(dm, pdf_d, pdf);
         ok = hn::AndNot(hn::AndNot(drawn, dm), ok);
       });

@@ -443,6 +443,25 @@ HWY_INLINE auto disney_sample(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, 
   return ok;
 }
 
+// Surfel::scatter's draw from a Disney closure, wo on +z (disney::scatter,
+// which core/surfel.cpp calls; the wavefront's scatter stage): a direction
+// from the mixture (disney_sample, `family` its lobe family), weighted by
+// f cos over the mixture's density there, whatever family drew it. False
+// where nothing was drawn or the density is unusable (usable_bsdf_pdf).
+template <unsigned F, class D, class Lobes, class Energy, class V = VecOf<D>>
+HWY_INLINE auto disney_scatter(D d, const ClosureLanes<V>& c, const Vec3<V>& wo, V u_lobe, V ux, V uy,
+                               const Lobes& lobes, const Energy& energy, V min_pdf,
+                               const disney::DisneyFaults& faults, Vec3<V>& wi, Vec3<V>& weight, V& pdf, V& family) {
+  auto drawn = disney_sample<F>(d, c, wo, u_lobe, ux, uy, lobes, energy, wi, family);
+  weight = {Zero(d), Zero(d), Zero(d)};
+  pdf = Zero(d);
+  if (AllFalse(d, drawn)) return drawn;
+  pdf = disney_pdf<F>(d, c, wo, wi, lobes, energy, faults);
+  drawn = And(drawn, usable_bsdf_pdf(d, pdf, min_pdf));
+  weight = disney_eval<F>(d, c, wo, wi, energy, faults) / pdf;
+  return drawn;
+}
+
 }  // namespace pathlab::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 

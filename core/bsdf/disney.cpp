@@ -62,6 +62,15 @@ std::optional<vec3> family_sample(const Closure& c, SampledLobe lobe, const vec3
   });
 }
 
+// The Lobe a sample of disney_sample's `family` reports (0 diffuse: the
+// Lambert lobe where the closure has one, 1 specular, 2 clearcoat).
+Lobe lobe_of(const Closure& c, F family) {
+  return family.raw == 1.0f   ? Lobe::Specular
+         : family.raw == 2.0f ? Lobe::Clearcoat
+         : is_black(c.lambert) ? Lobe::DisneyDiffuse
+                               : Lobe::Lambert;
+}
+
 // Both directions above the surface (disney-inl.h's disney_above).
 bool above(const vec3& wo, const vec3& wi) { return generic::disney_above(kScalar, lanes(wo), lanes(wi), faults()).raw; }
 
@@ -108,11 +117,21 @@ std::optional<DirectionSample> sample(const Closure& c, const vec3& wo, float u_
                                     TableEnergy{c.energy}, wi, family)
              .raw)
       return std::nullopt;
-    const Lobe lobe = family.raw == 1.0f   ? Lobe::Specular
-                      : family.raw == 2.0f ? Lobe::Clearcoat
-                      : is_black(c.lambert) ? Lobe::DisneyDiffuse
-                                            : Lobe::Lambert;
-    return DirectionSample{scalars(wi), lobe};
+    return DirectionSample{scalars(wi), lobe_of(c, family)};
+  });
+}
+
+template <unsigned Fs>
+std::optional<Scatter> scatter(const Closure& c, const vec3& wo, float u_lobe, vec2 u, BsdfSampling sampling,
+                               float min_pdf) {
+  return with_lobes(sampling, [&](const auto& lobes) -> std::optional<Scatter> {
+    F3 wi, weight;
+    F pdf, family;
+    if (!generic::disney_scatter<Fs>(kScalar, lanes_of(c), lanes(wo), F{u_lobe}, F{u.x}, F{u.y}, lobes,
+                                     TableEnergy{c.energy}, F{min_pdf}, faults(), wi, weight, pdf, family)
+             .raw)
+      return std::nullopt;
+    return Scatter{scalars(wi), scalars(weight), pdf.raw, lobe_of(c, family)};
   });
 }
 
@@ -126,6 +145,10 @@ template std::optional<DirectionSample> sample<kDisneyLobes>(const Closure&, con
 template std::optional<DirectionSample> sample<kDisneyLobes | kClearcoat>(const Closure&, const vec3&, float, vec2,
                                                                            BsdfSampling);
 template std::optional<DirectionSample> sample<kGeneral>(const Closure&, const vec3&, float, vec2, BsdfSampling);
+template std::optional<Scatter> scatter<kDisneyLobes>(const Closure&, const vec3&, float, vec2, BsdfSampling, float);
+template std::optional<Scatter> scatter<kDisneyLobes | kClearcoat>(const Closure&, const vec3&, float, vec2,
+                                                                   BsdfSampling, float);
+template std::optional<Scatter> scatter<kGeneral>(const Closure&, const vec3&, float, vec2, BsdfSampling, float);
 
 Spectrum lobe_eval(const Closure& c, SampledLobe lobe, const vec3& wo, const vec3& wi) {
   if (!above(wo, wi)) return Spectrum(0.0f);

@@ -68,6 +68,20 @@ struct DirectionSample {
 template <unsigned F>
 std::optional<DirectionSample> sample(const Closure& c, const vec3& wo, float u_lobe, vec2 u, BsdfSampling sampling);
 
+// Surfel::scatter's draw (wo on +z): a direction from the mixture,
+// weighted by f cos over the mixture's density there, whatever lobe drew
+// it; nothing where none was drawn or the density is below min_pdf
+// (disney-inl.h's disney_scatter, which the wavefront's lanes call too).
+struct Scatter {
+  vec3 wi;
+  Spectrum weight;
+  float pdf;
+  Lobe lobe;
+};
+template <unsigned F>
+std::optional<Scatter> scatter(const Closure& c, const vec3& wo, float u_lobe, vec2 u, BsdfSampling sampling,
+                               float min_pdf);
+
 LobeProbabilities lobe_probabilities(const Closure& c, const vec3& wo, unsigned features, BsdfSampling sampling);
 
 // One lobe family alone (the per-lobe chi-square tests; the energy tables).
