@@ -118,6 +118,11 @@ struct RenderSettings {
   float texture_cache_mb = 256.0f;
 };
 inline constexpr int kMaxVerticesUncapped = 1000;
+// The last vertex a path may scatter at under `settings`: max_depth, or the
+// safety cap where it is -1 (no cap).
+inline int max_vertex(const RenderSettings& settings) {
+  return settings.max_depth >= 0 ? settings.max_depth : kMaxVerticesUncapped;
+}
 
 struct Shape {
   enum class Kind : std::uint8_t { Triangles, Sphere };

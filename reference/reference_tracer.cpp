@@ -60,7 +60,7 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
                            static_cast<std::uint32_t>(s.material - scene.scene().materials.data()), s.shape, s.prim,
                            s.instance, Le, w_e, beta * L, beta});
 
-  const int cap = settings_.max_depth >= 0 ? settings_.max_depth : kMaxVerticesUncapped;
+  const int cap = max_vertex(settings_);
   if (vertex > cap) {
     if (path.observer) path.observer->on_end({vertex, PathEnd::MaxDepth});
     return L;

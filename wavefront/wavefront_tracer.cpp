@@ -201,12 +201,13 @@ struct WavefrontTracer::VectorStages {
     vs::Scene& sc = v->scene;
     sc.strategy = settings.strategy;
     sc.rr_depth = settings.rr_depth;
-    sc.max_vertex = settings.max_depth >= 0 ? settings.max_depth : kMaxVerticesUncapped;
-    // Untextured Lambert surfaces (shaded by lambert.h, not through the
-    // Disney closure) and Disney surfaces (disney-inl.h; with one min_pdf),
-    // in the geometric normal's frame or their own, and flat mirrors and
-    // dielectrics are shaded in the lanes; any other surface that scatters
-    // by core's Surfel, path by path (vector_stages.h).
+    sc.max_vertex = max_vertex(settings);
+    // Lambert surfaces (shaded by lambert.h, not through the Disney
+    // closure), Disney surfaces (disney-inl.h; with one min_pdf), mirrors and
+    // dielectrics, textured or not, in the geometric normal's frame or their
+    // own, are shaded in the lanes (in_lanes below); any other surface that
+    // scatters (a Lambert one under the General shading path) by core's
+    // Surfel, path by path (vector_stages.h).
     const Scene& scene = compiled.scene();
     const Material* diffuse = nullptr;
     const bool cosine = settings.strategy == Strategy::Cosine;  // every surface by scatter_cosine
@@ -248,9 +249,9 @@ struct WavefrontTracer::VectorStages {
     }
     // Alpha is decided inside Embree by the rays' keys, which the lanes make too.
     sc.alpha = compiled.has_alpha();
-    // Textured materials and normal maps are shaded by core's Surfel (their
-    // parameters read by resolve() with the path's ray cone), textured
-    // emission found by Surfel::emitted and sampled by LightSampler.
+    // Textured hits are resolved in the lanes (uv, frame, normal map, each
+    // path's ray cone), which ask core only for their texels (OpenImageIO's
+    // TextureSystem, per lane), textured emission included.
     sc.textured = compiled.has_textures();
     if (sc.textured) {
       const RayCone cone = compiled.camera_cone(settings.texture_filter);
@@ -258,8 +259,8 @@ struct WavefrontTracer::VectorStages {
       sc.camera_cone_spread = cone.spread;
       sc.texture_filter = static_cast<std::uint8_t>(settings.texture_filter);
     }
-    // The lanes sample triangle and sphere lights by area, the sky and delta
-    // lights; the rest is core's (below).
+    // The lanes sample triangle and sphere lights (by area or in solid
+    // angle), the sky and delta lights; the rest is core's (below).
     const LightSampler& lights = compiled.lights();
     // Delta lights: a second light sample and shadow ray per path, in the lanes.
     if (lights.has_delta_lights()) {
@@ -571,8 +572,8 @@ struct WavefrontTracer::VectorStages {
   // Whether the lanes shade m: Lambert, by lambert.h (every shading path but
   // General, which shades it through the Disney closure; core/surfel.cpp),
   // Disney (either sampling of its glossy lobes), a mirror (mirror.h) or a
-  // dielectric (dielectric.h), textured or not (core's resolve reads the
-  // textures and normal map into the hit's SurfaceParams and frame).
+  // dielectric (dielectric.h), textured or not (the lanes resolve a textured
+  // hit's parameters and frame; core reads only its texels).
   static bool in_lanes(const Material& m) {
     if (m.is_pure_impulse()) return true;
     const bool lambert = m.type == MaterialType::Diffuse && m.shading.path != ShadingPath::General;
@@ -714,7 +715,7 @@ void WavefrontTracer::intersect(Wave& w) const {
 // the end of paths that escape, pass the depth cap or reach a surface that
 // does not scatter.
 void WavefrontTracer::add_emission(Wave& w, PathObserver* obs) const {
-  const int cap = settings_.max_depth >= 0 ? settings_.max_depth : kMaxVerticesUncapped;
+  const int cap = max_vertex(settings_);
   const Strategy strategy = settings_.strategy;
   for (std::size_t i = 0; i < w.n; ++i) {
     const Surfel& s = w.surfel[i];
