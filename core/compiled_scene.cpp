@@ -12,31 +12,6 @@
 namespace pathlab {
 namespace {
 
-// A point with its error bound through an affine transform, the bound
-// growing as PBR 4th ed. 6.8.6 derives: the rounding of the three products
-// and three sums, plus the transformed input error.
-void transform_point(const mat4& m, vec3* p, vec3* p_error) {
-  using namespace width1;
-  F3 out = lanes(*p), err = lanes(*p_error);
-  generic::transform_point(kScalar, lanes(vec3(m[0])), lanes(vec3(m[1])), lanes(vec3(m[2])), lanes(vec3(m[3])), out, err);
-  *p = scalars(out);
-  *p_error = scalars(err);
-}
-
-// The point p under an affine placement, as mat4 * vec4(p, 1) (the generic
-// affine_point, which the wavefront's lanes run).
-vec3 affine_point(const mat4& m, const vec3& p) {
-  using namespace width1;
-  return scalars(generic::affine_point(lanes(vec3(m[0])), lanes(vec3(m[1])), lanes(vec3(m[2])), lanes(vec3(m[3])),
-                                       lanes(p)));
-}
-
-// glm::normalize(to_normal * n), by the generic place_normal.
-vec3 place_normal(const mat3& to_normal, const vec3& n) {
-  using namespace width1;
-  return scalars(generic::place_normal(kScalar, lanes(to_normal[0]), lanes(to_normal[1]), lanes(to_normal[2]), lanes(n)));
-}
-
 // The texture coordinates at a hit: a mesh's blended by TriangleMesh::uv_at
 // where it has them, else the barycentrics (a sphere's: its hit's).
 vec2 hit_uv(const Shape& shape, const RayHit& hit) {
@@ -56,10 +31,41 @@ struct PlacementColumns {
   void to_local(lane1::M m, width1::F3 (&c)[4]) const {
     for (int k = 0; k < 4; ++k) c[k] = width1::lanes(m.raw ? vec3(place->to_local[k]) : vec3(0.0f));
   }
+  void to_world(lane1::M m, width1::F3 (&c)[4]) const {
+    for (int k = 0; k < 4; ++k) c[k] = width1::lanes(m.raw ? vec3(place->to_world[k]) : vec3(0.0f));
+  }
   void to_normal(lane1::M m, width1::F3 (&c)[3]) const {
     for (int k = 0; k < 3; ++k) c[k] = width1::lanes(m.raw ? place->to_normal[k] : vec3(0.0f));
   }
   lane1::M mirrors(lane1::M m) const { return {m.raw && place->mirrors}; }
+};
+
+// A hit as the generic surface_point reads it (core/simd/lanes-inl.h), at
+// width 1: the traced ray, the hit's triangle (`triangles`: its shape's
+// first in CompiledScene's table) or sphere, and the instance's placement.
+// Asked only where the hit needs them (the mask true).
+struct HitColumns : PlacementColumns {
+  const Ray& traced;
+  const RayHit& hit;
+  const Shape& shape;
+  const Triangle* triangles;
+  void ray(lane1::M, width1::F3& o, width1::F3& dir, width1::F& t) const {
+    o = width1::lanes(traced.origin);
+    dir = width1::lanes(traced.dir);
+    t = width1::F{hit.t};
+  }
+  void triangle(lane1::M, width1::F3& p0, width1::F3& p1, width1::F3& p2, width1::F3& n) const {
+    const Triangle& tri = triangles[hit.prim];
+    p0 = width1::lanes(tri.p0);
+    p1 = width1::lanes(tri.p1);
+    p2 = width1::lanes(tri.p2);
+    n = width1::lanes(tri.n);
+  }
+  lane1::M sphere(lane1::M, width1::F3& center, width1::F& radius) const {
+    center = width1::lanes(shape.center);
+    radius = width1::F{shape.radius};
+    return {shape.flip_normals};
+  }
 };
 
 // The loaders check what a file says; a scene built in code gets the same
@@ -158,32 +164,25 @@ bool CompiledScene::intersect(const Ray& ray, Surfel* s, const RayCone& cone, Su
   return true;
 }
 
-void CompiledScene::resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, Surfel* s) const {
-  const SurfacePoint sp = shape.kind == Shape::Kind::Sphere
-                              ? sphere_point(shape, p_approx)
-                              : triangle_point(triangles_[first_triangle_[hit.shape] + hit.prim], hit.uv);
-  s->p = sp.p;
-  s->p_error = sp.p_error;
-  s->n = sp.n;
-  s->uv = hit_uv(shape, hit);
-}
-
 void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s, const RayCone& cone,
                             SurfaceParams* params) const {
+  // The point, its error bound and the front normal in world space by the
+  // generic surface_point at width 1, which the wavefront's lanes run too:
+  // an instance's hit was found in its group's space (at the same distance
+  // along the world ray), resolved there and placed.
+  using namespace width1;
   const Shape& shape = scene_.shapes[hit.shape];
-  if (hit.instance == kNoInstance) {
-    resolve_local(shape, hit, ray.origin + hit.t * ray.dir, s);
-  } else {
-    // Embree intersected the group in its own space; the hit distance is the
-    // same along the world ray.
-    const Placement& place = placements_[hit.instance];
-    const vec3 p_world = ray.origin + hit.t * ray.dir;
-    resolve_local(shape, hit, affine_point(place.to_local, p_world), s);
-    transform_point(place.to_world, &s->p, &s->p_error);
-    // Normals by the inverse transpose keep pointing to the image of their
-    // side, so the front stays the front under a mirroring placement too.
-    s->n = place_normal(place.to_normal, s->n);
-  }
+  const bool sphere = shape.kind == Shape::Kind::Sphere;
+  const bool placed = hit.instance != kNoInstance;
+  const HitColumns at{
+      {placed ? &placements_[hit.instance] : nullptr}, ray, hit, shape, triangles_.data() + first_triangle_[hit.shape]};
+  F3 p, error, n, to_normal[3];
+  generic::surface_point(kScalar, lane1::M{!sphere}, lane1::M{sphere}, lane1::M{placed}, F{hit.uv.x}, F{hit.uv.y}, at,
+                         p, error, n, to_normal);
+  s->p = scalars(p);
+  s->p_error = scalars(error);
+  s->n = scalars(n);
+  s->uv = hit_uv(shape, hit);
   shading_frame(shape, hit, s);
   if (textures_ && s->material->reads_textures_at_hits()) read_textures(shape, ray, hit, cone, params, s);
 }

@@ -124,10 +124,6 @@ class CompiledScene {
   std::span<const Placement> placements() const { return placements_; }
 
  private:
-  // The point, front normal and texture coordinates of a hit on `shape`, in
-  // the shape's own space (`p_approx` is the hit point there: spheres
-  // reproject it).
-  void resolve_local(const Shape& shape, const RayHit& hit, const vec3& p_approx, Surfel* s) const;
   // The shading frame, shading_normal, material and hit identity of a Surfel
   // whose point and geometric normal are placed in world space (the generic
   // surface_frame, core/simd/shading_frame-inl.h, at width 1).

@@ -50,8 +50,9 @@ TEST(Instancing, ResolvedHitsArePlacedExactly) {
       const vec2 u((static_cast<float>(i) + 0.5f) / 400.0f, std::fmod(0.618034f * static_cast<float>(i), 1.0f));
       const vec3 target = vec3(place(m, i % 4 == 0 ? bead.center : vec3(0.0f)));
       const vec3 origin = target + 0.8f * square_to_uniform_sphere(u);
+      const Ray ray{origin, glm::normalize(target - origin), kInfinity};
       Surfel s;
-      if (!compiled.intersect(Ray{origin, glm::normalize(target - origin), kInfinity}, &s)) continue;
+      if (!compiled.intersect(ray, &s)) continue;
       if (s.instance != k) continue;
       ASSERT_TRUE(scene.shapes[s.shape].in_group);
       ASSERT_NEAR(glm::length(s.n), 1.0f, 1e-5f);
@@ -85,6 +86,10 @@ TEST(Instancing, ResolvedHitsArePlacedExactly) {
         const dvec3 local = glm::dvec3(glm::inverse(dmat(m)) * glm::dvec4(dvec3(s.p), 1.0)) - dvec3(bead.center);
         ASSERT_NEAR(glm::length(local), bead.radius, 1e-5 * bead.radius) << "instance " << k;
         ASSERT_GT(glm::dot(dvec3(s.n), glm::normalize(to_normal * local)), 1.0 - 1e-6) << "instance " << k;
+        // Where the ray met it: its o + t d, taken into the group's space and
+        // reprojected there, so on the ray's line.
+        const dvec3 off = dvec3(s.p) - dvec3(ray.origin), dir(ray.dir);
+        ASSERT_LT(glm::length(off - glm::dot(off, dir) * dir), 1e-5) << "instance " << k;
         ASSERT_FALSE(s.shading_normal);
       }
     }
@@ -95,7 +100,7 @@ TEST(Instancing, ResolvedHitsArePlacedExactly) {
 
 // The Cornell box with the UV ball placed by instance_placements(), as a
 // group or flattened into world-space copies by transform_mesh, the path
-// the file's shapes take.
+// the file's shapes take, and a true sphere placed or in world space.
 Scene cornell_with_balls(bool instanced) {
   Scene scene = builtin_cornell_box();
   scene.film.width = scene.film.height = 24;
@@ -114,6 +119,26 @@ Scene cornell_with_balls(bool instanced) {
       EXPECT_EQ(transform_mesh(&copy.mesh, m), 0u);
       scene.shapes.push_back(std::move(copy));
     }
+  }
+  // And a true sphere placed by a similarity (turned, scaled by 1/4,
+  // moved), which flattens into a sphere.
+  Shape bead;
+  bead.kind = Shape::Kind::Sphere;
+  bead.material = ball.material;
+  bead.center = vec3(0.4f, -0.3f, 0.2f);
+  bead.radius = 0.8f;
+  const mat4 similar = glm::translate(mat4(1.0f), vec3(0.3f, 0.35f, -0.4f)) *
+                       glm::rotate(mat4(1.0f), 0.7f, glm::normalize(vec3(1.0f, 2.0f, 3.0f))) *
+                       glm::scale(mat4(1.0f), vec3(0.25f));
+  if (instanced) {
+    bead.in_group = true;
+    scene.groups.push_back({"bead", {static_cast<std::uint32_t>(scene.shapes.size())}});
+    scene.shapes.push_back(bead);
+    scene.instances.push_back({static_cast<std::uint32_t>(scene.groups.size() - 1), similar, "bead"});
+  } else {
+    bead.center = vec3(similar * vec4(bead.center, 1.0f));
+    bead.radius *= 0.25f;
+    scene.shapes.push_back(bead);
   }
   return scene;
 }

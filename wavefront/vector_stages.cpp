@@ -114,7 +114,6 @@ std::size_t lanes() { return 1; }
 #else
 
 using pathlab::HWY_NAMESPACE::add_sun;
-using pathlab::HWY_NAMESPACE::affine_point;
 using pathlab::HWY_NAMESPACE::area_light_sample;
 using pathlab::HWY_NAMESPACE::AreaLight;
 using pathlab::HWY_NAMESPACE::AreaLightSample;
@@ -162,16 +161,15 @@ using pathlab::HWY_NAMESPACE::pick_cdf;
 using pathlab::HWY_NAMESPACE::pick_pmf;
 using pathlab::HWY_NAMESPACE::tree_or_sky_pick;
 using pathlab::HWY_NAMESPACE::sky_sample;
-using pathlab::HWY_NAMESPACE::place_normal;
 using pathlab::HWY_NAMESPACE::roulette;
 using pathlab::HWY_NAMESPACE::surface_frame;
+using pathlab::HWY_NAMESPACE::surface_point;
 using pathlab::HWY_NAMESPACE::select;
 using pathlab::HWY_NAMESPACE::shadow_ray;
 using pathlab::HWY_NAMESPACE::spawn_origin;
 using pathlab::HWY_NAMESPACE::scattered_cone;
 using pathlab::HWY_NAMESPACE::solid_angle_draw;
 using pathlab::HWY_NAMESPACE::SolidAngleDraw;
-using pathlab::HWY_NAMESPACE::sphere_point;
 using pathlab::HWY_NAMESPACE::sphere_texture_inputs;
 using pathlab::HWY_NAMESPACE::stream_alpha_key;
 using pathlab::HWY_NAMESPACE::stream_key;
@@ -183,9 +181,7 @@ using pathlab::HWY_NAMESPACE::to_local;
 using pathlab::HWY_NAMESPACE::to_local_upper;
 using pathlab::HWY_NAMESPACE::to_world;
 using pathlab::HWY_NAMESPACE::TextureInputs;
-using pathlab::HWY_NAMESPACE::transform_point;
 using pathlab::HWY_NAMESPACE::triangle_texture_inputs;
-using pathlab::HWY_NAMESPACE::triangle_point;
 using pathlab::HWY_NAMESPACE::CospowLobes;
 using pathlab::HWY_NAMESPACE::VndfLobes;
 using pathlab::HWY_NAMESPACE::zero_unless;
@@ -486,11 +482,49 @@ void prefetch_hits(const Scene& sc, const Wave& w) {
   }
 }
 
+// A hit as core/simd/lanes-inl.h's surface_point reads it, for the lanes of
+// m: the path's ray and distance (kOx.., kDx.., kHitT), the shape's
+// triangle (Scene::triangles: corners and normal) or sphere (kCenter,
+// kRadius, kFlipped), and the instance's placement (PlacementField).
+struct HitLanes {
+  const Scene& sc;
+  const Wave& w;
+  std::size_t i0;
+  VI shape, instance;
+  void ray(M m, V3& o, V3& dir, VF& t) const {
+    o = load3(w, kOx, i0, m);
+    dir = load3(w, kDx, i0, m);
+    t = load(w, kHitT, i0, m);
+  }
+  void triangle(M m, V3& p0, V3& p1, V3& p2, V3& n) const {
+    const VI tri = shape_int(m, sc, shape, kFirstTriangle) + load(w, kPrim, i0, m);
+    p0 = gather3(m, sc.triangles, tri, 12, 0);
+    p1 = gather3(m, sc.triangles, tri, 12, 3);
+    p2 = gather3(m, sc.triangles, tri, 12, 6);
+    n = gather3(m, sc.triangles, tri, 12, 9);
+  }
+  M sphere(M m, V3& center, VF& radius) const {
+    center = shape_value3(m, sc, shape, kCenter);
+    radius = shape_value(m, sc, shape, kRadius);
+    return shape_flag(m, sc, shape, kFlipped);
+  }
+  V3 column(M m, int field) const { return gather3(m, sc.placements, instance, kPlacementFloats, field); }
+  void to_local(M m, V3 (&c)[4]) const {
+    for (int k = 0; k < 4; ++k) c[k] = column(m, kToLocal + 3 * k);
+  }
+  void to_world(M m, V3 (&c)[4]) const {
+    for (int k = 0; k < 4; ++k) c[k] = column(m, kToWorld + 3 * k);
+  }
+  void to_normal(M m, V3 (&c)[3]) const {
+    for (int k = 0; k < 3; ++k) c[k] = column(m, kToNormal + 3 * k);
+  }
+};
+
 // An instance's placement as core/simd/texture_inputs-inl.h and
 // shading_frame-inl.h read it: the columns of Scene::placements
 // (PlacementField) gathered for the lanes of m, but the inverse transpose's,
-// which resolve() gathered already for every placed lane (`normal`), and
-// whether it mirrors (kMirrors).
+// which resolve()'s surface_point gathered already for every placed lane
+// (`normal`), and whether it mirrors (kMirrors).
 struct PlacementLanes {
   const Scene& sc;
   VI instance;
@@ -526,45 +560,11 @@ void resolve(const Scene& sc, const Wave& w) {
       instance = load(w, kInstance, i0, found);
       placed = hn::And(found, fmask(instance != hn::Set(DI(), -1)));
     }
-    const auto placement = [&](M m, int field) { return gather3(m, sc.placements, instance, kPlacementFloats, field); };
-    V3 p = zero3(), error = zero3(), n = zero3();
-    if (!hn::AllFalse(df, mesh)) {
-      // triangle_point (core/geometry.cpp) of the shape's triangle prim.
-      const VI tri = shape_int(mesh, sc, shape, kFirstTriangle) + load(w, kPrim, i0, mesh);
-      const V3 p0 = gather3(mesh, sc.triangles, tri, 12, 0), p1 = gather3(mesh, sc.triangles, tri, 12, 3),
-               p2 = gather3(mesh, sc.triangles, tri, 12, 6);
-      n = gather3(mesh, sc.triangles, tri, 12, 9);
-      triangle_point(df, load(w, kHitU, i0, mesh), load(w, kHitV, i0, mesh), p0, p1, p2, p, error);
-    }
-    if (!hn::AllFalse(df, sphere)) {
-      // sphere_point (core/geometry.cpp) of origin + t dir.
-      const VF t = load(w, kHitT, i0, sphere);
-      const V3 o = load3(w, kOx, i0, sphere), d = load3(w, kDx, i0, sphere);
-      V3 at = o + t * d;
-      if (const M local = hn::And(sphere, placed); !hn::AllFalse(df, local))
-        at = select(local,
-                    affine_point(placement(local, kToLocal), placement(local, kToLocal + 3), placement(local, kToLocal + 6),
-                                 placement(local, kToLocal + 9), at),
-                    at);
-      V3 sp, serr, sn;
-      sphere_point(df, shape_value3(sphere, sc, shape, kCenter), shape_value(sphere, sc, shape, kRadius),
-                   shape_flag(sphere, sc, shape, kFlipped), at, sp, serr, sn);
-      p = select(sphere, sp, p);
-      error = select(sphere, serr, error);
-      n = select(sphere, sn, n);
-    }
-    // The instances' hits placed: the point and its error bound by
-    // transform_point, the normals by the inverse transpose (place_normal).
-    V3 to_normal[3] = {zero3(), zero3(), zero3()};
-    if (!hn::AllFalse(df, placed)) {
-      V3 pp = p, pe = error;
-      transform_point(df, placement(placed, kToWorld), placement(placed, kToWorld + 3), placement(placed, kToWorld + 6),
-                      placement(placed, kToWorld + 9), pp, pe);
-      for (int c = 0; c < 3; ++c) to_normal[c] = placement(placed, kToNormal + 3 * c);
-      p = select(placed, pp, p);
-      error = select(placed, pe, error);
-      n = select(placed, place_normal(df, to_normal[0], to_normal[1], to_normal[2], n), n);
-    }
+    // The point, its error bound and the front normal in world space
+    // (CompiledScene::resolve: core/simd/lanes-inl.h's surface_point).
+    V3 p, error, n, to_normal[3];
+    surface_point(df, mesh, sphere, placed, load(w, kHitU, i0, mesh), load(w, kHitV, i0, mesh),
+                  HitLanes{sc, w, i0, shape, instance}, p, error, n, to_normal);
     const PlacementLanes place{sc, instance, to_normal};
     store3(w, kPx, i0, found, p);
     store3(w, kErrX, i0, found, error);

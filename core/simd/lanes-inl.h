@@ -458,7 +458,7 @@ HWY_INLINE Vec3<V> affine_point(const Vec3<V>& c0, const Vec3<V>& c1, const Vec3
                                 const Vec3<V>& p) {
   return (p.x * c0 + p.y * c1) + (p.z * c2 + c3);
 }
-// transform_point (core/compiled_scene.cpp): p placed, ((c0 x + c1 y) +
+// transform_point (surface_point's placing): p placed, ((c0 x + c1 y) +
 // c2 z) + c3, and its error bound grown by the placement's rounding (PBR 4th
 // ed. 6.8.6): (gamma(3) + 1) (|c0| e.x + |c1| e.y + |c2| e.z) +
 // gamma(3) (|c0 x| + |c1 y| + |c2 z| + |c3|).
@@ -507,6 +507,64 @@ HWY_INLINE void sphere_point(D d, const Vec3<V>& center, V radius, M flip, const
   p = center + offset;
   error = Set(d, gamma_bound(5)) * abs(offset) + Set(d, gamma_bound(2)) * abs(p);
   n = select(flip, -dir, dir);
+}
+
+// CompiledScene::resolve's point of a hit in world space, with its error
+// bound and front normal n: where `mesh`, triangle_point of the hit
+// triangle at Embree's barycentrics (b1, b2), with the triangle's normal;
+// where `sphere`, sphere_point of the ray's o + t dir, taken first into the
+// group's space by the instance's to_local (affine_point) where `placed`:
+// Embree found an instance's hit there, at the same t. Then, where
+// `placed`, the point and its bound placed by to_world (transform_point)
+// and the normal by the inverse transpose (place_normal: it keeps pointing
+// to the image of its side, so the front stays the front under a mirroring
+// placement too), whose columns `to_normal` returns (0 where no lane is
+// placed). 0 in no mask's lanes.
+// Called by CompiledScene::resolve at width 1 and the wavefront's resolve.
+// The lookups, each asked only in the lanes of a mask m where some lane
+// needs it: at.ray(m, o, dir, t) the ray and the hit's distance along it;
+// at.triangle(m, p0, p1, p2, n) the triangle's corners and front normal
+// (core's Triangle, in its group's space); at.sphere(m, center, radius)
+// the sphere's, returning where it has flip_normals; at.to_local(m, c) and
+// at.to_world(m, c) the columns c[0..3] of the placement's inverse and of
+// the placement; at.to_normal(m, c) c[0..2] of its inverse transpose.
+template <class D, class M, class Lookup, class V = VecOf<D>>
+HWY_INLINE void surface_point(D d, M mesh, M sphere, M placed, V b1, V b2, const Lookup& at, Vec3<V>& p,
+                              Vec3<V>& error, Vec3<V>& n, Vec3<V> (&to_normal)[3]) {
+  p = error = n = splat3(d, 0.0f, 0.0f, 0.0f);
+  if (!AllFalse(d, mesh)) {
+    Vec3<V> p0, p1, p2;
+    at.triangle(mesh, p0, p1, p2, n);
+    triangle_point(d, b1, b2, p0, p1, p2, p, error);
+  }
+  if (!AllFalse(d, sphere)) {
+    Vec3<V> o, dir;
+    V t;
+    at.ray(sphere, o, dir, t);
+    Vec3<V> local = o + t * dir;
+    if (const M in_group = And(sphere, placed); !AllFalse(d, in_group)) {
+      Vec3<V> c[4];
+      at.to_local(in_group, c);
+      local = select(in_group, affine_point(c[0], c[1], c[2], c[3], local), local);
+    }
+    Vec3<V> center, sp, serr, sn;
+    V radius;
+    const M flipped = at.sphere(sphere, center, radius);
+    sphere_point(d, center, radius, flipped, local, sp, serr, sn);
+    p = select(sphere, sp, p);
+    error = select(sphere, serr, error);
+    n = select(sphere, sn, n);
+  }
+  for (Vec3<V>& c : to_normal) c = splat3(d, 0.0f, 0.0f, 0.0f);
+  if (!AllFalse(d, placed)) {
+    Vec3<V> c[4], pp = p, pe = error;
+    at.to_world(placed, c);
+    transform_point(d, c[0], c[1], c[2], c[3], pp, pe);
+    at.to_normal(placed, to_normal);
+    p = select(placed, pp, p);
+    error = select(placed, pe, error);
+    n = select(placed, place_normal(d, to_normal[0], to_normal[1], to_normal[2], n), n);
+  }
 }
 
 // A mesh's vertex normals n0, n1, n2 blended by the barycentrics
