@@ -64,8 +64,9 @@ void general_eval(const Scene& scene, const Wave& wave, std::size_t i, const flo
 // Surfel::scatter; false where it samples nothing.
 bool general_scatter(const Scene& scene, const Wave& wave, std::size_t i, float u_lobe, float u0, float u1,
                      GeneralSample* out);
-// Lights beyond triangles sampled by area (Scene::general_lights), by
-// core's LightSampler for the path in slot i: a light sample and its shadow
+// Lights beyond what the lanes sample (Scene::general_lights: an
+// environment image too large for the gathers' indices), by core's
+// LightSampler for the path in slot i: a light sample and its shadow
 // ray (origin, direction, tmax; shadow_ray), false where sample() gives none.
 struct GeneralLight {
   float wi[3], Le[3], pdf, ray[7];
@@ -602,7 +603,7 @@ void resolve(const Scene& sc, const Wave& w) {
       const M framed = shape_flag(hn::AndNot(hn::Or(general, by_core), found), sc, shape, kFramed);
       // The frames the lanes make (CompiledScene::shading_frame): of vertex normals (kNormalsAt), of tangents
       // (kTangentsAt) about those or the geometric normal, and Frame(n) for a flat textured mesh (kTexturedHits;
-      // its texture lookups' footprint below). The rest (normal maps) core's.
+      // its texture lookups' footprint below); a normal map's tilt after the texels are read (below).
       const VI normals_at = shape_int(framed, sc, shape, kNormalsAt);
       const M smooth = hn::And(framed, fmask(hn::Not(normals_at < hn::Zero(DI()))));
       M tangents = hn::FirstN(df, 0);
