@@ -174,6 +174,14 @@ void CompiledScene::resolve(const Ray& ray, const RayHit& hit, Surfel* s, const 
   const Shape& shape = scene_.shapes[hit.shape];
   const bool sphere = shape.kind == Shape::Kind::Sphere;
   const bool placed = hit.instance != kNoInstance;
+  // The vertex normals shading_frame blends, asked for first: on a large
+  // mesh each is a cache miss, which then overlaps the triangle's below
+  // (issued after surface_point, the reference's resolve took 1.05x the
+  // time on dragons-100).
+  if (!sphere && shape.mesh.has_normals()) {
+    const glm::uvec3 v = shape.mesh.triangles[hit.prim];
+    for (int k = 0; k < 3; ++k) __builtin_prefetch(&shape.mesh.normals[v[k]]);
+  }
   const HitColumns at{
       {placed ? &placements_[hit.instance] : nullptr}, ray, hit, shape, triangles_.data() + first_triangle_[hit.shape]};
   F3 p, error, n, to_normal[3];
