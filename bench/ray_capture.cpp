@@ -21,7 +21,11 @@ class RayRecorder final : public PathObserver {
   std::vector<Tagged> camera, bounce, shadow;
 
   void on_camera(const CameraEvent& e) override { camera.push_back({0, Ray{e.origin, e.dir, kInfinity}}); }
-  void on_light(const LightEvent& e) override { shadow.push_back({e.vertex, e.ray}); }
+  // A rejected light sample (no sample, the emitter's back, edge-on) casts
+  // no shadow ray: its event's ray is empty, and the tracers count no ray.
+  void on_light(const LightEvent& e) override {
+    if (e.rejected == LightRejection::None) shadow.push_back({e.vertex, e.ray});
+  }
   void on_scatter(const ScatterEvent& e) override {
     if (!is_black(e.throughput)) bounce.push_back({e.vertex, e.next});
   }

@@ -190,7 +190,8 @@ TEST(Instancing, SameBitsForAnyThreadCount) {
     Film film(20, 20, FilterKind::Box);
     if (wavefront) {
       const WavefrontTracer tracer(compiled, settings, wave);
-      // The vectorised stages place hits on instances by CompiledScene::resolve, path by path.
+      // The vectorised stages place hits on instances themselves, by the generic surface_point that
+      // CompiledScene::resolve calls too.
       EXPECT_EQ(tracer.vectorised(), vector_stages::cpu_supported());
       render(tracer, film);
     } else {

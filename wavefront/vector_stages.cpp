@@ -1516,7 +1516,7 @@ void scatter(const Scene& sc, const Wave& w) {
     if (!hn::AllFalse(df, dm)) {
       // Surfel::scatter_in_frame of a Disney material (wo's side up, as the
       // reflection models take it): a direction from the lobes' mixture,
-      // weighted by f cos over the mixture's density there (scatter_closure).
+      // weighted by f cos over the mixture's density there (disney_scatter, as disney::scatter).
       const ClosureLanes<VF> c = closure_lanes(dm, sc, w, i0, shape, textured);
       const V3 wo_local = to_local(fs, ft, fn, wo);
       const V3 wo_up{wo_local.x, wo_local.y, wo_local.z * side};
