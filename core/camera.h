@@ -12,6 +12,8 @@
 #include "core/math.h"
 #include "core/ray.h"
 
+#include <utility>
+
 namespace pathlab {
 
 struct CameraDesc {
@@ -31,9 +33,14 @@ class Camera {
   // y down, (0,0) the top-left corner of the image) and aperture sample
   // `u_lens` in [0,1)^2 (ignored by a pinhole).
   Ray generate_ray(vec2 film, vec2 u_lens) const;
-  // Whether generate_ray reads u_lens (a thin lens): the callers draw the
-  // lens pair (Dim::LensX) only then (under zsobol a draw costs a
-  // permutation of the Sobol' index).
+  // The same with the aperture sample drawn by u_lens() (the tracers' lens
+  // pair, Dim::LensX) only where it is read: for a thin lens (under zsobol
+  // a draw costs a permutation of the Sobol' index).
+  template <class DrawLens, class = decltype(std::declval<const DrawLens&>()())>
+  Ray generate_ray(vec2 film, const DrawLens& u_lens) const {
+    return generate_ray(film, has_lens() ? vec2(u_lens()) : vec2(0.0f));
+  }
+  // Whether generate_ray reads u_lens (a thin lens).
   bool has_lens() const { return desc_.aperture_radius > 0.0f; }
 
   const CameraDesc& desc() const { return desc_; }

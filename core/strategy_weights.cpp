@@ -43,11 +43,6 @@ bool samples_area_lights(Strategy strategy, LazyDraw u_technique) {
   return generic::samples_area_lights(kScalar, strategy, lane1::M{true}, [&] { return F{u_technique()}; }).raw;
 }
 
-bool chose_bsdf_technique(Strategy strategy, LazyDraw u_technique) {
-  using namespace width1;
-  return generic::chose_bsdf_technique(kScalar, strategy, lane1::M{true}, [&] { return F{u_technique()}; }).raw;
-}
-
 PreviousVertex previous_vertex(Strategy strategy, const Surfel& s, const vec3& wo, const BsdfSample& bs,
                                LazyDraw u_technique) {
   using namespace width1;

@@ -76,17 +76,16 @@ class LazyDraw {
 
 // The strategy's dispatch at a vertex (core/simd/lanes-inl.h's generic
 // functions at width 1, which the wavefront's lanes call too): whether it
-// samples area lights (next-event estimation), and whether its continuation
-// counts as BSDF sampling for the emitter it finds
-// (PreviousVertex::bsdf_technique). u_technique() draws the vertex's
-// Dim::Technique number, asked only under light+bsdf, the one strategy it
-// decides anything for (under zsobol a draw costs a permutation of the
-// Sobol' index).
+// samples area lights (next-event estimation). u_technique() draws the
+// vertex's Dim::Technique number, asked only under light+bsdf, the one
+// strategy it decides anything for (under zsobol a draw costs a
+// permutation of the Sobol' index).
 bool samples_area_lights(Strategy strategy, LazyDraw u_technique);
-bool chose_bsdf_technique(Strategy strategy, LazyDraw u_technique);
 
 // The vertex a scatter bs at s (wo towards the previous vertex) leaves for
-// the emitter its ray finds, under `strategy` (u_technique as above).
+// the emitter its ray finds, under `strategy`: with whether its
+// continuation counts as BSDF sampling (PreviousVertex::bsdf_technique;
+// u_technique as above).
 PreviousVertex previous_vertex(Strategy strategy, const Surfel& s, const vec3& wo, const BsdfSample& bs,
                                LazyDraw u_technique);
 

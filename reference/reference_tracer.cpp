@@ -7,6 +7,8 @@
 #include "core/scene_limits.h"
 #include "core/strategy_weights.h"
 
+#include <optional>
+
 namespace pathlab {
 
 // What one pixel sample carries down the recursion.
@@ -75,10 +77,13 @@ Spectrum ReferenceTracer::Li(const Ray& ray, int vertex, const PreviousVertex& p
 
   // Light a ray can find, as the strategy says.
   const Strategy strategy = settings_.strategy;
-  // The Technique number decides only under light+bsdf: drawn there, once,
-  // for both of the vertex's technique rules below.
-  const float u = strategy == Strategy::LightBsdf ? path.u(vertex, Dim::Technique) : 0.0f;
-  const auto u_technique = [u] { return u; };
+  // The Technique number, drawn when a technique rule below first asks
+  // (only light+bsdf's do) and kept for the other.
+  std::optional<float> technique;
+  const auto u_technique = [&] {
+    if (!technique) technique = path.u(vertex, Dim::Technique);
+    return *technique;
+  };
   if (samples_area_lights(strategy, u_technique)) L += direct_area(s, wo, vertex, beta, path);
 
   // Continue the path.
@@ -181,8 +186,7 @@ FilmSample ReferenceTracer::trace_sample(std::uint32_t x, std::uint32_t y, std::
   }
   FilmSample fs;
   fs.film = vec2(static_cast<float>(x), static_cast<float>(y)) + path.u2(0, Dim::FilmX);
-  const Camera& camera = scene_.camera();
-  Ray ray = camera.generate_ray(fs.film, camera.has_lens() ? path.u2(0, Dim::LensX) : vec2(0.0f));
+  Ray ray = scene_.camera().generate_ray(fs.film, [&] { return path.u2(0, Dim::LensX); });
   ray.alpha_key = path.alpha_key(scene_, 0);
   if (observer) observer->on_camera({x, y, sample, fs.film, ray.origin, ray.dir});
   fs.L = Li(ray, 1, PreviousVertex{}, Spectrum(1.0f), path);

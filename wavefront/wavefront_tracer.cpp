@@ -930,7 +930,7 @@ void WavefrontTracer::generate_camera_rays(Wave& w, PathObserver* obs) const {
   for (std::size_t i = 0; i < w.n; ++i) {
     w.vertex[i] = 0;  // the camera's random numbers are those of vertex 0
     w.film[i] = vec2(static_cast<float>(w.x[i]), static_cast<float>(w.y[i])) + w.u2(i, Dim::FilmX);
-    w.ray[i] = camera.generate_ray(w.film[i], camera.has_lens() ? w.u2(i, Dim::LensX) : vec2(0.0f));
+    w.ray[i] = camera.generate_ray(w.film[i], [&] { return w.u2(i, Dim::LensX); });
     w.ray[i].alpha_key = scene_.alpha_key(w.rng[i], 0);
     w.beta[i] = Spectrum(1.0f);
     w.L[i] = Spectrum(0.0f);

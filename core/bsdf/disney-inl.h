@@ -458,6 +458,7 @@ HWY_INLINE auto disney_scatter(D d, const ClosureLanes<V>& c, const Vec3<V>& wo,
   if (AllFalse(d, drawn)) return drawn;
   pdf = disney_pdf<F>(d, c, wo, wi, lobes, energy, faults);
   drawn = And(drawn, usable_bsdf_pdf(d, pdf, min_pdf));
+  if (AllFalse(d, drawn)) return drawn;
   weight = disney_eval<F>(d, c, wo, wi, energy, faults) / pdf;
   return drawn;
 }
